@@ -1,0 +1,1 @@
+//! Siconos' dense `.dat` LCP format (placeholder: being written).

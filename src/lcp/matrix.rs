@@ -1,0 +1,157 @@
+//! Matrix access for LCP solvers: dense, or block-circulant without forming it.
+
+/// What an LCP solver needs of A.
+pub trait LcpMatrix: Sync {
+    fn dim(&self) -> usize;
+    fn entry(&self, i: usize, j: usize) -> f64;
+    /// Column j of A into `out` (length dim).
+    fn column_into(&self, j: usize, out: &mut [f64]);
+    /// out = A z.
+    fn mul_into(&self, z: &[f64], out: &mut [f64]);
+    /// max |a_ij|, and whether every entry is finite.
+    fn max_abs(&self) -> (f64, bool);
+}
+
+/// A dense n×n matrix stored row-major.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DenseMatrix {
+    n: usize,
+    data: Vec<f64>,
+}
+
+impl DenseMatrix {
+    /// `data` holds n·n values, row after row. Panics on a length mismatch (a programming error).
+    pub fn from_row_major(n: usize, data: Vec<f64>) -> Self {
+        assert_eq!(data.len(), n * n, "DenseMatrix: {} values for {n}×{n}", data.len());
+        DenseMatrix { n, data }
+    }
+    pub fn from_fn(n: usize, f: impl Fn(usize, usize) -> f64) -> Self {
+        let mut data = Vec::with_capacity(n * n);
+        for i in 0..n {
+            for j in 0..n {
+                data.push(f(i, j));
+            }
+        }
+        DenseMatrix { n, data }
+    }
+    pub fn row(&self, i: usize) -> &[f64] {
+        &self.data[i * self.n..(i + 1) * self.n]
+    }
+    pub fn as_slice(&self) -> &[f64] {
+        &self.data
+    }
+    /// A dense copy of any LCP matrix.
+    pub fn from_matrix(a: &dyn LcpMatrix) -> Self {
+        let n = a.dim();
+        let mut data = vec![0.0; n * n];
+        let mut col = vec![0.0; n];
+        for j in 0..n {
+            a.column_into(j, &mut col);
+            for i in 0..n {
+                data[i * n + j] = col[i];
+            }
+        }
+        DenseMatrix { n, data }
+    }
+}
+
+impl LcpMatrix for DenseMatrix {
+    fn dim(&self) -> usize {
+        self.n
+    }
+    fn entry(&self, i: usize, j: usize) -> f64 {
+        self.data[i * self.n + j]
+    }
+    fn column_into(&self, j: usize, out: &mut [f64]) {
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = self.data[i * self.n + j];
+        }
+    }
+    fn mul_into(&self, z: &[f64], out: &mut [f64]) {
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = self.row(i).iter().zip(z).map(|(a, b)| a * b).sum();
+        }
+    }
+    fn max_abs(&self) -> (f64, bool) {
+        let finite = self.data.iter().all(|v| v.is_finite());
+        (self.data.iter().fold(0.0f64, |m, v| m.max(v.abs())), finite)
+    }
+}
+
+/// A block-circulant matrix of k×k blocks of size m×m, indexed time-major: row (j, a) is j·m + a.
+/// Entry ((j, a), (l, b)) = blocks[d][a][b] with d = (j − l) mod k: k·m² numbers in all.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BlockCirculant {
+    k: usize,
+    m: usize,
+    /// blocks[(d·m + a)·m + b]
+    blocks: Vec<f64>,
+}
+
+impl BlockCirculant {
+    pub fn new(k: usize, m: usize, blocks: Vec<f64>) -> Self {
+        assert_eq!(blocks.len(), k * m * m, "BlockCirculant: {} values for k={k}, m={m}", blocks.len());
+        BlockCirculant { k, m, blocks }
+    }
+    pub fn k(&self) -> usize {
+        self.k
+    }
+    pub fn m(&self) -> usize {
+        self.m
+    }
+    /// The first block column: block d is blocks()[d·m²..(d+1)·m²], row-major.
+    pub fn blocks(&self) -> &[f64] {
+        &self.blocks
+    }
+    /// Adds diag(values) (length m) to every diagonal block: A + I_k ⊗ diag(values).
+    pub fn add_block_diagonal(&mut self, values: &[f64]) {
+        for (a, v) in values.iter().enumerate() {
+            self.blocks[a * self.m + a] += v;
+        }
+    }
+    #[inline]
+    fn block_entry(&self, d: usize, a: usize, b: usize) -> f64 {
+        self.blocks[(d * self.m + a) * self.m + b]
+    }
+}
+
+impl LcpMatrix for BlockCirculant {
+    fn dim(&self) -> usize {
+        self.k * self.m
+    }
+    fn entry(&self, i: usize, j: usize) -> f64 {
+        let (ji, a) = (i / self.m, i % self.m);
+        let (l, b) = (j / self.m, j % self.m);
+        self.block_entry((ji + self.k - l) % self.k, a, b)
+    }
+    fn column_into(&self, j: usize, out: &mut [f64]) {
+        let (l, b) = (j / self.m, j % self.m);
+        for ji in 0..self.k {
+            let d = (ji + self.k - l) % self.k;
+            for a in 0..self.m {
+                out[ji * self.m + a] = self.block_entry(d, a, b);
+            }
+        }
+    }
+    /// Direct O(k²m²) product; FFT-based products belong to the solvers that need them.
+    fn mul_into(&self, z: &[f64], out: &mut [f64]) {
+        let (k, m) = (self.k, self.m);
+        out.iter_mut().for_each(|v| *v = 0.0);
+        for ji in 0..k {
+            for l in 0..k {
+                let d = (ji + k - l) % k;
+                for a in 0..m {
+                    let mut s = 0.0;
+                    for b in 0..m {
+                        s += self.block_entry(d, a, b) * z[l * m + b];
+                    }
+                    out[ji * m + a] += s;
+                }
+            }
+        }
+    }
+    fn max_abs(&self) -> (f64, bool) {
+        let finite = self.blocks.iter().all(|v| v.is_finite());
+        (self.blocks.iter().fold(0.0f64, |m, v| m.max(v.abs())), finite)
+    }
+}

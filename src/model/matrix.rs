@@ -1,0 +1,93 @@
+//! Structural matrices, dense or sparse, behind one type.
+use faer::Mat;
+use faer::sparse::SparseColMat;
+
+#[derive(Clone, Debug)]
+pub enum Matrix {
+    Dense(Mat<f64>),
+    /// Compressed sparse column, both triangles stored.
+    Sparse(SparseColMat<usize, f64>),
+}
+
+impl Matrix {
+    pub fn from_rows(rows: &[Vec<f64>]) -> Matrix {
+        let n = rows.len();
+        let c = rows.first().map_or(0, |r| r.len());
+        Matrix::Dense(Mat::from_fn(n, c, |i, j| rows[i][j]))
+    }
+    pub fn nrows(&self) -> usize {
+        match self {
+            Matrix::Dense(m) => m.nrows(),
+            Matrix::Sparse(m) => m.nrows(),
+        }
+    }
+    pub fn ncols(&self) -> usize {
+        match self {
+            Matrix::Dense(m) => m.ncols(),
+            Matrix::Sparse(m) => m.ncols(),
+        }
+    }
+    /// Entry (i, j); O(1) dense, O(log nnz(col)) sparse.
+    pub fn get(&self, i: usize, j: usize) -> f64 {
+        match self {
+            Matrix::Dense(m) => m[(i, j)],
+            Matrix::Sparse(m) => {
+                let rows = m.row_idx_of_col_raw(j);
+                let vals = m.val_of_col(j);
+                rows.binary_search(&i).map_or(0.0, |p| vals[p])
+            }
+        }
+    }
+    /// Visit every stored entry (i, j, v).
+    pub fn for_each(&self, mut f: impl FnMut(usize, usize, f64)) {
+        match self {
+            Matrix::Dense(m) => {
+                for j in 0..m.ncols() {
+                    for i in 0..m.nrows() {
+                        f(i, j, m[(i, j)]);
+                    }
+                }
+            }
+            Matrix::Sparse(m) => {
+                for j in 0..m.ncols() {
+                    for (&i, &v) in m.row_idx_of_col_raw(j).iter().zip(m.val_of_col(j)) {
+                        f(i, j, v);
+                    }
+                }
+            }
+        }
+    }
+    /// A dense copy (for small models and tests).
+    pub fn to_dense(&self) -> Mat<f64> {
+        match self {
+            Matrix::Dense(m) => m.clone(),
+            Matrix::Sparse(s) => {
+                let mut d = Mat::zeros(s.nrows(), s.ncols());
+                self.for_each(|i, j, v| d[(i, j)] += v);
+                let _ = s;
+                d
+            }
+        }
+    }
+    /// y = A x.
+    pub fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
+        y.iter_mut().for_each(|v| *v = 0.0);
+        self.for_each(|i, j, v| y[i] += v * x[j]);
+    }
+    /// α·self + β·other, same kind when both agree (dense otherwise).
+    pub fn lincomb(&self, alpha: f64, other: &Matrix, beta: f64) -> Matrix {
+        let n = self.nrows();
+        match (self, other) {
+            (Matrix::Dense(a), Matrix::Dense(b)) => Matrix::Dense(Mat::from_fn(n, n, |i, j| alpha * a[(i, j)] + beta * b[(i, j)])),
+            _ => {
+                let mut t = Vec::new();
+                self.for_each(|i, j, v| t.push(faer::sparse::Triplet::new(i, j, alpha * v)));
+                other.for_each(|i, j, v| t.push(faer::sparse::Triplet::new(i, j, beta * v)));
+                Matrix::Sparse(SparseColMat::try_new_from_triplets(n, n, &t).expect("valid triplets"))
+            }
+        }
+    }
+    pub fn is_sparse(&self) -> bool {
+        matches!(self, Matrix::Sparse(_))
+    }
+}

@@ -1,0 +1,156 @@
+//! The mechanical model: M x'' + C x' + K x = f(t) − Bᵀ z on the circle of period T = 2π/ω,
+//! with m unilateral contacts (notes §1).
+//!
+//! Sign conventions (user-facing, the paper's λ = −force, g = −gap):
+//! - contact `i` with direction s ∈ {+1, −1} acts on DOF d: s·x[d] ≤ gap(t);
+//! - its clearance is gap(t) − s·x[d] ≥ 0 and its force z ≥ 0 is compressive: it pushes DOF d
+//!   by −s·z, so row i of B is s·e_dᵀ.
+//!
+//! Units are the user's, as long as they are consistent (e.g. kg, N/m, m, s; or t, N/mm, mm, s).
+mod matrix;
+mod validate;
+
+pub use matrix::Matrix;
+pub use validate::ModelError;
+
+use std::f64::consts::PI;
+
+/// One cosine term `amplitude·cos(harmonic·ω·t + phase)`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Harmonic {
+    pub amplitude: f64,
+    /// Multiple of the fundamental ω (0 is a constant term).
+    pub harmonic: u32,
+    /// Phase [rad].
+    pub phase: f64,
+}
+
+impl Harmonic {
+    pub fn value(&self, omega: f64, t: f64) -> f64 {
+        self.amplitude * (self.harmonic as f64 * omega * t + self.phase).cos()
+    }
+    /// d/dt of [`Harmonic::value`].
+    pub fn rate(&self, omega: f64, t: f64) -> f64 {
+        let w = self.harmonic as f64 * omega;
+        -self.amplitude * w * (w * t + self.phase).sin()
+    }
+}
+
+/// An external force term on one DOF: f[dof] += amplitude·cos(harmonic·ω·t + phase).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Force {
+    pub dof: usize,
+    pub term: Harmonic,
+}
+
+/// How a contact transmits force.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Compliance {
+    /// Signorini: clearance ≥ 0, force ≥ 0, clearance·force = 0.
+    Rigid,
+    /// Penalty: force = stiffness·max(0, penetration).
+    Compliant { stiffness: f64 },
+}
+
+/// A unilateral contact on one DOF against an obstacle at clearance gap(t).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Contact {
+    pub dof: usize,
+    /// +1: x[dof] ≤ gap(t); −1: x[dof] ≥ −gap(t).
+    pub direction: f64,
+    /// Static clearance.
+    pub gap: f64,
+    pub compliance: Compliance,
+    /// Obstacle motion: gap(t) = gap + Σ motion terms. Empty for a static obstacle.
+    pub motion: Vec<Harmonic>,
+}
+
+impl Contact {
+    /// The clearance gap(t) of the obstacle, at zero displacement.
+    pub fn gap_at(&self, omega: f64, t: f64) -> f64 {
+        self.gap + self.motion.iter().map(|h| h.value(omega, t)).sum::<f64>()
+    }
+    pub fn is_rigid(&self) -> bool {
+        matches!(self.compliance, Compliance::Rigid)
+    }
+}
+
+/// M, C (optional), K: the structure's n×n matrices.
+#[derive(Clone, Debug)]
+pub struct Structure {
+    pub mass: Matrix,
+    pub stiffness: Matrix,
+    /// `None`: no damping term is assembled at all.
+    pub damping: Option<Matrix>,
+}
+
+impl Structure {
+    pub fn n(&self) -> usize {
+        self.mass.nrows()
+    }
+}
+
+/// The effects a model calls for; only these are assembled and computed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Effects {
+    pub damping: bool,
+    pub forcing: bool,
+    pub contact: bool,
+    pub compliance: bool,
+    pub moving_obstacle: bool,
+}
+
+impl Effects {
+    /// Names as they appear in the result's `effects` list.
+    pub fn names(&self) -> Vec<&'static str> {
+        let all = [
+            (self.damping, "damping"),
+            (self.forcing, "forcing"),
+            (self.contact, "contact"),
+            (self.compliance, "compliance"),
+            (self.moving_obstacle, "moving_obstacle"),
+        ];
+        all.iter().filter(|(on, _)| *on).map(|(_, n)| *n).collect()
+    }
+}
+
+/// A complete periodic contact model.
+#[derive(Clone, Debug)]
+pub struct Model {
+    pub structure: Structure,
+    pub forces: Vec<Force>,
+    pub contacts: Vec<Contact>,
+    /// Fundamental angular frequency ω [rad/s]; the period is T = 2π/ω.
+    pub frequency: f64,
+}
+
+impl Model {
+    pub fn n(&self) -> usize {
+        self.structure.n()
+    }
+    pub fn period(&self) -> f64 {
+        2.0 * PI / self.frequency
+    }
+    /// External force vector f(t).
+    pub fn force_at(&self, t: f64, out: &mut [f64]) {
+        out.iter_mut().for_each(|v| *v = 0.0);
+        for f in &self.forces {
+            out[f.dof] += f.term.value(self.frequency, t);
+        }
+    }
+    pub fn effects(&self) -> Effects {
+        Effects {
+            damping: self.structure.damping.is_some(),
+            forcing: self.forces.iter().any(|f| f.term.amplitude != 0.0),
+            contact: !self.contacts.is_empty(),
+            compliance: self.contacts.iter().any(|c| !c.is_rigid()),
+            moving_obstacle: self.contacts.iter().any(|c| !c.motion.is_empty()),
+        }
+    }
+    /// The highest harmonic of ω in the forcing or in any obstacle motion.
+    pub fn highest_harmonic(&self) -> u32 {
+        let f = self.forces.iter().map(|f| f.term.harmonic);
+        let g = self.contacts.iter().flat_map(|c| c.motion.iter().map(|h| h.harmonic));
+        f.chain(g).max().unwrap_or(0)
+    }
+}
