@@ -7,3 +7,7 @@
 pub mod lcp;
 pub mod model;
 pub mod time;
+pub mod periodic;
+pub mod response;
+pub mod scene;
+pub mod defaults;

@@ -9,5 +9,7 @@ pub struct Discretization {
     pub scheme: Scheme,
     /// Number of instants k per period.
     pub steps: usize,
-    pub pairing: Pairing,
+    /// `None`: the per-contact default that converges (forward for rigid under cds and galerkin,
+    /// same otherwise).
+    pub pairing: Option<Pairing>,
 }

@@ -1,1 +1,75 @@
-fn main() {}
+//! periodic-contact: the command-line tool.
+//! Exit status: 0 success, 1 the solver failed (typed outcome printed), 2 bad input.
+mod cmd_lcp;
+mod cmd_solve;
+
+use clap::{Parser, Subcommand};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(name = "periodic-contact", version, about = "Steady-state periodic responses under unilateral contact, as one LCP over the period")]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Solve a scene and write the periodic response as JSON.
+    Solve {
+        scene: PathBuf,
+        /// Output JSON file ("-" for stdout).
+        #[arg(short, long, default_value = "result.json")]
+        output: PathBuf,
+    },
+    /// Solve a raw LCP in Siconos' dense .dat format.
+    Lcp {
+        file: PathBuf,
+        #[arg(short, long, default_value = "-")]
+        output: PathBuf,
+    },
+}
+
+/// A failure with its exit status.
+pub struct Failure {
+    pub status: u8,
+    pub message: String,
+}
+
+impl Failure {
+    pub fn input(message: impl Into<String>) -> Self {
+        Failure { status: 2, message: message.into() }
+    }
+    pub fn solver(message: impl Into<String>) -> Self {
+        Failure { status: 1, message: message.into() }
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        None => cmd_solve::run_default(),
+        Some(Command::Solve { scene, output }) => cmd_solve::run(&scene, &output),
+        Some(Command::Lcp { file, output }) => cmd_lcp::run(&file, &output),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(f) => {
+            eprintln!("error: {}", f.message);
+            ExitCode::from(f.status)
+        }
+    }
+}
+
+/// Writes `text` to `path`, or stdout for "-", without leaving a half-written file behind.
+pub fn write_output(path: &std::path::Path, text: &str) -> Result<(), Failure> {
+    if path.as_os_str() == "-" {
+        println!("{text}");
+        return Ok(());
+    }
+    let tmp = path.with_extension("tmp~");
+    std::fs::write(&tmp, text)
+        .and_then(|_| std::fs::rename(&tmp, path))
+        .map_err(|e| Failure::input(format!("{}: cannot write the output: {e}", path.display())))
+}

@@ -1,0 +1,114 @@
+//! Recovery (notes §3): X̂_p = X̂lin_p − (Ẑ_p⁻¹Bᵀ) ẑ_p at the output DOFs only, velocities and
+//! accelerations by the symbols σ1, σ2; contact gaps from B X̂_p = B X̂lin_p − Ĝ_p ẑ_p.
+use super::{Assembly, PeriodFft, PeriodicProblem, SolveError};
+use crate::lcp::LcpSolution;
+use crate::response::{ContactResponse, LcpSummary, Response};
+use num_complex::Complex64 as C;
+use std::collections::BTreeMap;
+
+pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: &LcpSolution) -> Result<Response, SolveError> {
+    let (k, m) = (asm.k, asm.m);
+    let nh = k / 2 + 1;
+    let nd = asm.dofs.len();
+    let model = &problem.model;
+    let period = model.period();
+    let time: Vec<f64> = (0..k).map(|j| j as f64 * period / k as f64).collect();
+
+    // ẑ_p for each contact.
+    let z_hat: Vec<Vec<C>> = (0..m)
+        .map(|a| {
+            let series: Vec<f64> = (0..k).map(|j| sol.z[j * m + a]).collect();
+            fft.forward(&series)
+        })
+        .collect();
+
+    let mut displacement = BTreeMap::new();
+    let mut velocity = BTreeMap::new();
+    let mut acceleration = BTreeMap::new();
+    let out = &problem.outputs;
+    let mut x_hat = vec![C::ZERO; nh];
+    let mut tmp = vec![C::ZERO; nh];
+    for (r, &d) in asm.dofs.iter().enumerate() {
+        for p in 0..nh {
+            let mut v = asm.xlin_hat[p * nd + r];
+            for (b, zb) in z_hat.iter().enumerate() {
+                v -= asm.h_hat[(p * nd + r) * m + b] * zb[p];
+            }
+            x_hat[p] = v;
+        }
+        let key = d.to_string();
+        if out.displacement.contains(&d) {
+            displacement.insert(key.clone(), finite(fft.inverse(&x_hat), "displacement", d)?);
+        }
+        if out.velocity.contains(&d) {
+            for p in 0..nh {
+                tmp[p] = asm.symbols.sigma1[p] * x_hat[p];
+            }
+            velocity.insert(key.clone(), finite(fft.inverse(&tmp), "velocity", d)?);
+        }
+        if out.acceleration.contains(&d) {
+            for p in 0..nh {
+                tmp[p] = asm.symbols.sigma2[p] * x_hat[p];
+            }
+            acceleration.insert(key, finite(fft.inverse(&tmp), "acceleration", d)?);
+        }
+    }
+
+    let mut contacts = Vec::new();
+    if out.contacts {
+        for (a, ca) in model.contacts.iter().enumerate() {
+            for p in 0..nh {
+                let mut v = asm.bxlin_hat[p * m + a];
+                for (b, zb) in z_hat.iter().enumerate() {
+                    v -= asm.g_hat[(p * m + a) * m + b] * zb[p];
+                }
+                tmp[p] = v;
+            }
+            let bx = fft.inverse(&tmp);
+            let gap: Vec<f64> = time.iter().zip(&bx).map(|(&t, &b)| ca.gap_at(model.frequency, t) - b).collect();
+            let force: Vec<f64> = (0..k).map(|j| sol.z[j * m + a]).collect();
+            contacts.push(ContactResponse {
+                dof: ca.dof,
+                direction: ca.direction as i32,
+                pairing: problem.pairing_of(ca).name().to_string(),
+                force: finite(force, "contact force", a)?,
+                gap: finite(gap, "contact gap", a)?,
+            });
+        }
+    }
+
+    let pairings: Vec<&str> = model.contacts.iter().map(|c| problem.pairing_of(c).name()).collect();
+    let pairing = match pairings.first() {
+        None => problem.disc.pairing.unwrap_or(crate::time::Pairing::Same).name().to_string(),
+        Some(first) if pairings.iter().all(|p| p == first) => first.to_string(),
+        Some(_) => "mixed".to_string(),
+    };
+    let active_set = (0..sol.z.len()).filter(|&i| sol.z[i] > 0.0).collect();
+    Ok(Response {
+        period,
+        steps: k,
+        scheme: problem.disc.scheme.name().to_string(),
+        pairing,
+        effects: model.effects().names().into_iter().map(String::from).collect(),
+        time,
+        displacement,
+        velocity,
+        acceleration,
+        contacts,
+        lcp: LcpSummary {
+            size: k * m,
+            status: sol.outcome.name().to_string(),
+            pivots: sol.info.pivots,
+            residual: sol.info.residual,
+            relative_error: sol.info.relative_error,
+            warm_start_used: sol.info.warm_start_used,
+        },
+        warnings: problem.warnings(),
+        timing_s: Default::default(),
+        active_set,
+    })
+}
+
+fn finite(v: Vec<f64>, what: &str, index: usize) -> Result<Vec<f64>, SolveError> {
+    if v.iter().all(|x| x.is_finite()) { Ok(v) } else { Err(SolveError::NonFinite(format!("{what} {index}"))) }
+}
