@@ -48,11 +48,13 @@ pub struct SolverSettings {
     pub method: LcpMethod,
     /// Certification tolerance of the LCP residual, relative to max(1, ‖q‖∞).
     pub tolerance: f64,
+    /// Spread the harmonics over threads (rayon). Off inside an FMU.
+    pub parallel: bool,
 }
 
 impl Default for SolverSettings {
     fn default() -> Self {
-        SolverSettings { method: LcpMethod::Auto, tolerance: 1e-9 }
+        SolverSettings { method: LcpMethod::Auto, tolerance: 1e-9, parallel: true }
     }
 }
 
@@ -176,7 +178,7 @@ impl PeriodicProblem {
     pub fn solve_with(&self, fft: &PeriodFft, warm_start: Option<&[usize]>) -> Result<Response, SolveError> {
         let t_start = Instant::now();
         let dofs = self.outputs.dofs();
-        let asm = assembly::assemble(&self.model, &self.disc, &dofs, fft)?;
+        let asm = assembly::assemble(&self.model, &self.disc, &dofs, fft, self.solver.parallel)?;
         let (a, q) = self.lcp(&asm, fft);
         let t_assembly = t_start.elapsed().as_secs_f64();
 
