@@ -2,11 +2,15 @@
 //!
 //! This module knows nothing of mechanics. Matrices come through [`LcpMatrix`], so a solver can
 //! work on a dense matrix or on a structured one ([`BlockCirculant`]) without forming it.
-mod matrix;
+mod circulant_fft;
 mod lemke;
+mod matrix;
+mod pivoting;
 pub mod dat;
 
+pub use circulant_fft::CirculantOperator;
 pub use lemke::{Lemke, LemkeSettings};
+pub use pivoting::{BlockPivoting, PivotingSettings};
 pub use matrix::{BlockCirculant, DenseMatrix, LcpMatrix};
 
 use serde::Serialize;
