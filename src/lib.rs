@@ -7,3 +7,5 @@
 pub mod lcp;
 pub mod model;
 pub mod time;
+pub mod exact;
+pub mod marching;
