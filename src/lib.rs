@@ -4,10 +4,21 @@
 //!
 //! Flow: [`scene`] (TOML) → [`model`] → [`time`] (circulant symbols) → [`periodic`] (assembly,
 //! LCP, recovery) → [`response`]. The [`lcp`] solvers know nothing of mechanics.
-pub mod lcp;
-pub mod model;
-pub mod time;
-pub mod periodic;
-pub mod response;
-pub mod scene;
+/// The built-in default scene.
 pub mod defaults;
+/// Semi-analytic periodic orbits: the independent references of the tests.
+pub mod exact;
+/// LCP solvers; they know nothing of mechanics.
+pub mod lcp;
+/// Explicit time marching with forward-increment Lagrange multipliers (the paper's reference).
+pub mod marching;
+/// The mechanical model and its checks.
+pub mod model;
+/// Assembly in the frequency domain, the LCP of the period, recovery.
+pub mod periodic;
+/// The periodic response as written to JSON.
+pub mod response;
+/// Scene files (TOML).
+pub mod scene;
+/// Time schemes as circulant symbols; pairing.
+pub mod time;
