@@ -11,8 +11,9 @@ i.e. M (x_{n+1} - 2x_n + x_{n-1})/h² + C (x_{n+1} - x_{n-1})/(2h) + K x_n + B^T
 each force sample z_n is paired with the clearance at t_{n+1} ("forward" pairing) for rigid
 contacts (1/k_c = 0) and for compliant contacts when pairing="forward". With pairing="same" a
 compliant contact carries the explicit penalty force z_n = k_c max(0, -c(x_n, t_n)) instead
-(B_s rows above). The LCP on the contacts is solved by enumeration (m <= 8), starting from the
-predicted-active set {c^p < 0}.
+(B_s rows above). The LCP is solved on the predicted-active set {c^p < 0} by enumeration (up to 8
+simultaneously active contacts), growing the set if the correction pushes another contact into
+its obstacle (model.solve_contact_lcp); the total number of contacts is not limited.
 
 The steady state of this recursion is a k-periodic sequence satisfying exactly the periodic "cds"
 equations of the notes (§2) with the same pairing, which is why it is also a discrete reference.
@@ -24,7 +25,7 @@ import time
 
 import numpy as np
 
-from .model import MarchResult, System, periodicity_defect, solve_lcp_enum
+from .model import MarchResult, System, periodicity_defect, solve_contact_lcp
 
 
 def march_cds(sys_: System, steps: int, pairing: str = "forward", tol: float = 1e-10, min_periods: int = 3,
@@ -91,7 +92,7 @@ def march_cds(sys_: System, steps: int, pairing: str = "forward", tol: float = 1
             if Fi.size:
                 cp = gF_next[j] - BF @ xp
                 if np.any(cp < 0):
-                    zf = solve_lcp_enum(GF, cp, first_guess=cp < 0)
+                    zf = solve_contact_lcp(GF, cp)
                     lcp_calls += 1
                     xp = xp - WBF @ zf
                     Z[Fi, j] = zf

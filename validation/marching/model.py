@@ -276,8 +276,28 @@ def relative_errors(ref: np.ndarray, val: np.ndarray) -> tuple[float, float]:
     return float(np.max(np.abs(d))), float(np.max(np.sqrt(np.mean(d * d, axis=1))))
 
 
+def solve_lcp_murty(A: np.ndarray, q: np.ndarray, tol: float = 1e-13, max_iter: int = 100000):
+    """Murty's least-index principal pivoting for w = A z + q (finite for P-matrices, e.g. the SPD
+    step matrices of the marchers)."""
+    m = len(q)
+    eps = tol * max(1.0, float(np.max(np.abs(q))))
+    basic = np.zeros(m, dtype=bool)
+    for _ in range(max_iter):
+        z = np.zeros(m)
+        idx = np.flatnonzero(basic)
+        if idx.size:
+            z[idx] = np.linalg.solve(A[np.ix_(idx, idx)], -q[idx])
+        w = A @ z + q
+        bad = np.flatnonzero((basic & (z < -eps)) | (~basic & (w < -eps)))
+        if bad.size == 0:
+            return np.maximum(z, 0.0)
+        basic[bad[0]] = ~basic[bad[0]]
+    raise RuntimeError("LCP (Murty): no convergence")
+
+
 def solve_lcp_enum(A: np.ndarray, q: np.ndarray, first_guess=None, tol: float = 1e-13):
-    """w = A z + q, z >= 0, w >= 0, z.w = 0 for small m (<= 8) by enumerating active sets.
+    """w = A z + q, z >= 0, w >= 0, z.w = 0 for small m (<= 8) by enumerating active sets
+    (Murty's principal pivoting beyond 8).
 
     Tries `first_guess` (a boolean mask) first, then all subsets by increasing size. Returns z.
     Raises if no complementary solution exists (within tol relative to |q|)."""
@@ -285,7 +305,7 @@ def solve_lcp_enum(A: np.ndarray, q: np.ndarray, first_guess=None, tol: float = 
     if m == 0:
         return np.zeros(0)
     if m > 8:
-        raise ValueError("enumeration LCP is for m <= 8")
+        return solve_lcp_murty(A, q, tol=tol)
     scale = max(1.0, float(np.max(np.abs(q))))
     eps = tol * scale
 
@@ -319,3 +339,25 @@ def solve_lcp_enum(A: np.ndarray, q: np.ndarray, first_guess=None, tol: float = 
                 return z
     raise RuntimeError("LCP by enumeration: no complementary solution")
 
+
+
+def solve_contact_lcp(G: np.ndarray, cp: np.ndarray, tol: float = 1e-13) -> np.ndarray:
+    """w = G z + cp, z >= 0, w >= 0, z.w = 0 for the contact LCP of a time step, any m: start from
+    the predicted-active set {cp < 0}, solve the LCP restricted to the candidates (enumeration up
+    to 8, principal pivoting beyond), add any other contact the correction pushes into the obstacle, repeat.
+    Contacts outside the candidates keep z = 0 with w >= 0, so the result solves the full LCP."""
+    m = cp.size
+    z = np.zeros(m)
+    cand = cp < 0
+    if not cand.any():
+        return z
+    eps = tol * max(1.0, float(np.max(np.abs(cp))))
+    while True:
+        idx = np.flatnonzero(cand)
+        zc = solve_lcp_enum(G[np.ix_(idx, idx)], cp[idx], first_guess=np.ones(idx.size, dtype=bool), tol=tol)
+        w = cp + G[:, idx] @ zc
+        viol = (w < -eps) & ~cand
+        if not viol.any():
+            z[idx] = zc
+            return z
+        cand |= viol

@@ -22,7 +22,7 @@ import time
 
 import numpy as np
 
-from .model import MarchResult, System, periodicity_defect, solve_lcp_enum
+from .model import MarchResult, System, periodicity_defect, solve_contact_lcp
 
 
 def stencils(scheme: str, h: float):
@@ -109,7 +109,7 @@ def march_multistep(sys_: System, scheme: str, steps: int, pairing: str = "same"
             if Ii.size:
                 cp = gI[j] - BI @ xn
                 if np.any(cp < 0):
-                    zi = solve_lcp_enum(GI, cp, first_guess=cp < 0)
+                    zi = solve_contact_lcp(GI, cp)
                     lcp_calls += 1
                     xn = xn - WBI @ zi
                     Z[Ii, j] = zi
