@@ -45,7 +45,9 @@ def solved(cli, workdir):
 def _cost(res, ref):
     tot = res.total_s
     solve = f"solve {tot:.3g} s" if isinstance(tot, (int, float)) else "solve ? s"
-    return f"{solve} (wall {res.wall_s:.2f} s); marching {ref.periods} periods, {ref.cpu_time:.2f} s CPU"
+    lcp = res.lcp or {}
+    return (f"{solve} (wall {res.wall_s:.2f} s; LCP size {lcp.get('size')}, {lcp.get('status')}, "
+            f"{lcp.get('pivots')} pivots); marching {ref.periods} periods, {ref.cpu_time:.2f} s CPU")
 
 
 @pytest.mark.parametrize("name,run", RUNS, ids=IDS)

@@ -58,6 +58,11 @@ def plot_case(case, ref, discrete=None, engine=None, fmu=None, exact=None, path=
         ax.set_xlabel("phase t / T")
         ax.set_title(f"last period: {lab}")
         ax.legend(fontsize=7, loc="best")
+    for i, cont in enumerate(sys_.contacts):  # obstacle position in DOF coordinates: x[dof] = s gap(t)
+        ax_x.plot(ph, cont.direction * sys_.gaps(ref.t)[i], color="0.5", lw=1.0, ls="-.",
+                  label="obstacle (s·gap)" if i == 0 else None)
+    if sys_.contacts:
+        ax_x.legend(fontsize=7, loc="best")
     if exact is not None:
         te, xe = exact
         for c, d in enumerate(dofs):
