@@ -6,6 +6,7 @@ mod circulant_fft;
 mod lemke;
 mod matrix;
 mod pivoting;
+mod warm_lemke;
 pub mod dat;
 
 pub use circulant_fft::CirculantOperator;

@@ -8,8 +8,11 @@
 //!
 //! Measured on the rigid stop with forward-paired cds (k = 1024): two full exchanges bring the
 //! active set within two indices, then the front walks two instants per iteration (the odd–even
-//! coupling of central differences), so it needs O(k) iterations there. Hence opt-in only.
-use super::{LcpInfo, LcpMatrix, LcpOutcome, LcpSolution, residuals};
+//! coupling of central differences): O(k) LUs. So once full exchanges stop reducing the number
+//! of infeasible indices, Lemke takes over from the best basis (`warm_lemke`), one cheap pivot
+//! per wrong index.
+use super::{LcpInfo, LcpMatrix, LcpOutcome, LcpSolution, residuals, warm_lemke};
+use faer::linalg::solvers::PartialPivLu;
 use faer::Mat;
 use faer::linalg::solvers::Solve;
 use std::time::Instant;
@@ -27,11 +30,13 @@ pub struct PivotingSettings {
     pub certify_tol: f64,
     /// Initial active set (indices with z > 0); default {i : q_i < 0}.
     pub warm_start: Option<Vec<usize>>,
+    /// Pivot budget of the finishing Lemke run from the best basis.
+    pub max_lemke_pivots: usize,
 }
 
 impl Default for PivotingSettings {
     fn default() -> Self {
-        PivotingSettings { max_iterations: 200, max_stalls: 3, feasibility_tol: 1e-11, certify_tol: 1e-9, warm_start: None }
+        PivotingSettings { max_iterations: 50, max_stalls: 2, feasibility_tol: 1e-11, certify_tol: 1e-9, warm_start: None, max_lemke_pivots: 2000 }
     }
 }
 
@@ -42,11 +47,19 @@ pub struct BlockPivoting {
 /// Pivot ratio below which A_FF counts as singular (the fast path then gives up).
 const SINGULAR_RATIO: f64 = 1e-14;
 
+/// The LU's U has no pivot below SINGULAR_RATIO of the largest (NaN counts as singular).
+pub(crate) fn well_conditioned(u: faer::MatRef<'_, f64>) -> bool {
+    let (lo, hi) = (0..u.nrows()).fold((f64::INFINITY, 0.0f64), |(l, h), i| (l.min(u[(i, i)].abs()), h.max(u[(i, i)].abs())));
+    lo > SINGULAR_RATIO * hi || u.nrows() == 0
+}
+
 impl BlockPivoting {
     pub fn new(settings: PivotingSettings) -> Self {
         BlockPivoting { settings }
     }
 
+    /// Full exchanges while they reduce the number of infeasible indices; then Lemke from the
+    /// best basis found (`warm_lemke`), which repairs the last few indices pivot by pivot.
     pub fn solve(&self, a: &dyn LcpMatrix, q: &[f64]) -> LcpSolution {
         let start = Instant::now();
         let n = a.dim();
@@ -68,32 +81,37 @@ impl BlockPivoting {
         }
         let mut z = vec![0.0; n];
         let mut w = vec![0.0; n];
-        let mut best_infeasible = usize::MAX;
-        let mut stalls = s.max_stalls;
+        let mut best: Option<(usize, Vec<bool>, Option<PartialPivLu<f64>>)> = None;
+        let mut stalls = 0;
         let mut col = vec![0.0; n];
+        let mut iterations = 0;
         for iteration in 1..=s.max_iterations {
+            iterations = iteration;
             let f: Vec<usize> = (0..n).filter(|&i| active[i]).collect();
             z.iter_mut().for_each(|v| *v = 0.0);
+            let mut lu = None;
             if !f.is_empty() {
                 let r = f.len();
-                let mut aff = Mat::<f64>::zeros(r, r);
-                for (cj, &j) in f.iter().enumerate() {
-                    a.column_into(j, &mut col);
-                    for (ci, &i) in f.iter().enumerate() {
-                        aff[(ci, cj)] = col[i];
+                // A_FF lives only until it is factorised: memory is the LU's.
+                let factor = {
+                    let mut aff = Mat::<f64>::zeros(r, r);
+                    for (cj, &j) in f.iter().enumerate() {
+                        a.column_into(j, &mut col);
+                        for (ci, &i) in f.iter().enumerate() {
+                            aff[(ci, cj)] = col[i];
+                        }
                     }
-                }
-                let lu = aff.partial_piv_lu();
-                let u = lu.U();
-                let (lo, hi) = (0..r).fold((f64::INFINITY, 0.0f64), |(l, h), i| (l.min(u[(i, i)].abs()), h.max(u[(i, i)].abs())));
-                if !(lo > SINGULAR_RATIO * hi) {
-                    return fail(LcpOutcome::Inaccurate, iteration, vec![0.0; n], q.to_vec());
+                    aff.partial_piv_lu()
+                };
+                if !well_conditioned(factor.U()) {
+                    break;
                 }
                 let rhs = Mat::from_fn(r, 1, |i, _| -q[f[i]]);
-                let zf = lu.solve(&rhs);
+                let zf = factor.solve(&rhs);
                 for (ci, &i) in f.iter().enumerate() {
                     z[i] = zf[(ci, 0)];
                 }
+                lu = Some(factor);
             }
             a.mul_into(&z, &mut w);
             w.iter_mut().zip(q).for_each(|(wi, qi)| *wi += qi);
@@ -117,19 +135,26 @@ impl BlockPivoting {
                     info: LcpInfo { pivots: iteration, residual, relative_error, time_s: start.elapsed().as_secs_f64(), warm_start_used: s.warm_start.is_some() && iteration == 1 },
                 };
             }
-            if infeasible.len() < best_infeasible {
-                best_infeasible = infeasible.len();
-                stalls = s.max_stalls;
-                infeasible.iter().for_each(|&i| active[i] = !active[i]);
-            } else if stalls > 0 {
-                stalls -= 1;
-                infeasible.iter().for_each(|&i| active[i] = !active[i]);
+            if best.as_ref().is_none_or(|b| infeasible.len() < b.0) {
+                best = Some((infeasible.len(), active.clone(), lu));
+                stalls = 0;
             } else {
-                // Murty's least-index rule (here: the largest index), finite for P-matrices.
-                let i = *infeasible.last().expect("non-empty");
-                active[i] = !active[i];
+                stalls += 1;
+                if stalls > s.max_stalls {
+                    break;
+                }
             }
+            infeasible.iter().for_each(|&i| active[i] = !active[i]);
         }
-        fail(LcpOutcome::PivotLimit, s.max_iterations, z.iter().map(|v| v.max(0.0)).collect(), w)
+        let Some((_, basis, lu)) = best else {
+            return fail(LcpOutcome::Inaccurate, 0, vec![0.0; n], q.to_vec());
+        };
+        let exchanges = iterations;
+        let mut sol = warm_lemke::solve_from_basis(a, q, &basis, lu, s.max_lemke_pivots, s.certify_tol);
+        // Pivots: the block exchanges (one LU each) plus Lemke's single pivots.
+        sol.info.pivots += exchanges;
+        sol.info.time_s = start.elapsed().as_secs_f64();
+        sol.info.warm_start_used = s.warm_start.is_some();
+        sol
     }
 }

@@ -116,9 +116,9 @@ pub struct PeriodicProblem {
     pub solver: SolverSettings,
 }
 
-/// Up to this LCP size `auto` uses lexicographic Lemke directly. Block pivoting is not yet
-/// reliable on rigid contact (see `lcp::pivoting`), so for now `auto` always uses Lemke.
-pub const AUTO_LEMKE_MAX: usize = usize::MAX;
+/// Up to this LCP size `auto` uses lexicographic Lemke directly; above, block pivoting finished
+/// by Lemke from its best basis, with full lexicographic Lemke as the fallback.
+pub const AUTO_LEMKE_MAX: usize = 256;
 
 /// Fewest instants per period that any scheme needs.
 pub const MIN_STEPS: usize = 4;
