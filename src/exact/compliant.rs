@@ -48,8 +48,12 @@ impl CompliantStopOrbit {
     /// the linear orbit. Returns the contact-free linear orbit (see [`Self::has_contact`]) when
     /// no seed is given and max x of the linear response is ≤ g0.
     ///
-    /// Fails (naming the parameter) on invalid input, and when Newton does not converge or its
-    /// answer is not a one-contact orbit (x > g0 in the free phase, x < g0 in the contact phase,
+    /// When the simulation does not settle to a period-T attractor, Newton still starts from its
+    /// last contact phase: the orbit found may then be unstable (see [`Self::is_stable`]).
+    ///
+    /// Fails (naming the parameter) on invalid input, when the simulated steady state has several
+    /// contact phases per period, and when Newton does not converge or its answer is not a
+    /// one-contact orbit (x > g0 in the free phase, x < g0 in the contact phase,
     /// t1 − t0 ∉ (0, T), v0 ≤ 0).
     pub fn solve(osc: &Oscillator, contact_stiffness: f64, gap: f64, seed: Option<[f64; 3]>) -> Result<Self, String> {
         osc.validate()?;
@@ -116,7 +120,12 @@ impl CompliantStopOrbit {
         let mut last: Option<(f64, f64, f64)> = None; // (t_up, v_up, t_down)
         let mut pending_up: Option<(f64, f64)> = None;
         let mut prev_start = s;
-        for p in 0..20_000usize {
+        // Periods for the free transient e^{−ct/2m} to fall by e^{−200} (slower period maps near a
+        // bifurcation need more than e^{−20}), within bounds.
+        let decay = self.osc.damping / (2.0 * self.osc.mass) * period;
+        let max_periods = if decay > 0.0 { ((200.0 / decay).ceil() as usize + 100).min(20_000) } else { 200 };
+        let mut settled = None;
+        for p in 0..max_periods {
             let mut ups = 0;
             for j in 0..steps {
                 let mut ta = (p * steps + j) as f64 * dt;
@@ -159,19 +168,26 @@ impl CompliantStopOrbit {
             }
             let d = (s[0] - prev_start[0]).abs().max((s[1] - prev_start[1]).abs() / self.osc.omega);
             prev_start = s;
-            if p > 2 && ups == 1 && d < 1e-9 * scale {
+            if p > 2 && d < 1e-9 * scale {
+                settled = Some(ups);
                 break;
             }
-            if p > 2 && ups == 0 && d < 1e-12 * scale {
-                return Err(format!(
-                    "gap: is {g0}; the linear response exceeds it (max x = {}) but the simulated steady state never touches the stop: no one-contact orbit from the default seed, give a seed",
-                    self.linear.amplitude()
-                ));
-            }
         }
-        match last {
-            Some((t0, v0, t1)) => Ok([t0, t1, v0]),
-            None => Err(format!("gap: is {g0}; the simulation found no complete contact phase, give a seed")),
+        match (settled, last) {
+            (Some(1), Some((t0, v0, t1))) => Ok([t0, t1, v0]),
+            (Some(0), _) => Err(format!(
+                "gap: is {g0}; the linear response exceeds it (max x = {}) but the simulated steady state never touches the stop: no one-contact orbit from the default seed, give a seed",
+                self.linear.amplitude()
+            )),
+            (Some(u), _) => Err(format!(
+                "gap: is {g0}; the simulated steady state has {u} contact phases per period: not a one-contact orbit"
+            )),
+            // No period-T attractor (subharmonic, chaotic, undamped): an unstable period-T orbit
+            // may still exist; let Newton try from the last contact phase.
+            (None, Some((t0, v0, t1))) => Ok([t0, t1, v0]),
+            (None, None) => Err(format!(
+                "gap: is {g0}; the simulated response did not settle to a period-T orbit within {max_periods} periods and made no contact: give a seed"
+            )),
         }
     }
 
@@ -300,6 +316,38 @@ impl CompliantStopOrbit {
         (o.force * (o.omega * t).cos() - o.damping * v - o.stiffness * x - z) / o.mass
     }
 
+    /// Floquet multipliers: eigenvalues of the monodromy matrix Φ_free(T − (t1 − t0))·Φ_contact(t1 − t0)
+    /// (the vector field is continuous across x = g0, so the saltation matrices are the identity).
+    /// Their product is e^{−cT/m}. For the contact-free orbit: both equal to the free e^{AT}.
+    pub fn floquet_multipliers(&self) -> [num_complex::Complex64; 2] {
+        let period = self.osc.period();
+        let mono = match &self.phases {
+            None => PhaseFlow::new(self.osc.mass, self.osc.damping, self.osc.stiffness, 0.0, self.osc.omega, 0.0)
+                .map(|f| f.phi(period))
+                .unwrap_or([[f64::NAN; 2]; 2]),
+            Some(p) => {
+                let a = p.free.phi(p.t0 + period - p.t1);
+                let b = p.contact.phi(p.t1 - p.t0);
+                let mut m = [[0.0; 2]; 2];
+                for (i, row) in m.iter_mut().enumerate() {
+                    for (j, v) in row.iter_mut().enumerate() {
+                        *v = a[i][0] * b[0][j] + a[i][1] * b[1][j];
+                    }
+                }
+                m
+            }
+        };
+        let tr = mono[0][0] + mono[1][1];
+        let det = mono[0][0] * mono[1][1] - mono[0][1] * mono[1][0];
+        let disc = num_complex::Complex64::new(tr * tr / 4.0 - det, 0.0).sqrt();
+        [tr / 2.0 + disc, tr / 2.0 - disc]
+    }
+
+    /// Both Floquet multipliers inside the unit circle.
+    pub fn is_stable(&self) -> bool {
+        self.floquet_multipliers().iter().all(|m| m.norm() < 1.0)
+    }
+
     /// False for the contact-free linear orbit.
     pub fn has_contact(&self) -> bool {
         self.phases.is_some()
@@ -362,8 +410,9 @@ fn solve3(mut a: [[f64; 3]; 3], mut b: [f64; 3]) -> Option<[f64; 3]> {
         b.swap(col, piv);
         for row in col + 1..3 {
             let f = a[row][col] / a[col][col];
-            for k in col..3 {
-                a[row][k] -= f * a[col][k];
+            let pivot_row = a[col];
+            for (v, p) in a[row].iter_mut().zip(pivot_row).skip(col) {
+                *v -= f * p;
             }
             b[row] -= f * b[col];
         }

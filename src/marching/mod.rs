@@ -1,7 +1,7 @@
 //! Explicit time-marching reference (notes §5): central differences with forward-increment
 //! Lagrange multipliers (Carpenter, Taylor & Katona 1991), for dense multi-DOF models.
 //!
-//! In the user-facing signs of [`crate::model`] (contact i: s_i·x[d_i] ≤ gap_i(t), row i of B is
+//! In the user-facing signs of [`crate::model`] (contact i: `s_i·x[d_i] ≤ gap_i(t)`, row i of B is
 //! s_i e_{d_i}ᵀ, compressive force z_i ≥ 0 pushing DOF d_i by −s_i z_i):
 //!
 //! ```text
@@ -64,16 +64,16 @@ impl Default for MarchSettings {
 pub struct MarchResult {
     /// t_j = j·h.
     pub time: Vec<f64>,
-    /// displacement[j][dof].
+    /// `displacement[j][dof]`.
     pub displacement: Vec<Vec<f64>>,
-    /// Central velocity (x_{j+1} − x_{j−1}) / (2h), velocity[j][dof].
+    /// Central velocity (x_{j+1} − x_{j−1}) / (2h), `velocity[j][dof]`.
     pub velocity: Vec<Vec<f64>>,
-    /// contact_force[j][contact]: the force in the step equation at t_j (rigid: λ_j, enforcing
+    /// `contact_force[j][contact]`: the force in the step equation at t_j (rigid: λ_j, enforcing
     /// the clearance at t_{j+1}; compliant: k_c·max(0, penetration at t_j)).
     pub contact_force: Vec<Vec<f64>>,
-    /// contact_impulse[j][contact] = contact_force·h.
+    /// `contact_impulse[j][contact] = contact_force[j][contact]·h`.
     pub contact_impulse: Vec<Vec<f64>>,
-    /// clearance[j][contact] = gap(t_j) − s·x_j[d].
+    /// `clearance[j][contact] = gap(t_j) − s·x_j[d]`.
     pub clearance: Vec<Vec<f64>>,
     /// Periods simulated.
     pub periods: usize,
@@ -82,7 +82,7 @@ pub struct MarchResult {
     pub step: f64,
     /// The ω_max used for the stability check.
     pub omega_max: f64,
-    /// Elapsed time of the (single-threaded) march, set-up included [s].
+    /// Elapsed time of the (single-threaded) march, set-up included, in seconds.
     pub cpu_time_s: f64,
     pub converged: bool,
     /// Final periodicity defect (∞ when fewer than two periods were simulated).
