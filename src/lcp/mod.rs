@@ -5,8 +5,12 @@
 mod matrix;
 mod lemke;
 pub mod dat;
+mod brute;
+mod refine;
 
 pub use lemke::{Lemke, LemkeSettings};
+pub use brute::solve_by_enumeration;
+pub use dat::{DatError, parse_dat, read_dat, write_dat};
 pub use matrix::{BlockCirculant, DenseMatrix, LcpMatrix};
 
 use serde::Serialize;
