@@ -4,6 +4,9 @@
 //!
 //! Flow: [`scene`] (TOML) → [`model`] → [`time`] (circulant symbols) → [`periodic`] (assembly,
 //! LCP, recovery) → [`response`]. The [`lcp`] solvers know nothing of mechanics.
+#[cfg(feature = "plots")]
+/// PNG line charts.
+pub mod plot;
 /// The built-in default scene.
 pub mod defaults;
 /// Semi-analytic periodic orbits: the independent references of the tests.
