@@ -333,7 +333,11 @@ impl<'a> Revised<'a> {
                 vmin = vmin.min(self.binv(i, c) / self.y[i]);
             }
             let tol = LEX_TOL * vmin.abs().max(1.0);
-            ties.retain(|&i| self.binv(i, c) / self.y[i] - vmin <= tol);
+            let keep = |i: usize| self.binv(i, c) / self.y[i] - vmin <= tol;
+            // NaN-safe: a comparison with NaN is false, so never let the list run empty.
+            if ties.iter().any(|&i| keep(i)) {
+                ties.retain(|&i| keep(i));
+            }
         }
         // Exact arithmetic leaves one row (B⁻¹ is nonsingular); in floating point keep the
         // largest pivot among any survivors, the numerically safest.
