@@ -84,7 +84,6 @@ const LEX_TOL: f64 = 1e-11;
 /// off by a few indices, not to solve the LCP; a cap keeps its cost bounded.
 const POLISH_ROUNDS: usize = 8;
 
-
 /// One step of iterative refinement of B⁻¹q̂ every this many pivots. Why: the explicit B⁻¹
 /// updates accumulate round-off (≈ eps · cond(B) per pivot); on long runs with ill-conditioned
 /// bases the drift in B⁻¹q̂ can exceed the small basic values that degenerate ratio decisions
