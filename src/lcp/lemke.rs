@@ -84,7 +84,6 @@ const LEX_TOL: f64 = 1e-11;
 /// off by a few indices, not to solve the LCP; a cap keeps its cost bounded.
 const POLISH_ROUNDS: usize = 8;
 
-
 /// One step of iterative refinement of B⁻¹q̂ every this many pivots. Why: the explicit B⁻¹
 /// updates accumulate round-off (≈ eps · cond(B) per pivot); on long runs with ill-conditioned
 /// bases the drift in B⁻¹q̂ can exceed the small basic values that degenerate ratio decisions
@@ -333,7 +332,11 @@ impl<'a> Revised<'a> {
                 vmin = vmin.min(self.binv(i, c) / self.y[i]);
             }
             let tol = LEX_TOL * vmin.abs().max(1.0);
-            ties.retain(|&i| self.binv(i, c) / self.y[i] - vmin <= tol);
+            let keep = |i: usize| self.binv(i, c) / self.y[i] - vmin <= tol;
+            // NaN-safe: a comparison with NaN is false, so never let the list run empty.
+            if ties.iter().any(|&i| keep(i)) {
+                ties.retain(|&i| keep(i));
+            }
         }
         // Exact arithmetic leaves one row (B⁻¹ is nonsingular); in floating point keep the
         // largest pivot among any survivors, the numerically safest.
