@@ -11,3 +11,5 @@ pub mod periodic;
 pub mod response;
 pub mod scene;
 pub mod defaults;
+pub mod fe;
+pub mod reduction;
