@@ -274,7 +274,14 @@ pub fn craig_bampton(
         timings.static_modes = t1.elapsed().as_secs_f64();
 
         let t2 = Instant::now();
-        let modes = eigen::lanczos(&k_ii, &m_ii, &llt, opts.modes, &opts.lanczos)?;
+        // With η = 0 one mode is still computed, to detect a singular K_ii.
+        let mut modes = eigen::lanczos(&k_ii, &m_ii, &llt, opts.modes.max(1), &opts.lanczos).map_err(|e| match e {
+            EigenError::Singular { .. } => ReductionError::InternalStiffness(e.to_string()),
+            e => ReductionError::Eigen(e),
+        })?;
+        if opts.modes == 0 {
+            modes = Modes { omega: vec![], shapes: Mat::zeros(ni, 0), residual: vec![], krylov_dim: modes.krylov_dim };
+        }
         timings.eigen = t2.elapsed().as_secs_f64();
         interface_omega = modes.omega.clone();
         interface_residual = modes.residual.clone();

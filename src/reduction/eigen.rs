@@ -31,6 +31,26 @@ pub enum EigenError {
     NotConverged { converged: usize, requested: usize, dim: usize },
     #[error("the eigen decomposition failed: {0}")]
     Decomposition(String),
+    #[error(
+        "the stiffness matrix is singular to working precision (lowest ω² = {omega2:e}, against a stiffness/mass scale of {scale:e}): \
+         is every rigid-body motion clamped?"
+    )]
+    Singular { omega2: f64, scale: f64 },
+    #[error("mode {mode} did not converge: relative residual {residual:e}")]
+    Inaccurate { mode: usize, residual: f64 },
+}
+
+/// max diag(K) / max diag(M): the scale of ω² for a singularity test.
+fn stiffness_mass_scale(k: &SparseColMat<usize, f64>, m: &SparseColMat<usize, f64>) -> f64 {
+    let diag_max = |a: &SparseColMat<usize, f64>| {
+        (0..a.ncols())
+            .map(|j| {
+                let rows = a.row_idx_of_col_raw(j);
+                rows.binary_search(&j).map_or(0.0, |p| a.val_of_col(j)[p].abs())
+            })
+            .fold(0.0f64, f64::max)
+    };
+    diag_max(k) / diag_max(m)
 }
 
 /// Lanczos settings.
@@ -260,7 +280,7 @@ pub fn lanczos(
                 }
             }
             if converged >= count || dim >= n {
-                return Ok(finish(k, m, &q, &theta, &s, count, dim));
+                return check(k, m, finish(k, m, &q, &theta, &s, count, dim));
             }
             if exhausted {
                 return Err(EigenError::NotConverged { converged, requested: count, dim });
@@ -273,12 +293,27 @@ pub fn lanczos(
             let (vn, mvn, _) = m_orthonormalise(m, &q, &mq, &mut w, 1e-10);
             if vn.ncols() == 0 {
                 let (theta, s) = ritz(&t)?;
-                return Ok(finish(k, m, &q, &theta, &s, count.min(dim), dim));
+                return check(k, m, finish(k, m, &q, &theta, &s, count.min(dim), dim));
             }
             v = vn;
             mv = mvn;
         }
     }
+}
+
+/// Refuses a singular K (ω² negligible against the stiffness/mass scale: the Cholesky factor of
+/// a singular K can succeed in floating point) and modes whose true residual is poor.
+fn check(k: &SparseColMat<usize, f64>, m: &SparseColMat<usize, f64>, modes: Modes) -> Result<Modes, EigenError> {
+    let scale = stiffness_mass_scale(k, m);
+    if let Some(&w) = modes.omega.first() {
+        if !(w * w > 1e-12 * scale) {
+            return Err(EigenError::Singular { omega2: w * w, scale });
+        }
+    }
+    if let Some((i, &r)) = modes.residual.iter().enumerate().find(|(_, r)| !(**r < 1e-6)) {
+        return Err(EigenError::Inaccurate { mode: i + 1, residual: r });
+    }
+    Ok(modes)
 }
 
 /// Eigen of the projected symmetric matrix, ascending.
