@@ -353,3 +353,41 @@ fn cantilever_first_bending_frequency_against_euler_bernoulli() {
     let rel_plate = f_plate / f_eb - 1.0;
     assert!(rel_plate > 0.0 && rel_plate < 1.0 / (1.0 - 0.34f64 * 0.34).sqrt() - 1.0, "ν = 0.34: {rel_plate:+.4}");
 }
+
+#[test]
+fn blade_spec_from_toml() {
+    #[derive(serde::Deserialize)]
+    struct Wrap {
+        generator: BladeSpec,
+    }
+    let w: Wrap = toml::from_str(
+        "generator = { preset = \"fine\", twist_deg = 10.0, taper = 1.0, span_elements = 12, poisson = 0.3, element = \"hex8\" }",
+    )
+    .unwrap();
+    let p = w.generator.params().unwrap();
+    assert_eq!(p.mesh, MeshDensity { span: 12, chord: 24, thickness: 4 });
+    assert_eq!((p.twist_deg, p.taper, p.material.poisson, p.element), (10.0, 1.0, 0.3, ElementKind::Hex8));
+    assert_eq!(p.material.young, 114e9);
+    assert_eq!(BladeSpec::default().params().unwrap(), BladeParams::coarse());
+    let e = BladeSpec { preset: Some("medium".into()), ..Default::default() }.params().unwrap_err().to_string();
+    assert!(e.contains("preset") && e.contains("medium"), "{e}");
+    let e = BladeSpec { chord_elements: Some(5), ..Default::default() }.params().unwrap_err().to_string();
+    assert!(e.contains("mesh.chord"), "{e}");
+    assert!(toml::from_str::<Wrap>("generator = { lenght = 0.1 }").is_err());
+}
+
+#[test]
+fn clamp_structure_applies_one_map_to_every_matrix() {
+    let b = Blade::generate_free(&small_params()).unwrap();
+    let mut s = b.structure();
+    s.damping = Some(periodic_contact::model::Matrix::Dense(periodic_contact::model::Matrix::Sparse(b.mass.clone()).to_dense()));
+    let root = b.root_dofs();
+    let (c, map) = clamp_structure(&s, &root).unwrap();
+    let clamped = Blade::generate(&small_params()).unwrap();
+    assert_eq!(map, clamped.dofs);
+    let periodic_contact::model::Matrix::Sparse(k) = &c.stiffness else { panic!("stays sparse") };
+    assert_eq!(k.val(), clamped.stiffness.val());
+    let periodic_contact::model::Matrix::Dense(d) = c.damping.as_ref().unwrap() else { panic!("stays dense") };
+    let md = periodic_contact::model::Matrix::Sparse(clamped.mass.clone()).to_dense();
+    assert_eq!(d, &md);
+}

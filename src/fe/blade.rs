@@ -355,3 +355,70 @@ fn build(params: &BladeParams, clamp_root: bool) -> Result<Blade, BladeError> {
     let mass = SparseColMat::new(sym, mv);
     Ok(Blade { params: *params, nodes, elements, mass, stiffness, dofs })
 }
+
+/// The scene's `generator = { kind = "blade", … }` table (without `kind`, which the scene's
+/// enum consumes). Every key is optional and overrides the preset:
+///
+/// ```toml
+/// generator = { kind = "blade", preset = "coarse", length = 0.1, chord = 0.05, thickness = 0.004,
+///               twist_deg = 30.0, taper = 0.8, young = 114e9, poisson = 0.34, density = 4430.0,
+///               span_elements = 24, chord_elements = 8, thickness_elements = 2,
+///               element = "hex8-incompatible" }
+/// ```
+#[derive(Clone, Debug, Default, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BladeSpec {
+    /// `"coarse"` (default) or `"fine"`.
+    pub preset: Option<String>,
+    /// Span [m].
+    pub length: Option<f64>,
+    /// Root chord [m].
+    pub chord: Option<f64>,
+    /// Thickness [m].
+    pub thickness: Option<f64>,
+    /// Total twist root → tip [degrees].
+    pub twist_deg: Option<f64>,
+    /// Tip chord / root chord.
+    pub taper: Option<f64>,
+    /// Young's modulus [Pa].
+    pub young: Option<f64>,
+    /// Poisson's ratio.
+    pub poisson: Option<f64>,
+    /// Density [kg/m³].
+    pub density: Option<f64>,
+    pub span_elements: Option<usize>,
+    pub chord_elements: Option<usize>,
+    pub thickness_elements: Option<usize>,
+    /// `"hex8-incompatible"` (default) or `"hex8"`.
+    pub element: Option<String>,
+}
+
+impl BladeSpec {
+    /// The parameters this spec describes (validated).
+    pub fn params(&self) -> Result<BladeParams, BladeError> {
+        let bad = |field: &'static str, message: String| BladeError::Parameter { field, message };
+        let preset = match self.preset.as_deref() {
+            None => Preset::Coarse,
+            Some(name) => Preset::from_name(name).ok_or_else(|| bad("preset", format!("`{name}` is not a preset; expected `coarse` or `fine`")))?,
+        };
+        let mut p = BladeParams::preset(preset);
+        p.length = self.length.unwrap_or(p.length);
+        p.chord = self.chord.unwrap_or(p.chord);
+        p.thickness = self.thickness.unwrap_or(p.thickness);
+        p.twist_deg = self.twist_deg.unwrap_or(p.twist_deg);
+        p.taper = self.taper.unwrap_or(p.taper);
+        p.material.young = self.young.unwrap_or(p.material.young);
+        p.material.poisson = self.poisson.unwrap_or(p.material.poisson);
+        p.material.density = self.density.unwrap_or(p.material.density);
+        p.mesh.span = self.span_elements.unwrap_or(p.mesh.span);
+        p.mesh.chord = self.chord_elements.unwrap_or(p.mesh.chord);
+        p.mesh.thickness = self.thickness_elements.unwrap_or(p.mesh.thickness);
+        p.element = match self.element.as_deref() {
+            None | Some("hex8-incompatible") => ElementKind::Hex8Incompatible,
+            Some("hex8") => ElementKind::Hex8,
+            Some(other) => return Err(bad("element", format!("`{other}` is not an element; expected `hex8-incompatible` or `hex8`"))),
+        };
+        p.validate()?;
+        Ok(p)
+    }
+}

@@ -113,11 +113,34 @@ pub fn dense_submatrix(a: &SparseColMat<usize, f64>, rows: &[Option<usize>], col
     d
 }
 
-/// A · X for sparse A and dense X.
+/// A · X for sparse A and dense X. One pass over A for all columns of X (X is copied to a
+/// row-major buffer): several times faster than column-by-column products, which are limited
+/// by memory bandwidth.
 pub fn sparse_times_dense(a: &SparseColMat<usize, f64>, x: MatRef<'_, f64>) -> Mat<f64> {
-    let mut y = Mat::zeros(a.nrows(), x.ncols());
-    faer::sparse::linalg::matmul::sparse_dense_matmul(y.as_mut(), Accum::Replace, a.as_ref(), x, 1.0, Par::Seq);
-    y
+    let (n, m, p) = (a.nrows(), a.ncols(), x.ncols());
+    assert_eq!(x.nrows(), m, "sparse_times_dense: shapes do not match");
+    if p <= 1 {
+        let mut y = Mat::zeros(n, p);
+        faer::sparse::linalg::matmul::sparse_dense_matmul(y.as_mut(), Accum::Replace, a.as_ref(), x, 1.0, Par::Seq);
+        return y;
+    }
+    let mut xr = vec![0.0; m * p];
+    for k in 0..p {
+        for j in 0..m {
+            xr[j * p + k] = x[(j, k)];
+        }
+    }
+    let mut yr = vec![0.0; n * p];
+    for j in 0..m {
+        let xj = &xr[j * p..(j + 1) * p];
+        for (&i, &v) in a.row_idx_of_col_raw(j).iter().zip(a.val_of_col(j)) {
+            let yi = &mut yr[i * p..(i + 1) * p];
+            for (y, &xv) in yi.iter_mut().zip(xj) {
+                *y += v * xv;
+            }
+        }
+    }
+    Mat::from_fn(n, p, |i, k| yr[i * p + k])
 }
 
 /// y = A x for a sparse A.
@@ -146,4 +169,15 @@ pub fn asymmetry(a: &SparseColMat<usize, f64>) -> f64 {
         }
     }
     if scale > 0.0 { worst / scale } else { 0.0 }
+}
+
+/// Removes the DOFs `fixed` from M, K and C (if any) of a structure, consistently.
+pub fn clamp_structure(s: &crate::model::Structure, fixed: &[usize]) -> Result<(crate::model::Structure, DofMap), ClampError> {
+    let map = DofMap::clamping(s.mass.nrows(), fixed)?;
+    let out = crate::model::Structure {
+        mass: map.apply_matrix(&s.mass),
+        stiffness: map.apply_matrix(&s.stiffness),
+        damping: s.damping.as_ref().map(|c| map.apply_matrix(c)),
+    };
+    Ok((out, map))
 }
