@@ -9,6 +9,8 @@
 pub mod plot;
 /// The built-in default scene.
 pub mod defaults;
+/// Finite elements: Matrix Market input, DOF clamping, the blade model.
+pub mod fe;
 /// Semi-analytic periodic orbits: the independent references of the tests.
 pub mod exact;
 /// LCP solvers; they know nothing of mechanics.
@@ -17,6 +19,8 @@ pub mod lcp;
 pub mod marching;
 /// The mechanical model and its checks.
 pub mod model;
+/// Craig–Bampton reduction and modal analysis.
+pub mod reduction;
 /// Assembly in the frequency domain, the LCP of the period, recovery.
 pub mod periodic;
 /// The periodic response as written to JSON.
