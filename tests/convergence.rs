@@ -166,3 +166,27 @@ fn persistent_contact_follows_the_obstacle_and_the_force_converges() {
     eprintln!("persistent contact: force errors {force_errors:?}, order {p:.2}");
     assert!((1.8..2.3).contains(&p), "force order {p}");
 }
+
+/// The periodic LCP with cds and forward pairing is the steady state of the explicit
+/// central-difference marcher with forward-increment multipliers (notes §5) on the same grid:
+/// marching from rest until the transients die must land on the same samples.
+#[test]
+fn cds_forward_equals_the_steady_state_of_explicit_time_marching() {
+    use periodic_contact::marching::{MarchSettings, march};
+    let cases = [
+        ("pure impacts", Oscillator { mass: 1.0, damping: 0.1, stiffness: 1.0, force: 0.5, omega: 0.8 }, 0.6),
+        ("sticking", STICKING, 0.5),
+    ];
+    for (name, osc, gap) in cases {
+        for k in [256usize, 1024] {
+            let model = osc.model(vec![Oscillator::stop(gap, Compliance::Rigid)]);
+            let r = problem(&osc, Oscillator::stop(gap, Compliance::Rigid), Scheme::Cds, k, None).solve().unwrap();
+            let m = march(&model, &MarchSettings { steps_per_period: k, tolerance: 1e-12, max_periods: 5000, ..Default::default() }).unwrap();
+            assert!(m.converged, "{name} k={k}: the marcher did not reach a steady state");
+            let shift = (m.time[0] / (r.period / k as f64)).round() as usize % k;
+            let d = (0..k).map(|j| (r.displacement["0"][(j + shift) % k] - m.displacement[j][0]).abs()).fold(0.0, f64::max);
+            eprintln!("{name} k={k}: periodic LCP vs marcher steady state {d:.2e} ({} periods, {:.3} s)", m.periods, m.cpu_time_s);
+            assert!(d < 1e-9, "{name} k={k}: {d:e}");
+        }
+    }
+}
