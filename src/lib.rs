@@ -11,3 +11,4 @@ pub mod periodic;
 pub mod response;
 pub mod scene;
 pub mod defaults;
+pub mod fmi2;
