@@ -12,3 +12,4 @@ pub mod response;
 pub mod scene;
 pub mod defaults;
 pub mod fmi2;
+pub mod fmu_model;
