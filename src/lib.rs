@@ -13,3 +13,5 @@ pub mod scene;
 pub mod defaults;
 pub mod fmi2;
 pub mod fmu_model;
+#[cfg(feature = "capi")]
+pub mod capi;
