@@ -4,14 +4,28 @@
 //!
 //! Flow: [`scene`] (TOML) → [`model`] → [`time`] (circulant symbols) → [`periodic`] (assembly,
 //! LCP, recovery) → [`response`]. The [`lcp`] solvers know nothing of mechanics.
-pub mod lcp;
-pub mod model;
-pub mod time;
-pub mod periodic;
-pub mod response;
-pub mod scene;
+/// The built-in default scene.
 pub mod defaults;
+/// Semi-analytic periodic orbits: the independent references of the tests.
+pub mod exact;
+/// The FMI 2.0 co-simulation shell (knows nothing of contact).
 pub mod fmi2;
+/// The FMU's physics adapter: a scene as a quasi-steady co-simulation model.
 pub mod fmu_model;
+/// The native C API (include/periodic_contact.h).
 #[cfg(feature = "capi")]
 pub mod capi;
+/// LCP solvers; they know nothing of mechanics.
+pub mod lcp;
+/// Explicit time marching with forward-increment Lagrange multipliers (the paper's reference).
+pub mod marching;
+/// The mechanical model and its checks.
+pub mod model;
+/// Assembly in the frequency domain, the LCP of the period, recovery.
+pub mod periodic;
+/// The periodic response as written to JSON.
+pub mod response;
+/// Scene files (TOML).
+pub mod scene;
+/// Time schemes as circulant symbols; pairing.
+pub mod time;

@@ -2,11 +2,20 @@
 //!
 //! This module knows nothing of mechanics. Matrices come through [`LcpMatrix`], so a solver can
 //! work on a dense matrix or on a structured one ([`BlockCirculant`]) without forming it.
-mod matrix;
-mod lemke;
+mod brute;
+mod circulant_fft;
 pub mod dat;
+mod lemke;
+mod matrix;
+mod pivoting;
+mod refine;
+mod warm_lemke;
 
+pub use circulant_fft::CirculantOperator;
 pub use lemke::{Lemke, LemkeSettings};
+pub use brute::solve_by_enumeration;
+pub use dat::{DatError, parse_dat, read_dat, write_dat};
+pub use pivoting::{BlockPivoting, PivotingSettings};
 pub use matrix::{BlockCirculant, DenseMatrix, LcpMatrix};
 
 use serde::Serialize;

@@ -7,6 +7,8 @@ use super::SolveError;
 use crate::model::{Matrix, Model};
 use crate::time::{Discretization, Symbols};
 use faer::Mat;
+use faer::sparse::linalg::solvers::SymbolicLu;
+use faer::sparse::{SparseColMat, SymbolicSparseColMat, Triplet};
 use faer::linalg::solvers::Solve;
 use num_complex::Complex64 as C;
 
@@ -52,82 +54,137 @@ fn force_spectra(model: &Model, fft: &PeriodFft) -> Vec<(usize, Vec<C>)> {
         .collect()
 }
 
-/// The dense matrices as complex-ready real copies.
-struct DenseOperator {
-    mass: Mat<f64>,
-    stiffness: Mat<f64>,
-    damping: Option<Mat<f64>>,
+/// Ẑ_p = σ2 M + σ1 C + w K, factorised per harmonic: dense LU, or sparse LU on the union
+/// pattern of M, C, K with one symbolic analysis shared by every harmonic.
+enum Operator {
+    Dense { mass: Mat<f64>, stiffness: Mat<f64>, damping: Option<Mat<f64>> },
+    Sparse { symbolic: SymbolicLu<usize>, pattern: SymbolicSparseColMat<usize>, mass: Vec<f64>, stiffness: Vec<f64>, damping: Vec<f64> },
 }
 
-impl DenseOperator {
-    fn new(model: &Model) -> Self {
+impl Operator {
+    fn new(model: &Model) -> Result<Self, SolveError> {
         let s = &model.structure;
-        DenseOperator { mass: s.mass.to_dense(), stiffness: s.stiffness.to_dense(), damping: s.damping.as_ref().map(Matrix::to_dense) }
+        let sparse = s.mass.is_sparse() || s.stiffness.is_sparse() || s.damping.as_ref().is_some_and(Matrix::is_sparse);
+        if !sparse {
+            return Ok(Operator::Dense { mass: s.mass.to_dense(), stiffness: s.stiffness.to_dense(), damping: s.damping.as_ref().map(Matrix::to_dense) });
+        }
+        let n = model.n();
+        let mut triplets = Vec::new();
+        for a in [Some(&s.mass), Some(&s.stiffness), s.damping.as_ref()].into_iter().flatten() {
+            a.for_each(|i, j, _| triplets.push(Triplet::new(i, j, 0.0)));
+        }
+        let union = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &triplets).map_err(|e| SolveError::Invalid(format!("sparse pattern: {e:?}")))?;
+        let pattern = union.symbolic().to_owned().map_err(|e| SolveError::Invalid(format!("sparse pattern: {e:?}")))?;
+        // Values of one matrix laid out on the union pattern.
+        let values = |a: Option<&Matrix>| {
+            let mut v = vec![0.0; pattern.compute_nnz()];
+            if let Some(a) = a {
+                a.for_each(|i, j, x| {
+                    let start = pattern.col_ptr()[j];
+                    let rows = &pattern.row_idx()[start..pattern.col_ptr()[j + 1]];
+                    if let Ok(pos) = rows.binary_search(&i) {
+                        v[start + pos] += x;
+                    }
+                });
+            }
+            v
+        };
+        let (mass, stiffness, damping) = (values(Some(&s.mass)), values(Some(&s.stiffness)), values(s.damping.as_ref()));
+        let symbolic = SymbolicLu::try_new(pattern.as_ref()).map_err(|e| SolveError::Invalid(format!("sparse LU analysis failed: {e:?}")))?;
+        Ok(Operator::Sparse { symbolic, pattern, mass, stiffness, damping })
     }
-    fn z(&self, s2: C, s1: C, w: f64) -> Mat<C> {
-        let n = self.mass.nrows();
-        Mat::from_fn(n, n, |i, j| {
-            let c = self.damping.as_ref().map_or(0.0, |c| c[(i, j)]);
-            s2 * self.mass[(i, j)] + s1 * c + C::from(w * self.stiffness[(i, j)])
-        })
+
+    /// Solves Ẑ_p Y = rhs for one harmonic.
+    fn solve(&self, p: usize, s2: C, s1: C, w: f64, omega: f64, rhs: &Mat<C>) -> Result<Mat<C>, SolveError> {
+        let singular = SolveError::SingularOperator { harmonic: p, frequency: p as f64 * omega };
+        let y = match self {
+            Operator::Dense { mass, stiffness, damping } => {
+                let n = mass.nrows();
+                let z = Mat::from_fn(n, n, |i, j| {
+                    let c = damping.as_ref().map_or(0.0, |c| c[(i, j)]);
+                    s2 * mass[(i, j)] + s1 * c + C::from(w * stiffness[(i, j)])
+                });
+                let lu = z.partial_piv_lu();
+                check_pivots(lu.U()).map_err(|_| singular.clone())?;
+                lu.solve(rhs)
+            }
+            Operator::Sparse { symbolic, pattern, mass, stiffness, damping } => {
+                let vals: Vec<C> = (0..mass.len()).map(|e| s2 * mass[e] + s1 * damping[e] + C::from(w * stiffness[e])).collect();
+                let z = SparseColMat::<usize, C>::new(pattern.clone(), vals);
+                let lu = faer::sparse::linalg::solvers::Lu::try_new_with_symbolic(symbolic.clone(), z.as_ref()).map_err(|_| singular.clone())?;
+                lu.solve(rhs)
+            }
+        };
+        let finite = (0..y.ncols()).all(|j| (0..y.nrows()).all(|i| y[(i, j)].re.is_finite() && y[(i, j)].im.is_finite()));
+        if finite { Ok(y) } else { Err(singular) }
     }
+}
+
+/// What one harmonic contributes.
+struct HarmonicBlock {
+    g: Vec<C>,
+    bx: Vec<C>,
+    xl: Vec<C>,
+    h: Vec<C>,
 }
 
 /// Assembles Ĝ, X̂lin and Ẑ⁻¹Bᵀ at `dofs` for every distinct harmonic.
-pub fn assemble(model: &Model, disc: &Discretization, dofs: &[usize], fft: &PeriodFft) -> Result<Assembly, SolveError> {
+/// `parallel`: spread the harmonics over rayon's threads (never from inside an FMU).
+pub fn assemble(model: &Model, disc: &Discretization, dofs: &[usize], fft: &PeriodFft, parallel: bool) -> Result<Assembly, SolveError> {
     let k = disc.steps;
     let n = model.n();
     let m = model.contacts.len();
     let nh = k / 2 + 1;
     let symbols = disc.scheme.symbols(k, model.period());
     let forces = force_spectra(model, fft);
-    let op = DenseOperator::new(model);
+    let op = Operator::new(model)?;
     let nd = dofs.len();
-    let mut asm = Assembly {
-        k,
-        m,
-        dofs: dofs.to_vec(),
-        g_hat: vec![C::ZERO; nh * m * m],
-        xlin_hat: vec![C::ZERO; nh * nd],
-        bxlin_hat: vec![C::ZERO; nh * m],
-        h_hat: vec![C::ZERO; nh * nd * m],
-        symbols,
-    };
-    // Right-hand sides: Bᵀ (m columns, s_i e_{d_i}) then w_p F̂_p.
-    let mut rhs = Mat::<C>::zeros(n, m + 1);
-    for p in 0..nh {
-        let (s1, s2, w) = (asm.symbols.sigma1[p], asm.symbols.sigma2[p], asm.symbols.weight[p]);
-        let z = op.z(s2, s1, w);
-        let lu = z.partial_piv_lu();
-        check_pivots(lu.U(), p, model.frequency)?;
-        rhs.fill(C::ZERO);
+    let one = |p: usize| -> Result<HarmonicBlock, SolveError> {
+        let (s1, s2, w) = (symbols.sigma1[p], symbols.sigma2[p], symbols.weight[p]);
+        // Right-hand sides: Bᵀ (m columns, s_i e_{d_i}) then w_p F̂_p.
+        let mut rhs = Mat::<C>::zeros(n, m + 1);
         for (i, c) in model.contacts.iter().enumerate() {
             rhs[(c.dof, i)] = C::from(c.direction);
         }
         for (d, spec) in &forces {
             rhs[(*d, m)] = spec[p] * w;
         }
-        let y = lu.solve(&rhs);
-        if !(0..m + 1).all(|j| (0..n).all(|i| y[(i, j)].re.is_finite() && y[(i, j)].im.is_finite())) {
-            return Err(SolveError::SingularOperator { harmonic: p, frequency: p as f64 * model.frequency });
-        }
+        let y = op.solve(p, s2, s1, w, model.frequency, &rhs)?;
+        let mut b = HarmonicBlock { g: vec![C::ZERO; m * m], bx: vec![C::ZERO; m], xl: vec![C::ZERO; nd], h: vec![C::ZERO; nd * m] };
         for (a, ca) in model.contacts.iter().enumerate() {
-            for b in 0..m {
-                asm.g_hat[(p * m + a) * m + b] = y[(ca.dof, b)] * ca.direction;
+            for j in 0..m {
+                b.g[a * m + j] = y[(ca.dof, j)] * ca.direction;
             }
-            asm.bxlin_hat[p * m + a] = y[(ca.dof, m)] * ca.direction;
+            b.bx[a] = y[(ca.dof, m)] * ca.direction;
         }
         for (r, &d) in dofs.iter().enumerate() {
-            asm.xlin_hat[p * nd + r] = y[(d, m)];
-            for b in 0..m {
-                asm.h_hat[(p * nd + r) * m + b] = y[(d, b)];
+            b.xl[r] = y[(d, m)];
+            for j in 0..m {
+                b.h[r * m + j] = y[(d, j)];
             }
         }
+        Ok(b)
+    };
+    let blocks: Vec<HarmonicBlock> = if parallel && n >= PARALLEL_MIN_DOFS {
+        use rayon::prelude::*;
+        (0..nh).into_par_iter().map(one).collect::<Result<_, _>>()?
+    } else {
+        (0..nh).map(one).collect::<Result<_, _>>()?
+    };
+    let mut asm = Assembly { k, m, dofs: dofs.to_vec(), symbols, g_hat: Vec::with_capacity(nh * m * m), xlin_hat: Vec::with_capacity(nh * nd), bxlin_hat: Vec::with_capacity(nh * m), h_hat: Vec::with_capacity(nh * nd * m) };
+    for b in blocks {
+        asm.g_hat.extend(b.g);
+        asm.bxlin_hat.extend(b.bx);
+        asm.xlin_hat.extend(b.xl);
+        asm.h_hat.extend(b.h);
     }
     Ok(asm)
 }
 
-fn check_pivots(u: faer::MatRef<'_, C>, p: usize, omega: f64) -> Result<(), SolveError> {
+/// Below this many DOFs one factorisation is too cheap to be worth a thread.
+const PARALLEL_MIN_DOFS: usize = 64;
+
+fn check_pivots(u: faer::MatRef<'_, C>) -> Result<(), ()> {
     let n = u.nrows();
     let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
     for i in 0..n {
@@ -137,7 +194,7 @@ fn check_pivots(u: faer::MatRef<'_, C>, p: usize, omega: f64) -> Result<(), Solv
     }
     // NaN-safe: `!(lo > …)` is true for NaN.
     if !(lo > SINGULAR_PIVOT_RATIO * hi) {
-        return Err(SolveError::SingularOperator { harmonic: p, frequency: p as f64 * omega });
+        return Err(());
     }
     Ok(())
 }

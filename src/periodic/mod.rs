@@ -7,7 +7,7 @@ mod recovery;
 pub use assembly::Assembly;
 pub use fft::PeriodFft;
 
-use crate::lcp::{BlockCirculant, Lemke, LemkeSettings, LcpOutcome, LcpSolution};
+use crate::lcp::{BlockCirculant, BlockPivoting, CirculantOperator, Lemke, LemkeSettings, LcpOutcome, LcpSolution, PivotingSettings};
 use crate::model::{Contact, Model};
 use crate::response::Response;
 use crate::time::{Discretization, Pairing};
@@ -40,6 +40,18 @@ pub enum LcpMethod {
     Auto,
     /// Lexicographic Lemke.
     Lemke,
+    /// Block principal pivoting on the active set, FFT products (the fast path for large k).
+    Pivoting,
+}
+
+impl LcpMethod {
+    pub fn name(self) -> &'static str {
+        match self {
+            LcpMethod::Auto => "auto",
+            LcpMethod::Lemke => "lemke",
+            LcpMethod::Pivoting => "pivoting",
+        }
+    }
 }
 
 /// Solver settings with defaults.
@@ -48,11 +60,13 @@ pub struct SolverSettings {
     pub method: LcpMethod,
     /// Certification tolerance of the LCP residual, relative to max(1, ‖q‖∞).
     pub tolerance: f64,
+    /// Spread the harmonics over threads (rayon). Off inside an FMU.
+    pub parallel: bool,
 }
 
 impl Default for SolverSettings {
     fn default() -> Self {
-        SolverSettings { method: LcpMethod::Auto, tolerance: 1e-9 }
+        SolverSettings { method: LcpMethod::Auto, tolerance: 1e-9, parallel: true }
     }
 }
 
@@ -64,7 +78,8 @@ impl SolverSettings {
             s.method = match m.as_str() {
                 "auto" => LcpMethod::Auto,
                 "lemke" => LcpMethod::Lemke,
-                other => return Err(format!("solver.method: unknown method \"{other}\"; expected auto or lemke")),
+                "pivoting" => LcpMethod::Pivoting,
+                other => return Err(format!("solver.method: unknown method \"{other}\"; expected auto, lemke or pivoting")),
             };
         }
         if let Some(t) = spec.tolerance {
@@ -100,6 +115,10 @@ pub struct PeriodicProblem {
     pub outputs: OutputSelection,
     pub solver: SolverSettings,
 }
+
+/// Up to this LCP size `auto` uses lexicographic Lemke directly; above, block pivoting finished
+/// by Lemke from its best basis, with full lexicographic Lemke as the fallback.
+pub const AUTO_LEMKE_MAX: usize = 256;
 
 /// Fewest instants per period that any scheme needs.
 pub const MIN_STEPS: usize = 4;
@@ -176,7 +195,7 @@ impl PeriodicProblem {
     pub fn solve_with(&self, fft: &PeriodFft, warm_start: Option<&[usize]>) -> Result<Response, SolveError> {
         let t_start = Instant::now();
         let dofs = self.outputs.dofs();
-        let asm = assembly::assemble(&self.model, &self.disc, &dofs, fft)?;
+        let asm = assembly::assemble(&self.model, &self.disc, &dofs, fft, self.solver.parallel)?;
         let (a, q) = self.lcp(&asm, fft);
         let t_assembly = t_start.elapsed().as_secs_f64();
 
@@ -233,12 +252,31 @@ impl PeriodicProblem {
         if q.is_empty() {
             return Ok(LcpSolution { outcome: LcpOutcome::Solved, z: vec![], w: vec![], info: Default::default() });
         }
-        let settings = LemkeSettings {
-            certify_tol: self.solver.tolerance,
-            warm_start: warm_start.map(<[usize]>::to_vec),
-            ..LemkeSettings::default()
+        let lemke = || {
+            let settings = LemkeSettings { certify_tol: self.solver.tolerance, warm_start: warm_start.map(<[usize]>::to_vec), ..LemkeSettings::default() };
+            Lemke::new(settings).solve(a, q)
         };
-        let sol = Lemke::new(settings).solve(a, q);
+        let pivoting = || {
+            let settings = PivotingSettings { certify_tol: self.solver.tolerance, warm_start: warm_start.map(<[usize]>::to_vec), ..PivotingSettings::default() };
+            BlockPivoting::new(settings).solve(&CirculantOperator::new(a), q)
+        };
+        let sol = match self.solver.method {
+            LcpMethod::Lemke => lemke(),
+            LcpMethod::Pivoting => pivoting(),
+            LcpMethod::Auto if q.len() <= AUTO_LEMKE_MAX => lemke(),
+            LcpMethod::Auto => {
+                let fast = pivoting();
+                if fast.outcome == LcpOutcome::Solved {
+                    fast
+                } else {
+                    // The robust fallback: lexicographic Lemke; its pivots add to the fast path's.
+                    let mut sol = lemke();
+                    sol.info.pivots += fast.info.pivots;
+                    sol.info.time_s += fast.info.time_s;
+                    sol
+                }
+            }
+        };
         if sol.outcome != LcpOutcome::Solved {
             let hint = match sol.outcome {
                 LcpOutcome::RayTermination => {

@@ -1,5 +1,6 @@
 //! periodic-contact: the command-line tool.
 //! Exit status: 0 success, 1 the solver failed (typed outcome printed), 2 bad input.
+mod cmd_bench;
 mod cmd_fmu;
 mod cmd_lcp;
 mod cmd_solve;
@@ -34,6 +35,18 @@ enum Command {
         #[arg(long)]
         binary: Option<PathBuf>,
     },
+    /// Benchmark: assembly and LCP time of the rigid 1-DOF stop (cds) per k, and peak memory.
+    Bench {
+        /// LCP sizes k to measure.
+        #[arg(long, value_delimiter = ',', default_value = "256,512,1024,2048,4096")]
+        steps: Vec<usize>,
+        /// Repeats per size (the best time is kept).
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
+        /// Internal: measure one size in this process.
+        #[arg(long, hide = true)]
+        single: Option<usize>,
+    },
     /// Solve a raw LCP in Siconos' dense .dat format.
     Lcp {
         file: PathBuf,
@@ -64,6 +77,10 @@ fn main() -> ExitCode {
         Some(Command::Solve { scene, output }) => cmd_solve::run(&scene, &output),
         Some(Command::Lcp { file, output }) => cmd_lcp::run(&file, &output),
         Some(Command::Fmu { scene, output, binary }) => cmd_fmu::run(&scene, &output, binary.as_deref()),
+        Some(Command::Bench { steps, repeats, single }) => match single {
+            Some(k) => cmd_bench::run_single(k, repeats),
+            None => cmd_bench::run(&steps, repeats),
+        },
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

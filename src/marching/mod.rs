@@ -1,0 +1,340 @@
+//! Explicit time-marching reference (notes §5): central differences with forward-increment
+//! Lagrange multipliers (Carpenter, Taylor & Katona 1991), for dense multi-DOF models.
+//!
+//! In the user-facing signs of [`crate::model`] (contact i: `s_i·x[d_i] ≤ gap_i(t)`, row i of B is
+//! s_i e_{d_i}ᵀ, compressive force z_i ≥ 0 pushing DOF d_i by −s_i z_i):
+//!
+//! ```text
+//! Ŵ = (M/h² + C/(2h))⁻¹
+//! f_n   = f(t_n) − Σ_compliant s_i e_{d_i} k_c,i max(0, s_i x_n[d_i] − gap_i(t_n))    (explicit penalty)
+//! x^p   = Ŵ [ f_n + (2M/h² − K) x_n − (M/h² − C/(2h)) x_{n−1} ]                       (predictor)
+//! w^p   = gap(t_{n+1}) − B_r x^p                                                        (rigid contacts)
+//! LCP   w = G λ + w^p,  G = B_r Ŵ B_rᵀ,  λ ≥ 0, w ≥ 0, λᵀw = 0
+//! x_{n+1} = x^p − Ŵ B_rᵀ λ                                                              (corrector)
+//! ```
+//!
+//! λ_n is a force acting in the step equation at t_n; it enforces the clearance at t_{n+1}
+//! (forward increment), and its impulse is λ_n·h. On a contact DOF carrying mass this is a
+//! perfectly plastic impact (restitution 0).
+//!
+//! Stability: h < 2/ω_max, with ω_max² the largest eigenvalue of (K + Σ k_c e_d e_dᵀ, M)
+//! (compliant contacts closed). The viscous term C(x_{n+1} − x_{n−1})/(2h) does not lower this
+//! bound for a 1-DOF or proportionally damped system.
+mod small_lcp;
+
+use crate::model::{Compliance, Model};
+use faer::linalg::solvers::{DenseSolveCore, Solve};
+use faer::{Mat, Side};
+use small_lcp::solve_small_lcp;
+use std::time::Instant;
+
+/// Settings of [`march`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct MarchSettings {
+    /// N: time steps per period, h = T/N.
+    pub steps_per_period: usize,
+    /// Stop after this many periods even when not converged.
+    pub max_periods: usize,
+    /// Compare at least this many periods (≥ 2).
+    pub min_periods: usize,
+    /// Converged when ‖x(period p) − x(period p−1)‖∞ / peak-to-peak < tolerance.
+    pub tolerance: f64,
+    /// x(0); zeros when `None`.
+    pub initial_displacement: Option<Vec<f64>>,
+    /// v(0); zeros when `None`.
+    pub initial_velocity: Option<Vec<f64>>,
+}
+
+impl Default for MarchSettings {
+    fn default() -> Self {
+        MarchSettings {
+            steps_per_period: 1000,
+            max_periods: 10_000,
+            min_periods: 2,
+            tolerance: 1e-8,
+            initial_displacement: None,
+            initial_velocity: None,
+        }
+    }
+}
+
+/// The last simulated period, sampled at t_j = j·h, j = 0…N−1 (times within the period;
+/// the absolute time is `(periods − 1)·T + t_j`).
+#[derive(Clone, Debug)]
+pub struct MarchResult {
+    /// t_j = j·h.
+    pub time: Vec<f64>,
+    /// `displacement[j][dof]`.
+    pub displacement: Vec<Vec<f64>>,
+    /// Central velocity (x_{j+1} − x_{j−1}) / (2h), `velocity[j][dof]`.
+    pub velocity: Vec<Vec<f64>>,
+    /// `contact_force[j][contact]`: the force in the step equation at t_j (rigid: λ_j, enforcing
+    /// the clearance at t_{j+1}; compliant: k_c·max(0, penetration at t_j)).
+    pub contact_force: Vec<Vec<f64>>,
+    /// `contact_impulse[j][contact] = contact_force[j][contact]·h`.
+    pub contact_impulse: Vec<Vec<f64>>,
+    /// `clearance[j][contact] = gap(t_j) − s·x_j[d]`.
+    pub clearance: Vec<Vec<f64>>,
+    /// Periods simulated.
+    pub periods: usize,
+    pub steps_per_period: usize,
+    /// h = T/N.
+    pub step: f64,
+    /// The ω_max used for the stability check.
+    pub omega_max: f64,
+    /// Elapsed time of the (single-threaded) march, set-up included, in seconds.
+    pub cpu_time_s: f64,
+    pub converged: bool,
+    /// Final periodicity defect (∞ when fewer than two periods were simulated).
+    pub defect: f64,
+    /// Defect after each period p ≥ 2.
+    pub defect_history: Vec<f64>,
+}
+
+impl MarchResult {
+    /// Σ_j impulse over the last period, per contact.
+    pub fn impulse_per_period(&self) -> Vec<f64> {
+        let m = self.contact_impulse.first().map_or(0, |r| r.len());
+        (0..m).map(|i| self.contact_impulse.iter().map(|r| r[i]).sum()).collect()
+    }
+}
+
+/// Largest undamped angular frequency of (K, M): M = L Lᵀ, eigenvalues of L⁻¹ K L⁻ᵀ.
+pub fn omega_max_dense(mass: &Mat<f64>, stiffness: &Mat<f64>) -> Result<f64, String> {
+    let llt = mass.llt(Side::Lower).map_err(|_| "structure.mass: is not positive definite".to_string())?;
+    let l = llt.L();
+    let mut x = stiffness.clone();
+    l.solve_lower_triangular_in_place(x.as_mut());
+    let mut s = x.transpose().to_owned();
+    l.solve_lower_triangular_in_place(s.as_mut());
+    let n = s.nrows();
+    let sym = Mat::<f64>::from_fn(n, n, |i, j| 0.5 * (s[(i, j)] + s[(j, i)]));
+    let ev = sym
+        .self_adjoint_eigenvalues(Side::Lower)
+        .map_err(|e| format!("structure.stiffness: eigenvalues of M⁻¹K failed ({e:?})"))?;
+    let lmax = ev.iter().copied().fold(0.0f64, f64::max);
+    if !lmax.is_finite() {
+        return Err(format!("structure.stiffness: largest eigenvalue of M⁻¹K is {lmax}"));
+    }
+    Ok(lmax.sqrt())
+}
+
+/// Row-major n×n product y = A x.
+fn matvec_add(a: &[f64], x: &[f64], y: &mut [f64], n: usize) {
+    for i in 0..n {
+        let row = &a[i * n..(i + 1) * n];
+        y[i] += row.iter().zip(x).map(|(p, q)| p * q).sum::<f64>();
+    }
+}
+
+/// Marches the model period after period from the initial state until the periodicity defect is
+/// below `settings.tolerance` (and at least `min_periods` periods ran) or `max_periods` is
+/// reached. Errors (naming the parameter and value) on an invalid model or settings, an unstable
+/// step, a failed step LCP or a non-finite state.
+pub fn march(model: &Model, settings: &MarchSettings) -> Result<MarchResult, String> {
+    let start = Instant::now();
+    model.validate().map_err(|e| e.to_string())?;
+    let n = model.n();
+    let ns = settings.steps_per_period;
+    if ns < 2 {
+        return Err(format!("settings.steps_per_period: is {ns}, must be ≥ 2"));
+    }
+    if settings.max_periods < 1 {
+        return Err(format!("settings.max_periods: is {}, must be ≥ 1", settings.max_periods));
+    }
+    if !(settings.tolerance.is_finite() && settings.tolerance > 0.0) {
+        return Err(format!("settings.tolerance: is {}, must be finite and > 0", settings.tolerance));
+    }
+    for (name, v) in [("settings.initial_displacement", &settings.initial_displacement), ("settings.initial_velocity", &settings.initial_velocity)] {
+        if let Some(v) = v {
+            if v.len() != n {
+                return Err(format!("{name}: has {} entries, the model has {n} DOFs", v.len()));
+            }
+            if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+                return Err(format!("{name}[{i}]: is {}, must be finite", v[i]));
+            }
+        }
+    }
+    let period = model.period();
+    let h = period / ns as f64;
+    let mm = model.structure.mass.to_dense();
+    let kk = model.structure.stiffness.to_dense();
+    let cc = model.structure.damping.as_ref().map_or_else(|| Mat::<f64>::zeros(n, n), |c| c.to_dense());
+
+    // Stability limit with the compliant contacts closed.
+    let mut kc = kk.clone();
+    for c in &model.contacts {
+        if let Compliance::Compliant { stiffness } = c.compliance {
+            kc[(c.dof, c.dof)] += stiffness;
+        }
+    }
+    let omega_max = omega_max_dense(&mm, &kc)?;
+    if omega_max * h >= 2.0 {
+        let n_min = (period * omega_max / 2.0).floor() as usize + 1;
+        return Err(format!(
+            "settings.steps_per_period: is {ns}, h = T/N = {h:e} exceeds the central-difference stability limit 2/ω_max = {:e} (ω_max = {omega_max:e}); use more than {n_min} steps per period",
+            2.0 / omega_max
+        ));
+    }
+
+    // Ŵ and the two recurrence matrices.
+    let lhs = Mat::<f64>::from_fn(n, n, |i, j| mm[(i, j)] / (h * h) + cc[(i, j)] / (2.0 * h));
+    let w_hat = lhs.partial_piv_lu().inverse();
+    let b1 = Mat::<f64>::from_fn(n, n, |i, j| 2.0 * mm[(i, j)] / (h * h) - kk[(i, j)]);
+    let b0 = Mat::<f64>::from_fn(n, n, |i, j| -(mm[(i, j)] / (h * h) - cc[(i, j)] / (2.0 * h)));
+    let a1m = &w_hat * &b1;
+    let a0m = &w_hat * &b0;
+    let row_major = |a: &Mat<f64>| -> Vec<f64> { (0..n).flat_map(|i| (0..n).map(move |j| (i, j))).map(|(i, j)| a[(i, j)]).collect() };
+    let (a1, a0, wr) = (row_major(&a1m), row_major(&a0m), row_major(&w_hat));
+    if a1.iter().chain(&a0).chain(&wr).any(|v| !v.is_finite()) {
+        return Err("structure: M/h² + C/(2h) is singular".to_string());
+    }
+
+    let nc = model.contacts.len();
+    let rigid: Vec<usize> = (0..nc).filter(|&i| model.contacts[i].is_rigid()).collect();
+    let mr = rigid.len();
+    // Columns s_i Ŵ e_{d_i} and G = B_r Ŵ B_rᵀ.
+    let cols: Vec<Vec<f64>> = rigid
+        .iter()
+        .map(|&i| {
+            let c = &model.contacts[i];
+            (0..n).map(|r| c.direction * w_hat[(r, c.dof)]).collect()
+        })
+        .collect();
+    let mut g = vec![0.0; mr * mr];
+    for (a, &i) in rigid.iter().enumerate() {
+        let ci = &model.contacts[i];
+        for b in 0..mr {
+            g[a * mr + b] = ci.direction * cols[b][ci.dof];
+        }
+    }
+
+    // Start-up: x_{−1} = x_0 − h v_0 + h²/2 a_0, a_0 from the equation of motion (no rigid force).
+    let omega = model.frequency;
+    let x0 = settings.initial_displacement.clone().unwrap_or_else(|| vec![0.0; n]);
+    let v0 = settings.initial_velocity.clone().unwrap_or_else(|| vec![0.0; n]);
+    let mut f = vec![0.0; n];
+    let penalty = |t: f64, x: &[f64], f: &mut [f64], z: &mut [f64]| {
+        for (i, c) in model.contacts.iter().enumerate() {
+            if let Compliance::Compliant { stiffness } = c.compliance {
+                let zi = stiffness * (c.direction * x[c.dof] - c.gap_at(omega, t)).max(0.0);
+                z[i] = zi;
+                f[c.dof] -= c.direction * zi;
+            }
+        }
+    };
+    let mut zbuf = vec![0.0; nc];
+    model.force_at(0.0, &mut f);
+    penalty(0.0, &x0, &mut f, &mut zbuf);
+    let mut r0 = Mat::<f64>::from_fn(n, 1, |i, _| f[i]);
+    for i in 0..n {
+        for j in 0..n {
+            r0[(i, 0)] -= cc[(i, j)] * v0[j] + kk[(i, j)] * x0[j];
+        }
+    }
+    let acc0 = mm.partial_piv_lu().solve(&r0);
+    let mut x_prev: Vec<f64> = (0..n).map(|i| x0[i] - h * v0[i] + 0.5 * h * h * acc0[(i, 0)]).collect();
+    let mut x_cur = x0;
+    let mut x_next = vec![0.0; n];
+
+    let mut disp = vec![0.0; ns * n];
+    let mut disp_prev = vec![0.0; ns * n];
+    let mut vel = vec![0.0; ns * n];
+    let mut force = vec![0.0; ns * nc];
+    let mut clear = vec![0.0; ns * nc];
+    let mut q = vec![0.0; mr];
+    let mut defect = f64::INFINITY;
+    let mut history = Vec::new();
+    let mut converged = false;
+    let mut periods = 0;
+    for p in 0..settings.max_periods {
+        for j in 0..ns {
+            let t = j as f64 * h;
+            let t1 = (j + 1) as f64 * h;
+            model.force_at(t, &mut f);
+            zbuf.iter_mut().for_each(|v| *v = 0.0);
+            penalty(t, &x_cur, &mut f, &mut zbuf);
+            // Predictor.
+            x_next.iter_mut().for_each(|v| *v = 0.0);
+            matvec_add(&a1, &x_cur, &mut x_next, n);
+            matvec_add(&a0, &x_prev, &mut x_next, n);
+            for (k, &fk) in f.iter().enumerate() {
+                if fk != 0.0 {
+                    for i in 0..n {
+                        x_next[i] += wr[i * n + k] * fk;
+                    }
+                }
+            }
+            // Rigid contacts: forward-increment multipliers.
+            if mr > 0 {
+                for (a, &i) in rigid.iter().enumerate() {
+                    let c = &model.contacts[i];
+                    q[a] = c.gap_at(omega, t1) - c.direction * x_next[c.dof];
+                }
+                if q.iter().any(|&v| v < 0.0) {
+                    let lam = solve_small_lcp(&g, &q, mr).map_err(|e| format!("step {} of period {}: {e}", j, p + 1))?;
+                    for (a, &i) in rigid.iter().enumerate() {
+                        if lam[a] != 0.0 {
+                            for r in 0..n {
+                                x_next[r] -= lam[a] * cols[a][r];
+                            }
+                        }
+                        zbuf[i] = lam[a];
+                    }
+                }
+            }
+            if x_next.iter().any(|v| !v.is_finite()) {
+                return Err(format!("the march diverged at step {j} of period {} (non-finite displacement)", p + 1));
+            }
+            // Record sample j.
+            for i in 0..n {
+                disp[j * n + i] = x_cur[i];
+                vel[j * n + i] = (x_next[i] - x_prev[i]) / (2.0 * h);
+            }
+            for (i, c) in model.contacts.iter().enumerate() {
+                force[j * nc + i] = zbuf[i];
+                clear[j * nc + i] = c.gap_at(omega, t) - c.direction * x_cur[c.dof];
+            }
+            std::mem::swap(&mut x_prev, &mut x_cur);
+            std::mem::swap(&mut x_cur, &mut x_next);
+        }
+        periods = p + 1;
+        if p >= 1 {
+            let mut ptp = 0.0f64;
+            for i in 0..n {
+                let (lo, hi) = (0..ns).map(|j| disp[j * n + i]).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+                ptp = ptp.max(hi - lo);
+            }
+            let diff = disp.iter().zip(&disp_prev).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+            defect = if ptp > 0.0 { diff / ptp } else { diff };
+            history.push(defect);
+            if defect < settings.tolerance && periods >= settings.min_periods.max(2) {
+                converged = true;
+                break;
+            }
+        }
+        std::mem::swap(&mut disp, &mut disp_prev);
+    }
+    // After a converged break `disp` holds the last period; otherwise the final swap moved it
+    // to `disp_prev`.
+    let last = if converged { &disp } else { &disp_prev };
+    let rows = |buf: &[f64], w: usize| -> Vec<Vec<f64>> { (0..ns).map(|j| buf[j * w..(j + 1) * w].to_vec()).collect() };
+    let contact_force = rows(&force, nc);
+    let contact_impulse = contact_force.iter().map(|r| r.iter().map(|v| v * h).collect()).collect();
+    Ok(MarchResult {
+        time: (0..ns).map(|j| j as f64 * h).collect(),
+        displacement: rows(last, n),
+        velocity: rows(&vel, n),
+        contact_force,
+        contact_impulse,
+        clearance: rows(&clear, nc),
+        periods,
+        steps_per_period: ns,
+        step: h,
+        omega_max,
+        cpu_time_s: start.elapsed().as_secs_f64(),
+        converged,
+        defect,
+        defect_history: history,
+    })
+}

@@ -1,0 +1,88 @@
+//! The command-line tool: every shipped scene solves; bad input exits with status 2 and a message
+//! naming the file and the field.
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn cli() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_periodic-contact"))
+}
+
+fn scenes() -> Vec<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fmu/scenes");
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|e| e == "toml")).collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn every_shipped_scene_solves_from_the_cli() {
+    let tmp = std::env::temp_dir().join(format!("pc-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&tmp).unwrap();
+    let list = scenes();
+    assert!(list.len() >= 4, "expected the example scenes in fmu/scenes");
+    for scene in list {
+        let out = tmp.join(scene.file_stem().unwrap()).with_extension("json");
+        let o = cli().arg("solve").arg(&scene).arg("-o").arg(&out).output().unwrap();
+        assert!(o.status.success(), "{}: {}", scene.display(), String::from_utf8_lossy(&o.stderr));
+        let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+        assert_eq!(v["lcp"]["status"], "solved", "{}", scene.display());
+        let k = v["steps"].as_u64().unwrap() as usize;
+        assert_eq!(v["time"].as_array().unwrap().len(), k);
+        for series in v["displacement"].as_object().unwrap().values() {
+            let s = series.as_array().unwrap();
+            assert_eq!(s.len(), k);
+            assert!(s.iter().all(|x| x.as_f64().is_some_and(f64::is_finite)));
+        }
+        for c in v["contacts"].as_array().unwrap() {
+            // Force ≥ 0 (compressive) and clearance ≥ 0 at the certified tolerance.
+            assert!(c["force"].as_array().unwrap().iter().all(|x| x.as_f64().unwrap() >= 0.0));
+            assert!(c["gap"].as_array().unwrap().iter().all(|x| x.as_f64().unwrap() >= -1e-8));
+        }
+    }
+}
+
+#[test]
+fn the_default_run_prints_the_table() {
+    let o = cli().output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8_lossy(&o.stdout);
+    for key in ["amplitude", "max contact force", "fraction of period in contact", "LCP size", "pivots", "residual", "time"] {
+        assert!(text.contains(key), "missing {key} in\n{text}");
+    }
+}
+
+fn bad(scene: &str) -> String {
+    let dir = std::env::temp_dir().join(format!("pc-bad-{}-{}", std::process::id(), scene.len()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("bad.toml");
+    std::fs::write(&path, scene).unwrap();
+    let o = cli().arg("solve").arg(&path).arg("-o").arg(dir.join("r.json")).output().unwrap();
+    assert_eq!(o.status.code(), Some(2), "stderr: {}", String::from_utf8_lossy(&o.stderr));
+    assert!(!dir.join("r.json").exists(), "no output is written on bad input");
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert!(err.contains("bad.toml"), "the message names the file: {err}");
+    err
+}
+
+const GOOD: &str = "[structure]\nmass = [[1.0]]\nstiffness = [[1.0]]\n[excitation]\nfrequency = 1.0\n[[force]]\ndof = 0\namplitude = 1.0\n";
+
+#[test]
+fn bad_input_exits_2_naming_the_field_and_value() {
+    assert!(bad("[structure\nmass = 1").contains("line"));
+    assert!(bad(&GOOD.replace("frequency = 1.0", "frequncy = 1.0")).contains("did you mean `frequency`"));
+    assert!(bad(&GOOD.replace("mass = [[1.0]]", "mass = [[-1.0]]")).contains("structure.mass"));
+    let e = bad(&GOOD.replace("dof = 0", "dof = 7"));
+    assert!(e.contains("force[0].dof") && e.contains('7'), "{e}");
+    let e = bad(&format!("{GOOD}[discretization]\nscheme = \"rk4\"\n"));
+    assert!(e.contains("discretization.scheme") && e.contains("rk4"), "{e}");
+    let e = bad(&format!("{GOOD}[[contact]]\ndof = 0\ngap = -0.5\n"));
+    assert!(e.contains("contact[0].gap") && e.contains("-0.5"), "{e}");
+    let e = bad(&GOOD.replace("stiffness = [[1.0]]", "stiffness = [[1.0, 2.0], [3.0, 1.0]]"));
+    assert!(e.contains("structure.stiffness"), "{e}");
+    let e = bad(&GOOD.replace("amplitude = 1.0", "amplitude = nan"));
+    assert!(e.contains("force[0].amplitude") && e.contains("NaN"), "{e}");
+    let e = bad(&format!("{GOOD}[discretization]\nsteps = 2\n"));
+    assert!(e.contains("discretization.steps") && e.contains('2'), "{e}");
+    let e = bad(&GOOD.replace("amplitude = 1.0", "amplitude = 1.0\nharmonic = 300"));
+    assert!(e.contains("force[0].harmonic") && e.contains("300"), "{e}");
+}

@@ -1,0 +1,149 @@
+//! Contact cases against semi-analytic periodic orbits (notes §6; `periodic_contact::exact`):
+//! convergence orders of each scheme, error bounds, impulse per period, persistent contact.
+use periodic_contact::exact::{CompliantStopOrbit, Oscillator, PersistentContact, RigidRegime, RigidStopOrbit};
+use periodic_contact::model::{Compliance, Harmonic};
+use periodic_contact::periodic::{OutputSelection, PeriodicProblem, SolveError, SolverSettings};
+use periodic_contact::response::Response;
+use periodic_contact::time::{Discretization, Pairing, Scheme};
+
+fn problem(osc: &Oscillator, contact: periodic_contact::model::Contact, scheme: Scheme, k: usize, pairing: Option<Pairing>) -> PeriodicProblem {
+    let outputs = OutputSelection { displacement: vec![0], velocity: vec![], acceleration: vec![], contacts: true };
+    PeriodicProblem::new(osc.model(vec![contact]), Discretization { scheme, steps: k, pairing }, outputs, SolverSettings::default()).unwrap()
+}
+
+/// max_j |x_j − x(t_j)| / peak-to-peak, and the relative error of the impulse per period.
+fn errors(r: &Response, exact_x: impl Fn(f64) -> f64, ptp: f64, impulse: f64) -> (f64, f64) {
+    let x = &r.displacement["0"];
+    let e = r.time.iter().zip(x).map(|(&t, &v)| (v - exact_x(t)).abs()).fold(0.0, f64::max) / ptp;
+    (e, (r.impulse_per_period(0) - impulse).abs() / impulse)
+}
+
+fn order(e_coarse: f64, e_fine: f64) -> f64 {
+    (e_coarse / e_fine).log2()
+}
+
+const COMPLIANT: Oscillator = Oscillator { mass: 1.0, damping: 0.05, stiffness: 1.0, force: 1.0, omega: 1.3 };
+
+#[test]
+fn compliant_stop_converges_at_each_schemes_order() {
+    let exact = CompliantStopOrbit::solve(&COMPLIANT, 10.0, 1.0, None).unwrap();
+    let ptp = exact.peak_to_peak();
+    let stop = || Oscillator::stop(1.0, Compliance::Compliant { stiffness: 10.0 });
+    for scheme in Scheme::ALL {
+        let e: Vec<f64> = [256, 512, 1024]
+            .iter()
+            .map(|&k| {
+                let r = problem(&COMPLIANT, stop(), scheme, k, None).solve().unwrap();
+                assert_eq!(r.pairing, "same", "compliant contacts default to same pairing");
+                assert!(r.warnings.is_empty(), "{scheme}: {:?}", r.warnings);
+                errors(&r, |t| exact.eval(t).0, ptp, exact.impulse_per_period()).0
+            })
+            .collect();
+        let p = order(e[1], e[2]);
+        eprintln!("compliant {scheme}: errors {e:.3e?}, order {p:.2}");
+        match scheme.order() {
+            Some(1) => assert!((0.85..1.3).contains(&p), "{scheme}: order {p}"),
+            Some(2) => assert!((1.8..2.3).contains(&p), "{scheme}: order {p}"),
+            _ => assert!(p > 1.5, "fourier: order {p} (the kink of the force limits it to about 2)"),
+        }
+        if scheme != Scheme::Bds1 {
+            assert!(e[2] < 1e-3, "{scheme}: error at k = 1024 is {:.3e} of the peak-to-peak amplitude", e[2]);
+        }
+    }
+}
+
+const STICKING: Oscillator = Oscillator { mass: 1.0, damping: 0.1, stiffness: 1.0, force: 1.0, omega: 1.0 };
+
+#[test]
+fn rigid_stop_with_sticking_converges_bds1_first_cds_galerkin_second_order() {
+    let exact = RigidStopOrbit::solve(&STICKING, 0.5).unwrap();
+    assert_eq!(exact.regime(), RigidRegime::Sticking);
+    let (ptp, impulse) = (exact.peak_to_peak(), exact.impulse_per_period());
+    for (scheme, expected) in [(Scheme::Bds1, 1.0), (Scheme::Cds, 2.0), (Scheme::Galerkin, 2.0)] {
+        let e: Vec<(f64, f64)> = [256, 512, 1024]
+            .iter()
+            .map(|&k| {
+                let r = problem(&STICKING, Oscillator::stop(0.5, Compliance::Rigid), scheme, k, None).solve().unwrap();
+                assert!(r.warnings.is_empty(), "{scheme} with its default pairing converges: {:?}", r.warnings);
+                errors(&r, |t| exact.eval(t).0, ptp, impulse)
+            })
+            .collect();
+        let (px, pi) = (order(e[1].0, e[2].0), order(e[1].1, e[2].1));
+        eprintln!("rigid+sticking {scheme}: errors {e:.3e?}, orders x {px:.2}, impulse {pi:.2}");
+        assert!((expected - 0.25..expected + 0.4).contains(&px), "{scheme}: displacement order {px}");
+        assert!((expected - 0.25..expected + 0.6).contains(&pi), "{scheme}: impulse order {pi}");
+    }
+}
+
+/// Without a sticking phase every fixed-grid scheme is first order: the impact instant falls
+/// between samples and shifts the next free flight.
+#[test]
+fn pure_impacts_are_first_order_for_every_converging_scheme() {
+    let osc = Oscillator { mass: 1.0, damping: 0.1, stiffness: 1.0, force: 0.5, omega: 0.8 };
+    let exact = RigidStopOrbit::solve(&osc, 0.6).unwrap();
+    assert_eq!(exact.regime(), RigidRegime::Impacting);
+    let ptp = exact.peak_to_peak();
+    for scheme in [Scheme::Bds1, Scheme::Cds, Scheme::Galerkin] {
+        let e: Vec<f64> = [512, 1024, 2048]
+            .iter()
+            .map(|&k| {
+                let r = problem(&osc, Oscillator::stop(0.6, Compliance::Rigid), scheme, k, None).solve().unwrap();
+                errors(&r, |t| exact.eval(t).0, ptp, exact.impulse_per_period()).0
+            })
+            .collect();
+        let p = order(e[1], e[2]);
+        eprintln!("pure impacts {scheme}: errors {e:.3e?}, order {p:.2}");
+        assert!((0.7..1.5).contains(&p), "{scheme}: order {p}");
+        assert!(e[2] < 0.02, "{scheme}: error {:.3e} at k = 2048", e[2]);
+    }
+}
+
+/// Same-instant pairing with cds or fourier on a rigid contact is solved with a warning or
+/// refused with a typed diagnostic, never reported as a good answer.
+#[test]
+fn same_pairing_with_cds_or_fourier_is_warned_or_refused() {
+    for scheme in [Scheme::Cds, Scheme::Fourier, Scheme::Bds2, Scheme::Galerkin] {
+        let p = problem(&STICKING, Oscillator::stop(0.5, Compliance::Rigid), scheme, 128, Some(Pairing::Same));
+        assert!(!p.warnings().is_empty(), "{scheme}: the problem warns before solving");
+        match p.solve() {
+            Ok(r) => {
+                assert!(r.warnings.iter().any(|w| w.contains("pairing = \"forward\"")), "{scheme}: the warning says what to use: {:?}", r.warnings);
+                assert!(r.displacement["0"].iter().all(|v| v.is_finite()));
+            }
+            Err(SolveError::Lcp { outcome, .. }) => eprintln!("{scheme}/same refused: {}", outcome.name()),
+            Err(e) => panic!("{scheme}: unexpected error {e}"),
+        }
+    }
+}
+
+#[test]
+fn persistent_contact_follows_the_obstacle_and_the_force_converges() {
+    let osc = Oscillator { mass: 1.0, damping: 0.1, stiffness: 1.0, force: 0.2, omega: 0.9 };
+    let motion = vec![Harmonic { amplitude: 0.05, harmonic: 2, phase: 0.3 }];
+    // A constant load of 1 keeps the mass pressed on the obstacle.
+    let build = |k: usize| {
+        let mut model = osc.model(vec![periodic_contact::model::Contact { dof: 0, direction: 1.0, gap: 0.2, compliance: Compliance::Rigid, motion: motion.clone() }]);
+        model.forces.push(periodic_contact::model::Force { dof: 0, term: Harmonic { amplitude: 1.0, harmonic: 0, phase: 0.0 } });
+        let outputs = OutputSelection { displacement: vec![0], velocity: vec![], acceleration: vec![], contacts: true };
+        PeriodicProblem::new(model, Discretization { scheme: Scheme::Cds, steps: k, pairing: None }, outputs, SolverSettings::default()).unwrap()
+    };
+    let exact_osc = Oscillator { force: 0.2, ..osc };
+    let exact = PersistentContact::solve(&exact_osc, 1.0, 0.2, &motion).unwrap();
+    let mut force_errors = Vec::new();
+    for k in [128, 256, 512] {
+        let r = build(k).solve().unwrap();
+        let c = &r.contacts[0];
+        // Every gap is closed (forward pairing closes gap(t_{j+1}) for every j: all of them).
+        assert!(c.gap.iter().all(|g| g.abs() < 1e-9), "k = {k}: max gap {:e}", c.gap.iter().fold(0.0f64, |m, g| m.max(g.abs())));
+        for (&t, &x) in r.time.iter().zip(&r.displacement["0"]) {
+            let obstacle = 0.2 + 0.05 * (2.0 * 0.9 * t + 0.3).cos();
+            assert!((x - obstacle).abs() < 1e-9);
+        }
+        // Exact force: the constant load adds 1 to the oscillator's own.
+        let e = r.time.iter().zip(&c.force).map(|(&t, &f)| (f - (exact.eval(t).2 + 1.0)).abs()).fold(0.0, f64::max);
+        force_errors.push(e);
+    }
+    let p = order(force_errors[1], force_errors[2]);
+    eprintln!("persistent contact: force errors {force_errors:.3e?}, order {p:.2}");
+    assert!((1.8..2.3).contains(&p), "force order {p}");
+}

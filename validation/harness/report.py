@@ -1,0 +1,63 @@
+"""A registry of measured numbers, written by the tests and dumped to figures/errors.md at the end
+of the pytest session (conftest.py)."""
+from __future__ import annotations
+
+import datetime
+import os
+from dataclasses import dataclass, field
+
+FIGURES = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "figures")
+
+
+@dataclass
+class Row:
+    case: str
+    what: str           # e.g. "cli cds/forward k=512 vs rigid event-driven"
+    max_err: float | None = None
+    rms_err: float | None = None
+    tol: float | None = None
+    impulse: str = ""   # impulse per period (value and reference)
+    onset: str = ""     # phase of the first impact
+    cost: str = ""      # periods / CPU time / solve time
+    status: str = ""
+
+
+@dataclass
+class Report:
+    rows: list[Row] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+
+    def add(self, row: Row) -> None:
+        self.rows.append(row)
+
+    def note(self, text: str) -> None:
+        if text not in self.notes:
+            self.notes.append(text)
+
+    def markdown(self) -> str:
+        def f(v):
+            return "" if v is None else f"{v:.3e}"
+
+        out = ["# Validation errors and costs", "",
+               f"Written by `pytest` on {datetime.datetime.now().isoformat(timespec='seconds')} "
+               f"({len(self.rows)} rows). Errors are relative to the peak-to-peak amplitude of the reference; "
+               "`tol` is the asserted bound. Costs: marching periods and CPU time (`time.process_time`), "
+               "periodic solve time from the result's `timing_s.total`.", "",
+               "| case | comparison | max err | rms err | tol | impulse/period | first impact (t/T) | cost | status |",
+               "|---|---|---|---|---|---|---|---|---|"]
+        for r in self.rows:
+            out.append(f"| {r.case} | {r.what} | {f(r.max_err)} | {f(r.rms_err)} | {f(r.tol)} | {r.impulse} | "
+                       f"{r.onset} | {r.cost} | {r.status} |")
+        if self.notes:
+            out += ["", "## Notes", ""] + [f"- {n}" for n in self.notes]
+        return "\n".join(out) + "\n"
+
+    def write(self, path: str | None = None) -> str:
+        path = path or os.path.join(FIGURES, "errors.md")
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        with open(path, "w") as fh:
+            fh.write(self.markdown())
+        return path
+
+
+REPORT = Report()
