@@ -320,6 +320,9 @@ impl ContactModel {
         }
 
         let mut base = problem.clone();
+        // No rayon inside an FMU: its global pool would outlive the instance and keep the
+        // library mapped (notes, rust-crates §faer).
+        base.solver.parallel = false;
         let mut recovered = unique(&[shown.displacement.clone(), shown.velocity.clone()].concat());
         recovered.sort_unstable();
         base.outputs.displacement = recovered.clone();
