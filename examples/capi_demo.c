@@ -85,6 +85,7 @@ int main(int argc, char **argv) {
     const double C[4] = {0.1, -0.02, -0.02, 0.05};
     p = pc_problem_from_matrices(2, M, K, C, 1.7, "fourier", 32);
     if (!p) return fail("pc_problem_from_matrices");
+    if (pc_problem_set_parallel(p, 0) != PC_OK) return fail("set_parallel");
     if (pc_problem_add_force(p, 1, 0.8, 1, 0.4) != PC_OK) return fail("add_force");
     r = pc_problem_solve(p);
     if (!r) return fail("pc_problem_solve (matrices)");

@@ -70,6 +70,8 @@ int pc_problem_set_outputs(pc_problem *p, const size_t *displacement, size_t n_d
                            const size_t *acceleration, size_t n_acceleration, int contacts);
 /* "same", "forward", or NULL for the per-contact default. */
 int pc_problem_set_pairing(pc_problem *p, const char *pairing);
+/* 1 (default): factorise the harmonics on rayon's global thread pool; 0: on the calling thread. */
+int pc_problem_set_parallel(pc_problem *p, int parallel);
 /* Tunable values, applied at the next solve. */
 int pc_problem_set_frequency(pc_problem *p, double omega);   /* rad/s, > 0             */
 int pc_problem_set_force_scale(pc_problem *p, double scale); /* times every force      */

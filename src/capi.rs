@@ -306,6 +306,19 @@ pub unsafe extern "C" fn pc_problem_set_pairing(p: *mut PcProblem, pairing: *con
     })
 }
 
+/// Whether the harmonics are factorised on rayon's global thread pool (1, the default) or
+/// on the calling thread only (0).
+///
+/// # Safety
+/// `p` is NULL or a live problem handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pc_problem_set_parallel(p: *mut PcProblem, parallel: c_int) -> c_int {
+    guarded(|| {
+        unsafe { problem(p) }?.base.solver.parallel = parallel != 0;
+        Ok(())
+    })
+}
+
 macro_rules! tuning_setter {
     ($name:ident, $field:ident, $check:expr, $what:literal) => {
         #[doc = concat!("Sets ", $what, " for the next solve.")]

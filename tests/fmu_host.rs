@@ -637,3 +637,98 @@ fn the_binary_exports_exactly_the_34_functions_and_links_only_the_c_runtime() {
         assert!(ok, "{} needs {n}; all NEEDED: {needed:?}", so.display());
     }
 }
+
+// --- scenes with contact (the shipped examples) ----------------------------------------------
+
+fn shipped(name: &str) -> String {
+    std::fs::read_to_string(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fmu/scenes").join(name)).unwrap()
+}
+
+fn rigid() -> &'static Fmu {
+    static F: OnceLock<Fmu> = OnceLock::new();
+    F.get_or_init(|| Fmu::package("rigid-stop", &shipped("rigid-stop.toml")))
+}
+
+fn contact_series(json: &serde_json::Value, i: usize, field: &str) -> Vec<f64> {
+    json["contacts"][i][field].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect()
+}
+
+/// Steps two periods on the grid and compares every output with the CLI's JSON.
+fn compare_two_periods(fmu: &Fmu, s: &Slave, reference: &serde_json::Value, t0: f64) {
+    let k = reference["steps"].as_u64().unwrap() as usize;
+    let h = reference["period"].as_f64().unwrap() / k as f64;
+    let x = series(reference, "displacement", "0");
+    let v = series(reference, "velocity", "0");
+    let (f, g) = (contact_series(reference, 0, "force"), contact_series(reference, 0, "gap"));
+    let got = run(s, t0, h, 2 * k, &["displacement[0]", "velocity[0]", "contact[0].force", "contact[0].gap"]);
+    let scale = max_abs(&x).max(max_abs(&v)).max(max_abs(&f)).max(1.0);
+    for (i, row) in got.iter().enumerate() {
+        let j = (i + 1) % k;
+        for (name, a, b) in [("x", row[0], x[j]), ("v", row[1], v[j]), ("force", row[2], f[j]), ("gap", row[3], g[j])] {
+            assert!((a - b).abs() <= 1e-9 * scale, "{}: step {i}, {name}: FMU {a} vs CLI {b}", fmu.scene.display());
+        }
+    }
+    assert_eq!(s.integer("lcp.pivots") as u64, reference["lcp"]["pivots"].as_u64().unwrap());
+    // serde_json's default float parser may be off by one ulp.
+    let residual = reference["lcp"]["residual"].as_f64().unwrap();
+    assert!((s.real("lcp.residual") - residual).abs() <= 1e-12 * residual.abs(), "{} vs {residual}", s.real("lcp.residual"));
+}
+
+#[test]
+fn rigid_stop_two_periods_match_the_cli_with_contact_outputs() {
+    let fmu = rigid();
+    for present in ["gap_offset", "gap_offset_in", "contact[0].force", "contact[0].gap", "lcp.pivots", "lcp.residual"] {
+        assert!(fmu.vars.contains_key(present), "{present}");
+    }
+    assert!(!fmu.vars.contains_key("motion_scale"), "a static obstacle has no motion parameters");
+    let reference = cli_solve(&fmu.scene);
+    let s = fmu.instantiate("rigid").unwrap();
+    s.init(0.0);
+    compare_two_periods(fmu, &s, &reference, 0.0);
+    // Between the instants force and gap are interpolated linearly: never negative.
+    let k = reference["steps"].as_u64().unwrap() as usize;
+    let h = reference["period"].as_f64().unwrap() / k as f64;
+    let t0 = 2.0 * reference["period"].as_f64().unwrap();
+    for row in run(&s, t0, h / 3.0, 3 * k, &["contact[0].force", "contact[0].gap"]) {
+        assert!(row[0] >= 0.0 && row[1] >= -1e-12, "{row:?}");
+    }
+}
+
+#[test]
+fn contact_start_values_and_a_warm_started_re_solve_match_the_cli() {
+    let fmu = rigid();
+    let s = fmu.instantiate("rigid-tuned").unwrap();
+    assert_eq!(s.set_real("gap_offset", 0.1), OK);
+    let on = [c"logEvents".as_ptr()];
+    assert_eq!(unsafe { (fmu.api.set_debug_logging)(s.c, 1, 1, on.as_ptr()) }, OK);
+    s.init(0.0);
+    let scene = fmu.dir.join("gap06.toml");
+    std::fs::write(&scene, shipped("rigid-stop.toml").replace("gap = 0.5", "gap = 0.6")).unwrap();
+    let reference = cli_solve(&scene);
+    compare_two_periods(fmu, &s, &reference, 0.0);
+    // A small change of frequency at t = 2T: re-solved at the next step, warm-started.
+    assert_eq!(s.set_real("frequency", 1.02), OK);
+    let scene = fmu.dir.join("gap06-w102.toml");
+    std::fs::write(&scene, shipped("rigid-stop.toml").replace("gap = 0.5", "gap = 0.6").replace("frequency = 1.0", "frequency = 1.02")).unwrap();
+    let tuned = cli_solve(&scene);
+    compare_two_periods(fmu, &s, &tuned, 2.0 * reference["period"].as_f64().unwrap());
+    let line = s.log.find("re-solved").expect("a logEvents line about the re-solve");
+    assert_eq!(line.status, OK);
+}
+
+#[test]
+fn moving_obstacle_and_compliant_stop_match_the_cli() {
+    let moving = Fmu::package("moving-obstacle", &shipped("moving-obstacle.toml"));
+    assert!(moving.vars.contains_key("motion_scale") && moving.vars.contains_key("motion_scale_in"));
+    let s = moving.instantiate("moving").unwrap();
+    assert_eq!(s.set_real("motion_scale", 2.0), OK);
+    s.init(0.0);
+    let scene = moving.dir.join("motion2.toml");
+    std::fs::write(&scene, shipped("moving-obstacle.toml").replace("amplitude = 0.05", "amplitude = 0.1")).unwrap();
+    compare_two_periods(&moving, &s, &cli_solve(&scene), 0.0);
+
+    let compliant = Fmu::package("compliant-stop", &shipped("compliant-stop.toml"));
+    let s = compliant.instantiate("compliant").unwrap();
+    s.init(0.0);
+    compare_two_periods(&compliant, &s, &cli_solve(&compliant.scene), 0.0);
+}
