@@ -19,7 +19,7 @@
 //!   `fmi2GetRealOutputDerivatives` (order 1) is the exact time derivative of the interpolant:
 //!   for `displacement[d]` it is the velocity.
 use crate::fmi2::bytes::{ByteReader, ByteWriter};
-use crate::fmi2::table::{EnumerationType, Kind, UnitDefinition, Variability, Variable, VariableTable};
+use crate::fmi2::table::{Kind, UnitDefinition, Variability, Variable, VariableTable};
 use crate::fmi2::{DefaultExperiment, Fmi2Model, Logger, ModelDescription};
 use crate::periodic::{MAX_STEPS, MIN_STEPS, PeriodFft, PeriodicProblem, SolveError};
 use crate::response::Response;
@@ -279,7 +279,10 @@ impl ContactModel {
         }
         let k = problem.disc.steps;
         add(&mut t, Variable::parameter("steps", Fixed, Kind::Integer { start: Some(k as i32), min: Some(MIN_STEPS as i32), max: None }, "Number of instants k per period"), Role::Steps);
-        add(&mut t, Variable::parameter("scheme", Fixed, Kind::Enumeration { declared_type: "Scheme".into(), start: Some(scheme_code(problem.disc.scheme)) }, "Time scheme on the period"), Role::Scheme);
+        // An Integer rather than an Enumeration: libcosim ignores FMI 2 Enumeration variables.
+        let codes: Vec<String> = Scheme::ALL.iter().map(|s| format!("{} {}", scheme_code(*s), s)).collect();
+        let scheme = Kind::Integer { start: Some(scheme_code(problem.disc.scheme)), min: Some(1), max: Some(Scheme::ALL.len() as i32) };
+        add(&mut t, Variable::parameter("scheme", Fixed, scheme, &format!("Time scheme on the period: {}", codes.join(", "))), Role::Scheme);
         add(&mut t, Variable::input("frequency_in", 0.0, Some("rad/s"), "Drives the frequency continuously: when > 0 it replaces the parameter frequency; 0 = not driven"), Role::FrequencyIn);
         if has_forces {
             add(&mut t, Variable::input("force_scale_in", 1.0, None, "Multiplies force_scale (1 = not driven)"), Role::ForceScaleIn);
@@ -349,10 +352,7 @@ impl ContactModel {
             generation_tool: format!("periodic-contact {}", env!("CARGO_PKG_VERSION")),
             variables: t,
             units: vec![UnitDefinition { name: "rad/s".into(), base: vec![("s", -1), ("rad", 1)] }],
-            enumerations: vec![EnumerationType {
-                name: "Scheme".into(),
-                items: Scheme::ALL.iter().map(|s| (s.name().to_string(), scheme_code(*s), scheme_doc(*s).to_string())).collect(),
-            }],
+            enumerations: vec![],
             default_experiment: Some(DefaultExperiment { start_time: 0.0, stop_time: 3.0 * period, step_size: period / k as f64 }),
             max_output_derivative_order: 1,
         };
@@ -505,7 +505,7 @@ impl ContactModel {
             let (ty, start, unit) = match &v.kind {
                 Kind::Real { start, unit, .. } => ("Real", start.map(crate::fmi2::xml::real), unit.clone()),
                 Kind::Integer { start, .. } => ("Integer", start.map(|s| s.to_string()), None),
-                Kind::Enumeration { start, .. } => ("Enumeration Scheme", start.map(|s| format!("{s} ({})", Scheme::ALL[(s - 1) as usize])), None),
+                Kind::Enumeration { start, .. } => ("Enumeration", start.map(|s| s.to_string()), None),
                 Kind::Boolean { start } => ("Boolean", start.map(|s| s.to_string()), None),
                 Kind::String { start } => ("String", start.clone(), None),
             };

@@ -29,7 +29,7 @@ fn do_step_throughput() {
     for (name, text) in [
         ("linear-2dof (cds)", std::fs::read_to_string(scene_path("linear-2dof.toml")).unwrap()),
         ("rigid-stop (cds)", std::fs::read_to_string(scene_path("rigid-stop.toml")).unwrap()),
-        ("rigid-stop (fourier)", std::fs::read_to_string(scene_path("rigid-stop.toml")).unwrap().replace("\"cds\"", "\"fourier\"").replace("[[contact]]\ndof = 0\ndirection = 1\ngap = 0.5", "[[contact]]\ndof = 0\ndirection = 1\ngap = 0.5\nstiffness = 100.0")),
+        ("stop k_c=100 (fourier)", std::fs::read_to_string(scene_path("rigid-stop.toml")).unwrap().replace("\"cds\"", "\"fourier\"").replace("[[contact]]\ndof = 0\ndirection = 1\ngap = 0.5", "[[contact]]\ndof = 0\ndirection = 1\ngap = 0.5\nstiffness = 100.0")),
         ("chain-3dof-two-stops", std::fs::read_to_string(scene_path("chain-3dof-two-stops.toml")).unwrap()),
     ] {
         let tag = name.split_whitespace().next().unwrap().to_string() + if name.contains("fourier") { "-fourier" } else { "" };

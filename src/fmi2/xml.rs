@@ -202,3 +202,60 @@ fn type_element(w: &mut Writer<Vec<u8>>, kind: &Kind) -> io::Result<()> {
     w.create_element(name).with_attributes(attrs.iter().map(|(k, v)| (*k, v.as_str()))).write_empty()?;
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fmi2::DefaultExperiment;
+    use crate::fmi2::table::*;
+
+    fn description() -> ModelDescription {
+        let mut t = VariableTable::new();
+        t.push(Variable::parameter("mode", Variability::Fixed, Kind::Enumeration { declared_type: "Mode".into(), start: Some(2) }, "a <mode> & \"more\""));
+        t.push(Variable::input("u", 0.5, Some("rad/s"), ""));
+        t.push(Variable::output("y[0]", Variability::Continuous, Kind::Real { start: None, unit: None, min: None, max: None }, ""));
+        t.push(Variable::output("n", Variability::Discrete, Kind::Integer { start: None, min: None, max: None }, ""));
+        ModelDescription {
+            model_name: "M".into(),
+            model_identifier: "M".into(),
+            description: "d".into(),
+            generation_tool: "t".into(),
+            variables: t,
+            units: vec![UnitDefinition { name: "rad/s".into(), base: vec![("s", -1), ("rad", 1)] }],
+            enumerations: vec![EnumerationType { name: "Mode".into(), items: vec![("a".into(), 1, "".into()), ("b".into(), 2, "".into())] }],
+            default_experiment: Some(DefaultExperiment { start_time: 0.0, stop_time: 1.0, step_size: 0.1 }),
+            max_output_derivative_order: 1,
+        }
+    }
+
+    #[test]
+    fn schema_order_escaping_and_structure() {
+        let (doc, guid) = render(&description());
+        let order = ["<CoSimulation", "<UnitDefinitions", "<TypeDefinitions", "<LogCategories", "<DefaultExperiment", "<ModelVariables", "<ModelStructure", "<Outputs", "<InitialUnknowns"];
+        let pos: Vec<usize> = order.iter().map(|e| doc.find(e).unwrap_or_else(|| panic!("{e}"))).collect();
+        assert!(pos.windows(2).all(|w| w[0] < w[1]), "{doc}");
+        assert!(doc.contains("description=\"a &lt;mode&gt; &amp; &quot;more&quot;\""), "{doc}");
+        assert!(doc.contains("<Enumeration declaredType=\"Mode\" start=\"2\"/>"));
+        assert!(doc.contains("<Real unit=\"rad/s\" start=\"0.5\"/>"));
+        assert!(doc.contains("<BaseUnit s=\"-1\" rad=\"1\"/>"));
+        // Outputs and InitialUnknowns: the two outputs, 1-based.
+        for section in ["Outputs", "InitialUnknowns"] {
+            let a = doc.find(&format!("<{section}>")).unwrap();
+            let b = doc.find(&format!("</{section}>")).unwrap();
+            assert_eq!(doc[a..b].matches("<Unknown").count(), 2);
+            assert!(doc[a..b].contains("index=\"3\"") && doc[a..b].contains("index=\"4\""));
+        }
+        assert!(doc.contains(&format!("guid=\"{guid}\"")));
+        // Deterministic, and the guid is the hash of the document with an empty guid.
+        assert_eq!(render(&description()), (doc.clone(), guid.clone()));
+        assert_eq!(guid, crate::fmi2::guid::from_content(doc.replace(&guid, "").as_bytes()));
+    }
+
+    #[test]
+    fn reals_read_back_exactly() {
+        for v in [0.0, 1.0, -2.5, 0.1, 1e-7, 6.02214076e23, std::f64::consts::PI] {
+            assert_eq!(real(v).parse::<f64>().unwrap(), v);
+        }
+        assert_eq!(real(f64::INFINITY), "INF");
+    }
+}
