@@ -317,7 +317,8 @@ impl ContactModel {
                 out(&mut t, Variable::output(&format!("contact[{i}].gap"), Continuous, real(None, None), &format!("Clearance >= 0 of contact {i} on DOF {} (length unit)", c.dof)), Quantity::Gap(i));
             }
         }
-        if m > 0 {
+        // Always present, like the result's `lcp` (size 0, 0 pivots, residual 0 without contact).
+        {
             out(&mut t, Variable::output("lcp.pivots", Discrete, Kind::Integer { start: None, min: None, max: None }, "Pivots of the last LCP solve"), Quantity::Pivots);
             out(&mut t, Variable::output("lcp.residual", Discrete, real(None, None), "Residual max|min(z, Az+q)| of the last LCP solve"), Quantity::Residual);
         }
@@ -548,7 +549,8 @@ With a constant &omega;, &tau; = t: the outputs at t = j&middot;T/k are exactly 
 <code>frequency</code> (0, its start value, means not driven); <code>force_scale_in</code> and <code>motion_scale_in</code> multiply their
 parameters; <code>gap_offset_in</code> adds to <code>gap_offset</code>. Inputs and parameters set after initialisation take effect at the next step.</li>
 <li>Only the effects the scene calls for have variables: no contact outputs or <code>gap_offset</code> without contacts,
-no <code>force_scale</code> without forces, no <code>motion_scale</code> for static obstacles, no <code>lcp.*</code> without contact.</li>
+no <code>force_scale</code> without forces, no <code>motion_scale</code> for static obstacles. <code>lcp.pivots</code> and
+<code>lcp.residual</code> are always there, like the result's <code>lcp</code> (0 without contact).</li>
 </ul>
 <h2>Between the instants</h2>
 <ul>

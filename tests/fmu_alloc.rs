@@ -2,6 +2,7 @@
 //! allocator around 20 000 steps (and output reads) of the generic shell with the contact model,
 //! for a Hermite (cds) and a trigonometric (fourier) interpolant. One test in this binary, so
 //! no other thread allocates meanwhile.
+use periodic_contact::fmi2::table::BaseType;
 use periodic_contact::fmi2::types::*;
 use periodic_contact::fmi2::{ffi, xml};
 use periodic_contact::fmu_model::ContactModel;
@@ -73,7 +74,8 @@ fn do_step_allocates_nothing() {
             assert_eq!(ffi::exit_initialization_mode::<ContactModel>(c), 0);
             let vrs: Vec<u32> = (0..model.model_description().variables.len() as u32).collect();
             let mut values = vec![0.0; vrs.len()];
-            let outputs: Vec<u32> = model.model_description().variables.outputs().collect();
+            let table = &model.model_description().variables;
+            let outputs: Vec<u32> = table.outputs().filter(|vr| table.get(*vr).unwrap().kind.base() == BaseType::Real).collect();
             let h = 0.013;
             ARMED.store(true, Ordering::SeqCst);
             for i in 0..20_000 {
