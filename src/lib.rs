@@ -13,6 +13,13 @@ pub mod defaults;
 pub mod fe;
 /// Semi-analytic periodic orbits: the independent references of the tests.
 pub mod exact;
+/// The FMI 2.0 co-simulation shell (knows nothing of contact).
+pub mod fmi2;
+/// The FMU's physics adapter: a scene as a quasi-steady co-simulation model.
+pub mod fmu_model;
+/// The native C API (include/periodic_contact.h).
+#[cfg(feature = "capi")]
+pub mod capi;
 /// LCP solvers; they know nothing of mechanics.
 pub mod lcp;
 /// Explicit time marching with forward-increment Lagrange multipliers (the paper's reference).

@@ -1,6 +1,7 @@
 //! periodic-contact: the command-line tool.
 //! Exit status: 0 success, 1 the solver failed (typed outcome printed), 2 bad input.
 mod cmd_bench;
+mod cmd_fmu;
 mod cmd_lcp;
 mod cmd_solve;
 
@@ -23,6 +24,16 @@ enum Command {
         /// Output JSON file ("-" for stdout).
         #[arg(short, long, default_value = "result.json")]
         output: PathBuf,
+    },
+    /// Package a scene as an FMI 2.0 co-simulation FMU (needs `cargo build --release -p periodic-contact-fmu`).
+    Fmu {
+        scene: PathBuf,
+        /// Output .fmu file.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// The FMU binary libPeriodicContact.so (default: $PERIODIC_CONTACT_FMU_BINARY, else next to this executable).
+        #[arg(long)]
+        binary: Option<PathBuf>,
     },
     /// Benchmark: assembly and LCP time of the rigid 1-DOF stop (cds) per k, and peak memory.
     Bench {
@@ -68,6 +79,7 @@ fn main() -> ExitCode {
         None => cmd_solve::run_default(),
         Some(Command::Solve { scene, output }) => cmd_solve::run(&scene, &output),
         Some(Command::Lcp { file, output }) => cmd_lcp::run(&file, &output),
+        Some(Command::Fmu { scene, output, binary }) => cmd_fmu::run(&scene, &output, binary.as_deref()),
         Some(Command::Bench { steps, repeats, method, single }) => match single {
             Some(k) => cmd_bench::run_single(k, repeats, &method),
             None => cmd_bench::run(&steps, repeats, &method),

@@ -1,0 +1,144 @@
+//! The C API from C: examples/capi_demo.c is compiled with `cc` against the root cdylib
+//! (libperiodic_contact.so, next to the CLI in target/<profile>/), run on a scene, and every
+//! number it prints is checked against the Rust API for the same problem.
+use periodic_contact::fmu_model::Tuning;
+use periodic_contact::scene::Scene;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const SCENE: &str = r#"
+[structure]
+mass = [[2.0, 0.3], [0.3, 1.0]]
+stiffness = [[5.0, -2.0], [-2.0, 3.0]]
+[damping]
+matrix = [[0.1, -0.02], [-0.02, 0.05]]
+[excitation]
+frequency = 1.7
+[[force]]
+dof = 1
+amplitude = 0.8
+phase = 0.4
+[discretization]
+scheme = "cds"
+steps = 48
+[output]
+displacement = [0, 1]
+velocity = [0]
+"#;
+
+/// The same 2-DOF structure the demo builds from matrices.
+const MATRICES: &str = r#"
+[structure]
+mass = [[2.0, 0.3], [0.3, 1.0]]
+stiffness = [[5.0, -2.0], [-2.0, 3.0]]
+[damping]
+matrix = [[0.1, -0.02], [-0.02, 0.05]]
+[excitation]
+frequency = 1.7
+[[force]]
+dof = 1
+amplitude = 0.8
+phase = 0.4
+[discretization]
+scheme = "fourier"
+steps = 32
+[output]
+displacement = [0, 1]
+velocity = [0, 1]
+"#;
+
+/// target/<profile>/ of this test run, holding libperiodic_contact.so after `cargo build`
+/// (`cargo test` builds the library as an rlib only, so the cdylib comes from `cargo build`).
+fn cdylib_dir() -> PathBuf {
+    let dir = Path::new(env!("CARGO_BIN_EXE_periodic-contact")).parent().unwrap().to_path_buf();
+    let so = dir.join("libperiodic_contact.so");
+    let how = "build it first with `cargo build` (same profile as the tests)";
+    let built = std::fs::metadata(&so).and_then(|m| m.modified()).unwrap_or_else(|_| panic!("{} is missing; {how}", so.display()));
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for src in ["src/capi.rs", "include/periodic_contact.h"] {
+        let changed = std::fs::metadata(root.join(src)).and_then(|m| m.modified()).unwrap();
+        assert!(built >= changed, "{} is older than {src}; {how}", so.display());
+    }
+    dir
+}
+
+/// key → values by index, from "key index value" lines.
+fn parse(out: &str) -> HashMap<String, Vec<String>> {
+    let mut m: HashMap<String, Vec<String>> = HashMap::new();
+    for line in out.lines() {
+        let mut it = line.splitn(3, ' ');
+        let (k, i, v) = (it.next().unwrap(), it.next().unwrap().parse::<usize>().unwrap(), it.next().unwrap_or(""));
+        let e = m.entry(k.to_string()).or_default();
+        assert_eq!(e.len(), i, "{line}");
+        e.push(v.to_string());
+    }
+    m
+}
+
+fn numbers(m: &HashMap<String, Vec<String>>, key: &str) -> Vec<f64> {
+    m.get(key).unwrap_or_else(|| panic!("the demo printed no {key}")).iter().map(|v| v.parse().unwrap()).collect()
+}
+
+fn assert_close(a: &[f64], b: &[f64], what: &str) {
+    assert_eq!(a.len(), b.len(), "{what}: lengths");
+    let scale = b.iter().fold(1e-300f64, |m, x| m.max(x.abs()));
+    for (j, (x, y)) in a.iter().zip(b).enumerate() {
+        assert!((x - y).abs() <= 1e-13 * scale, "{what}[{j}]: C {x} vs Rust {y}");
+    }
+}
+
+#[test]
+fn the_c_example_links_solves_and_prints_what_the_rust_api_computes() {
+    let lib = cdylib_dir();
+    let work = std::env::temp_dir().join(format!("periodic-contact-capi-{}", std::process::id()));
+    std::fs::create_dir_all(&work).unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let exe = work.join("capi_demo");
+    let cc = Command::new("cc")
+        .args(["-std=c99", "-Wall", "-Wextra", "-Werror", "-O1"])
+        .arg(format!("-I{}", root.join("include").display()))
+        .arg(root.join("examples/capi_demo.c"))
+        .arg(format!("-L{}", lib.display()))
+        .arg("-lperiodic_contact")
+        .arg(format!("-Wl,-rpath,{}", lib.display()))
+        .arg("-o")
+        .arg(&exe)
+        .output()
+        .expect("run cc");
+    assert!(cc.status.success(), "cc: {}", String::from_utf8_lossy(&cc.stderr));
+    let scene = work.join("scene.toml");
+    std::fs::write(&scene, SCENE).unwrap();
+    let run = Command::new(&exe).arg(&scene).output().unwrap();
+    assert!(run.status.success(), "capi_demo: {}", String::from_utf8_lossy(&run.stderr));
+    let out = parse(&String::from_utf8(run.stdout).unwrap());
+    assert_eq!(out["version"][0], env!("CARGO_PKG_VERSION"));
+
+    // 1. The scene as is.
+    let p = Scene::parse(SCENE, "t").unwrap().to_problem("t").unwrap();
+    let r = p.solve().unwrap();
+    assert_eq!(out["scene.steps"][0], "48");
+    assert_eq!(numbers(&out, "scene.period")[0], r.period);
+    assert_eq!(out["scene.lcp_size"][0], "0");
+    assert_close(&numbers(&out, "scene.x"), &r.displacement["0"], "scene.x");
+    assert_close(&numbers(&out, "scene.v"), &r.velocity["0"], "scene.v");
+
+    // 2. frequency × 1.05 and force scale 2.
+    let tuning = Tuning { frequency: 1.05 * 1.7, force_scale: 2.0, gap_offset: 0.0, motion_scale: 1.0 };
+    let r2 = tuning.apply(&p, p.disc).unwrap().solve().unwrap();
+    assert_eq!(numbers(&out, "tuned.period")[0], r2.period);
+    assert_close(&numbers(&out, "tuned.x"), &r2.displacement["0"], "tuned.x");
+    assert_close(&numbers(&out, "tuned.v"), &r2.velocity["0"], "tuned.v");
+
+    // 3. Matrices.
+    let r3 = Scene::parse(MATRICES, "m").unwrap().to_problem("m").unwrap().solve().unwrap();
+    assert_close(&numbers(&out, "matrices.x"), &r3.displacement["0"], "matrices.x");
+    assert_close(&numbers(&out, "matrices.v"), &r3.velocity["0"], "matrices.v");
+
+    // 4. Errors: codes and messages.
+    assert_eq!(out["bad_dof.code"][0], "2", "PC_ERROR_INPUT");
+    assert!(out["bad_dof.message"][0].contains('7'), "{:?}", out["bad_dof.message"]);
+    assert_eq!(out["missing.null"][0], "1");
+    assert!(out["missing.message"][0].contains("/nonexistent/scene.toml"), "{:?}", out["missing.message"]);
+    assert_eq!(out["null.code"][0], "1", "PC_ERROR_ARGUMENT");
+}

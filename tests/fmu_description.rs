@@ -1,0 +1,100 @@
+//! The variable table and modelDescription.xml of the contact model, without the FMU binary:
+//! only the effects a scene calls for have variables; the XML follows the schema's element
+//! order with Outputs and InitialUnknowns consistent; the GUID is derived from the content.
+use periodic_contact::fmi2::table::Causality;
+use periodic_contact::fmi2::xml;
+use periodic_contact::fmu_model::ContactModel;
+use std::collections::BTreeSet;
+
+const BASE: &str = r#"
+[structure]
+mass = [[1.0]]
+stiffness = [[1.0]]
+[damping]
+matrix = [[0.1]]
+[excitation]
+frequency = 1.0
+"#;
+
+fn names(text: &str) -> BTreeSet<String> {
+    let m = ContactModel::from_scene_text(text, "t").unwrap();
+    m.model_description().variables.iter().map(|(_, v)| v.name.clone()).collect()
+}
+
+fn set(v: &[&str]) -> BTreeSet<String> {
+    v.iter().map(|s| s.to_string()).collect()
+}
+
+#[test]
+fn variables_follow_the_effects() {
+    let common = ["frequency", "steps", "scheme", "frequency_in", "displacement[0]", "lcp.pivots", "lcp.residual"];
+    // No force, no contact: only the frequency and the grid.
+    assert_eq!(names(BASE), set(&common));
+    // A force: its scale and input.
+    let forced = format!("{BASE}[[force]]\ndof = 0\namplitude = 1.0\n");
+    assert_eq!(names(&forced), set(&[&common[..], &["force_scale", "force_scale_in"]].concat()));
+    // A static rigid obstacle: gap offset and contact outputs, no motion parameters.
+    let contact = format!("{forced}[[contact]]\ndof = 0\ngap = 0.5\n");
+    let c = ["gap_offset", "gap_offset_in", "contact[0].force", "contact[0].gap"];
+    assert_eq!(names(&contact), set(&[&common[..], &["force_scale", "force_scale_in"], &c].concat()));
+    // A moving obstacle: motion_scale too.
+    let moving = format!("{contact}motion = [{{ amplitude = 0.1, harmonic = 2 }}]\n");
+    assert_eq!(names(&moving), set(&[&common[..], &["force_scale", "force_scale_in"], &c, &["motion_scale", "motion_scale_in"]].concat()));
+    // [output] decides which responses are outputs.
+    let out = format!("{contact}[output]\ndisplacement = []\nvelocity = [0]\nacceleration = [0]\ncontacts = false\n");
+    let n = names(&out);
+    assert!(n.contains("velocity[0]") && n.contains("acceleration[0]") && !n.contains("displacement[0]") && !n.contains("contact[0].force"));
+    assert!(n.contains("lcp.pivots"), "the LCP diagnostics are always there");
+}
+
+#[test]
+fn model_description_order_outputs_and_initial_unknowns() {
+    let text = format!("{BASE}[[force]]\ndof = 0\namplitude = 1.0\n[[contact]]\ndof = 0\ngap = 0.5\nmotion = [{{ amplitude = 0.1 }}]\n[output]\ndisplacement = [0]\nvelocity = [0]\n");
+    let m = ContactModel::from_scene_text(&text, "t").unwrap();
+    let d = m.model_description();
+    d.variables.check().unwrap();
+    let (doc, guid) = xml::render(d);
+    // Schema order of the children of fmiModelDescription.
+    let order = ["<CoSimulation", "<UnitDefinitions", "<LogCategories", "<DefaultExperiment", "<ModelVariables", "<ModelStructure"];
+    let pos: Vec<usize> = order.iter().map(|e| doc.find(e).unwrap_or_else(|| panic!("{e} missing"))).collect();
+    assert!(pos.windows(2).all(|w| w[0] < w[1]), "{pos:?}");
+    assert!(doc.find("<Outputs").unwrap() < doc.find("<InitialUnknowns").unwrap());
+    // Outputs = every causality="output" (1-based indices); InitialUnknowns the same (all calculated).
+    let outputs: Vec<u32> = d.variables.iter().filter(|(_, v)| v.causality == Causality::Output).map(|(vr, _)| vr + 1).collect();
+    let section = |name: &str| -> Vec<u32> {
+        let s = &doc[doc.find(&format!("<{name}>")).unwrap()..doc.find(&format!("</{name}>")).unwrap()];
+        s.match_indices("index=\"").map(|(i, _)| s[i + 7..].split('"').next().unwrap().parse().unwrap()).collect()
+    };
+    assert_eq!(section("Outputs"), outputs);
+    assert_eq!(section("InitialUnknowns"), outputs);
+    assert!(doc.contains(&format!("guid=\"{guid}\"")));
+    assert!(doc.contains("variableNamingConvention=\"structured\""));
+    assert!(doc.contains("modelIdentifier=\"PeriodicContact\""));
+    assert!(doc.contains("<Integer min=\"1\" max=\"5\" start=\"3\"/>"), "scheme is an Integer (libcosim ignores Enumerations)");
+    // Outputs have no start; parameters and inputs have one.
+    for (_, v) in d.variables.iter() {
+        let start = match &v.kind {
+            periodic_contact::fmi2::table::Kind::Real { start, .. } => start.is_some(),
+            periodic_contact::fmi2::table::Kind::Integer { start, .. } | periodic_contact::fmi2::table::Kind::Enumeration { start, .. } => start.is_some(),
+            _ => unreachable!(),
+        };
+        assert_eq!(start, v.causality != Causality::Output, "{}", v.name);
+    }
+}
+
+#[test]
+fn the_guid_is_derived_from_the_content() {
+    let a = ContactModel::from_scene_text(BASE, "a").unwrap();
+    let b = ContactModel::from_scene_text(BASE, "another/file/name.toml").unwrap();
+    let c = ContactModel::from_scene_text(&BASE.replace("frequency = 1.0", "frequency = 1.1"), "c").unwrap();
+    let ga = xml::render(a.model_description()).1;
+    assert_eq!(ga, xml::render(b.model_description()).1, "the file name is not content");
+    assert_ne!(ga, xml::render(c.model_description()).1, "a different start value is");
+    assert_eq!(ga.len(), 38);
+}
+
+#[test]
+fn invalid_scenes_are_refused_with_the_field() {
+    let e = ContactModel::from_scene_text(&BASE.replace("stiffness = [[1.0]]", "stiffness = [[-1.0, 2.0]]"), "bad.toml").err().unwrap();
+    assert!(e.contains("bad.toml") && e.contains("stiffness"), "{e}");
+}
