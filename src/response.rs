@@ -28,6 +28,8 @@ pub struct LcpSummary {
     /// Siconos' ‖z − max(0, z − w)‖₂/‖q‖₂.
     pub relative_error: f64,
     pub warm_start_used: bool,
+    /// The Tikhonov shift added to A's diagonal, when `[solver] regularization` was needed.
+    pub regularization: Option<f64>,
 }
 
 #[derive(Clone, Debug, Default, Serialize)]

@@ -35,12 +35,13 @@ fn check(name: &str, p: &PeriodicProblem) -> Option<Response> {
             let mut worst = 0.0f64;
             for (c, contact) in r.contacts.iter().zip(&p.model.contacts) {
                 let s = p.pairing_of(contact).offset();
-                let kc = match contact.compliance {
-                    Compliance::Rigid => f64::INFINITY,
-                    Compliance::Compliant { stiffness } => stiffness,
-                };
+                // Compliance 1/k_c, plus the Tikhonov shift when the result records one.
+                let compliance = match contact.compliance {
+                    Compliance::Rigid => 0.0,
+                    Compliance::Compliant { stiffness } => 1.0 / stiffness,
+                } + r.lcp.regularization.unwrap_or(0.0);
                 for j in 0..k {
-                    let w = c.gap[(j + s) % k] + c.force[j] / kc;
+                    let w = c.gap[(j + s) % k] + c.force[j] * compliance;
                     worst = worst.max(c.force[j].min(w).abs()).max((-c.force[j]).max(0.0)).max((-w).max(0.0));
                 }
             }
@@ -189,4 +190,23 @@ fn same_instant_pairing_for_cds_and_fourier_with_rigid_contact() {
             assert!(!r.warnings.is_empty(), "never silently presented as converged");
         }
     }
+}
+
+/// Regularisation policy: a failed LCP says so and suggests remedies; the opt-in
+/// `[solver] regularization` retries on A + εI, and the result records it — never silently.
+#[test]
+fn regularization_is_opt_in_and_recorded() {
+    let osc = oscillator(1.0, 1.0, 0.1);
+    let mut p = build(osc.model(vec![Oscillator::stop(0.5, Compliance::Rigid)]), Scheme::Cds, 256, Some(Pairing::Same));
+    let err = p.solve().expect_err("cds with same pairing ends without a solution");
+    let msg = err.to_string();
+    assert!(msg.contains("compliant") && msg.contains("regularization"), "the error suggests remedies: {msg}");
+    p.solver.regularization = Some(1e-6);
+    let r = check("cds with same pairing, [solver] regularization = 1e-6", &p).expect("solved after regularisation");
+    let shift = r.lcp.regularization.expect("recorded in the result");
+    assert!(shift > 0.0);
+    assert!(r.warnings.iter().any(|w| w.contains("regularization") && w.contains("not the rigid-contact answer")), "{:?}", r.warnings);
+    // Without the opt-in the same scene still fails: nothing is regularised silently.
+    p.solver.regularization = None;
+    assert!(p.solve().is_err());
 }

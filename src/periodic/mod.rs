@@ -7,7 +7,7 @@ mod recovery;
 pub use assembly::Assembly;
 pub use fft::PeriodFft;
 
-use crate::lcp::{BlockCirculant, BlockPivoting, CirculantOperator, Lemke, LemkeSettings, LcpOutcome, LcpSolution, PivotingSettings};
+use crate::lcp::{BlockCirculant, BlockPivoting, CirculantOperator, LcpMatrix, LcpOutcome, LcpSolution, Lemke, LemkeSettings, PivotingSettings};
 use crate::model::{Contact, Model};
 use crate::response::Response;
 use crate::time::{Discretization, Pairing};
@@ -62,11 +62,13 @@ pub struct SolverSettings {
     pub tolerance: f64,
     /// Spread the harmonics over threads (rayon). Off inside an FMU.
     pub parallel: bool,
+    /// Opt-in Tikhonov retry: ε relative to max|A| added to A's diagonal when the LCP fails.
+    pub regularization: Option<f64>,
 }
 
 impl Default for SolverSettings {
     fn default() -> Self {
-        SolverSettings { method: LcpMethod::Auto, tolerance: 1e-9, parallel: true }
+        SolverSettings { method: LcpMethod::Auto, tolerance: 1e-9, parallel: true, regularization: None }
     }
 }
 
@@ -87,6 +89,12 @@ impl SolverSettings {
                 return Err(format!("solver.tolerance: is {t}, must be in (0, 1)"));
             }
             s.tolerance = t;
+        }
+        if let Some(r) = spec.regularization {
+            if !(r.is_finite() && r > 0.0 && r < 1.0) {
+                return Err(format!("solver.regularization: is {r}, must be in (0, 1) (relative to the largest entry of the LCP matrix)"));
+            }
+            s.regularization = Some(r);
         }
         Ok(s)
     }
@@ -200,11 +208,18 @@ impl PeriodicProblem {
         let t_assembly = t_start.elapsed().as_secs_f64();
 
         let t_lcp = Instant::now();
-        let sol = self.solve_lcp(&a, &q, warm_start)?;
+        let (sol, regularization) = self.solve_lcp(&a, &q, warm_start)?;
         let t_lcp = t_lcp.elapsed().as_secs_f64();
 
         let t_rec = Instant::now();
         let mut response = recovery::recover(self, &asm, fft, &sol)?;
+        if let Some(shift) = regularization {
+            response.lcp.regularization = Some(shift);
+            response.warnings.push(format!(
+                "the LCP of the scene ended without a solution; [solver] regularization solved A + {shift:.3e}·I instead: every contact then behaves as compliant with stiffness {:.3e}, so this is not the rigid-contact answer",
+                1.0 / shift
+            ));
+        }
         response.timing_s.assembly = t_assembly;
         response.timing_s.lcp = t_lcp;
         response.timing_s.recovery = t_rec.elapsed().as_secs_f64();
@@ -248,9 +263,31 @@ impl PeriodicProblem {
         (BlockCirculant::new(k, m, blocks), q)
     }
 
-    fn solve_lcp(&self, a: &BlockCirculant, q: &[f64], warm_start: Option<&[usize]>) -> Result<LcpSolution, SolveError> {
+    /// Solves the LCP by the configured method; on failure, and only when the scene opted in
+    /// with `[solver] regularization = ε`, retries once on A + ε·max|A|·I (Tikhonov). The
+    /// second value is the regularization used, if any: the caller records it in the result.
+    fn solve_lcp(&self, a: &BlockCirculant, q: &[f64], warm_start: Option<&[usize]>) -> Result<(LcpSolution, Option<f64>), SolveError> {
+        let first = self.solve_lcp_once(a, q, warm_start);
+        if first.outcome == LcpOutcome::Solved {
+            return Ok((first, None));
+        }
+        if let (Some(eps), LcpOutcome::RayTermination | LcpOutcome::PivotLimit | LcpOutcome::Inaccurate) = (self.solver.regularization, first.outcome) {
+            let shift = eps * a.max_abs().0;
+            let mut regularized = a.clone();
+            regularized.add_block_diagonal(&vec![shift; a.m()]);
+            let mut second = self.solve_lcp_once(&regularized, q, None);
+            second.info.pivots += first.info.pivots;
+            second.info.time_s += first.info.time_s;
+            if second.outcome == LcpOutcome::Solved {
+                return Ok((second, Some(shift)));
+            }
+        }
+        Err(lcp_failure(first))
+    }
+
+    fn solve_lcp_once(&self, a: &BlockCirculant, q: &[f64], warm_start: Option<&[usize]>) -> LcpSolution {
         if q.is_empty() {
-            return Ok(LcpSolution { outcome: LcpOutcome::Solved, z: vec![], w: vec![], info: Default::default() });
+            return LcpSolution { outcome: LcpOutcome::Solved, z: vec![], w: vec![], info: Default::default() };
         }
         let lemke = || {
             let settings = LemkeSettings { certify_tol: self.solver.tolerance, warm_start: warm_start.map(<[usize]>::to_vec), ..LemkeSettings::default() };
@@ -260,7 +297,7 @@ impl PeriodicProblem {
             let settings = PivotingSettings { certify_tol: self.solver.tolerance, warm_start: warm_start.map(<[usize]>::to_vec), ..PivotingSettings::default() };
             BlockPivoting::new(settings).solve(&CirculantOperator::new(a), q)
         };
-        let sol = match self.solver.method {
+        match self.solver.method {
             LcpMethod::Lemke => lemke(),
             LcpMethod::Pivoting => pivoting(),
             LcpMethod::Auto if q.len() <= AUTO_LEMKE_MAX => lemke(),
@@ -276,19 +313,21 @@ impl PeriodicProblem {
                     sol
                 }
             }
-        };
-        if sol.outcome != LcpOutcome::Solved {
-            let hint = match sol.outcome {
-                LcpOutcome::RayTermination => {
-                    "no periodic solution was reached (the LCP matrix is not a P-matrix above the first resonance); remedies: make the contact compliant (stiffness = …), use cds or galerkin with pairing = \"forward\" or bds1, or add damping"
-                }
-                LcpOutcome::PivotLimit => "the pivot budget ran out (a degenerate or ill-posed LCP); try compliance, another scheme or pairing, or damping",
-                LcpOutcome::NonFiniteData => "the assembled LCP holds NaN or infinite values; check the model for a singular operator",
-                LcpOutcome::Inaccurate => "the final basis is too ill-conditioned to certify the residual; add damping or compliance, or reduce steps",
-                LcpOutcome::Solved => unreachable!(),
-            };
-            return Err(SolveError::Lcp { outcome: sol.outcome, info: sol.info, hint: hint.into() });
         }
-        Ok(sol)
     }
 }
+
+/// The typed failure of an LCP solve, with the remedy to try.
+fn lcp_failure(sol: LcpSolution) -> SolveError {
+let hint = match sol.outcome {
+                LcpOutcome::RayTermination => {
+                    "no periodic solution was reached (the LCP matrix is not a P-matrix above the first resonance); remedies: make the contact compliant (stiffness = …), use cds or galerkin with pairing = \"forward\" or bds1, add damping, or opt in to [solver] regularization = 1e-8"
+                }
+                LcpOutcome::PivotLimit => "the pivot budget ran out (a degenerate or ill-posed LCP); remedies: make the contact compliant, use another scheme or pairing, add damping, or opt in to [solver] regularization = 1e-8",
+                LcpOutcome::NonFiniteData => "the assembled LCP holds NaN or infinite values; check the model for a singular operator",
+                LcpOutcome::Inaccurate => "the final basis is too ill-conditioned to certify the residual; remedies: add damping or make the contact compliant, reduce steps, or opt in to [solver] regularization = 1e-8",
+                LcpOutcome::Solved => unreachable!(),
+            };
+    SolveError::Lcp { outcome: sol.outcome, info: sol.info, hint: hint.into() }
+}
+

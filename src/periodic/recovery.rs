@@ -106,6 +106,7 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
             residual: sol.info.residual,
             relative_error: sol.info.relative_error,
             warm_start_used: sol.info.warm_start_used,
+            regularization: None,
         },
         warnings: problem.warnings(),
         timing_s: Default::default(),

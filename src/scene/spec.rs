@@ -134,6 +134,8 @@ pub struct SolverSpec {
     pub method: Option<String>,
     /// Certification tolerance of the LCP residual, relative to max(1, ‖q‖∞).
     pub tolerance: Option<f64>,
+    /// Opt-in Tikhonov retry when the LCP fails (relative to max|A|); recorded in the result.
+    pub regularization: Option<f64>,
 }
 
 /// toml's message already carries the line, column and the offending text; add the closest
