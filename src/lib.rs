@@ -4,8 +4,13 @@
 //!
 //! Flow: [`scene`] (TOML) → [`model`] → [`time`] (circulant symbols) → [`periodic`] (assembly,
 //! LCP, recovery) → [`response`]. The [`lcp`] solvers know nothing of mechanics.
+#[cfg(feature = "plots")]
+/// PNG line charts.
+pub mod plot;
 /// The built-in default scene.
 pub mod defaults;
+/// Finite elements: Matrix Market input, DOF clamping, the blade model.
+pub mod fe;
 /// Semi-analytic periodic orbits: the independent references of the tests.
 pub mod exact;
 /// The FMI 2.0 co-simulation shell (knows nothing of contact).
@@ -21,6 +26,8 @@ pub mod lcp;
 pub mod marching;
 /// The mechanical model and its checks.
 pub mod model;
+/// Craig–Bampton reduction and modal analysis.
+pub mod reduction;
 /// Assembly in the frequency domain, the LCP of the period, recovery.
 pub mod periodic;
 /// The periodic response as written to JSON.

@@ -6,6 +6,9 @@ use std::collections::BTreeMap;
 pub struct ContactResponse {
     pub dof: usize,
     pub direction: i32,
+    /// Contact stiffness of a compliant contact; null for a rigid one (whose gap never goes
+    /// below 0, while a compliant contact's gap is negative when it penetrates).
+    pub stiffness: Option<f64>,
     /// Which gap sample each force sample is complementary to.
     pub pairing: String,
     /// Compressive force ≥ 0 at each instant (the paper's λ = −force).

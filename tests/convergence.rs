@@ -18,8 +18,16 @@ fn errors(r: &Response, exact_x: impl Fn(f64) -> f64, ptp: f64, impulse: f64) ->
     (e, (r.impulse_per_period(0) - impulse).abs() / impulse)
 }
 
-fn order(e_coarse: f64, e_fine: f64) -> f64 {
-    (e_coarse / e_fine).log2()
+/// Least-squares slope of −log e against log k: the observed order over several grids
+/// (errors of contact problems oscillate with the position of the switches on the grid).
+fn fitted_order(ks: &[usize], e: &[f64]) -> f64 {
+    let x: Vec<f64> = ks.iter().map(|&k| (k as f64).ln()).collect();
+    let y: Vec<f64> = e.iter().map(|v| -v.ln()).collect();
+    let n = x.len() as f64;
+    let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+    let sxy: f64 = x.iter().zip(&y).map(|(a, b)| (a - mx) * (b - my)).sum();
+    let sxx: f64 = x.iter().map(|a| (a - mx).powi(2)).sum();
+    sxy / sxx
 }
 
 const COMPLIANT: Oscillator = Oscillator { mass: 1.0, damping: 0.05, stiffness: 1.0, force: 1.0, omega: 1.3 };
@@ -30,7 +38,8 @@ fn compliant_stop_converges_at_each_schemes_order() {
     let ptp = exact.peak_to_peak();
     let stop = || Oscillator::stop(1.0, Compliance::Compliant { stiffness: 10.0 });
     for scheme in Scheme::ALL {
-        let e: Vec<f64> = [256, 512, 1024]
+        let ks = [128, 256, 512, 1024];
+        let e: Vec<f64> = ks
             .iter()
             .map(|&k| {
                 let r = problem(&COMPLIANT, stop(), scheme, k, None).solve().unwrap();
@@ -39,15 +48,15 @@ fn compliant_stop_converges_at_each_schemes_order() {
                 errors(&r, |t| exact.eval(t).0, ptp, exact.impulse_per_period()).0
             })
             .collect();
-        let p = order(e[1], e[2]);
-        eprintln!("compliant {scheme}: errors {e:.3e?}, order {p:.2}");
+        let p = fitted_order(&ks, &e);
+        eprintln!("compliant {scheme}: errors {e:?}, fitted order {p:.2}");
         match scheme.order() {
-            Some(1) => assert!((0.85..1.3).contains(&p), "{scheme}: order {p}"),
-            Some(2) => assert!((1.8..2.3).contains(&p), "{scheme}: order {p}"),
+            Some(1) => assert!((0.85..1.2).contains(&p), "{scheme}: order {p}"),
+            Some(2) => assert!((1.8..2.4).contains(&p), "{scheme}: order {p}"),
             _ => assert!(p > 1.5, "fourier: order {p} (the kink of the force limits it to about 2)"),
         }
         if scheme != Scheme::Bds1 {
-            assert!(e[2] < 1e-3, "{scheme}: error at k = 1024 is {:.3e} of the peak-to-peak amplitude", e[2]);
+            assert!(e[3] < 1e-3, "{scheme}: error at k = 1024 is {:.3e} of the peak-to-peak amplitude", e[3]);
         }
     }
 }
@@ -60,7 +69,8 @@ fn rigid_stop_with_sticking_converges_bds1_first_cds_galerkin_second_order() {
     assert_eq!(exact.regime(), RigidRegime::Sticking);
     let (ptp, impulse) = (exact.peak_to_peak(), exact.impulse_per_period());
     for (scheme, expected) in [(Scheme::Bds1, 1.0), (Scheme::Cds, 2.0), (Scheme::Galerkin, 2.0)] {
-        let e: Vec<(f64, f64)> = [256, 512, 1024]
+        let ks = [128, 256, 512, 1024];
+        let e: Vec<(f64, f64)> = ks
             .iter()
             .map(|&k| {
                 let r = problem(&STICKING, Oscillator::stop(0.5, Compliance::Rigid), scheme, k, None).solve().unwrap();
@@ -68,10 +78,15 @@ fn rigid_stop_with_sticking_converges_bds1_first_cds_galerkin_second_order() {
                 errors(&r, |t| exact.eval(t).0, ptp, impulse)
             })
             .collect();
-        let (px, pi) = (order(e[1].0, e[2].0), order(e[1].1, e[2].1));
-        eprintln!("rigid+sticking {scheme}: errors {e:.3e?}, orders x {px:.2}, impulse {pi:.2}");
-        assert!((expected - 0.25..expected + 0.4).contains(&px), "{scheme}: displacement order {px}");
-        assert!((expected - 0.25..expected + 0.6).contains(&pi), "{scheme}: impulse order {pi}");
+        let ex: Vec<f64> = e.iter().map(|v| v.0).collect();
+        let ei: Vec<f64> = e.iter().map(|v| v.1).collect();
+        let (px, pi) = (fitted_order(&ks, &ex), fitted_order(&ks, &ei));
+        eprintln!("rigid+sticking {scheme}: errors (x, impulse) {e:?}, fitted orders x {px:.2}, impulse {pi:.2}");
+        assert!((expected - 0.2..expected + 0.4).contains(&px), "{scheme}: displacement order {px}");
+        assert!(pi > expected - 0.3, "{scheme}: impulse order {pi}");
+        // Error bounds at k = 1024, from the orders: C·h^p with C measured once (×3 margin).
+        let bound = if expected == 1.0 { 0.02 } else { 2e-5 };
+        assert!(ex[3] < bound && ei[3] < bound, "{scheme}: errors at k = 1024: {:?}", e[3]);
     }
 }
 
@@ -84,17 +99,21 @@ fn pure_impacts_are_first_order_for_every_converging_scheme() {
     assert_eq!(exact.regime(), RigidRegime::Impacting);
     let ptp = exact.peak_to_peak();
     for scheme in [Scheme::Bds1, Scheme::Cds, Scheme::Galerkin] {
-        let e: Vec<f64> = [512, 1024, 2048]
+        let ks = [256, 512, 1024, 2048, 4096];
+        let e: Vec<f64> = ks
             .iter()
             .map(|&k| {
                 let r = problem(&osc, Oscillator::stop(0.6, Compliance::Rigid), scheme, k, None).solve().unwrap();
                 errors(&r, |t| exact.eval(t).0, ptp, exact.impulse_per_period()).0
             })
             .collect();
-        let p = order(e[1], e[2]);
-        eprintln!("pure impacts {scheme}: errors {e:.3e?}, order {p:.2}");
-        assert!((0.7..1.5).contains(&p), "{scheme}: order {p}");
-        assert!(e[2] < 0.02, "{scheme}: error {:.3e} at k = 2048", e[2]);
+        let p = fitted_order(&ks, &e);
+        eprintln!("pure impacts {scheme}: errors {e:?}, fitted order {p:.2}");
+        assert!((0.6..1.4).contains(&p), "{scheme}: order {p}");
+        // First-order bound: e ≤ C/k with C = 8 (measured e·k ≤ 4 for bds1, ≤ 1.3 for cds).
+        for (k, v) in ks.iter().zip(&e) {
+            assert!(v * (*k as f64) < 8.0, "{scheme}: error {v:.3e} at k = {k}");
+        }
     }
 }
 
@@ -143,7 +162,31 @@ fn persistent_contact_follows_the_obstacle_and_the_force_converges() {
         let e = r.time.iter().zip(&c.force).map(|(&t, &f)| (f - (exact.eval(t).2 + 1.0)).abs()).fold(0.0, f64::max);
         force_errors.push(e);
     }
-    let p = order(force_errors[1], force_errors[2]);
-    eprintln!("persistent contact: force errors {force_errors:.3e?}, order {p:.2}");
+    let p = fitted_order(&[128, 256, 512], &force_errors);
+    eprintln!("persistent contact: force errors {force_errors:?}, order {p:.2}");
     assert!((1.8..2.3).contains(&p), "force order {p}");
+}
+
+/// The periodic LCP with cds and forward pairing is the steady state of the explicit
+/// central-difference marcher with forward-increment multipliers (notes §5) on the same grid:
+/// marching from rest until the transients die must land on the same samples.
+#[test]
+fn cds_forward_equals_the_steady_state_of_explicit_time_marching() {
+    use periodic_contact::marching::{MarchSettings, march};
+    let cases = [
+        ("pure impacts", Oscillator { mass: 1.0, damping: 0.1, stiffness: 1.0, force: 0.5, omega: 0.8 }, 0.6),
+        ("sticking", STICKING, 0.5),
+    ];
+    for (name, osc, gap) in cases {
+        for k in [256usize, 1024] {
+            let model = osc.model(vec![Oscillator::stop(gap, Compliance::Rigid)]);
+            let r = problem(&osc, Oscillator::stop(gap, Compliance::Rigid), Scheme::Cds, k, None).solve().unwrap();
+            let m = march(&model, &MarchSettings { steps_per_period: k, tolerance: 1e-12, max_periods: 5000, ..Default::default() }).unwrap();
+            assert!(m.converged, "{name} k={k}: the marcher did not reach a steady state");
+            let shift = (m.time[0] / (r.period / k as f64)).round() as usize % k;
+            let d = (0..k).map(|j| (r.displacement["0"][(j + shift) % k] - m.displacement[j][0]).abs()).fold(0.0, f64::max);
+            eprintln!("{name} k={k}: periodic LCP vs marcher steady state {d:.2e} ({} periods, {:.3} s)", m.periods, m.cpu_time_s);
+            assert!(d < 1e-9, "{name} k={k}: {d:e}");
+        }
+    }
 }

@@ -17,8 +17,9 @@ const SINGULAR_REL: f64 = 1e-11;
 
 /// All distinct complementary basic solutions z of w = A z + q, z ≥ 0, w ≥ 0, zᵀw = 0.
 ///
-/// A candidate is accepted when z_α ≥ −tol·max(1, ‖z‖∞) and w_ᾱ ≥ −tol·max(1, ‖q‖∞); such small
-/// negatives are set to 0 in the result. Two solutions closer than tol·max(1, ‖z‖∞) (∞-norm)
+/// A candidate is accepted when z_α ≥ −tol·max(1, ‖z‖∞) and w_ᾱ ≥ −tol·max(1, ‖q‖∞, ‖A‖∞‖z‖∞)
+/// (w = A z + q carries round-off proportional to ‖A‖‖z‖); such small negatives are set to 0 in
+/// the result. Two solutions closer than tol·max(1, ‖z‖∞) (∞-norm)
 /// count as one. Returns nothing for non-finite data. Meant for n ≤ 12 (2ⁿ small solves);
 /// panics for n > 20.
 pub fn solve_by_enumeration(a: &dyn LcpMatrix, q: &[f64], tol: f64) -> Vec<Vec<f64>> {
@@ -30,6 +31,8 @@ pub fn solve_by_enumeration(a: &dyn LcpMatrix, q: &[f64], tol: f64) -> Vec<Vec<f
         return Vec::new();
     }
     let qscale = q.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+    // ‖A‖∞: the largest absolute row sum.
+    let anorm = (0..n).map(|i| full[i * n..(i + 1) * n].iter().map(|v| v.abs()).sum::<f64>()).fold(0.0f64, f64::max);
     let mut found: Vec<Vec<f64>> = Vec::new();
     let mut alpha = Vec::with_capacity(n);
     let mut m = Vec::with_capacity(n * n);
@@ -58,7 +61,8 @@ pub fn solve_by_enumeration(a: &dyn LcpMatrix, q: &[f64], tol: f64) -> Vec<Vec<f
             continue;
         }
         let w: Vec<f64> = (0..n).map(|i| q[i] + (0..n).map(|j| full[i * n + j] * z[j]).sum::<f64>()).collect();
-        if w.iter().any(|&v| v.is_nan() || v < -tol * qscale) {
+        let wscale = qscale.max(anorm * zscale);
+        if w.iter().any(|&v| v.is_nan() || v < -tol * wscale) {
             continue;
         }
         z.iter_mut().for_each(|v| *v = v.max(0.0));

@@ -84,7 +84,6 @@ const LEX_TOL: f64 = 1e-11;
 /// off by a few indices, not to solve the LCP; a cap keeps its cost bounded.
 const POLISH_ROUNDS: usize = 8;
 
-
 /// One step of iterative refinement of B⁻¹q̂ every this many pivots. Why: the explicit B⁻¹
 /// updates accumulate round-off (≈ eps · cond(B) per pivot); on long runs with ill-conditioned
 /// bases the drift in B⁻¹q̂ can exceed the small basic values that degenerate ratio decisions
@@ -130,8 +129,9 @@ struct Revised<'a> {
     pos_z0: u32,
     /// Values of the basic variables, B⁻¹ q̂, by position.
     x: Vec<f64>,
-    /// Entering column B⁻¹ d, and the raw column d.
+    /// Entering column B⁻¹ d, the next one (see [`Revised::pivot`]), and the raw column d.
     y: Vec<f64>,
+    ynext: Vec<f64>,
     d: Vec<f64>,
     ties: Vec<usize>,
     /// q̂, kept for the iterative refinement of x.
@@ -159,6 +159,7 @@ impl<'a> Revised<'a> {
             qhat,
             r: vec![0.0; n],
             y: vec![0.0; n],
+            ynext: vec![0.0; n],
             d: vec![0.0; n],
             ties: Vec::with_capacity(n),
         }
@@ -223,10 +224,7 @@ impl<'a> Revised<'a> {
             debug_assert!(s != NONE);
             self.y.copy_from_slice(&self.slots[s as usize]);
         } else {
-            let j = v - n;
-            self.a.column_into(j, &mut self.d);
-            let f = self.neg_inv_sa;
-            self.d.iter_mut().for_each(|v| *v *= f);
+            self.load_column(v - n);
             self.y.copy_from_slice(&self.d);
             for &p in &self.plist {
                 self.y[p as usize] = 0.0;
@@ -334,7 +332,11 @@ impl<'a> Revised<'a> {
                 vmin = vmin.min(self.binv(i, c) / self.y[i]);
             }
             let tol = LEX_TOL * vmin.abs().max(1.0);
-            ties.retain(|&i| self.binv(i, c) / self.y[i] - vmin <= tol);
+            let keep = |i: usize| self.binv(i, c) / self.y[i] - vmin <= tol;
+            // NaN-safe: a comparison with NaN is false, so never let the list run empty.
+            if ties.iter().any(|&i| keep(i)) {
+                ties.retain(|&i| keep(i));
+            }
         }
         // Exact arithmetic leaves one row (B⁻¹ is nonsingular); in floating point keep the
         // largest pivot among any survivors, the numerically safest.
@@ -348,22 +350,55 @@ impl<'a> Revised<'a> {
         Some(r)
     }
 
-    /// Pivot: v enters at row r (with the entering column in self.y); returns the leaving
-    /// variable. Returns None if B⁻¹q became non-finite.
-    fn pivot(&mut self, r: usize, v: usize) -> Option<usize> {
+    /// d = −Â_{·j}: the raw column of an entering z_j.
+    fn load_column(&mut self, j: usize) {
+        self.a.column_into(j, &mut self.d);
+        let f = self.neg_inv_sa;
+        self.d.iter_mut().for_each(|v| *v *= f);
+    }
+
+    /// Pivot: v enters at row r (with its column B⁻¹d in self.y); returns the leaving variable,
+    /// or None if B⁻¹q became non-finite.
+    ///
+    /// With `fuse`, self.d holds the raw column d' of the variable that enters next, and the new
+    /// B⁻¹d' is accumulated into self.ynext column by column, right after each column's update,
+    /// while it is still in cache: B⁻¹ is streamed from memory once per pivot instead of twice.
+    fn pivot(&mut self, r: usize, v: usize, fuse: bool) -> Option<usize> {
         let n = self.n;
         let piv = self.y[r];
         if self.slot_of_pos[r] == NONE {
             // w_r leaves: position r starts hosting a non-w variable.
             self.add_column(r);
         }
-        for &p in &self.plist {
-            let col = &mut self.slots[self.slot_of_pos[p as usize] as usize];
+        // w_j entering: rows r and j of B⁻¹ are swapped afterwards and column j becomes e_j.
+        let drop = if v < n { v } else { usize::MAX };
+        let swap = v < n && v != r;
+        let Revised { slots, plist, slot_of_pos, y, ynext, d, .. } = self;
+        if fuse {
+            // B⁻¹_new d' = d' − Σ_{p∈P_new} d'_p e_p + Σ_{p∈P_new} d'_p g_p, P_new = P \ {drop}.
+            ynext.copy_from_slice(d);
+            for &p in plist.iter() {
+                if p as usize != drop {
+                    ynext[p as usize] = 0.0;
+                }
+            }
+        }
+        for &p in plist.iter() {
+            let col = &mut slots[slot_of_pos[p as usize] as usize];
             let f = col[r] / piv;
             if f != 0.0 {
-                axpy(col, -f, &self.y);
+                axpy(col, -f, y);
             }
             col[r] = f;
+            if swap {
+                col.swap(r, drop);
+            }
+            if fuse && p as usize != drop {
+                let dp = d[p as usize];
+                if dp != 0.0 {
+                    axpy(ynext, dp, col);
+                }
+            }
         }
         let f = self.x[r] / piv;
         if f != 0.0 {
@@ -382,9 +417,6 @@ impl<'a> Revised<'a> {
             // w_j enters: it belongs at position j; the variable hosted there moves to r.
             let j = v;
             if j != r {
-                for &p in &self.plist {
-                    self.slots[self.slot_of_pos[p as usize] as usize].swap(r, j);
-                }
                 self.x.swap(r, j);
                 self.basic.swap(r, j);
                 let moved = self.basic[r];
@@ -415,17 +447,15 @@ impl<'a> Revised<'a> {
         let tie_tol = TIE_TOL * xmax.max(1.0);
         let r0 = (0..n).rev().find(|&i| self.x[i] - qmin <= tie_tol).unwrap_or(0);
         self.y.fill(-1.0);
-        let Some(leaving) = self.pivot(r0, 2 * n) else { return (RunEnd::Breakdown, 1) };
+        let Some(leaving) = self.pivot(r0, 2 * n, false) else { return (RunEnd::Breakdown, 1) };
         let mut pivots = 1;
         let mut entering = n + leaving; // leaving = w_{r0}: z_{r0} enters.
+        let mut column_ok = self.entering_column(entering);
         loop {
             if pivots >= limit {
                 return (RunEnd::Limit, pivots);
             }
-            if pivots % REFINE_EVERY == 0 && !self.refine_x() {
-                return (RunEnd::Breakdown, pivots);
-            }
-            if !self.entering_column(entering) {
+            if !column_ok {
                 return (RunEnd::Breakdown, pivots);
             }
             let ymax = self.y.iter().fold(0.0f64, |m, &v| m.max(v.abs()));
@@ -433,16 +463,34 @@ impl<'a> Revised<'a> {
             // max|A| = max|q| = 1): entries below it are round-off of zeros, not pivots.
             let ptol = ptol_rel * ymax.max(1.0);
             let Some(r) = self.ratio_test(ptol) else { return (RunEnd::Ray, pivots) };
-            let Some(u) = self.pivot(r, entering) else { return (RunEnd::Breakdown, pivots + 1) };
-            pivots += 1;
-            // The complement of the leaving variable enters; z0 leaving ends the run.
-            entering = if u < n {
-                n + u
+            // The complement of the leaving variable enters next; z0 leaving ends the run.
+            let u = self.basic[r];
+            let next = if u < n {
+                Some(n + u)
             } else if u < 2 * n {
-                u - n
+                Some(u - n)
             } else {
-                return (RunEnd::Complementary, pivots);
+                None
             };
+            let fuse = matches!(next, Some(v) if v >= n);
+            if let Some(v) = next.filter(|_| fuse) {
+                self.load_column(v - n);
+            }
+            if self.pivot(r, entering, fuse).is_none() {
+                return (RunEnd::Breakdown, pivots + 1);
+            }
+            pivots += 1;
+            let Some(next) = next else { return (RunEnd::Complementary, pivots) };
+            if pivots % REFINE_EVERY == 0 && !self.refine_x() {
+                return (RunEnd::Breakdown, pivots);
+            }
+            column_ok = if fuse {
+                std::mem::swap(&mut self.y, &mut self.ynext);
+                self.y.iter().all(|v| v.is_finite())
+            } else {
+                self.entering_column(next)
+            };
+            entering = next;
         }
     }
 

@@ -162,3 +162,39 @@ pub(super) fn polish(
     }
     None
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lcp::{DenseMatrix, solve_by_enumeration};
+
+    /// A P-matrix LCP (tridiagonal SPD) started from a basis off by two indices: the polish must
+    /// recover the unique solution (found independently by enumeration).
+    #[test]
+    fn polish_repairs_a_nearly_right_basis() {
+        let n = 12;
+        let a = DenseMatrix::from_fn(n, |i, j| if i == j { 2.0 } else if i.abs_diff(j) == 1 { -1.0 } else { 0.0 });
+        let q: Vec<f64> = (0..n).map(|i| 0.3 - (2.0 * std::f64::consts::PI * i as f64 / n as f64).cos()).collect();
+        let sols = solve_by_enumeration(&a, &q, 1e-12);
+        assert_eq!(sols.len(), 1);
+        let exact = &sols[0];
+        let active: Vec<usize> = (0..n).filter(|&i| exact[i] > 0.0).collect();
+        assert!(active.len() >= 3 && active.len() < n, "{active:?}");
+        // Drop the first active index, add the first inactive one.
+        let outside = (0..n).find(|i| !active.contains(i)).unwrap();
+        let mut wrong: Vec<usize> = active[1..].to_vec();
+        wrong.push(outside);
+        wrong.sort_unstable();
+        let cert = 1e-12;
+        let start = evaluate(&a, &q, solve_principal(&a, &q, &wrong, 2).unwrap(), cert);
+        assert!(start.residual > 1e-3, "the wrong basis must not certify");
+        let fixed = polish(&a, &q, &wrong, &start, 2, cert, 8).expect("polish");
+        assert!(fixed.residual <= cert);
+        let err = fixed.z.iter().zip(exact).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+        assert!(err <= 1e-12, "{:?} vs {exact:?}", fixed.z);
+        // A basis that is right already needs no polish: polish answers None (nothing violated).
+        let right = evaluate(&a, &q, solve_principal(&a, &q, &active, 2).unwrap(), cert);
+        assert!(right.residual <= cert);
+        assert!(polish(&a, &q, &active, &right, 2, cert, 8).is_none());
+    }
+}

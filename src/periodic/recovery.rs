@@ -70,6 +70,10 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
             contacts.push(ContactResponse {
                 dof: ca.dof,
                 direction: ca.direction as i32,
+                stiffness: match ca.compliance {
+                    crate::model::Compliance::Rigid => None,
+                    crate::model::Compliance::Compliant { stiffness } => Some(stiffness),
+                },
                 pairing: problem.pairing_of(ca).name().to_string(),
                 force: finite(force, "contact force", a)?,
                 gap: finite(gap, "contact gap", a)?,

@@ -25,7 +25,7 @@ import time
 
 import numpy as np
 
-from .model import MarchResult, System, periodicity_defect, solve_contact_lcp
+from .model import MarchResult, System, PeriodMonitor, solve_contact_lcp
 
 
 def march_cds(sys_: System, steps: int, pairing: str = "forward", tol: float = 1e-10, min_periods: int = 3,
@@ -72,10 +72,7 @@ def march_cds(sys_: System, steps: int, pairing: str = "forward", tol: float = 1
     a0 = np.linalg.solve(M, sys_.force(0.0) - C @ v - K @ x)
     xm = x - h * v + 0.5 * h * h * a0
 
-    hist_stride = max(1, k // history_per_period)
-    hist_t, hist_x = [], []
-    defects: list[float] = []
-    prev = None
+    monitor = PeriodMonitor("cds", k, history_per_period, tol, min_periods, max_periods)
     lcp_calls = 0
     for p in range(max_periods):
         X = np.empty((n, k))
@@ -97,16 +94,10 @@ def march_cds(sys_: System, steps: int, pairing: str = "forward", tol: float = 1
                     xp = xp - WBF @ zf
                     Z[Fi, j] = zf
             xm, x = x, xp
-        hist_t.append(p * T + tj[::hist_stride])
-        hist_x.append(X[:, ::hist_stride])
-        if prev is not None:
-            defects.append(periodicity_defect(prev, X))
-        prev = X
-        if p + 1 >= min_periods and defects and defects[-1] < tol:
+        if monitor.end_period(p, p * T + tj, X):
             break
     else:
-        raise RuntimeError(f"cds marcher: no periodicity within {max_periods} periods "
-                           f"(last defect {defects[-1]:.3e})")
+        raise monitor.not_periodic()
     # periodic central differences of the last period (the engine applies the same symbols)
     Xp, Xm = np.roll(X, -1, axis=1), np.roll(X, 1, axis=1)
     V = (Xp - Xm) / (2 * h)
@@ -119,6 +110,6 @@ def march_cds(sys_: System, steps: int, pairing: str = "forward", tol: float = 1
     onsets.sort()
     return MarchResult(
         method=f"cds/{pairing}", system=sys_, t=tj, x=X, v=V, a=A, force=Z, impulse=impulse, periods=p + 1,
-        cpu_time=time.process_time() - cpu0, defect=defects[-1], defect_history=defects,
-        hist_t=np.concatenate(hist_t), hist_x=np.concatenate(hist_x, axis=1), onsets=onsets, steps=k,
+        cpu_time=time.process_time() - cpu0, **monitor.history(),
+        onsets=onsets, steps=k,
         info={"lcp_calls": lcp_calls, "tol": tol, "h_omega_max": h * wmax})

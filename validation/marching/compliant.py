@@ -15,7 +15,7 @@ import time
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from .model import MarchResult, System, periodicity_defect
+from .model import MarchResult, System, PeriodMonitor
 
 
 def march_compliant(sys_: System, tol: float = 1e-8, samples: int = 2048, rtol: float = 1e-10,
@@ -73,10 +73,7 @@ def march_compliant(sys_: System, tol: float = 1e-8, samples: int = 2048, rtol: 
 
     N = samples
     phase = np.arange(N) * (T / N)
-    hist_stride = max(1, N // history_per_period)
-    hist_t, hist_x = [], []
-    defects: list[float] = []
-    prev = None
+    monitor = PeriodMonitor("compliant", N, history_per_period, tol, min_periods, max_periods)
     onsets_last: list = []
     nfev = 0
     nseg = 0
@@ -119,18 +116,12 @@ def march_compliant(sys_: System, tol: float = 1e-8, samples: int = 2048, rtol: 
                 t = tb
         assert filled.all()
         x_cur = X[:n]
-        hist_t.append(tgrid[::hist_stride])
-        hist_x.append(x_cur[:, ::hist_stride])
         impulse = y[2 * n:] - Q0
-        if prev is not None:
-            defects.append(periodicity_defect(prev, x_cur))
-        prev = x_cur
         onsets_last = onsets
-        if p + 1 >= min_periods and defects and defects[-1] < tol:
+        if monitor.end_period(p, tgrid, x_cur):
             break
     else:
-        raise RuntimeError(f"compliant marcher: no periodicity within {max_periods} periods "
-                           f"(last defect {defects[-1]:.3e})")
+        raise monitor.not_periodic()
 
     x, v = X[:n], X[n:2 * n]
     pen = sgn[:, None] * x[dofs] - sys_.gaps(phase + p * T)
@@ -138,6 +129,6 @@ def march_compliant(sys_: System, tol: float = 1e-8, samples: int = 2048, rtol: 
     a = Minv @ (sys_.force(phase) - C @ v - K @ x - (sys_.B.T @ force))
     return MarchResult(
         method=f"compliant/{method}", system=sys_, t=phase, x=x, v=v, a=a, force=force, impulse=impulse,
-        periods=p + 1, cpu_time=time.process_time() - cpu0, defect=defects[-1], defect_history=defects,
-        hist_t=np.concatenate(hist_t), hist_x=np.concatenate(hist_x, axis=1), onsets=onsets_last,
+        periods=p + 1, cpu_time=time.process_time() - cpu0, **monitor.history(),
+        onsets=onsets_last,
         info={"nfev": nfev, "segments": nseg, "rtol": rtol, "atol": atol, "tol": tol})

@@ -361,3 +361,36 @@ def solve_contact_lcp(G: np.ndarray, cp: np.ndarray, tol: float = 1e-13) -> np.n
             z[idx] = zc
             return z
         cand |= viol
+
+
+class PeriodMonitor:
+    """Period-by-period bookkeeping shared by the marchers: the transient history kept for
+    plots, and the stop test on the periodicity defect between consecutive periods."""
+
+    def __init__(self, name: str, samples_per_period: int, history_per_period: int, tol: float,
+                 min_periods: int, max_periods: int):
+        self.name, self.tol = name, tol
+        self.min_periods, self.max_periods = min_periods, max_periods
+        self.stride = max(1, samples_per_period // history_per_period)
+        self.hist_t: list = []
+        self.hist_x: list = []
+        self.defects: list[float] = []
+        self.prev = None
+
+    def end_period(self, p: int, t: np.ndarray, x: np.ndarray) -> bool:
+        """Records period p (times t, samples x[dof, j]); True when the march may stop."""
+        self.hist_t.append(t[::self.stride])
+        self.hist_x.append(x[:, ::self.stride])
+        if self.prev is not None:
+            self.defects.append(periodicity_defect(self.prev, x))
+        self.prev = x
+        return p + 1 >= self.min_periods and bool(self.defects) and self.defects[-1] < self.tol
+
+    def not_periodic(self) -> RuntimeError:
+        return RuntimeError(f"{self.name} marcher: no periodicity within {self.max_periods} periods "
+                            f"(last defect {self.defects[-1]:.3e})")
+
+    def history(self) -> dict:
+        """The MarchResult fields this monitor owns."""
+        return dict(defect=self.defects[-1], defect_history=self.defects,
+                    hist_t=np.concatenate(self.hist_t), hist_x=np.concatenate(self.hist_x, axis=1))

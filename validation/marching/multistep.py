@@ -22,7 +22,7 @@ import time
 
 import numpy as np
 
-from .model import MarchResult, System, periodicity_defect, solve_contact_lcp
+from .model import MarchResult, System, PeriodMonitor, solve_contact_lcp
 
 
 def stencils(scheme: str, h: float):
@@ -84,10 +84,7 @@ def march_multistep(sys_: System, scheme: str, steps: int, pairing: str = "same"
     # ring buffer of the last L - lo samples x_{j+lo} ... x_{j+L-1}, from rest
     depth = L - lo
     buf = [np.zeros(n) for _ in range(depth)]  # buf[i] = x_{j+lo+i}
-    hist_stride = max(1, k // history_per_period)
-    hist_t, hist_x = [], []
-    defects: list[float] = []
-    prev = None
+    monitor = PeriodMonitor(scheme, k, history_per_period, tol, min_periods, max_periods)
     lcp_calls = 0
     # Step j of period p computes x_{j+L}; it is stored in column (j+L) mod k, so for L = 1 column 0
     # holds the first sample of the next period (identical at the periodic steady state).
@@ -115,16 +112,10 @@ def march_multistep(sys_: System, scheme: str, steps: int, pairing: str = "same"
                     Z[Ii, j] = zi
             buf = buf[1:] + [xn]
             X[:, (j + L) % k] = xn
-        hist_t.append(p * T + tj[::hist_stride])
-        hist_x.append(X[:, ::hist_stride])
-        if prev is not None:
-            defects.append(periodicity_defect(prev, X))
-        prev = X
-        if p + 1 >= min_periods and defects and defects[-1] < tol:
+        if monitor.end_period(p, p * T + tj, X):
             break
     else:
-        raise RuntimeError(f"{scheme} marcher: no periodicity within {max_periods} periods "
-                           f"(last defect {defects[-1]:.3e})")
+        raise monitor.not_periodic()
     V = sum(b * np.roll(X, -l, axis=1) for l, b in be.items())
     A = sum(a * np.roll(X, -l, axis=1) for l, a in al.items())
     impulse = h * Z.sum(axis=1)
@@ -135,6 +126,6 @@ def march_multistep(sys_: System, scheme: str, steps: int, pairing: str = "same"
     onsets.sort()
     return MarchResult(
         method=f"{scheme}/{pairing}", system=sys_, t=tj, x=X, v=V, a=A, force=Z, impulse=impulse,
-        periods=p + 1, cpu_time=time.process_time() - cpu0, defect=defects[-1], defect_history=defects,
-        hist_t=np.concatenate(hist_t), hist_x=np.concatenate(hist_x, axis=1), onsets=onsets, steps=k,
+        periods=p + 1, cpu_time=time.process_time() - cpu0, **monitor.history(),
+        onsets=onsets, steps=k,
         info={"lcp_calls": lcp_calls, "tol": tol})

@@ -25,7 +25,7 @@ import time
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from .model import MarchResult, System, periodicity_defect, solve_lcp_enum
+from .model import MarchResult, System, PeriodMonitor, solve_lcp_enum
 
 
 def march_rigid(sys_: System, tol: float = 1e-8, samples: int = 2048, rtol: float = 1e-10,
@@ -146,10 +146,7 @@ def march_rigid(sys_: System, tol: float = 1e-8, samples: int = 2048, rtol: floa
 
     N = samples
     phase = np.arange(N) * (T / N)
-    hist_stride = max(1, N // history_per_period)
-    hist_t, hist_x = [], []
-    defects: list[float] = []
-    prev = None
+    monitor = PeriodMonitor("rigid", N, history_per_period, tol, min_periods, max_periods)
     nfev = nseg = nimp = 0
     for p in range(max_periods):
         ta, tb = p * T, (p + 1) * T
@@ -203,17 +200,11 @@ def march_rigid(sys_: System, tol: float = 1e-8, samples: int = 2048, rtol: floa
             X[:, ~filled] = y[:, None]
             S[:, ~filled] = stuck[:, None]
         x_cur = X[:n]
-        hist_t.append(tgrid[::hist_stride])
-        hist_x.append(x_cur[:, ::hist_stride])
         impulse = y[2 * n:] - Q0
-        if prev is not None:
-            defects.append(periodicity_defect(prev, x_cur))
-        prev = x_cur
-        if p + 1 >= min_periods and defects and defects[-1] < tol:
+        if monitor.end_period(p, tgrid, x_cur):
             break
     else:
-        raise RuntimeError(f"rigid marcher: no periodicity within {max_periods} periods "
-                           f"(last defect {defects[-1]:.3e})")
+        raise monitor.not_periodic()
 
     x, v = X[:n], X[n:2 * n]
     a = np.empty_like(x)
@@ -224,7 +215,7 @@ def march_rigid(sys_: System, tol: float = 1e-8, samples: int = 2048, rtol: floa
         force[sidx, j] = zs
     return MarchResult(
         method=f"rigid/{method}", system=sys_, t=phase, x=x, v=v, a=a, force=force, impulse=impulse,
-        periods=p + 1, cpu_time=time.process_time() - cpu0, defect=defects[-1], defect_history=defects,
-        hist_t=np.concatenate(hist_t), hist_x=np.concatenate(hist_x, axis=1), impacts=impacts,
+        periods=p + 1, cpu_time=time.process_time() - cpu0, **monitor.history(),
+        impacts=impacts,
         onsets=onsets, info={"nfev": nfev, "segments": nseg, "impacts": nimp, "rtol": rtol, "atol": atol,
                              "tol": tol})

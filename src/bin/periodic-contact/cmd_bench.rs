@@ -13,8 +13,10 @@ pub fn peak_rss_mib() -> Option<f64> {
 }
 
 /// One measurement, printed as one tab-separated line for the parent.
-pub fn run_single(steps: usize, repeats: usize) -> Result<(), Failure> {
-    let text = periodic_contact::defaults::DEFAULT_SCENE.replace("steps = 256", &format!("steps = {steps}"));
+pub fn run_single(steps: usize, repeats: usize, method: &str) -> Result<(), Failure> {
+    let text = periodic_contact::defaults::DEFAULT_SCENE
+        .replace("steps = 256", &format!("steps = {steps}"))
+        .replace("[output]", &format!("[solver]\nmethod = \"{method}\"\n\n[output]"));
     let problem = Scene::parse(&text, "bench").and_then(|s| s.to_problem("bench")).map_err(|e| Failure::input(e.to_string()))?;
     let mut best: Option<periodic_contact::response::Response> = None;
     for _ in 0..repeats.max(1) {
@@ -37,14 +39,14 @@ pub fn run_single(steps: usize, repeats: usize) -> Result<(), Failure> {
     Ok(())
 }
 
-pub fn run(steps: &[usize], repeats: usize) -> Result<(), Failure> {
+pub fn run(steps: &[usize], repeats: usize, method: &str) -> Result<(), Failure> {
     let exe = std::env::current_exe().map_err(|e| Failure::solver(e.to_string()))?;
-    println!("rigid 1-DOF stop (fmu/scenes/rigid-stop.toml), cds, forward pairing, one core; best of {repeats}");
+    println!("rigid 1-DOF stop (fmu/scenes/rigid-stop.toml), cds, forward pairing, solver.method = {method}, one core; best of {repeats}");
     println!("| k = LCP size | assembly [s] | LCP [s] | total [s] | pivots | residual | peak RSS [MiB] |");
     println!("|---:|---:|---:|---:|---:|---:|---:|");
     for &k in steps {
         let out = Command::new(&exe)
-            .args(["bench", "--single", &k.to_string(), "--repeats", &repeats.to_string()])
+            .args(["bench", "--single", &k.to_string(), "--repeats", &repeats.to_string(), "--method", method])
             .env("RAYON_NUM_THREADS", "1")
             .output()
             .map_err(|e| Failure::solver(format!("cannot run the benchmark child: {e}")))?;

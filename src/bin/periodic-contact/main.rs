@@ -43,6 +43,9 @@ enum Command {
         /// Repeats per size (the best time is kept).
         #[arg(long, default_value_t = 3)]
         repeats: usize,
+        /// LCP method: auto, lemke or pivoting.
+        #[arg(long, default_value = "auto")]
+        method: String,
         /// Internal: measure one size in this process.
         #[arg(long, hide = true)]
         single: Option<usize>,
@@ -77,9 +80,9 @@ fn main() -> ExitCode {
         Some(Command::Solve { scene, output }) => cmd_solve::run(&scene, &output),
         Some(Command::Lcp { file, output }) => cmd_lcp::run(&file, &output),
         Some(Command::Fmu { scene, output, binary }) => cmd_fmu::run(&scene, &output, binary.as_deref()),
-        Some(Command::Bench { steps, repeats, single }) => match single {
-            Some(k) => cmd_bench::run_single(k, repeats),
-            None => cmd_bench::run(&steps, repeats),
+        Some(Command::Bench { steps, repeats, method, single }) => match single {
+            Some(k) => cmd_bench::run_single(k, repeats, &method),
+            None => cmd_bench::run(&steps, repeats, &method),
         },
     };
     match result {

@@ -1,0 +1,83 @@
+//! Line charts as PNG (plotters): response curves, Pareto fronts, spectra.
+//! One function for every chart the tools draw, so that they all look alike.
+use plotters::prelude::*;
+use std::path::Path;
+
+/// One curve: a legend label, its points, and whether to draw markers.
+pub struct Series {
+    pub label: String,
+    pub points: Vec<(f64, f64)>,
+    pub markers: bool,
+}
+
+/// Axis scaling.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum Scale {
+    Linear,
+    Log,
+}
+
+/// A chart: title, axis labels and scales.
+pub struct Chart<'a> {
+    pub title: &'a str,
+    pub x_label: &'a str,
+    pub y_label: &'a str,
+    pub x_scale: Scale,
+    pub y_scale: Scale,
+}
+
+fn range(values: impl Iterator<Item = f64>, scale: Scale) -> (f64, f64) {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite() && (scale == Scale::Linear || *v > 0.0))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(v), h.max(v)));
+    if !lo.is_finite() {
+        return (if scale == Scale::Log { 1e-3 } else { 0.0 }, 1.0);
+    }
+    match scale {
+        Scale::Linear => {
+            let pad = 0.05 * (hi - lo).max(hi.abs() * 1e-3).max(1e-12);
+            (lo - pad, hi + pad)
+        }
+        Scale::Log => (lo / 1.5, hi * 1.5),
+    }
+}
+
+/// Draws the series into a PNG of `width`×`height` pixels. Non-finite points (and
+/// non-positive ones on a log axis) are skipped.
+pub fn line_chart(path: &Path, chart: &Chart, series: &[Series], width: u32, height: u32) -> Result<(), String> {
+    let err = |e: &dyn std::fmt::Display| format!("{}: cannot draw the chart: {e}", path.display());
+    let root = BitMapBackend::new(path, (width, height)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let keep = |(x, y): &(f64, f64)| {
+        x.is_finite() && y.is_finite() && (chart.x_scale == Scale::Linear || *x > 0.0) && (chart.y_scale == Scale::Linear || *y > 0.0)
+    };
+    let xs = range(series.iter().flat_map(|s| s.points.iter().map(|p| p.0)), chart.x_scale);
+    let ys = range(series.iter().flat_map(|s| s.points.iter().map(|p| p.1)), chart.y_scale);
+    let mut builder = ChartBuilder::on(&root);
+    builder.caption(chart.title, ("sans-serif", 22)).margin(12).x_label_area_size(45).y_label_area_size(70);
+    macro_rules! draw {
+        ($ctx:expr) => {{
+            let mut ctx = $ctx;
+            ctx.configure_mesh().x_desc(chart.x_label).y_desc(chart.y_label).draw().map_err(|e| err(&e))?;
+            for (i, s) in series.iter().enumerate() {
+                let color = Palette99::pick(i).to_rgba();
+                let pts: Vec<(f64, f64)> = s.points.iter().copied().filter(keep).collect();
+                ctx.draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))
+                    .map_err(|e| err(&e))?
+                    .label(s.label.clone())
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+                if s.markers {
+                    ctx.draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled()))).map_err(|e| err(&e))?;
+                }
+            }
+            ctx.configure_series_labels().background_style(WHITE.mix(0.85)).border_style(BLACK).draw().map_err(|e| err(&e))?;
+        }};
+    }
+    match (chart.x_scale, chart.y_scale) {
+        (Scale::Linear, Scale::Linear) => draw!(builder.build_cartesian_2d(xs.0..xs.1, ys.0..ys.1).map_err(|e| err(&e))?),
+        (Scale::Log, Scale::Log) => draw!(builder.build_cartesian_2d((xs.0..xs.1).log_scale(), (ys.0..ys.1).log_scale()).map_err(|e| err(&e))?),
+        (Scale::Linear, Scale::Log) => draw!(builder.build_cartesian_2d(xs.0..xs.1, (ys.0..ys.1).log_scale()).map_err(|e| err(&e))?),
+        (Scale::Log, Scale::Linear) => draw!(builder.build_cartesian_2d((xs.0..xs.1).log_scale(), ys.0..ys.1).map_err(|e| err(&e))?),
+    }
+    root.present().map_err(|e| err(&e))
+}
