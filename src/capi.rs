@@ -240,7 +240,7 @@ pub unsafe extern "C" fn pc_problem_add_contact(p: *mut PcProblem, dof: usize, d
         if direction != 1 && direction != -1 {
             return Err(arg(format!("direction is {direction}, must be +1 or -1")));
         }
-        if !(stiffness >= 0.0) {
+        if stiffness.is_nan() || stiffness < 0.0 {
             return Err(arg(format!("stiffness is {stiffness}, must be > 0 (compliant) or 0 (rigid)")));
         }
         let p = unsafe { problem(p) }?;

@@ -217,7 +217,7 @@ impl<M: Fmi2Model> Instance<M> {
             return self.fail(&format!("fmi2SetupExperiment: startTime {start_time} is not finite"));
         }
         if let Some(stop) = stop_time {
-            if !(stop >= start_time) {
+            if stop.is_nan() || stop < start_time {
                 return self.fail(&format!("fmi2SetupExperiment: stopTime {stop} is before startTime {start_time}"));
             }
         }

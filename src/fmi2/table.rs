@@ -278,13 +278,10 @@ impl VariableTable {
             }
             use Causality::*;
             use Variability::*;
-            let legal = match (v.causality, v.variability) {
-                (Parameter | CalculatedParameter, Fixed | Tunable) => true,
-                (Input, Discrete | Continuous) => true,
-                (Output, _) | (Local, _) => true,
-                (Independent, Continuous) => true,
-                _ => false,
-            };
+            let legal = matches!(
+                (v.causality, v.variability),
+                (Parameter | CalculatedParameter, Fixed | Tunable) | (Input, Discrete | Continuous) | (Output | Local, _) | (Independent, Continuous)
+            );
             if !legal {
                 return Err(format!("{} (vr {vr}): causality {} with variability {} is not allowed", v.name, v.causality.name(), v.variability.name()));
             }

@@ -249,6 +249,15 @@ pub fn fmu_binary() -> PathBuf {
         for profile in ["release", "debug"] {
             let p = r.join(profile).join("libPeriodicContact.so");
             if p.is_file() {
+                let built = std::fs::metadata(&p).and_then(|m| m.modified()).unwrap();
+                let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+                if let Some(newer) = newest_source(&[root.join("src"), root.join("fmu/src")]).filter(|(t, _)| *t > built) {
+                    panic!(
+                        "{} is older than {} (the FMU embeds the engine): rebuild it with\n  cargo build --release -p periodic-contact-fmu",
+                        p.display(),
+                        newer.1.display()
+                    );
+                }
                 return p;
             }
         }
@@ -258,6 +267,30 @@ pub fn fmu_binary() -> PathBuf {
          Build it first with:  cargo build --release -p periodic-contact-fmu",
         roots
     );
+}
+
+/// The most recently modified Rust source under `dirs` (the CLI and the C API excepted: the FMU
+/// binary does not contain them).
+fn newest_source(dirs: &[PathBuf]) -> Option<(std::time::SystemTime, PathBuf)> {
+    let mut best: Option<(std::time::SystemTime, PathBuf)> = None;
+    let mut stack: Vec<PathBuf> = dirs.to_vec();
+    while let Some(d) = stack.pop() {
+        let Ok(entries) = std::fs::read_dir(&d) else { continue };
+        for e in entries.flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                if !p.ends_with("bin") {
+                    stack.push(p);
+                }
+            } else if p.extension().is_some_and(|x| x == "rs") && !p.ends_with("capi.rs") {
+                let t = e.metadata().and_then(|m| m.modified()).unwrap();
+                if best.as_ref().is_none_or(|(b, _)| t > *b) {
+                    best = Some((t, p));
+                }
+            }
+        }
+    }
+    best
 }
 
 pub fn cli() -> PathBuf {
