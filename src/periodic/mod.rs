@@ -124,14 +124,42 @@ pub const AUTO_LEMKE_MAX: usize = 256;
 pub const MIN_STEPS: usize = 4;
 /// Most instants per period we accept (memory of the recovery grows like k·outputs).
 pub const MAX_STEPS: usize = 1 << 22;
+/// Largest LCP accepted, k·m unknowns. Why: both LCP methods may store a dense block as large as
+/// the active set squared (Lemke's B⁻¹ columns, the pivoting LU): the rigid stop at k = 16384 peaks
+/// at 1.5 GiB, and 2^22 unknowns would ask for terabytes (a panic inside the allocator, found by
+/// the bad-input tests). 32768 keeps the worst case within a few GiB.
+pub const MAX_LCP_SIZE: usize = 1 << 15;
+/// Most floating-point operations the dense assembly may cost, ≈ (k/2+1)·(8/3)·n³ (one complex LU
+/// per distinct harmonic). Why: a 5000×5000 dense model at k = 256 would take hours; it must be
+/// refused at once with a remedy, not attempted. 10¹² is a few minutes on one core
+/// (n = 1000 at k = 256 is 3.4·10¹¹ and accepted).
+pub const MAX_DENSE_FLOPS: f64 = 1e12;
 
 impl PeriodicProblem {
     pub fn new(model: Model, disc: Discretization, outputs: OutputSelection, solver: SolverSettings) -> Result<Self, SolveError> {
-        model.validate().map_err(|e| SolveError::Invalid(e.to_string()))?;
+        // Size limits first: they are O(1), the validation below factorises M.
         let k = disc.steps;
         if !(MIN_STEPS..=MAX_STEPS).contains(&k) {
             return Err(SolveError::Invalid(format!("discretization.steps: is {k}, must be in {MIN_STEPS}..={MAX_STEPS}")));
         }
+        let m = model.contacts.len();
+        if k.saturating_mul(m) > MAX_LCP_SIZE {
+            return Err(SolveError::Invalid(format!(
+                "discretization.steps: is {k} with {m} contact(s), an LCP of {} unknowns (steps × contacts); at most {MAX_LCP_SIZE} are accepted: reduce steps",
+                k.saturating_mul(m)
+            )));
+        }
+        let s = &model.structure;
+        let dense = !(s.mass.is_sparse() || s.stiffness.is_sparse() || s.damping.as_ref().is_some_and(crate::model::Matrix::is_sparse));
+        let n = model.n();
+        let flops = (k / 2 + 1) as f64 * (8.0 / 3.0) * (n as f64).powi(3);
+        if dense && flops > MAX_DENSE_FLOPS {
+            return Err(SolveError::Invalid(format!(
+                "structure.mass: a dense {n}×{n} model with steps = {k} needs {} complex {n}×{n} factorisations (≈ {flops:.1e} flops, at most {MAX_DENSE_FLOPS:.0e} accepted): give the matrices in sparse form, reduce the model (Craig–Bampton), or reduce steps",
+                k / 2 + 1
+            )));
+        }
+        model.validate().map_err(|e| SolveError::Invalid(e.to_string()))?;
         // A harmonic h is resolved by k samples only if h < k/2 (Nyquist).
         for (i, f) in model.forces.iter().enumerate() {
             if 2 * f.term.harmonic as usize >= k {
@@ -153,7 +181,6 @@ impl PeriodicProblem {
                 }
             }
         }
-        let n = model.n();
         if let Some(d) = outputs.dofs().into_iter().find(|&d| d >= n) {
             return Err(SolveError::Invalid(format!("output: DOF {d} does not exist, the model has DOFs 0..{}", n - 1)));
         }
