@@ -60,7 +60,12 @@ impl BlockPivoting {
 
     /// Full exchanges while they reduce the number of infeasible indices; then Lemke from the
     /// best basis found (`warm_lemke`), which repairs the last few indices pivot by pivot.
+    /// z and w are always finite: an iterate that overflowed is reported as z = 0, w = q.
     pub fn solve(&self, a: &dyn LcpMatrix, q: &[f64]) -> LcpSolution {
+        finite_or_zero(self.solve_unchecked(a, q), q)
+    }
+
+    fn solve_unchecked(&self, a: &dyn LcpMatrix, q: &[f64]) -> LcpSolution {
         let start = Instant::now();
         let n = a.dim();
         let s = &self.settings;
@@ -157,4 +162,21 @@ impl BlockPivoting {
         sol.info.warm_start_used = s.warm_start.is_some();
         sol
     }
+}
+
+/// The [`LcpSolution`] contract: z and w finite. An overflowed iterate (A_FF⁻¹q beyond f64 on data
+/// spanning hundreds of decades, found by tests/props.rs) becomes z = 0, w = q, never `Solved`.
+pub(crate) fn finite_or_zero(mut sol: LcpSolution, q: &[f64]) -> LcpSolution {
+    if sol.z.iter().chain(&sol.w).all(|v| v.is_finite()) {
+        return sol;
+    }
+    sol.z = vec![0.0; q.len()];
+    sol.w = q.to_vec();
+    let (residual, relative_error) = residuals(q, &sol.z, &sol.w);
+    sol.info.residual = residual;
+    sol.info.relative_error = relative_error;
+    if sol.outcome == LcpOutcome::Solved {
+        sol.outcome = LcpOutcome::Inaccurate;
+    }
+    sol
 }
