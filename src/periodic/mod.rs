@@ -224,6 +224,7 @@ impl PeriodicProblem {
         let dofs = self.outputs.dofs();
         let asm = assembly::assemble(&self.model, &self.disc, &dofs, fft, self.solver.parallel)?;
         let (a, q) = self.lcp(&asm, fft);
+        self.check_lcp_finite(&a, &q)?;
         let t_assembly = t_start.elapsed().as_secs_f64();
 
         let t_lcp = Instant::now();
@@ -273,6 +274,27 @@ impl PeriodicProblem {
             }
         }
         (BlockCirculant::new(k, m, blocks), q)
+    }
+
+    /// The LCP's data must be finite; when they are not, name the contact and the instant.
+    /// Why: values that pass validation one by one (a static gap plus obstacle motions near
+    /// 1e308, say) can still sum past f64, and a solver's "non-finite data" says nothing of where.
+    fn check_lcp_finite(&self, a: &BlockCirculant, q: &[f64]) -> Result<(), SolveError> {
+        let m = self.model.contacts.len().max(1);
+        let what = "gaps, obstacle motions, forces or compliances overflow floating point; rescale the units";
+        if let Some(i) = q.iter().position(|v| !v.is_finite()) {
+            return Err(SolveError::Invalid(format!("contact[{}]: the gap of the LCP at instant {} is {}: {what}", i % m, i / m, q[i])));
+        }
+        if let Some(i) = a.blocks().iter().position(|v| !v.is_finite()) {
+            let (d, ab) = (i / (m * m), i % (m * m));
+            return Err(SolveError::Invalid(format!(
+                "contact[{}]: the LCP matrix (its response to contact[{}] {d} instants earlier) is {}: {what}",
+                ab / m,
+                ab % m,
+                a.blocks()[i]
+            )));
+        }
+        Ok(())
     }
 
     fn solve_lcp(&self, a: &BlockCirculant, q: &[f64], warm_start: Option<&[usize]>) -> Result<LcpSolution, SolveError> {
