@@ -100,8 +100,7 @@ impl Operator {
         // Not singular but beyond floating point: say so rather than "singular".
         let overflow = || {
             SolveError::Invalid(format!(
-                "the dynamic operator σ2·M + σ1·C + w·K overflows at harmonic {p} (excitation.frequency = {omega:e} rad/s, σ2 = {:.3e}): the matrices, the frequency or steps are too large for floating point; rescale the units",
-                s2.re
+                "the dynamic operator σ2·M + σ1·C + w·K overflows at harmonic {p} (excitation.frequency = {omega:e} rad/s): the matrices, the frequency or steps are too large for floating point; rescale the units"
             ))
         };
         let y = match self {

@@ -160,6 +160,15 @@ impl PeriodicProblem {
             )));
         }
         model.validate().map_err(|e| SolveError::Invalid(e.to_string()))?;
+        // The difference operators divide by h²: a time step whose 1/h² overflows (ω = 1e308)
+        // gives σ2 = 0/0 = NaN at harmonic 0 (found by tests/props.rs).
+        let h = model.period() / k as f64;
+        if !(1.0 / (h * h)).is_finite() {
+            return Err(SolveError::Invalid(format!(
+                "excitation.frequency: is {:e} with steps = {k}: the time step T/k = {h:e} is too small for floating point (1/h² overflows); rescale the time unit",
+                model.frequency
+            )));
+        }
         // A harmonic h is resolved by k samples only if h < k/2 (Nyquist).
         for (i, f) in model.forces.iter().enumerate() {
             if 2 * f.term.harmonic as usize >= k {
