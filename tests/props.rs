@@ -19,7 +19,7 @@ use periodic_contact::fe::mtx::matrix_market_string;
 use periodic_contact::fe::parse_matrix_market;
 use periodic_contact::lcp::{BlockCirculant, BlockPivoting, CirculantOperator, DenseMatrix, Lemke, LemkeSettings, LcpMatrix, LcpOutcome, LcpSolution, PivotingSettings, dat::parse_dat};
 use periodic_contact::model::{Compliance, Contact, Force, Harmonic, Matrix, Model, Structure};
-use periodic_contact::periodic::{LcpMethod, OutputSelection, PeriodicProblem, SolverSettings};
+use periodic_contact::periodic::{LcpMethod, OutputSelection, PeriodicProblem, SolveError, SolverSettings};
 use periodic_contact::response::Response;
 use periodic_contact::scene::Scene;
 use periodic_contact::time::{Discretization, Pairing, Scheme};
@@ -109,7 +109,15 @@ fn check_solve(p: &PeriodicProblem, tally: &Tally) -> Result<(), TestCaseError> 
             check_response(p, &r, tally)
         }
         Err(e) => {
-            tally.add("solve error");
+            tally.add(match &e {
+                SolveError::Invalid(_) => "refused by the solve (input)",
+                SolveError::SingularOperator { .. } => "refused: singular operator",
+                SolveError::Lcp { outcome: LcpOutcome::RayTermination, .. } => "refused: LCP ray termination",
+                SolveError::Lcp { outcome: LcpOutcome::PivotLimit, .. } => "refused: LCP pivot limit",
+                SolveError::Lcp { outcome: LcpOutcome::Inaccurate, .. } => "refused: LCP inaccurate",
+                SolveError::Lcp { .. } => "refused: LCP other",
+                SolveError::NonFinite(_) => "refused: non-finite response",
+            });
             let msg = e.to_string();
             prop_assert!(!msg.trim().is_empty(), "empty solve error {e:?}");
             prop_assert!(!msg.contains("NaN"), "a solve error mentions NaN: {msg}");
