@@ -60,6 +60,12 @@ enum Symmetry {
     Skew,
 }
 
+/// Largest order accepted. Why: the size line is untrusted and the sparse matrix allocates its
+/// column pointers (8 bytes per column) before any entry is stored: a 3-line file announcing
+/// 10⁹ rows would take 8 GB. 2²⁴ ≈ 16.8 million DOFs is far beyond what one LU per harmonic can
+/// handle anyway (the fine blade preset has 30 000).
+pub const MAX_ORDER: usize = 1 << 24;
+
 /// Reads a square Matrix Market coordinate file into a sparse matrix holding both triangles.
 pub fn read_matrix_market(path: &Path) -> Result<SparseColMat<usize, f64>, MtxError> {
     let name = path.display().to_string();
@@ -197,6 +203,13 @@ pub fn parse_matrix_market<R: Read>(reader: R, name: &str) -> Result<SparseColMa
     if n == 0 {
         return Err(err(size_no, MtxErrorKind::Size, "the matrix is 0×0; expected at least one row".into()));
     }
+    if n > MAX_ORDER {
+        return Err(err(
+            size_no,
+            MtxErrorKind::Size,
+            format!("the matrix is {n}×{n}; at most {MAX_ORDER} rows are supported"),
+        ));
+    }
     let max_nnz = if symmetry == Symmetry::General { n.saturating_mul(n) } else { n.saturating_mul(n + 1) / 2 };
     if nnz > max_nnz {
         return Err(err(
@@ -207,7 +220,9 @@ pub fn parse_matrix_market<R: Read>(reader: R, name: &str) -> Result<SparseColMa
     }
 
     // Entries: (row, col, value, line).
-    let mut entries: Vec<(usize, usize, f64, usize)> = Vec::with_capacity(nnz);
+    // No up-front reservation beyond what a line-sized file could hold: the size line is
+    // untrusted (`100000 100000 10000000000` would ask for 320 GB and abort the process).
+    let mut entries: Vec<(usize, usize, f64, usize)> = Vec::with_capacity(nnz.min(1 << 16));
     while entries.len() < nnz {
         let Some(l) = next_line(&mut lineno)? else {
             return Err(err(

@@ -196,5 +196,6 @@ fn finish(a: &dyn LcpMatrix, q: &[f64], basic: &[Var], x: &[f64], pivots: usize,
     let (residual, relative_error) = residuals(q, &z, &w);
     let qmax = q.iter().fold(1.0f64, |m, v| m.max(v.abs()));
     let outcome = if residual <= certify_tol * qmax { LcpOutcome::Solved } else { LcpOutcome::Inaccurate };
-    LcpSolution { outcome, z, w, info: LcpInfo { pivots, residual, relative_error, time_s: start.elapsed().as_secs_f64(), warm_start_used: false } }
+    let sol = LcpSolution { outcome, z, w, info: LcpInfo { pivots, residual, relative_error, time_s: start.elapsed().as_secs_f64(), warm_start_used: false } };
+    super::pivoting::finite_or_zero(sol, q)
 }

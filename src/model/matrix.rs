@@ -74,16 +74,28 @@ impl Matrix {
         y.iter_mut().for_each(|v| *v = 0.0);
         self.for_each(|i, j, v| y[i] += v * x[j]);
     }
-    /// α·self + β·other, same kind when both agree (dense otherwise).
+    /// α·self + β·other, same kind when both agree (sparse otherwise), of self's shape.
+    ///
+    /// Operands of different sizes never panic: entries of `other` outside self's shape are
+    /// dropped. Such a result is never used, since [`crate::model::Model::validate`] refuses the
+    /// mismatched operand; but the scene builds Rayleigh damping C = αM + βK before validating,
+    /// and a 2×2 M with a 1×1 K used to panic here (found by tests/props.rs).
     pub fn lincomb(&self, alpha: f64, other: &Matrix, beta: f64) -> Matrix {
-        let n = self.nrows();
+        let (r, c) = (self.nrows(), self.ncols());
         match (self, other) {
-            (Matrix::Dense(a), Matrix::Dense(b)) => Matrix::Dense(Mat::from_fn(n, n, |i, j| alpha * a[(i, j)] + beta * b[(i, j)])),
+            (Matrix::Dense(a), Matrix::Dense(b)) => Matrix::Dense(Mat::from_fn(r, c, |i, j| {
+                let bij = if i < b.nrows() && j < b.ncols() { b[(i, j)] } else { 0.0 };
+                alpha * a[(i, j)] + beta * bij
+            })),
             _ => {
                 let mut t = Vec::new();
                 self.for_each(|i, j, v| t.push(faer::sparse::Triplet::new(i, j, alpha * v)));
-                other.for_each(|i, j, v| t.push(faer::sparse::Triplet::new(i, j, beta * v)));
-                Matrix::Sparse(SparseColMat::try_new_from_triplets(n, n, &t).expect("valid triplets"))
+                other.for_each(|i, j, v| {
+                    if i < r && j < c {
+                        t.push(faer::sparse::Triplet::new(i, j, beta * v))
+                    }
+                });
+                Matrix::Sparse(SparseColMat::try_new_from_triplets(r, c, &t).expect("triplets within the shape"))
             }
         }
     }

@@ -92,6 +92,14 @@ impl Model {
                 format!("is {}, must be a finite angular frequency > 0 [rad/s]", self.frequency),
             ));
         }
+        // A subnormal ω (e.g. 1e-320) passes the test above but its period 2π/ω overflows, and
+        // the instants t_j = j·T/k would start with 0·∞ = NaN (found by tests/props.rs).
+        if !self.period().is_finite() {
+            return Err(ModelError::new(
+                "excitation.frequency",
+                format!("is {:e}, too small: the period 2π/ω is not finite; rescale the time unit", self.frequency),
+            ));
+        }
         for (i, f) in self.forces.iter().enumerate() {
             if f.dof >= n {
                 return Err(ModelError::new(format!("force[{i}].dof"), format!("is {}, the model has DOFs 0..{}", f.dof, n - 1)));
@@ -118,6 +126,13 @@ impl Model {
                     return Err(ModelError::new(
                         format!("contact[{i}].stiffness"),
                         format!("is {stiffness}, a contact stiffness must be finite and > 0"),
+                    ));
+                }
+                // The LCP holds the compliance 1/k: a subnormal k (1e-320) makes it infinite.
+                if !(1.0 / stiffness).is_finite() {
+                    return Err(ModelError::new(
+                        format!("contact[{i}].stiffness"),
+                        format!("is {stiffness:e}, too small: its compliance 1/k is not finite; rescale the units or remove the contact"),
                     ));
                 }
             }

@@ -97,6 +97,12 @@ impl Operator {
     /// Solves Ẑ_p Y = rhs for one harmonic.
     fn solve(&self, p: usize, s2: C, s1: C, w: f64, omega: f64, rhs: &Mat<C>) -> Result<Mat<C>, SolveError> {
         let singular = SolveError::SingularOperator { harmonic: p, frequency: p as f64 * omega };
+        // Not singular but beyond floating point: say so rather than "singular".
+        let overflow = || {
+            SolveError::Invalid(format!(
+                "the dynamic operator σ2·M + σ1·C + w·K overflows at harmonic {p} (excitation.frequency = {omega:e} rad/s): the matrices, the frequency or steps are too large for floating point; rescale the units"
+            ))
+        };
         let y = match self {
             Operator::Dense { mass, stiffness, damping } => {
                 let n = mass.nrows();
@@ -104,12 +110,18 @@ impl Operator {
                     let c = damping.as_ref().map_or(0.0, |c| c[(i, j)]);
                     s2 * mass[(i, j)] + s1 * c + C::from(w * stiffness[(i, j)])
                 });
+                if !(0..n).all(|j| (0..n).all(|i| z[(i, j)].re.is_finite() && z[(i, j)].im.is_finite())) {
+                    return Err(overflow());
+                }
                 let lu = z.partial_piv_lu();
                 check_pivots(lu.U()).map_err(|_| singular.clone())?;
                 lu.solve(rhs)
             }
             Operator::Sparse { symbolic, pattern, mass, stiffness, damping } => {
                 let vals: Vec<C> = (0..mass.len()).map(|e| s2 * mass[e] + s1 * damping[e] + C::from(w * stiffness[e])).collect();
+                if !vals.iter().all(|v| v.re.is_finite() && v.im.is_finite()) {
+                    return Err(overflow());
+                }
                 let z = SparseColMat::<usize, C>::new(pattern.clone(), vals);
                 let lu = faer::sparse::linalg::solvers::Lu::try_new_with_symbolic(symbolic.clone(), z.as_ref()).map_err(|_| singular.clone())?;
                 lu.solve(rhs)
@@ -137,6 +149,13 @@ pub fn assemble(model: &Model, disc: &Discretization, dofs: &[usize], fft: &Peri
     let nh = k / 2 + 1;
     let symbols = disc.scheme.symbols(k, model.period());
     let forces = force_spectra(model, fft);
+    // Finite amplitudes can still sum past f64 (two forces of 1e308 on one DOF): say so, rather
+    // than let the NaN surface as a "singular operator".
+    if let Some((d, _)) = forces.iter().find(|(_, s)| !s.iter().all(|c| c.re.is_finite() && c.im.is_finite())) {
+        return Err(SolveError::Invalid(format!(
+            "force: the samples of the force on DOF {d} overflow floating point (amplitudes too large); rescale the units"
+        )));
+    }
     let op = Operator::new(model)?;
     let nd = dofs.len();
     let one = |p: usize| -> Result<HarmonicBlock, SolveError> {

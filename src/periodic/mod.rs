@@ -132,13 +132,50 @@ pub const AUTO_LEMKE_MAX: usize = 256;
 pub const MIN_STEPS: usize = 4;
 /// Most instants per period we accept (memory of the recovery grows like k·outputs).
 pub const MAX_STEPS: usize = 1 << 22;
+/// Largest LCP accepted, k·m unknowns. Why: both LCP methods may store a dense block as large as
+/// the active set squared (Lemke's B⁻¹ columns, the pivoting LU): the rigid stop at k = 16384 peaks
+/// at 1.5 GiB, and 2^22 unknowns would ask for terabytes (a panic inside the allocator, found by
+/// the bad-input tests). 32768 keeps the worst case within a few GiB.
+pub const MAX_LCP_SIZE: usize = 1 << 15;
+/// Most floating-point operations the dense assembly may cost, ≈ (k/2+1)·(8/3)·n³ (one complex LU
+/// per distinct harmonic). Why: a 5000×5000 dense model at k = 256 would take hours; it must be
+/// refused at once with a remedy, not attempted. 10¹² is a few minutes on one core
+/// (n = 1000 at k = 256 is 3.4·10¹¹ and accepted).
+pub const MAX_DENSE_FLOPS: f64 = 1e12;
 
 impl PeriodicProblem {
     pub fn new(model: Model, disc: Discretization, outputs: OutputSelection, solver: SolverSettings) -> Result<Self, SolveError> {
-        model.validate().map_err(|e| SolveError::Invalid(e.to_string()))?;
+        // Size limits first: they are O(1), the validation below factorises M.
         let k = disc.steps;
         if !(MIN_STEPS..=MAX_STEPS).contains(&k) {
             return Err(SolveError::Invalid(format!("discretization.steps: is {k}, must be in {MIN_STEPS}..={MAX_STEPS}")));
+        }
+        let m = model.contacts.len();
+        if k.saturating_mul(m) > MAX_LCP_SIZE {
+            return Err(SolveError::Invalid(format!(
+                "discretization.steps: is {k} with {m} contact(s), an LCP of {} unknowns (steps × contacts); at most {MAX_LCP_SIZE} are accepted: reduce steps",
+                k.saturating_mul(m)
+            )));
+        }
+        let s = &model.structure;
+        let dense = !(s.mass.is_sparse() || s.stiffness.is_sparse() || s.damping.as_ref().is_some_and(crate::model::Matrix::is_sparse));
+        let n = model.n();
+        let flops = (k / 2 + 1) as f64 * (8.0 / 3.0) * (n as f64).powi(3);
+        if dense && flops > MAX_DENSE_FLOPS {
+            return Err(SolveError::Invalid(format!(
+                "structure.mass: a dense {n}×{n} model with steps = {k} needs {} complex {n}×{n} factorisations (≈ {flops:.1e} flops, at most {MAX_DENSE_FLOPS:.0e} accepted): give the matrices in sparse form, reduce the model (Craig–Bampton), or reduce steps",
+                k / 2 + 1
+            )));
+        }
+        model.validate().map_err(|e| SolveError::Invalid(e.to_string()))?;
+        // The difference operators divide by h²: a time step whose 1/h² overflows (ω = 1e308)
+        // gives σ2 = 0/0 = NaN at harmonic 0 (found by tests/props.rs).
+        let h = model.period() / k as f64;
+        if !(1.0 / (h * h)).is_finite() {
+            return Err(SolveError::Invalid(format!(
+                "excitation.frequency: is {:e} with steps = {k}: the time step T/k = {h:e} is too small for floating point (1/h² overflows); rescale the time unit",
+                model.frequency
+            )));
         }
         // A harmonic h is resolved by k samples only if h < k/2 (Nyquist).
         for (i, f) in model.forces.iter().enumerate() {
@@ -161,7 +198,6 @@ impl PeriodicProblem {
                 }
             }
         }
-        let n = model.n();
         if let Some(d) = outputs.dofs().into_iter().find(|&d| d >= n) {
             return Err(SolveError::Invalid(format!("output: DOF {d} does not exist, the model has DOFs 0..{}", n - 1)));
         }
@@ -205,6 +241,7 @@ impl PeriodicProblem {
         let dofs = self.outputs.dofs();
         let asm = assembly::assemble(&self.model, &self.disc, &dofs, fft, self.solver.parallel)?;
         let (a, q) = self.lcp(&asm, fft);
+        self.check_lcp_finite(&a, &q)?;
         let t_assembly = t_start.elapsed().as_secs_f64();
 
         let t_lcp = Instant::now();
@@ -261,6 +298,27 @@ impl PeriodicProblem {
             }
         }
         (BlockCirculant::new(k, m, blocks), q)
+    }
+
+    /// The LCP's data must be finite; when they are not, name the contact and the instant.
+    /// Why: values that pass validation one by one (a static gap plus obstacle motions near
+    /// 1e308, say) can still sum past f64, and a solver's "non-finite data" says nothing of where.
+    fn check_lcp_finite(&self, a: &BlockCirculant, q: &[f64]) -> Result<(), SolveError> {
+        let m = self.model.contacts.len().max(1);
+        let what = "gaps, obstacle motions, forces or compliances overflow floating point; rescale the units";
+        if let Some(i) = q.iter().position(|v| !v.is_finite()) {
+            return Err(SolveError::Invalid(format!("contact[{}]: the gap of the LCP at instant {} is {}: {what}", i % m, i / m, q[i])));
+        }
+        if let Some(i) = a.blocks().iter().position(|v| !v.is_finite()) {
+            let (d, ab) = (i / (m * m), i % (m * m));
+            return Err(SolveError::Invalid(format!(
+                "contact[{}]: the LCP matrix (its response to contact[{}] {d} instants earlier) is {}: {what}",
+                ab / m,
+                ab % m,
+                a.blocks()[i]
+            )));
+        }
+        Ok(())
     }
 
     /// Solves the LCP by the configured method; on failure, and only when the scene opted in

@@ -22,7 +22,8 @@ pub fn load(scene: &Path) -> Result<PeriodicProblem, Failure> {
 
 pub fn run(scene: &Path, output: &Path) -> Result<(), Failure> {
     let problem = load(scene)?;
-    let r = solve(&problem)?;
+    // Errors found while solving name the scene too (those of loading already do).
+    let r = solve(&problem).map_err(|f| Failure { message: format!("{}: {}", scene.display(), f.message), ..f })?;
     let json = serde_json::to_string_pretty(&r).map_err(|e| Failure::solver(e.to_string()))?;
     write_output(output, &json)?;
     if output.as_os_str() != "-" {
