@@ -230,7 +230,8 @@ impl Scene {
                     let s = match (&spec.arc, &source) {
                         (Some(arc), _) => arc[i],
                         (None, Source::Blade(blade)) => {
-                            let node = dofs.new_to_old[c.dof] / 3;
+                            // Full (clamped) DOF → scene DOF → the blade's unclamped DOF → node.
+                            let node = blade.dofs.new_to_old[dofs.new_to_old[c.dof]] / 3;
                             let [x, y, z] = blade.nodes[node];
                             casing.arc(x, y, blade.params.twist_deg.to_radians() * z / blade.params.length)
                         }
