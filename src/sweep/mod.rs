@@ -6,6 +6,11 @@
 //! parallel (rayon); within a chunk each point is warm-started from the previous point's active
 //! set, with a cold re-solve when the warm one fails. FFT plans are made once and shared.
 //! The contact-free (linear) curve comes from the same assembly ([`Response::linear_displacement`]).
+//!
+//! Several periodic solutions can coexist (the hardening branch of a rubbing blade overhangs
+//! the resonance): a warm-started chunk follows the branch it starts on, and each chunk starts
+//! cold. For a strictly sequential continuation in the direction of the sweep, use one thread
+//! and one chunk (`--threads 1 --chunks-per-thread 1`).
 pub mod marching;
 pub mod spectrum;
 

@@ -29,7 +29,8 @@ pub struct Args {
     /// Worker threads (0: every core).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
-    /// Contiguous chunks per thread (each chunk starts cold).
+    /// Contiguous chunks per thread (each chunk starts cold; where several periodic solutions
+    /// coexist, `--threads 1 --chunks-per-thread 1` continues strictly in the sweep's direction).
     #[arg(long, default_value_t = 4)]
     pub chunks_per_thread: usize,
     /// Parameter values at which to draw the spectrum (comma-separated).
