@@ -34,5 +34,7 @@ pub mod periodic;
 pub mod response;
 /// Scene files (TOML).
 pub mod scene;
+/// Frequency sweeps, spectra, and the comparison with time marching.
+pub mod sweep;
 /// Time schemes as circulant symbols; pairing.
 pub mod time;

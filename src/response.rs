@@ -57,6 +57,10 @@ pub struct Response {
     pub lcp: LcpSummary,
     pub warnings: Vec<String>,
     pub timing_s: Timing,
+    /// The contact-free (linear) response at the displacement outputs, same keys: a by-product
+    /// of the assembly, for frequency-response curves.
+    #[serde(skip)]
+    pub linear_displacement: BTreeMap<String, Vec<f64>>,
     /// Indices of the LCP unknowns with z > 0 (time-major j·m + i): a warm start for the next solve.
     #[serde(skip)]
     pub active_set: Vec<usize>,

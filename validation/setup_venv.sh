@@ -50,7 +50,7 @@ fi
 
 rm -f "$stamp"
 "$venv/bin/python" -m pip install --disable-pip-version-check -r "$req"
-"$venv/bin/python" -c 'import numpy, scipy, matplotlib, pytest, fmpy, libcosimpy' \
+"$venv/bin/python" -c 'import numpy, scipy, matplotlib, pytest, fmpy, libcosimpy, dask, distributed' \
   || die "packages installed but do not import"
 echo "$hash" > "$stamp"
 echo "validation/.venv ready: $("$venv/bin/python" -V)"

@@ -55,9 +55,12 @@ fn force_spectra(model: &Model, fft: &PeriodFft) -> Vec<(usize, Vec<C>)> {
 }
 
 /// Ẑ_p = σ2 M + σ1 C + w K, factorised per harmonic: dense LU, or sparse LU on the union
-/// pattern of M, C, K with one symbolic analysis shared by every harmonic.
+/// pattern of M, C, K with one symbolic analysis shared by every harmonic; or, for a dense model
+/// whose damping is diagonal in its modes (none, Rayleigh, modal ratios: a reduced model),
+/// Ẑ_p⁻¹ = Φ diag(1/(σ2 + σ1 c_i + w ω_i²)) Φᵀ from one eigen-decomposition: O(n²) per harmonic.
 enum Operator {
     Dense { mass: Mat<f64>, stiffness: Mat<f64>, damping: Option<Mat<f64>> },
+    Modal { phi: Mat<f64>, lambda: Vec<f64>, c: Vec<f64> },
     Sparse { symbolic: SymbolicLu<usize>, pattern: SymbolicSparseColMat<usize>, mass: Vec<f64>, stiffness: Vec<f64>, damping: Vec<f64> },
 }
 
@@ -66,6 +69,9 @@ impl Operator {
         let s = &model.structure;
         let sparse = s.mass.is_sparse() || s.stiffness.is_sparse() || s.damping.as_ref().is_some_and(Matrix::is_sparse);
         if !sparse {
+            if let Some(op) = Operator::modal(s) {
+                return Ok(op);
+            }
             return Ok(Operator::Dense { mass: s.mass.to_dense(), stiffness: s.stiffness.to_dense(), damping: s.damping.as_ref().map(Matrix::to_dense) });
         }
         let n = model.n();
@@ -94,6 +100,35 @@ impl Operator {
         Ok(Operator::Sparse { symbolic, pattern, mass, stiffness, damping })
     }
 
+    /// The modal form of a dense structure, if it has at least [`MODAL_MIN_DOFS`] DOFs and its
+    /// damping is diagonal in the undamped modes (to 1e-9 of the largest modal damping).
+    fn modal(s: &crate::model::Structure) -> Option<Operator> {
+        let n = s.n();
+        if n < MODAL_MIN_DOFS {
+            return None;
+        }
+        let (mass, stiffness) = (s.mass.to_dense(), s.stiffness.to_dense());
+        let modes = crate::reduction::dense_modes(stiffness.as_ref(), mass.as_ref(), n).ok()?;
+        if modes.omega.len() != n || modes.residual.iter().any(|r| !(*r < 1e-8)) {
+            return None;
+        }
+        let phi = modes.shapes;
+        let lambda: Vec<f64> = modes.omega.iter().map(|w| w * w).collect();
+        let c = match &s.damping {
+            None => vec![0.0; n],
+            Some(c) => {
+                let d = phi.transpose() * c.to_dense() * &phi;
+                let scale = (0..n).map(|i| d[(i, i)].abs()).fold(0.0, f64::max);
+                let off = (0..n).flat_map(|i| (0..n).map(move |j| (i, j))).filter(|(i, j)| i != j).map(|(i, j)| d[(i, j)].abs()).fold(0.0, f64::max);
+                if !(off <= 1e-9 * scale) {
+                    return None;
+                }
+                (0..n).map(|i| d[(i, i)]).collect()
+            }
+        };
+        Some(Operator::Modal { phi, lambda, c })
+    }
+
     /// Solves Ẑ_p Y = rhs for one harmonic.
     fn solve(&self, p: usize, s2: C, s1: C, w: f64, omega: f64, rhs: &Mat<C>) -> Result<Mat<C>, SolveError> {
         let singular = SolveError::SingularOperator { harmonic: p, frequency: p as f64 * omega };
@@ -117,6 +152,7 @@ impl Operator {
                 check_pivots(lu.U()).map_err(|_| singular.clone())?;
                 lu.solve(rhs)
             }
+            Operator::Modal { .. } => unreachable!("a modal operator is assembled in one batch (assemble_modal)"),
             Operator::Sparse { symbolic, pattern, mass, stiffness, damping } => {
                 let vals: Vec<C> = (0..mass.len()).map(|e| s2 * mass[e] + s1 * damping[e] + C::from(w * stiffness[e])).collect();
                 if !vals.iter().all(|v| v.re.is_finite() && v.im.is_finite()) {
@@ -157,6 +193,9 @@ pub fn assemble(model: &Model, disc: &Discretization, dofs: &[usize], fft: &Peri
         )));
     }
     let op = Operator::new(model)?;
+    if let Operator::Modal { phi, lambda, c } = &op {
+        return assemble_modal(model, symbols, &forces, dofs, phi, lambda, c, k);
+    }
     let nd = dofs.len();
     let one = |p: usize| -> Result<HarmonicBlock, SolveError> {
         let (s1, s2, w) = (symbols.sigma1[p], symbols.sigma2[p], symbols.weight[p]);
@@ -199,6 +238,95 @@ pub fn assemble(model: &Model, disc: &Discretization, dofs: &[usize], fft: &Peri
     }
     Ok(asm)
 }
+
+/// The modal operator for every harmonic at once: with D_p = diag(1/(σ2 + σ1 c_i + w λ_i)),
+/// Ĝ_p = (BΦ) D_p (BΦ)ᵀ, X̂lin_p = Φ_out D_p Φᵀ w_p F̂_p and Ẑ_p⁻¹Bᵀ at the outputs
+/// Φ_out D_p (BΦ)ᵀ, as real matrix products over all harmonics (real and imaginary parts apart).
+#[allow(clippy::too_many_arguments)]
+fn assemble_modal(
+    model: &Model,
+    symbols: Symbols,
+    forces: &[(usize, Vec<C>)],
+    dofs: &[usize],
+    phi: &Mat<f64>,
+    lambda: &[f64],
+    c: &[f64],
+    k: usize,
+) -> Result<Assembly, SolveError> {
+    let n = phi.nrows();
+    let m = model.contacts.len();
+    let nd = dofs.len();
+    let nh = k / 2 + 1;
+    // D_p[i], stored [i][p] as real and imaginary parts.
+    let mut dre = Mat::<f64>::zeros(n, nh);
+    let mut dim = Mat::<f64>::zeros(n, nh);
+    for p in 0..nh {
+        let (s1, s2, w) = (symbols.sigma1[p], symbols.sigma2[p], symbols.weight[p]);
+        for i in 0..n {
+            let d = s2 + s1 * c[i] + C::from(w * lambda[i]);
+            // |d| against the size of its terms (squared norms: no hypot in this loop).
+            let scale = s2.norm_sqr() + s1.norm_sqr() * c[i] * c[i] + (w * lambda[i]).powi(2);
+            if !(d.norm_sqr() > 1e-26 * scale) {
+                return Err(SolveError::SingularOperator { harmonic: p, frequency: p as f64 * model.frequency });
+            }
+            let inv = d.inv();
+            dre[(i, p)] = inv.re;
+            dim[(i, p)] = inv.im;
+        }
+    }
+    // Modal force f̃_p = Φᵀ w_p F̂_p (n × nh), and u = D ∘ f̃.
+    let nl = forces.len();
+    let phil = Mat::<f64>::from_fn(n, nl, |i, l| phi[(forces[l].0, i)]);
+    let fre = &phil * Mat::<f64>::from_fn(nl, nh, |l, p| (forces[l].1[p] * symbols.weight[p]).re);
+    let fim = &phil * Mat::<f64>::from_fn(nl, nh, |l, p| (forces[l].1[p] * symbols.weight[p]).im);
+    let ure = Mat::<f64>::from_fn(n, nh, |i, p| dre[(i, p)] * fre[(i, p)] - dim[(i, p)] * fim[(i, p)]);
+    let uim = Mat::<f64>::from_fn(n, nh, |i, p| dre[(i, p)] * fim[(i, p)] + dim[(i, p)] * fre[(i, p)]);
+    let bphi = Mat::<f64>::from_fn(m, n, |a, i| model.contacts[a].direction * phi[(model.contacts[a].dof, i)]);
+    let phio = Mat::<f64>::from_fn(nd, n, |r, i| phi[(dofs[r], i)]);
+    let (xre, xim) = (&phio * &ure, &phio * &uim);
+    let (bre, bim) = (&bphi * &ure, &bphi * &uim);
+    let mut asm = Assembly {
+        k,
+        m,
+        dofs: dofs.to_vec(),
+        symbols,
+        g_hat: vec![C::ZERO; nh * m * m],
+        xlin_hat: vec![C::ZERO; nh * nd],
+        bxlin_hat: vec![C::ZERO; nh * m],
+        h_hat: vec![C::ZERO; nh * nd * m],
+    };
+    for p in 0..nh {
+        for r in 0..nd {
+            asm.xlin_hat[p * nd + r] = C::new(xre[(r, p)], xim[(r, p)]);
+        }
+        for a in 0..m {
+            asm.bxlin_hat[p * m + a] = C::new(bre[(a, p)], bim[(a, p)]);
+        }
+    }
+    for b in 0..m {
+        // v_b = D ∘ (BΦ)[b, :]ᵀ, then Φ_out v_b and BΦ v_b.
+        let vre = Mat::<f64>::from_fn(n, nh, |i, p| dre[(i, p)] * bphi[(b, i)]);
+        let vim = Mat::<f64>::from_fn(n, nh, |i, p| dim[(i, p)] * bphi[(b, i)]);
+        let (hre, him) = (&phio * &vre, &phio * &vim);
+        let (gre, gim) = (&bphi * &vre, &bphi * &vim);
+        for p in 0..nh {
+            for r in 0..nd {
+                asm.h_hat[(p * nd + r) * m + b] = C::new(hre[(r, p)], him[(r, p)]);
+            }
+            for a in 0..m {
+                asm.g_hat[(p * m + a) * m + b] = C::new(gre[(a, p)], gim[(a, p)]);
+            }
+        }
+    }
+    let finite = asm.g_hat.iter().chain(&asm.xlin_hat).chain(&asm.h_hat).all(|v| v.re.is_finite() && v.im.is_finite());
+    if !finite {
+        return Err(SolveError::SingularOperator { harmonic: 0, frequency: 0.0 });
+    }
+    Ok(asm)
+}
+
+/// From this many DOFs a dense model with modal damping is solved in its modes.
+const MODAL_MIN_DOFS: usize = 16;
 
 /// Below this many DOFs one factorisation is too cheap to be worth a thread.
 const PARALLEL_MIN_DOFS: usize = 64;

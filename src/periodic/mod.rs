@@ -33,6 +33,19 @@ impl OutputSelection {
     }
 }
 
+/// Outputs named in the user's numbering when the solved model's DOFs are not the user's: a
+/// clamped model (DOFs removed) or a reduced one (x_full = Φ q). Output `label` is the
+/// combination Σ c·x_model[d] of the model's DOFs; the result's keys are the labels.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct OutputMap {
+    /// For each user DOF that may be output: its (model DOF, coefficient) terms.
+    pub rows: std::collections::BTreeMap<usize, Vec<(usize, f64)>>,
+    /// The user's DOF of each contact, in model order (reported as the contact's `dof`).
+    pub contact_dofs: Vec<usize>,
+    /// Effects named in the result besides the model's own (e.g. `reduction`).
+    pub effects: Vec<String>,
+}
+
 /// Which LCP method to use.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LcpMethod {
@@ -122,6 +135,8 @@ pub struct PeriodicProblem {
     pub disc: Discretization,
     pub outputs: OutputSelection,
     pub solver: SolverSettings,
+    /// `Some`: `outputs` are user DOFs (labels), computed through the map.
+    pub output_map: Option<OutputMap>,
 }
 
 /// Up to this LCP size `auto` uses lexicographic Lemke directly; above, block pivoting finished
@@ -201,7 +216,37 @@ impl PeriodicProblem {
         if let Some(d) = outputs.dofs().into_iter().find(|&d| d >= n) {
             return Err(SolveError::Invalid(format!("output: DOF {d} does not exist, the model has DOFs 0..{}", n - 1)));
         }
-        Ok(PeriodicProblem { model, disc, outputs, solver })
+        Ok(PeriodicProblem { model, disc, outputs, solver, output_map: None })
+    }
+
+    /// Names the outputs in the user's numbering: `outputs` lists labels of `map`.
+    pub fn with_output_map(mut self, outputs: OutputSelection, map: OutputMap) -> Result<Self, SolveError> {
+        let n = self.model.n();
+        if let Some(d) = outputs.dofs().into_iter().find(|d| !map.rows.contains_key(d)) {
+            return Err(SolveError::Invalid(format!("output: DOF {d} cannot be recovered (it is fixed or does not exist)")));
+        }
+        if let Some((l, _)) = map.rows.iter().find(|(_, r)| r.iter().any(|&(d, c)| d >= n || !c.is_finite())) {
+            return Err(SolveError::Invalid(format!("output: the recovery of DOF {l} names a model DOF out of 0..{n} or a non-finite coefficient")));
+        }
+        if !map.contact_dofs.is_empty() && map.contact_dofs.len() != self.model.contacts.len() {
+            return Err(SolveError::Invalid(format!("output: {} contact labels for {} contacts", map.contact_dofs.len(), self.model.contacts.len())));
+        }
+        self.outputs = outputs;
+        self.output_map = Some(map);
+        Ok(self)
+    }
+
+    /// The model DOFs whose responses the outputs need, sorted and unique.
+    pub fn recovery_dofs(&self) -> Vec<usize> {
+        match &self.output_map {
+            None => self.outputs.dofs(),
+            Some(map) => {
+                let mut d: Vec<usize> = self.outputs.dofs().iter().flat_map(|l| map.rows[l].iter().map(|&(d, _)| d)).collect();
+                d.sort_unstable();
+                d.dedup();
+                d
+            }
+        }
     }
 
     /// The pairing of one contact: the scene's, or the default that converges for it.
@@ -238,7 +283,7 @@ impl PeriodicProblem {
     /// Solves reusing `fft` (planned for k = steps), warm-started from a previous active set.
     pub fn solve_with(&self, fft: &PeriodFft, warm_start: Option<&[usize]>) -> Result<Response, SolveError> {
         let t_start = Instant::now();
-        let dofs = self.outputs.dofs();
+        let dofs = self.recovery_dofs();
         let asm = assembly::assemble(&self.model, &self.disc, &dofs, fft, self.solver.parallel)?;
         let (a, q) = self.lcp(&asm, fft);
         self.check_lcp_finite(&a, &q)?;

@@ -25,20 +25,43 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
     let mut displacement = BTreeMap::new();
     let mut velocity = BTreeMap::new();
     let mut acceleration = BTreeMap::new();
+    let mut linear_displacement = BTreeMap::new();
     let out = &problem.outputs;
+    // Each output label as (index into asm.dofs, coefficient) terms: the DOF itself, or the
+    // user-numbered combination of the output map.
+    let rows: Vec<(usize, Vec<(usize, f64)>)> = match &problem.output_map {
+        None => asm.dofs.iter().enumerate().map(|(r, &d)| (d, vec![(r, 1.0)])).collect(),
+        Some(map) => out
+            .dofs()
+            .into_iter()
+            .map(|l| {
+                let terms = map.rows[&l].iter().map(|&(d, c)| (asm.dofs.binary_search(&d).expect("recovery DOF assembled"), c)).collect();
+                (l, terms)
+            })
+            .collect(),
+    };
     let mut x_hat = vec![C::ZERO; nh];
+    let mut xl_hat = vec![C::ZERO; nh];
     let mut tmp = vec![C::ZERO; nh];
-    for (r, &d) in asm.dofs.iter().enumerate() {
-        for p in 0..nh {
-            let mut v = asm.xlin_hat[p * nd + r];
-            for (b, zb) in z_hat.iter().enumerate() {
-                v -= asm.h_hat[(p * nd + r) * m + b] * zb[p];
+    for (d, terms) in &rows {
+        let d = *d;
+        x_hat.iter_mut().for_each(|v| *v = C::ZERO);
+        xl_hat.iter_mut().for_each(|v| *v = C::ZERO);
+        for &(r, c) in terms {
+            for p in 0..nh {
+                let lin = asm.xlin_hat[p * nd + r];
+                let mut v = lin;
+                for (b, zb) in z_hat.iter().enumerate() {
+                    v -= asm.h_hat[(p * nd + r) * m + b] * zb[p];
+                }
+                x_hat[p] += v * c;
+                xl_hat[p] += lin * c;
             }
-            x_hat[p] = v;
         }
         let key = d.to_string();
         if out.displacement.contains(&d) {
             displacement.insert(key.clone(), finite(fft.inverse(&x_hat), "displacement", d)?);
+            linear_displacement.insert(key.clone(), finite(fft.inverse(&xl_hat), "linear displacement", d)?);
         }
         if out.velocity.contains(&d) {
             for p in 0..nh {
@@ -68,7 +91,7 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
             let gap: Vec<f64> = time.iter().zip(&bx).map(|(&t, &b)| ca.gap_at(model.frequency, t) - b).collect();
             let force: Vec<f64> = (0..k).map(|j| sol.z[j * m + a]).collect();
             contacts.push(ContactResponse {
-                dof: ca.dof,
+                dof: problem.output_map.as_ref().and_then(|m| m.contact_dofs.get(a).copied()).unwrap_or(ca.dof),
                 direction: ca.direction as i32,
                 stiffness: match ca.compliance {
                     crate::model::Compliance::Rigid => None,
@@ -93,7 +116,13 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
         steps: k,
         scheme: problem.disc.scheme.name().to_string(),
         pairing,
-        effects: model.effects().names().into_iter().map(String::from).collect(),
+        effects: model
+            .effects()
+            .names()
+            .into_iter()
+            .map(String::from)
+            .chain(problem.output_map.iter().flat_map(|m| m.effects.iter().cloned()))
+            .collect(),
         time,
         displacement,
         velocity,
@@ -110,6 +139,7 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
         },
         warnings: problem.warnings(),
         timing_s: Default::default(),
+        linear_displacement,
         active_set,
     })
 }

@@ -15,29 +15,111 @@ pub struct Scene {
     pub discretization: DiscretizationSpec,
     pub output: Option<OutputSpec>,
     pub solver: Option<SolverSpec>,
+    /// Craig–Bampton reduction of the structure before solving.
+    pub reduction: Option<ReductionSpec>,
+    /// An out-of-round casing: adds obstacle motion to every contact.
+    pub casing: Option<CasingSpec>,
 }
 
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct StructureSpec {
-    /// Mass matrix M, n×n dense rows.
-    pub mass: MatrixSpec,
-    /// Stiffness matrix K, n×n dense rows.
-    pub stiffness: MatrixSpec,
+    /// Mass matrix M: n×n dense rows, or `{ matrix_market = "M.mtx" }`.
+    pub mass: Option<MatrixSpec>,
+    /// Stiffness matrix K, as `mass`.
+    pub stiffness: Option<MatrixSpec>,
+    /// A built-in model instead of matrices: `{ kind = "blade", … }` (the rest is a
+    /// [`crate::fe::BladeSpec`]).
+    pub generator: Option<toml::Table>,
+    /// DOFs removed (clamped), in the numbering of the matrices. Every other DOF index of the
+    /// scene keeps that numbering.
+    #[serde(default)]
+    pub fixed: Vec<usize>,
 }
 
+/// A structural matrix: dense rows, or a Matrix Market file (path relative to the scene file).
+/// Anything else is kept to be refused with a message naming the field.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(untagged)]
 pub enum MatrixSpec {
     Dense(Vec<Vec<f64>>),
+    File(MatrixFileSpec),
+    Invalid(toml::Value),
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MatrixFileSpec {
+    pub matrix_market: String,
 }
 
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DampingSpec {
-    pub matrix: Option<Vec<Vec<f64>>>,
-    /// C = alpha·M + beta·K.
+    /// C: dense rows or `{ matrix_market = "C.mtx" }`.
+    pub matrix: Option<MatrixSpec>,
+    /// C = alpha·M + beta·K (on the full model; projected exactly by a reduction).
     pub rayleigh: Option<[f64; 2]>,
+    /// Damping ratios ζ_j of the reduced model's modes, ascending frequency; the last one is
+    /// repeated for the remaining modes. Needs `[reduction]`.
+    pub modal_ratios: Option<Vec<f64>>,
+}
+
+/// A DOF named by index (the matrices' numbering) or by a generator's node name: `"LE"` (its
+/// radial z DOF) or `"LE:x"`, `"LE:y"`, `"LE:z"`.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(untagged)]
+pub enum DofSpec {
+    Index(usize),
+    Name(String),
+    /// Anything else, refused with a message naming the field.
+    Invalid(toml::Value),
+}
+
+impl std::fmt::Display for DofSpec {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            DofSpec::Index(i) => write!(f, "{i}"),
+            DofSpec::Name(n) => write!(f, "\"{n}\""),
+            DofSpec::Invalid(v) => write!(f, "{v}"),
+        }
+    }
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReductionSpec {
+    /// `"craig-bampton"`.
+    pub method: String,
+    /// Fixed-interface modes η (default [`crate::reduction::DEFAULT_MODES`]).
+    pub modes: Option<usize>,
+    /// DOFs kept physical besides the contact DOFs.
+    #[serde(default)]
+    pub extra_boundary: Vec<DofSpec>,
+}
+
+/// An out-of-round casing with `lobes` lobes of depth `depth`, turning relative to the blade at
+/// Ω = excitation.frequency / lobes (see [`crate::scene::casing`] for the formula and signs).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CasingSpec {
+    /// Number of lobes = engine order EO (≥ 1).
+    pub lobes: u32,
+    /// Depth δ ≥ 0 of the lobes (the clearance varies by ±δ around each contact's `gap`).
+    pub depth: f64,
+    /// Casing radius R [m] (> 0).
+    pub radius: f64,
+    /// Stagger γ [degrees]: angle between the tip chord and the engine axis (default 0).
+    #[serde(default)]
+    pub stagger: f64,
+    /// Rotation speed Ω [rad/s]; optional, must then equal excitation.frequency / lobes.
+    pub speed: Option<f64>,
+    /// Phase φ0 of the lobes at t = 0 [rad] (default 0).
+    #[serde(default)]
+    pub phase: f64,
+    /// Circumferential arc position s [m] of each contact along the direction of rotation;
+    /// default: from the blade generator's node positions.
+    pub arc: Option<Vec<f64>>,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -60,7 +142,11 @@ fn yes() -> bool {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ForceSpec {
-    pub dof: usize,
+    pub dof: Option<usize>,
+    /// A generator's node instead of `dof`: `"LE"`, `"MC"`, `"TE"`.
+    pub node: Option<String>,
+    /// With `node`: `"x"`, `"y"` or `"z"` (default `"z"`, radial).
+    pub axis: Option<String>,
     pub amplitude: f64,
     #[serde(default = "one")]
     pub harmonic: u32,
@@ -81,7 +167,11 @@ pub struct HarmonicSpec {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ContactSpec {
-    pub dof: usize,
+    pub dof: Option<usize>,
+    /// A generator's node instead of `dof`: `"LE"`, `"MC"`, `"TE"`.
+    pub node: Option<String>,
+    /// With `node`: `"x"`, `"y"` or `"z"` (default `"z"`, radial).
+    pub axis: Option<String>,
     #[serde(default = "plus_one")]
     pub direction: i32,
     pub gap: f64,
@@ -117,11 +207,11 @@ impl Default for DiscretizationSpec {
 #[serde(deny_unknown_fields)]
 pub struct OutputSpec {
     #[serde(default)]
-    pub displacement: Vec<usize>,
+    pub displacement: Vec<DofSpec>,
     #[serde(default)]
-    pub velocity: Vec<usize>,
+    pub velocity: Vec<DofSpec>,
     #[serde(default)]
-    pub acceleration: Vec<usize>,
+    pub acceleration: Vec<DofSpec>,
     /// Contact forces and gaps (default true).
     #[serde(default = "yes")]
     pub contacts: bool,

@@ -15,13 +15,16 @@ fn solve(problem: &PeriodicProblem) -> Result<Response, Failure> {
     })
 }
 
-pub fn load(scene: &Path) -> Result<PeriodicProblem, Failure> {
-    let (s, _dir) = Scene::load(scene).map_err(|e| Failure::input(e.to_string()))?;
-    s.to_problem(&scene.display().to_string()).map_err(|e| Failure::input(e.to_string()))
+pub fn load(scene: &Path, frequency: Option<f64>) -> Result<PeriodicProblem, Failure> {
+    let (mut s, dir) = Scene::load(scene).map_err(|e| Failure::input(e.to_string()))?;
+    if let Some(f) = frequency {
+        s.set_frequency(f);
+    }
+    Ok(s.build_in(&scene.display().to_string(), &dir).map_err(|e| Failure::input(e.to_string()))?.problem)
 }
 
-pub fn run(scene: &Path, output: &Path) -> Result<(), Failure> {
-    let problem = load(scene)?;
+pub fn run(scene: &Path, output: &Path, frequency: Option<f64>) -> Result<(), Failure> {
+    let problem = load(scene, frequency)?;
     // Errors found while solving name the scene too (those of loading already do).
     let r = solve(&problem).map_err(|f| Failure { message: format!("{}: {}", scene.display(), f.message), ..f })?;
     let json = serde_json::to_string_pretty(&r).map_err(|e| Failure::solver(e.to_string()))?;

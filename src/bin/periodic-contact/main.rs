@@ -3,7 +3,9 @@
 mod cmd_bench;
 mod cmd_fmu;
 mod cmd_lcp;
+mod cmd_modes;
 mod cmd_solve;
+mod cmd_sweep;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -24,6 +26,9 @@ enum Command {
         /// Output JSON file ("-" for stdout).
         #[arg(short, long, default_value = "result.json")]
         output: PathBuf,
+        /// Override excitation.frequency ω [rad/s] (with a casing: ω = lobes·Ω).
+        #[arg(long)]
+        frequency: Option<f64>,
     },
     /// Package a scene as an FMI 2.0 co-simulation FMU (needs `cargo build --release -p periodic-contact-fmu`).
     Fmu {
@@ -35,6 +40,15 @@ enum Command {
         #[arg(long)]
         binary: Option<PathBuf>,
     },
+    /// First eigenfrequencies of the full model and, with [reduction], of the reduced one.
+    Modes {
+        scene: PathBuf,
+        /// How many modes.
+        #[arg(long, default_value_t = 10)]
+        count: usize,
+    },
+    /// Frequency sweep: CSV, frequency-response PNG, spectra, comparison with time marching.
+    Sweep(cmd_sweep::Args),
     /// Benchmark: assembly and LCP time of the rigid 1-DOF stop (cds) per k, and peak memory.
     Bench {
         /// LCP sizes k to measure.
@@ -77,7 +91,9 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         None => cmd_solve::run_default(),
-        Some(Command::Solve { scene, output }) => cmd_solve::run(&scene, &output),
+        Some(Command::Solve { scene, output, frequency }) => cmd_solve::run(&scene, &output, frequency),
+        Some(Command::Modes { scene, count }) => cmd_modes::run(&scene, count),
+        Some(Command::Sweep(args)) => cmd_sweep::run(&args),
         Some(Command::Lcp { file, output }) => cmd_lcp::run(&file, &output),
         Some(Command::Fmu { scene, output, binary }) => cmd_fmu::run(&scene, &output, binary.as_deref()),
         Some(Command::Bench { steps, repeats, method, single }) => match single {

@@ -1,0 +1,235 @@
+//! `sweep`: a frequency sweep of a scene, warm-started and parallel, with its CSV, the
+//! frequency-response PNG, spectra at chosen points and the comparison with time marching.
+use crate::{write_output, Failure};
+use indicatif::{ProgressBar, ProgressStyle};
+use periodic_contact::scene::Scene;
+use periodic_contact::sweep::{self, marching::MarchOptions, SweepSettings};
+use periodic_contact::periodic::PeriodFft;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+#[derive(clap::Args)]
+pub struct Args {
+    pub scene: PathBuf,
+    /// The swept parameter: frequency (ω [rad/s]) or speed (Ω [rad/s] of the casing; ω = lobes·Ω).
+    #[arg(long, default_value = "frequency")]
+    pub param: String,
+    #[arg(long, allow_negative_numbers = true)]
+    pub from: f64,
+    #[arg(long, allow_negative_numbers = true)]
+    pub to: f64,
+    #[arg(long, default_value_t = 100)]
+    pub points: usize,
+    /// Output CSV; the PNGs go next to it (same stem).
+    #[arg(short, long, default_value = "sweep.csv")]
+    pub output: PathBuf,
+    /// No warm start (every point solved from scratch).
+    #[arg(long)]
+    pub cold: bool,
+    /// Worker threads (0: every core).
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+    /// Contiguous chunks per thread (each chunk starts cold; where several periodic solutions
+    /// coexist, `--threads 1 --chunks-per-thread 1` continues strictly in the sweep's direction).
+    #[arg(long, default_value_t = 4)]
+    pub chunks_per_thread: usize,
+    /// Parameter values at which to draw the spectrum (comma-separated).
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    pub spectrum_at: Vec<f64>,
+    /// Highest harmonic in the spectra.
+    #[arg(long, default_value_t = 20)]
+    pub harmonics: usize,
+    /// Parameter values at which to compare with explicit time marching (comma-separated).
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    pub march_at: Vec<f64>,
+    /// Periodicity defects at which the march stops (one march each, comma-separated).
+    #[arg(long, value_delimiter = ',', default_value = "1e-6")]
+    pub march_tol: Vec<f64>,
+    /// The reference LCP for the errors has this many times the scene's steps (0: none).
+    #[arg(long, default_value_t = 4)]
+    pub reference_factor: usize,
+    /// Time steps per period of the march (a multiple of the LCP's steps; default: stable).
+    #[arg(long)]
+    pub march_steps: Option<usize>,
+    /// No PNG.
+    #[arg(long)]
+    pub no_plot: bool,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+fn sibling(path: &Path, suffix: &str, ext: &str) -> PathBuf {
+    let stem = path.file_stem().map_or("sweep".into(), |s| s.to_string_lossy().to_string());
+    path.with_file_name(format!("{stem}{suffix}.{ext}"))
+}
+
+pub fn run(a: &Args) -> Result<(), Failure> {
+    if a.points == 0 {
+        return Err(Failure::input("--points: is 0, a sweep needs at least one point"));
+    }
+    if !(a.from.is_finite() && a.to.is_finite() && a.from > 0.0 && a.to > 0.0) {
+        return Err(Failure::input(format!("--from/--to: are {} and {}, must be finite and > 0", a.from, a.to)));
+    }
+    let t_all = Instant::now();
+    let (scene, dir) = Scene::load(&a.scene).map_err(|e| Failure::input(e.to_string()))?;
+    let file = a.scene.display().to_string();
+    let built = scene.build_in(&file, &dir).map_err(|e| Failure::input(e.to_string()))?;
+    let to_frequency: Box<dyn Fn(f64) -> f64> = match a.param.as_str() {
+        "frequency" => Box::new(|v| v),
+        "speed" => {
+            let lobes = built.casing.as_ref().map(|c| c.lobes).ok_or_else(|| Failure::input(format!("{file}: --param speed needs a [casing] section (ω = lobes·Ω)")))?;
+            Box::new(move |v| lobes as f64 * v)
+        }
+        other => return Err(Failure::input(format!("--param: is \"{other}\", expected frequency or speed"))),
+    };
+    let problem = &built.problem;
+    match &built.reduction {
+        Some(r) => eprintln!(
+            "{file}: {} DOFs reduced to {} (Craig–Bampton, {} boundary + {} modes) in {:.3} s; set-up {:.3} s",
+            built.full.n(),
+            r.n(),
+            r.n_boundary(),
+            r.n_modes(),
+            built.timings.reduction,
+            built.timings.total
+        ),
+        None => eprintln!("{file}: {} DOFs, set-up {:.3} s", built.full.n(), built.timings.total),
+    }
+    let values = sweep::linspace(a.from, a.to, a.points);
+    let freqs: Vec<f64> = values.iter().map(|&v| to_frequency(v)).collect();
+    let settings = SweepSettings { warm_start: !a.cold, threads: a.threads, chunks_per_thread: a.chunks_per_thread };
+    let bar = if a.quiet { ProgressBar::hidden() } else { ProgressBar::new(a.points as u64) };
+    bar.set_style(ProgressStyle::with_template("{spinner} sweep [{bar:40}] {pos}/{len} points, {elapsed_precise} elapsed, ETA {eta}").unwrap().progress_chars("=> "));
+    let t = Instant::now();
+    let points = sweep::run(problem, &freqs, &settings, &|| bar.inc(1)).map_err(Failure::input)?;
+    let wall = t.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+
+    write_output(&a.output, &sweep::to_csv(&a.param, &values, problem, &points))?;
+    let failed: Vec<&sweep::SweepPoint> = points.iter().filter(|p| p.error.is_some()).collect();
+    let pivots: usize = points.iter().map(|p| p.pivots).sum();
+    let warm = points.iter().filter(|p| p.warm_start_used).count();
+    let fallback = points.iter().filter(|p| p.cold_fallback).count();
+    let asm: f64 = points.iter().map(|p| p.assembly_s).sum();
+    let lcp: f64 = points.iter().map(|p| p.lcp_s).sum();
+    eprintln!(
+        "sweep: {} points in {wall:.3} s wall ({} threads, {}): {} solved, {} failed; {} warm-started, {} cold fallbacks; {pivots} pivots; assembly {asm:.3} s + LCP {lcp:.3} s summed over points → {}",
+        points.len(),
+        if a.threads == 0 { rayon::current_num_threads() } else { a.threads },
+        if a.cold { "cold" } else { "warm-started" },
+        points.len() - failed.len(),
+        failed.len(),
+        warm,
+        fallback,
+        a.output.display()
+    );
+    for (i, d) in problem.outputs.displacement.iter().enumerate() {
+        let nl = sweep::peak(&points, |p| p.amplitude[i]);
+        let li = sweep::peak(&points, |p| p.linear_amplitude[i]);
+        if let (Some(nl), Some(li)) = (nl, li) {
+            eprintln!("  DOF {d}: peak with contact {:.6e} at ω = {:.6}, linear peak {:.6e} at ω = {:.6}", nl.1, nl.0, li.1, li.0);
+        }
+    }
+    for p in &failed {
+        eprintln!("  failed at ω = {}: {}", p.frequency, p.error.as_deref().unwrap_or(""));
+    }
+
+    #[cfg(feature = "plots")]
+    if !a.no_plot {
+        let stem = a.scene.file_stem().map_or(String::new(), |s| s.to_string_lossy().to_string());
+        for (i, d) in problem.outputs.displacement.iter().enumerate() {
+            // The first output's curve is <csv stem>.png, the others <csv stem>-dof<d>.png.
+            let png = if i == 0 { sibling(&a.output, "", "png") } else { sibling(&a.output, &format!("-dof{d}"), "png") };
+            sweep::plot_frc(&png, &a.param, &values, problem, &points, i, &format!("{stem}: frequency response")).map_err(Failure::solver)?;
+            eprintln!("frequency-response curve of DOF {d} → {}", png.display());
+        }
+    }
+
+    if !a.spectrum_at.is_empty() {
+        let fft = PeriodFft::new(problem.disc.steps);
+        let mut spectra = Vec::new();
+        for &v in &a.spectrum_at {
+            let f = to_frequency(v);
+            if !(f.is_finite() && f > 0.0) {
+                return Err(Failure::input(format!("--spectrum-at: {v} is not a valid {}", a.param)));
+            }
+            // Warm-start from the nearest solved sweep point, so as to stay on its branch.
+            let near = points.iter().filter(|p| p.error.is_none()).min_by(|x, y| (x.frequency - f).abs().total_cmp(&(y.frequency - f).abs()));
+            let mut p = problem.clone();
+            p.solver.parallel = false;
+            let (r, _) = sweep::solve_point(&mut p, &fft, f, near.map(|n| n.active_set.as_slice()));
+            let r = r.map_err(|e| Failure::solver(format!("spectrum at {} = {v}: {e}", a.param)))?;
+            let sp = sweep::spectrum::spectrum(&p, &r, a.harmonics);
+            #[cfg(feature = "plots")]
+            if !a.no_plot {
+                let png = sibling(&a.output, &format!("-spectrum-{v}"), "png");
+                sweep::spectrum::plot(&png, &sp, &format!("spectrum at {} = {v} (ω = {f:.4} rad/s)", a.param)).map_err(Failure::solver)?;
+                eprintln!("spectrum at {} = {v} → {}", a.param, png.display());
+            }
+            spectra.push(sp);
+        }
+        let csv = sibling(&a.output, "-spectrum", "csv");
+        write_output(&csv, &sweep::spectrum::to_csv(&a.param, &a.spectrum_at, &spectra))?;
+        eprintln!("spectra → {}", csv.display());
+    }
+
+    if !a.march_at.is_empty() {
+        let per_point = wall / points.len() as f64;
+        let opts = MarchOptions { steps_per_period: a.march_steps, tolerances: a.march_tol.clone(), reference_factor: a.reference_factor, ..Default::default() };
+        let k = problem.disc.steps;
+        println!(
+            "time marching (explicit central differences with penalty contacts, from rest) against the periodic LCP (k = {k}); errors: max over the {k} instants of |x − x_ref| / amplitude, per displacement output ({}); reference: the LCP with k = {}",
+            problem.outputs.displacement.iter().map(|d| d.to_string()).collect::<Vec<_>>().join("/"),
+            k * a.reference_factor
+        );
+        println!("sweep: {per_point:.5} s per point (wall, {} points, {})", points.len(), if a.cold { "cold" } else { "warm-started" });
+        println!(
+            "{:>12} {:>8} {:>10} {:>8} {:>6} {:>11} {:>11} {:>35} {:>35} {:>12} {:>10}",
+            a.param, "method", "tolerance", "periods", "conv", "N/period", "time [s]", "err vs ref", "err vs LCP", "× sweep pt", "× cold LCP"
+        );
+        let fmt = |e: &[Option<f64>]| -> String {
+            let v: Vec<String> = e.iter().map(|e| e.map_or("—".to_string(), |e| format!("{e:.1e}"))).collect();
+            if v.is_empty() { "—".to_string() } else { v.join("/") }
+        };
+        for &v in &a.march_at {
+            let f = to_frequency(v);
+            let c = sweep::marching::compare(problem, f, &opts).map_err(|e| Failure::solver(format!("march at {} = {v}: {e}", a.param)))?;
+            println!(
+                "{:>12} {:>8} {:>10} {:>8} {:>6} {:>11} {:>11.4} {:>35} {:>35} {:>12} {:>10}",
+                v,
+                "LCP",
+                "—",
+                "—",
+                "—",
+                k,
+                c.lcp_time_s,
+                fmt(&c.lcp_error_vs_reference),
+                "—",
+                "—",
+                "—"
+            );
+            for r in &c.runs {
+                println!(
+                    "{:>12} {:>8} {:>10.0e} {:>8} {:>6} {:>11} {:>11.4} {:>35} {:>35} {:>12.0} {:>10.0}",
+                    v,
+                    "march",
+                    r.tolerance,
+                    r.periods,
+                    r.converged,
+                    c.steps_per_period,
+                    r.time_s,
+                    fmt(&r.error_vs_reference),
+                    fmt(&r.error_vs_lcp),
+                    r.time_s / per_point,
+                    r.time_s / c.lcp_time_s
+                );
+            }
+        }
+    }
+    eprintln!("total {:.3} s", t_all.elapsed().as_secs_f64());
+    if !failed.is_empty() {
+        return Err(Failure::solver(format!("{} of {} sweep points failed (see the status column of {})", failed.len(), points.len(), a.output.display())));
+    }
+    Ok(())
+}

@@ -1,0 +1,249 @@
+//! Frequency sweeps: one periodic problem solved at many excitation frequencies.
+//!
+//! Everything that does not depend on the frequency is built once by the caller (the structure,
+//! the Craig–Bampton reduction, the casing's phases, the output map) and shared by every point:
+//! a point only changes `model.frequency`. The points are cut into contiguous chunks that run in
+//! parallel (rayon); within a chunk each point is warm-started from the previous point's active
+//! set, with a cold re-solve when the warm one fails. FFT plans are made once and shared.
+//! The contact-free (linear) curve comes from the same assembly ([`Response::linear_displacement`]).
+//!
+//! Several periodic solutions can coexist (the hardening branch of a rubbing blade overhangs
+//! the resonance): a warm-started chunk follows the branch it starts on, and each chunk starts
+//! cold. For a strictly sequential continuation in the direction of the sweep, use one thread
+//! and one chunk (`--threads 1 --chunks-per-thread 1`).
+pub mod marching;
+pub mod spectrum;
+
+use crate::periodic::{PeriodFft, PeriodicProblem};
+use crate::response::Response;
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// How to run a sweep.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SweepSettings {
+    /// Warm-start each point from the previous point of its chunk.
+    pub warm_start: bool,
+    /// Worker threads; 0: rayon's default (every core).
+    pub threads: usize,
+    /// Contiguous chunks per thread (more balance the load, fewer keep more warm starts).
+    pub chunks_per_thread: usize,
+}
+
+impl Default for SweepSettings {
+    fn default() -> Self {
+        SweepSettings { warm_start: true, threads: 0, chunks_per_thread: 4 }
+    }
+}
+
+/// The result at one frequency. Vectors follow the problem's `outputs.displacement` order and
+/// the contact order.
+#[derive(Clone, Debug, Default)]
+pub struct SweepPoint {
+    /// The excitation frequency ω [rad/s].
+    pub frequency: f64,
+    /// Peak-to-peak/2 of each displacement output.
+    pub amplitude: Vec<f64>,
+    /// The same, contact-free.
+    pub linear_amplitude: Vec<f64>,
+    /// Largest contact force over the period, per contact.
+    pub max_force: Vec<f64>,
+    /// Fraction of the instants with a force, per contact.
+    pub contact_fraction: Vec<f64>,
+    pub lcp_size: usize,
+    /// Pivots (or block exchanges plus pivots) of the point's final solve.
+    pub pivots: usize,
+    /// The solve started from the previous point's active set.
+    pub warm_start_used: bool,
+    /// The warm-started solve failed and a cold solve was made.
+    pub cold_fallback: bool,
+    /// Wall time of the point (both solves if there was a fallback) [s].
+    pub time_s: f64,
+    /// Assembly and LCP times of the final solve [s].
+    pub assembly_s: f64,
+    pub lcp_s: f64,
+    /// The failure, if the point could not be solved.
+    pub error: Option<String>,
+    /// Active set of the solution (warm start of a neighbour).
+    pub active_set: Vec<usize>,
+}
+
+impl SweepPoint {
+    fn from_response(problem: &PeriodicProblem, frequency: f64, r: &Response) -> SweepPoint {
+        let amp = |m: &std::collections::BTreeMap<String, Vec<f64>>| -> Vec<f64> {
+            problem.outputs.displacement.iter().map(|d| m.get(&d.to_string()).map_or(f64::NAN, |s| Response::peak_to_peak(s) / 2.0)).collect()
+        };
+        SweepPoint {
+            frequency,
+            amplitude: amp(&r.displacement),
+            linear_amplitude: amp(&r.linear_displacement),
+            max_force: r.contacts.iter().map(|c| c.force.iter().copied().fold(0.0, f64::max)).collect(),
+            contact_fraction: (0..r.contacts.len()).map(|i| r.contact_fraction(i)).collect(),
+            lcp_size: r.lcp.size,
+            pivots: r.lcp.pivots,
+            warm_start_used: false,
+            cold_fallback: false,
+            time_s: 0.0,
+            assembly_s: r.timing_s.assembly,
+            lcp_s: r.timing_s.lcp,
+            error: None,
+            active_set: r.active_set.clone(),
+        }
+    }
+}
+
+/// `n` equally spaced values from `from` to `to` (both included): from + (to − from)·i/(n − 1).
+pub fn linspace(from: f64, to: f64, n: usize) -> Vec<f64> {
+    match n {
+        0 => vec![],
+        1 => vec![from],
+        _ => (0..n).map(|i| from + (to - from) * i as f64 / (n - 1) as f64).collect(),
+    }
+}
+
+/// Solves `problem` at one frequency, warm-started if `warm` is given, cold if that fails.
+/// Returns the response (or the error) and whether a cold fallback was needed.
+pub fn solve_point(problem: &mut PeriodicProblem, fft: &PeriodFft, frequency: f64, warm: Option<&[usize]>) -> (Result<Response, String>, bool) {
+    problem.model.frequency = frequency;
+    match problem.solve_with(fft, warm) {
+        Ok(r) => (Ok(r), false),
+        Err(e) if warm.is_none() => (Err(e.to_string()), false),
+        Err(_) => (problem.solve_with(fft, None).map_err(|e| e.to_string()), true),
+    }
+}
+
+/// Runs the sweep over `frequencies` (any order; chunks are contiguous in the given order).
+/// `on_point` is called after each point (from worker threads), e.g. to advance a progress bar.
+pub fn run(template: &PeriodicProblem, frequencies: &[f64], settings: &SweepSettings, on_point: &(dyn Fn() + Sync)) -> Result<Vec<SweepPoint>, String> {
+    if let Some(f) = frequencies.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
+        return Err(format!("frequency: {f} is not a finite angular frequency > 0 [rad/s]"));
+    }
+    let mut template = template.clone();
+    // Parallelism is over points: each solve stays on its thread.
+    template.solver.parallel = false;
+    let fft = PeriodFft::new(template.disc.steps);
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(settings.threads).build().map_err(|e| format!("threads: {e}"))?;
+    let threads = pool.current_num_threads().max(1);
+    let n = frequencies.len();
+    let chunks = (threads * settings.chunks_per_thread.max(1)).min(n).max(1);
+    let bounds: Vec<(usize, usize)> = (0..chunks).map(|c| (c * n / chunks, (c + 1) * n / chunks)).collect();
+    let results: Vec<Vec<SweepPoint>> = pool.install(|| {
+        bounds
+            .par_iter()
+            .map(|&(lo, hi)| {
+                let mut problem = template.clone();
+                let fft = fft.clone();
+                let mut prev: Option<Vec<usize>> = None;
+                let mut out = Vec::with_capacity(hi - lo);
+                for &f in &frequencies[lo..hi] {
+                    let t = Instant::now();
+                    let warm = if settings.warm_start { prev.as_deref() } else { None };
+                    let (r, fallback) = solve_point(&mut problem, &fft, f, warm);
+                    let mut point = match &r {
+                        Ok(r) => SweepPoint::from_response(&problem, f, r),
+                        Err(e) => SweepPoint { frequency: f, error: Some(e.clone()), ..Default::default() },
+                    };
+                    point.warm_start_used = warm.is_some() && !fallback && r.is_ok();
+                    point.cold_fallback = fallback;
+                    point.time_s = t.elapsed().as_secs_f64();
+                    prev = r.ok().map(|r| r.active_set);
+                    out.push(point);
+                    on_point();
+                }
+                out
+            })
+            .collect()
+    });
+    Ok(results.into_iter().flatten().collect())
+}
+
+/// The CSV of a sweep: the parameter, amplitude per displacement output (nonlinear, then
+/// linear), max force and contact fraction per contact, LCP size, pivots, warm start, fallback,
+/// time and status.
+pub fn to_csv(param: &str, values: &[f64], problem: &PeriodicProblem, points: &[SweepPoint]) -> String {
+    let mut s = String::new();
+    let mut head = vec![param.to_string()];
+    if param != "frequency" {
+        head.push("frequency".into());
+    }
+    head.extend(problem.outputs.displacement.iter().map(|d| format!("amplitude_{d}")));
+    head.extend(problem.outputs.displacement.iter().map(|d| format!("linear_amplitude_{d}")));
+    let contact_dofs = contact_labels(problem);
+    head.extend(contact_dofs.iter().enumerate().map(|(i, d)| format!("max_force_c{i}_dof{d}")));
+    head.extend(contact_dofs.iter().enumerate().map(|(i, d)| format!("contact_fraction_c{i}_dof{d}")));
+    head.extend(["lcp_size", "pivots", "warm_start_used", "cold_fallback", "time_s", "status"].map(String::from));
+    s.push_str(&head.join(","));
+    s.push('\n');
+    for (v, p) in values.iter().zip(points) {
+        let mut row = vec![v.to_string()];
+        if param != "frequency" {
+            row.push(p.frequency.to_string());
+        }
+        let nd = problem.outputs.displacement.len();
+        let nc = contact_dofs.len();
+        let num = |x: Option<&f64>| x.map_or("nan".to_string(), |x| format!("{x:e}"));
+        row.extend((0..nd).map(|i| num(p.amplitude.get(i))));
+        row.extend((0..nd).map(|i| num(p.linear_amplitude.get(i))));
+        row.extend((0..nc).map(|i| num(p.max_force.get(i))));
+        row.extend((0..nc).map(|i| num(p.contact_fraction.get(i))));
+        row.push(p.lcp_size.to_string());
+        row.push(p.pivots.to_string());
+        row.push(u8::from(p.warm_start_used).to_string());
+        row.push(u8::from(p.cold_fallback).to_string());
+        row.push(format!("{:.6}", p.time_s));
+        row.push(match &p.error {
+            None => "solved".to_string(),
+            Some(e) => format!("\"{}\"", e.replace('"', "'")),
+        });
+        s.push_str(&row.join(","));
+        s.push('\n');
+    }
+    s
+}
+
+/// The user's DOF of each contact.
+pub fn contact_labels(problem: &PeriodicProblem) -> Vec<usize> {
+    match &problem.output_map {
+        Some(m) if !m.contact_dofs.is_empty() => m.contact_dofs.clone(),
+        _ => problem.model.contacts.iter().map(|c| c.dof).collect(),
+    }
+}
+
+/// The frequency of the largest value of `amplitude(point)` over the solved points, if any.
+pub fn peak(points: &[SweepPoint], amplitude: impl Fn(&SweepPoint) -> f64) -> Option<(f64, f64)> {
+    points
+        .iter()
+        .filter(|p| p.error.is_none())
+        .map(|p| (p.frequency, amplitude(p)))
+        .filter(|(_, a)| a.is_finite())
+        .fold(None, |best: Option<(f64, f64)>, (f, a)| match best {
+            Some((_, b)) if b >= a => best,
+            _ => Some((f, a)),
+        })
+}
+
+/// PNG of the frequency-response curve of displacement output `i`: with contact and linear.
+#[cfg(feature = "plots")]
+pub fn plot_frc(path: &std::path::Path, param: &str, values: &[f64], problem: &PeriodicProblem, points: &[SweepPoint], i: usize, title: &str) -> Result<(), String> {
+    use crate::plot::{line_chart, Chart, Scale, Series};
+    let d = problem.outputs.displacement[i];
+    let pts = |lin: bool| -> Vec<(f64, f64)> {
+        values
+            .iter()
+            .zip(points)
+            .filter(|(_, p)| p.error.is_none())
+            .map(|(v, p)| (*v, if lin { p.linear_amplitude[i] } else { p.amplitude[i] }))
+            .collect()
+    };
+    let series = [
+        Series { label: "with contact".into(), points: pts(false), markers: false },
+        Series { label: "linear (contact-free)".into(), points: pts(true), markers: false },
+    ];
+    let x_label = match param {
+        "speed" => "rotation speed Ω [rad/s]",
+        _ => "excitation frequency ω [rad/s]",
+    };
+    let y_label = format!("amplitude of DOF {d} (peak-to-peak / 2)");
+    let chart = Chart { title, x_label, y_label: &y_label, x_scale: Scale::Linear, y_scale: Scale::Linear };
+    line_chart(path, &chart, &series, 1000, 650)
+}

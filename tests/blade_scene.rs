@@ -1,0 +1,317 @@
+//! Scenes with finite-element input: Matrix Market files, fixed DOFs, the blade generator with
+//! named nodes, the Craig–Bampton reduction (eigenfrequencies and periodic responses against the
+//! full model), the casing, and the error messages.
+use periodic_contact::fe::{write_matrix_market, Blade, BladeParams};
+use periodic_contact::model::Harmonic;
+use periodic_contact::reduction::sparse_modes;
+use periodic_contact::response::Response;
+use periodic_contact::scene::{Scene, SceneModel};
+use std::path::{Path, PathBuf};
+
+fn build(text: &str) -> SceneModel {
+    Scene::parse(text, "test.toml").unwrap().build("test.toml").unwrap()
+}
+
+fn build_err(text: &str) -> String {
+    match Scene::parse(text, "bad.toml").and_then(|s| s.build("bad.toml")) {
+        Ok(_) => panic!("accepted:\n{text}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+fn coarse_scene() -> String {
+    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("fmu/scenes/blade-casing-coarse.toml")).unwrap()
+}
+
+/// The coarse blade scene with its [reduction] section replaced (`None`: no reduction).
+fn blade_scene(reduction: Option<&str>, damping: &str, steps: usize, frequency: f64) -> String {
+    let base = coarse_scene();
+    let mut out = String::new();
+    let mut skip = false;
+    for line in base.lines() {
+        if line.starts_with('[') {
+            skip = line == "[reduction]" || line == "[damping]" || line == "[excitation]" || line == "[discretization]";
+        }
+        if !skip {
+            out.push_str(line);
+            out.push('\n');
+        }
+    }
+    if let Some(r) = reduction {
+        out.push_str(&format!("[reduction]\nmethod = \"craig-bampton\"\n{r}\n"));
+    }
+    out.push_str(&format!("[damping]\n{damping}\n[excitation]\nfrequency = {frequency}\n"));
+    out.push_str(&format!("[discretization]\nscheme = \"cds\"\nsteps = {steps}\npairing = \"same\"\n"));
+    out
+}
+
+#[test]
+fn reduced_eigenfrequencies_converge_to_the_full_ones_through_the_scene() {
+    let full_scene = build(&blade_scene(None, "rayleigh = [0.0, 0.0]", 64, 2300.0));
+    let s = &full_scene.full;
+    let (periodic_contact::model::Matrix::Sparse(k), periodic_contact::model::Matrix::Sparse(m)) = (&s.stiffness, &s.mass) else {
+        panic!("the generator gives sparse matrices")
+    };
+    let full = sparse_modes(k, m, 5).unwrap().omega;
+    let mut previous = f64::INFINITY;
+    for eta in [2, 4, 6, 10, 15] {
+        let b = build(&blade_scene(Some(&format!("modes = {eta}")), "modal_ratios = [0.005]", 64, 2300.0));
+        let red = b.reduction.as_ref().unwrap();
+        assert_eq!((red.n_boundary(), red.n_modes()), (3, eta));
+        let w = red.modes(5).unwrap().omega;
+        let worst = w.iter().zip(&full).map(|(r, f)| (r - f) / f).fold(0.0f64, f64::max);
+        eprintln!("η = {eta:>2}: worst relative difference of the first five eigenfrequencies {worst:.3e}");
+        assert!(worst >= -1e-9 && worst <= previous * (1.0 + 1e-9), "η = {eta}: {worst:e} after {previous:e}");
+        previous = worst;
+    }
+    // The default η (no `modes` key).
+    let b = build(&blade_scene(Some(""), "modal_ratios = [0.005]", 64, 2300.0));
+    let red = b.reduction.as_ref().unwrap();
+    assert_eq!(red.n_modes(), periodic_contact::reduction::DEFAULT_MODES);
+    let w = red.modes(5).unwrap().omega;
+    let worst = w.iter().zip(&full).map(|(r, f)| ((r - f) / f).abs()).fold(0.0f64, f64::max);
+    eprintln!("default η = {}: worst {worst:.3e}", red.n_modes());
+    assert!(worst < 1e-3, "{worst:e}");
+    assert!(worst <= previous);
+}
+
+/// max_j |a_j − b_j| / amplitude(b), per output key of b.
+fn rel_diff(a: &Response, b: &Response) -> Vec<(String, f64)> {
+    b.displacement
+        .iter()
+        .map(|(key, xb)| {
+            let xa = &a.displacement[key];
+            let amp = Response::peak_to_peak(xb) / 2.0;
+            (key.clone(), xa.iter().zip(xb).map(|(p, q)| (p - q).abs()).fold(0.0, f64::max) / amp)
+        })
+        .collect()
+}
+
+#[test]
+fn reduced_periodic_response_converges_to_the_full_sparse_one() {
+    // Rayleigh damping is defined on the full model and projected exactly, so that both models
+    // are the same structure; ζ ≈ 0.5 % at the first mode. ω = 2260 rad/s: in contact.
+    let damping = "rayleigh = [11.3, 2.2e-6]";
+    let (k, omega) = (128, 2260.0);
+    let t = std::time::Instant::now();
+    let full = build(&blade_scene(None, damping, k, omega));
+    assert!(full.problem.model.structure.mass.is_sparse(), "the full model goes through the sparse path");
+    let rf = full.problem.solve().unwrap();
+    eprintln!("full coarse blade ({} DOFs, k = {k}): {:.2} s, LCP size {}", full.full.n(), t.elapsed().as_secs_f64(), rf.lcp.size);
+    assert!(rf.contacts[0].force.iter().any(|&f| f > 0.0), "the point is in contact");
+    let mut previous = f64::INFINITY;
+    let mut last = f64::NAN;
+    for eta in [1, 2, 5, 10, 20] {
+        let red = build(&blade_scene(Some(&format!("modes = {eta}")), damping, k, omega));
+        let rr = red.problem.solve().unwrap();
+        assert_eq!(rr.displacement.keys().collect::<Vec<_>>(), rf.displacement.keys().collect::<Vec<_>>(), "same output keys (full numbering)");
+        let d = rel_diff(&rr, &rf);
+        let worst = d.iter().map(|x| x.1).fold(0.0, f64::max);
+        let fmax = |r: &Response| r.contacts[0].force.iter().copied().fold(0.0, f64::max);
+        let txt: Vec<String> = d.iter().map(|(k, e)| format!("DOF {k}: {e:.2e}")).collect();
+        eprintln!("η = {eta:>2}: max |x_red − x_full| / amplitude {}; max force LE {:.4} (full {:.4})", txt.join(", "), fmax(&rr), fmax(&rf));
+        assert!(worst < previous * 1.02, "η = {eta}: {worst:e} did not decrease from {previous:e}");
+        previous = worst;
+        last = worst;
+    }
+    assert!(last < 1e-3, "default η: {last:e}");
+}
+
+fn tmpdir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("pc-blade-scene-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn sparse(rows: &[Vec<f64>]) -> faer::sparse::SparseColMat<usize, f64> {
+    let mut t = Vec::new();
+    for (i, r) in rows.iter().enumerate() {
+        for (j, &v) in r.iter().enumerate() {
+            if v != 0.0 {
+                t.push(faer::sparse::Triplet::new(i, j, v));
+            }
+        }
+    }
+    faer::sparse::SparseColMat::try_new_from_triplets(rows.len(), rows.len(), &t).unwrap()
+}
+
+/// A chain of 6 masses with springs between neighbours and to the ground at DOF 0.
+fn chain() -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
+    let n = 6;
+    let mut k = vec![vec![0.0; n]; n];
+    let mut m = vec![vec![0.0; n]; n];
+    for i in 0..n {
+        m[i][i] = 1.0 + 0.1 * i as f64;
+        k[i][i] += if i == 0 { 2.0 } else { 1.0 };
+        if i + 1 < n {
+            k[i][i] += 1.0;
+            k[i][i + 1] = -1.0;
+            k[i + 1][i] = -1.0;
+        }
+    }
+    (m, k)
+}
+
+fn rows_toml(a: &[Vec<f64>]) -> String {
+    let r: Vec<String> = a.iter().map(|r| format!("[{}]", r.iter().map(|v| format!("{v:?}")).collect::<Vec<_>>().join(", "))).collect();
+    format!("[{}]", r.join(", "))
+}
+
+#[test]
+fn matrix_market_scene_with_fixed_dofs_matches_the_inline_clamped_model() {
+    let dir = tmpdir("mtx");
+    let (m, k) = chain();
+    let c: Vec<Vec<f64>> = k.iter().map(|r| r.iter().map(|v| 0.02 * v).collect()).collect();
+    write_matrix_market(&dir.join("M.mtx"), &sparse(&m), true).unwrap();
+    write_matrix_market(&dir.join("K.mtx"), &sparse(&k), true).unwrap();
+    write_matrix_market(&dir.join("C.mtx"), &sparse(&c), true).unwrap();
+    let tail = |shift: usize| {
+        format!(
+            "[excitation]\nfrequency = 0.7\n[[force]]\ndof = {}\namplitude = 0.4\n[[contact]]\ndof = {}\ngap = 0.3\n[discretization]\nsteps = 128\n[output]\ndisplacement = [{}, {}]\nvelocity = [{}]\n",
+            3 - shift,
+            5 - shift,
+            5 - shift,
+            3 - shift,
+            5 - shift
+        )
+    };
+    // The file scene clamps DOF 0; everything keeps the file's numbering.
+    let file_scene = format!(
+        "[structure]\nmass = {{ matrix_market = \"M.mtx\" }}\nstiffness = {{ matrix_market = \"K.mtx\" }}\nfixed = [0]\n[damping]\nmatrix = {{ matrix_market = \"C.mtx\" }}\n{}",
+        tail(0)
+    );
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, &file_scene).unwrap();
+    let (scene, d) = Scene::load(&path).unwrap();
+    let built = scene.build_in(&path.display().to_string(), &d).unwrap();
+    assert!(built.problem.model.structure.mass.is_sparse());
+    let r = built.problem.solve().unwrap();
+    // The inline model of DOFs 1..5 (DOF 0 removed), numbered from 0.
+    let keep = |a: &Vec<Vec<f64>>| -> Vec<Vec<f64>> { a[1..].iter().map(|r| r[1..].to_vec()).collect() };
+    let inline = format!(
+        "[structure]\nmass = {}\nstiffness = {}\n[damping]\nmatrix = {}\n{}",
+        rows_toml(&keep(&m)),
+        rows_toml(&keep(&k)),
+        rows_toml(&keep(&c)),
+        tail(1)
+    );
+    let ri = build(&inline).problem.solve().unwrap();
+    assert!(ri.contacts[0].force.iter().any(|&f| f > 0.0), "the contact closes");
+    for (file_key, inline_key) in [("5", "4"), ("3", "2")] {
+        let (a, b) = (&r.displacement[file_key], &ri.displacement[inline_key]);
+        let e = a.iter().zip(b).map(|(p, q)| (p - q).abs()).fold(0.0, f64::max);
+        assert!(e < 1e-12, "DOF {file_key}: {e:e}");
+    }
+    assert!(r.velocity.contains_key("5"));
+    assert_eq!(r.contacts[0].dof, 5, "the contact reports the file's DOF");
+    assert_eq!(ri.contacts[0].dof, 4);
+
+    // The same file model reduced with every internal mode kept is the full model.
+    let reduced = file_scene.replace("[excitation]", "[reduction]\nmethod = \"craig-bampton\"\nmodes = 3\nextra_boundary = [3]\n[excitation]");
+    std::fs::write(&path, &reduced).unwrap();
+    let (scene, d) = Scene::load(&path).unwrap();
+    let rr = scene.build_in(&path.display().to_string(), &d).unwrap().problem.solve().unwrap();
+    assert!(rr.effects.contains(&"reduction".to_string()));
+    for key in ["5", "3"] {
+        let e = rr.displacement[key].iter().zip(&r.displacement[key]).map(|(p, q)| (p - q).abs()).fold(0.0, f64::max);
+        assert!(e < 1e-9, "DOF {key}: {e:e}");
+    }
+
+    // Naming a fixed DOF is refused, naming the field.
+    std::fs::write(&path, file_scene.replace("dof = 5\ngap", "dof = 0\ngap")).unwrap();
+    let (scene, d) = Scene::load(&path).unwrap();
+    let e = scene.build_in(&path.display().to_string(), &d).unwrap_err().to_string();
+    assert!(e.contains("scene.toml") && e.contains("contact[0].dof") && e.contains("fixed"), "{e}");
+    std::fs::write(&path, file_scene.replace("displacement = [5, 3]", "displacement = [5, 0]")).unwrap();
+    let (scene, d) = Scene::load(&path).unwrap();
+    let e = scene.build_in(&path.display().to_string(), &d).unwrap_err().to_string();
+    assert!(e.contains("output.displacement[1]") && e.contains("fixed"), "{e}");
+    // A missing file names the field and the file.
+    std::fs::write(&path, file_scene.replace("K.mtx", "missing.mtx")).unwrap();
+    let (scene, d) = Scene::load(&path).unwrap();
+    let e = scene.build_in(&path.display().to_string(), &d).unwrap_err().to_string();
+    assert!(e.contains("structure.stiffness.matrix_market") && e.contains("missing.mtx"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn blade_scene_outputs_keep_the_full_numbering_and_the_casing_follows_its_formula() {
+    let b = build(&coarse_scene());
+    let blade = Blade::generate(&BladeParams::coarse()).unwrap();
+    let (le, mc, te) = (blade.node_dof("LE").unwrap(), blade.node_dof("MC").unwrap(), blade.node_dof("TE").unwrap());
+    let mcy = blade.dof(blade.named_node("MC").unwrap(), 1).unwrap();
+    assert_eq!(b.contact_dofs, vec![le, mc, te]);
+    assert_eq!(b.problem.outputs.displacement, vec![mcy, le, te]);
+    let r = b.problem.solve().unwrap();
+    let keys: Vec<String> = [mcy, le, te].iter().map(|d| d.to_string()).collect();
+    assert!(keys.iter().all(|k| r.displacement.contains_key(k)), "{:?}", r.displacement.keys());
+    assert_eq!(r.contacts.iter().map(|c| c.dof).collect::<Vec<_>>(), vec![le, mc, te]);
+    assert!(r.effects.contains(&"reduction".to_string()) && r.effects.contains(&"moving_obstacle".to_string()));
+    // A boundary DOF is recovered exactly: the LE output is the reduced coordinate.
+    let red = b.reduction.as_ref().unwrap();
+    assert_eq!(red.boundary, vec![le, mc, te]);
+
+    // gap_i(t) = g0 − δ cos(ω t + EO·s_i/R), s_LE = +(c_tip/2) sin γ (the leading edge leads),
+    // s_MC = 0, s_TE = −(c_tip/2) sin γ; c_tip = chord·taper.
+    let (lobes, depth, radius, stagger) = (3.0, 1e-5, 0.25, 40f64.to_radians());
+    let c_tip = 0.05 * 0.8;
+    let s = [0.5 * c_tip * stagger.sin(), 0.0, -0.5 * c_tip * stagger.sin()];
+    for (i, c) in b.problem.model.contacts.iter().enumerate() {
+        assert_eq!(c.motion.len(), 1);
+        let h: &Harmonic = &c.motion[0];
+        assert_eq!((h.amplitude, h.harmonic), (-depth, 1));
+        let phase = lobes * s[i] / radius;
+        assert!((h.phase - phase).abs() < 1e-12, "contact {i}: phase {} expected {phase}", h.phase);
+        let w = b.problem.model.frequency;
+        for t in [0.0, 1e-4, 7e-4] {
+            let expected = 3e-5 - depth * (w * t + phase).cos();
+            assert!((c.gap_at(w, t) - expected).abs() < 1e-18);
+        }
+    }
+    // The leading edge meets each lobe crest first: its phase leads the trailing edge's.
+    assert!(b.problem.model.contacts[0].motion[0].phase > b.problem.model.contacts[2].motion[0].phase);
+}
+
+#[test]
+fn bad_scenes_name_the_file_the_field_and_the_value() {
+    let blade = coarse_scene();
+    let cases: Vec<(String, Vec<&str>)> = vec![
+        (blade.replace("kind = \"blade\"", "kind = \"disk\""), vec!["structure.generator.kind", "disk"]),
+        (blade.replace("preset = \"coarse\"", "preset = \"coarse\", lenght = 0.1"), vec!["structure.generator", "lenght", "length"]),
+        (blade.replace("preset = \"coarse\"", "preset = \"coarse\", taper = -1.0"), vec!["structure.generator", "taper", "-1"]),
+        (blade.replace("node = \"TE\"", "node = \"XX\""), vec!["contact[2].node", "XX", "LE, MC, TE"]),
+        (blade.replace("axis = \"y\"", "axis = \"w\""), vec!["force[0].node", "\"w\""]),
+        (blade.replace("method = \"craig-bampton\"", "method = \"guyan\""), vec!["reduction.method", "guyan"]),
+        (blade.replace("modes = 20", "modes = 5000"), vec!["reduction.modes", "5000"]),
+        (blade.replace("modal_ratios = [0.005]", "modal_ratios = [-0.1]"), vec!["damping.modal_ratios[0]", "-0.1"]),
+        (blade.replace("lobes = 3", "lobes = 0"), vec!["casing.lobes", "0"]),
+        (blade.replace("depth = 1e-5", "depth = -1e-5"), vec!["casing.depth", "-0.00001"]),
+        (blade.replace("radius = 0.25", "radius = 0.25\nspeed = 100.0"), vec!["casing.speed", "100", "excitation.frequency"]),
+        (blade.replace("[\"MC:y\", \"LE\", \"TE\"]", "[\"MC:q\"]"), vec!["output.displacement[0]", "\"q\""]),
+        (blade.replace("[\"MC:y\", \"LE\", \"TE\"]", "[99999]"), vec!["output.displacement[0]", "99999"]),
+        (blade.replace("node = \"LE\"", "node = \"LE\"\ndof = 3"), vec!["contact[0]", "either dof or node"]),
+        (blade.replace("generator = {", "mass = [[1.0]]\ngenerator = {"), vec!["structure", "not both"]),
+    ];
+    for (text, needles) in cases {
+        let e = build_err(&text);
+        assert!(e.starts_with("bad.toml: "), "names the file: {e}");
+        for n in needles {
+            assert!(e.contains(n), "`{n}` missing from: {e}");
+        }
+    }
+    let inline = "[structure]\nmass = [[1.0]]\nstiffness = [[1.0]]\n[excitation]\nfrequency = 1.0\n";
+    let cases: Vec<(String, Vec<&str>)> = vec![
+        (format!("{inline}[[contact]]\nnode = \"LE\"\ngap = 0.1\n"), vec!["contact[0].node", "structure.generator"]),
+        (format!("{inline}[damping]\nmodal_ratios = [0.01]\n"), vec!["damping.modal_ratios", "[reduction]"]),
+        (format!("{inline}[[contact]]\ndof = 0\ngap = 0.1\n[casing]\nlobes = 2\ndepth = 0.01\nradius = 1.0\n"), vec!["casing.arc"]),
+        (inline.replace("mass = [[1.0]]", "mass = { matrix_market = 3 }"), vec!["structure.mass", "matrix_market"]),
+        (inline.replace("[structure]\n", "[structure]\nfixed = [4]\n"), vec!["structure.fixed", "4"]),
+    ];
+    for (text, needles) in cases {
+        let e = build_err(&text);
+        assert!(e.starts_with("bad.toml: "), "names the file: {e}");
+        for n in needles {
+            assert!(e.contains(n), "`{n}` missing from: {e}");
+        }
+    }
+}

@@ -1,0 +1,184 @@
+//! Frequency sweeps of the coarse blade rubbing the casing: speed, the contact-induced shift of
+//! the resonance, warm against cold starts, spectra, the CLI, and agreement with time marching.
+use periodic_contact::periodic::{PeriodFft, PeriodicProblem};
+use periodic_contact::scene::Scene;
+use periodic_contact::sweep::{self, marching, SweepSettings};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+fn coarse() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("fmu/scenes/blade-casing-coarse.toml")
+}
+
+fn problem() -> PeriodicProblem {
+    let (s, dir) = Scene::load(&coarse()).unwrap();
+    s.build_in("blade-casing-coarse.toml", &dir).unwrap().problem
+}
+
+#[test]
+fn coarse_blade_sweep_of_300_points_shows_the_stiffening_shift_of_the_resonance() {
+    let t = Instant::now();
+    let p = problem();
+    let setup = t.elapsed().as_secs_f64();
+    let freqs = sweep::linspace(2000.0, 2700.0, 300);
+    let t = Instant::now();
+    let points = sweep::run(&p, &freqs, &SweepSettings::default(), &|| {}).unwrap();
+    let wall = t.elapsed().as_secs_f64();
+    let warm = points.iter().filter(|x| x.warm_start_used).count();
+    eprintln!("coarse blade: set-up {setup:.2} s, 300-point sweep {wall:.2} s wall, {warm} warm-started");
+    assert!(setup + wall < 60.0, "{setup} + {wall} s");
+    assert!(points.iter().all(|x| x.error.is_none()), "every point solves");
+    assert!(warm > 250, "warm starts are used: {warm}");
+    // Output 0 is the tip flap displacement (MC:y).
+    let (f_lin, a_lin) = sweep::peak(&points, |x| x.linear_amplitude[0]).unwrap();
+    let (f_nl, a_nl) = sweep::peak(&points, |x| x.amplitude[0]).unwrap();
+    eprintln!("linear peak {a_lin:.4e} at ω = {f_lin:.2}; with contact {a_nl:.4e} at ω = {f_nl:.2} ({:+.2} %)", 100.0 * (f_nl / f_lin - 1.0));
+    // The linear peak is the first bending mode (2 264.6 rad/s for the coarse blade).
+    assert!((f_lin / 2264.64 - 1.0).abs() < 2e-3, "{f_lin}");
+    // The stiff casing contact stiffens the blade: the peak moves up, by more than 2 %, and the
+    // contact limits the amplitude.
+    assert!(f_nl > 1.02 * f_lin, "peak with contact at {f_nl}, linear at {f_lin}");
+    assert!(a_nl < a_lin);
+    // Off resonance there is no contact and both curves coincide.
+    for x in points.iter().filter(|x| x.frequency < 2150.0 || x.frequency > 2450.0) {
+        assert!(x.max_force.iter().all(|&f| f == 0.0), "contact at ω = {}", x.frequency);
+        assert!((x.amplitude[0] - x.linear_amplitude[0]).abs() <= 1e-9 * x.linear_amplitude[0]);
+    }
+    // Contact on the branch leading to the shifted peak (above it the response has jumped down).
+    let near = points.iter().filter(|x| x.frequency > f_nl - 40.0 && x.frequency <= f_nl).all(|x| x.contact_fraction[0] > 0.0);
+    assert!(near, "the leading edge rubs near the shifted peak");
+}
+
+#[test]
+fn warm_starts_save_pivots_and_agree_with_cold_solves_where_the_solution_is_unique() {
+    let p = problem();
+    let freqs = sweep::linspace(2150.0, 2450.0, 61);
+    let one = SweepSettings { threads: 1, chunks_per_thread: 1, ..Default::default() };
+    let warm = sweep::run(&p, &freqs, &one, &|| {}).unwrap();
+    let cold = sweep::run(&p, &freqs, &SweepSettings { warm_start: false, ..one.clone() }, &|| {}).unwrap();
+    let (pw, pc): (usize, usize) = (warm.iter().map(|x| x.pivots).sum(), cold.iter().map(|x| x.pivots).sum());
+    eprintln!("pivots: warm {pw}, cold {pc}");
+    assert!(pw < pc);
+    assert!(warm.iter().skip(1).all(|x| x.warm_start_used && !x.cold_fallback));
+    // Below the fold (ω < 2 320 rad/s) the periodic solution is unique: both agree.
+    for (w, c) in warm.iter().zip(&cold).filter(|(w, _)| w.frequency < 2320.0) {
+        for i in 0..w.amplitude.len() {
+            assert!((w.amplitude[i] - c.amplitude[i]).abs() <= 1e-8 * c.amplitude[i], "ω = {}: {} vs {}", w.frequency, w.amplitude[i], c.amplitude[i]);
+        }
+    }
+    // The sweep gives the same answers on two threads in contiguous chunks.
+    let two = sweep::run(&p, &freqs, &SweepSettings { threads: 2, chunks_per_thread: 2, ..Default::default() }, &|| {}).unwrap();
+    for (a, b) in two.iter().zip(&warm).filter(|(a, _)| a.frequency < 2320.0) {
+        assert_eq!(a.frequency, b.frequency);
+        assert!((a.amplitude[0] - b.amplitude[0]).abs() <= 1e-8 * b.amplitude[0]);
+    }
+}
+
+#[test]
+fn spectrum_of_a_cosine_and_of_the_rubbing_blade() {
+    let fft = PeriodFft::new(64);
+    let x: Vec<f64> = (0..64).map(|j| 0.5 + 2.0 * (3.0 * 2.0 * std::f64::consts::PI * j as f64 / 64.0 + 0.3).cos()).collect();
+    let a = sweep::spectrum::harmonic_amplitudes(&fft, &x);
+    assert!((a[0] - 0.5).abs() < 1e-12 && (a[3] - 2.0).abs() < 1e-12);
+    assert!(a.iter().enumerate().filter(|(p, _)| *p != 0 && *p != 3).all(|(_, v)| v.abs() < 1e-12));
+
+    let mut p = problem();
+    p.model.frequency = 2300.0;
+    let r = p.solve().unwrap();
+    let s = sweep::spectrum::spectrum(&p, &r, 20);
+    assert_eq!(s.displacement.len(), 3);
+    assert_eq!(s.force.len(), 3);
+    let (_, flap) = &s.displacement[0];
+    // The flap response is dominated by the forced harmonic; the rubbing force is rich in
+    // higher harmonics.
+    assert!(flap[1] > 10.0 * flap[2..].iter().copied().fold(0.0, f64::max));
+    let le = &s.force[0].2;
+    assert!(le[0] > 0.0 && le[1] > 0.0 && le[2] > 0.1 * le[1] && le[3] > 0.01 * le[1], "{le:?}");
+}
+
+#[test]
+fn time_marching_agrees_with_the_lcp_at_three_sweep_points() {
+    let p = problem();
+    let opts = marching::MarchOptions { tolerances: vec![1e-6], reference_factor: 0, ..Default::default() };
+    for f in [2220.0, 2260.0, 2300.0] {
+        let c = marching::compare(&p, f, &opts).unwrap();
+        let r = &c.runs[0];
+        assert!(c.response.contacts[0].force.iter().any(|&x| x > 0.0), "ω = {f} is in contact");
+        let txt: Vec<String> = r.error_vs_lcp.iter().map(|e| e.map_or("—".into(), |e| format!("{e:.2e}"))).collect();
+        eprintln!(
+            "ω = {f}: march N = {}/period, {} periods, {:.3} s; LCP (cold) {:.4} s; max |x_march − x_LCP| / amplitude (MC:y, LE, TE): {}",
+            c.steps_per_period,
+            r.periods,
+            r.time_s,
+            c.lcp_time_s,
+            txt.join(", ")
+        );
+        assert!(r.converged);
+        // Both are second-order discretisations of the same orbit (measured ≤ 1.3e-3 with
+        // k = 512 and N ≈ 1 000): agreement within 5e-3 of the amplitude.
+        for e in &r.error_vs_lcp {
+            assert!(e.unwrap() < 5e-3, "ω = {f}: {e:?}");
+        }
+    }
+}
+
+fn cli() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_periodic-contact"))
+}
+
+#[test]
+fn cli_sweep_writes_the_csv_the_curves_and_the_spectra() {
+    let dir = std::env::temp_dir().join(format!("pc-sweep-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("s.csv");
+    let o = cli()
+        .args(["sweep", coarse().to_str().unwrap(), "--from", "2200", "--to", "2400", "--points", "21", "--threads", "2", "--spectrum-at", "2300", "-o"])
+        .arg(&csv)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("21 solved, 0 failed"), "{err}");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(head[0], "frequency");
+    for col in ["amplitude_1903", "linear_amplitude_1868", "max_force_c0_dof1868", "contact_fraction_c2_dof1940", "lcp_size", "pivots", "warm_start_used", "time_s", "status"] {
+        assert!(head.contains(&col), "{col} missing from {head:?}");
+    }
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 21);
+    assert_eq!(rows[10][0].parse::<f64>().unwrap(), 2300.0);
+    assert!(rows.iter().all(|r| r.last() == Some(&"solved") && r[head.iter().position(|c| *c == "lcp_size").unwrap()] == "1536"));
+    if cfg!(feature = "plots") {
+        for f in ["s.png", "s-dof1868.png", "s-spectrum-2300.png"] {
+            assert!(std::fs::metadata(dir.join(f)).map(|m| m.len() > 1000).unwrap_or(false), "{f}");
+        }
+    }
+    let spec = std::fs::read_to_string(dir.join("s-spectrum.csv")).unwrap();
+    assert!(spec.starts_with("frequency,frequency,harmonic,displacement_1903"), "{spec}");
+
+    // `solve --frequency` gives the sweep's point (a cold solve; below the fold it is unique).
+    let out = dir.join("r.json");
+    let o = cli().args(["solve", coarse().to_str().unwrap(), "--frequency", "2300", "-o"]).arg(&out).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    let x: Vec<f64> = v["displacement"]["1903"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+    let amp = periodic_contact::response::Response::peak_to_peak(&x) / 2.0;
+    let col = head.iter().position(|c| *c == "amplitude_1903").unwrap();
+    let swept: f64 = rows[10][col].parse().unwrap();
+    assert!((amp - swept).abs() <= 1e-9 * swept, "{amp} vs {swept}");
+
+    // `modes`: full against reduced.
+    let o = cli().args(["modes", coarse().to_str().unwrap(), "--count", "5"]).output().unwrap();
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success() && text.contains("rel. diff") && text.contains("1944 DOFs") && text.contains("23 DOFs"), "{text}");
+    assert_eq!(text.lines().filter(|l| l.trim_start().starts_with(|c: char| c.is_ascii_digit())).count(), 5, "{text}");
+
+    // Bad arguments exit 2 with a message.
+    let o = cli().args(["sweep", coarse().to_str().unwrap(), "--from", "2200", "--to", "2400", "--param", "pressure"]).output().unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--param"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
