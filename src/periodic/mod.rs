@@ -248,35 +248,14 @@ impl PeriodicProblem {
         (BlockCirculant::new(k, m, blocks), q)
     }
 
+    /// The LCP (A, q) of the period without solving it (for exports and studies).
+    pub fn assemble_lcp(&self, fft: &PeriodFft) -> Result<(BlockCirculant, Vec<f64>), SolveError> {
+        let asm = assembly::assemble(&self.model, &self.disc, &[], fft, self.solver.parallel)?;
+        Ok(self.lcp(&asm, fft))
+    }
+
     fn solve_lcp(&self, a: &BlockCirculant, q: &[f64], warm_start: Option<&[usize]>) -> Result<LcpSolution, SolveError> {
-        if q.is_empty() {
-            return Ok(LcpSolution { outcome: LcpOutcome::Solved, z: vec![], w: vec![], info: Default::default() });
-        }
-        let lemke = || {
-            let settings = LemkeSettings { certify_tol: self.solver.tolerance, warm_start: warm_start.map(<[usize]>::to_vec), ..LemkeSettings::default() };
-            Lemke::new(settings).solve(a, q)
-        };
-        let pivoting = || {
-            let settings = PivotingSettings { certify_tol: self.solver.tolerance, warm_start: warm_start.map(<[usize]>::to_vec), ..PivotingSettings::default() };
-            BlockPivoting::new(settings).solve(&CirculantOperator::new(a), q)
-        };
-        let sol = match self.solver.method {
-            LcpMethod::Lemke => lemke(),
-            LcpMethod::Pivoting => pivoting(),
-            LcpMethod::Auto if q.len() <= AUTO_LEMKE_MAX => lemke(),
-            LcpMethod::Auto => {
-                let fast = pivoting();
-                if fast.outcome == LcpOutcome::Solved {
-                    fast
-                } else {
-                    // The robust fallback: lexicographic Lemke; its pivots add to the fast path's.
-                    let mut sol = lemke();
-                    sol.info.pivots += fast.info.pivots;
-                    sol.info.time_s += fast.info.time_s;
-                    sol
-                }
-            }
-        };
+        let sol = solve_circulant_lcp(a, q, self.solver.method, self.solver.tolerance, warm_start);
         if sol.outcome != LcpOutcome::Solved {
             let hint = match sol.outcome {
                 LcpOutcome::RayTermination => {
@@ -290,5 +269,40 @@ impl PeriodicProblem {
             return Err(SolveError::Lcp { outcome: sol.outcome, info: sol.info, hint: hint.into() });
         }
         Ok(sol)
+    }
+}
+
+/// Solves a block-circulant LCP with `method` (the engine's logic: `auto` uses lexicographic
+/// Lemke up to [`AUTO_LEMKE_MAX`], above it block pivoting with FFT products, falling back to
+/// Lemke when that fails). Used by the engine and by `periodic-contact lcp` for a raw LCP whose
+/// matrix is block-circulant.
+pub fn solve_circulant_lcp(a: &BlockCirculant, q: &[f64], method: LcpMethod, tolerance: f64, warm_start: Option<&[usize]>) -> LcpSolution {
+    if q.is_empty() {
+        return LcpSolution { outcome: LcpOutcome::Solved, z: vec![], w: vec![], info: Default::default() };
+    }
+    let lemke = || {
+        let settings = LemkeSettings { certify_tol: tolerance, warm_start: warm_start.map(<[usize]>::to_vec), ..LemkeSettings::default() };
+        Lemke::new(settings).solve(a, q)
+    };
+    let pivoting = || {
+        let settings = PivotingSettings { certify_tol: tolerance, warm_start: warm_start.map(<[usize]>::to_vec), ..PivotingSettings::default() };
+        BlockPivoting::new(settings).solve(&CirculantOperator::new(a), q)
+    };
+    match method {
+        LcpMethod::Lemke => lemke(),
+        LcpMethod::Pivoting => pivoting(),
+        LcpMethod::Auto if q.len() <= AUTO_LEMKE_MAX => lemke(),
+        LcpMethod::Auto => {
+            let fast = pivoting();
+            if fast.outcome == LcpOutcome::Solved {
+                fast
+            } else {
+                // The robust fallback: lexicographic Lemke; its pivots add to the fast path's.
+                let mut sol = lemke();
+                sol.info.pivots += fast.info.pivots;
+                sol.info.time_s += fast.info.time_s;
+                sol
+            }
+        }
     }
 }
