@@ -27,5 +27,7 @@ pub mod periodic;
 pub mod response;
 /// Scene files (TOML).
 pub mod scene;
+/// Studies: accuracy against cost, warm starts (issue 6).
+pub mod study;
 /// Time schemes as circulant symbols; pairing.
 pub mod time;

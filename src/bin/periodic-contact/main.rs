@@ -3,6 +3,7 @@
 mod cmd_bench;
 mod cmd_lcp;
 mod cmd_solve;
+mod cmd_study;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -39,11 +40,24 @@ enum Command {
         #[arg(long, hide = true)]
         single: Option<usize>,
     },
-    /// Solve a raw LCP in Siconos' dense .dat format.
+    /// Solve a raw LCP in Siconos' dense .dat format (block-circulant matrices are detected and
+    /// solved by the fast path).
     Lcp {
         file: PathBuf,
         #[arg(short, long, default_value = "-")]
         output: PathBuf,
+        /// auto (block-circulant detection, fast path above N = 256), lemke (dense lexicographic
+        /// Lemke) or pivoting.
+        #[arg(long, default_value = "auto")]
+        method: String,
+        /// Certification: ‖min(z, Az+q)‖∞ ≤ tolerance·max(1, ‖q‖∞).
+        #[arg(long, default_value_t = 1e-9)]
+        tolerance: f64,
+    },
+    /// Studies: accuracy against cost, warm starts.
+    Study {
+        #[command(subcommand)]
+        study: cmd_study::StudyCommand,
     },
 }
 
@@ -67,7 +81,8 @@ fn main() -> ExitCode {
     let result = match cli.command {
         None => cmd_solve::run_default(),
         Some(Command::Solve { scene, output }) => cmd_solve::run(&scene, &output),
-        Some(Command::Lcp { file, output }) => cmd_lcp::run(&file, &output),
+        Some(Command::Lcp { file, output, method, tolerance }) => cmd_lcp::run(&file, &output, &method, tolerance),
+        Some(Command::Study { study }) => cmd_study::run(study),
         Some(Command::Bench { steps, repeats, method, single }) => match single {
             Some(k) => cmd_bench::run_single(k, repeats, &method),
             None => cmd_bench::run(&steps, repeats, &method),
