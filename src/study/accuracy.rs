@@ -476,38 +476,48 @@ impl AccuracyStudy {
         s
     }
 
-    /// One panel per case: error against CPU time, log axes, one line per method.
+    /// One panel per case: error against CPU time, log axes, one line per method; a last panel
+    /// with the impulse error of the rigid stop.
     #[cfg(feature = "plots")]
     pub fn plot(&self, path: &Path) -> Result<(), String> {
         use crate::plot::{Chart, Legend, Scale, Series, panel_chart};
-        let mut charts = Vec::new();
-        let mut all_series = Vec::new();
-        for &case in &self.settings.cases {
+        let series_of = |case: Case, value: &dyn Fn(&Row) -> Option<f64>| -> Vec<Series> {
             let mut labels: Vec<String> = Vec::new();
             for r in self.ok_rows(case) {
-                if !labels.contains(&r.method) {
+                if !labels.contains(&r.method) && value(r).is_some() {
                     labels.push(r.method.clone());
                 }
             }
-            let series: Vec<Series> = labels
+            labels
                 .iter()
                 .map(|l| {
-                    let rows: Vec<&Row> = self.ok_rows(case).filter(|r| &r.method == l).collect();
+                    let rows: Vec<&Row> = self.ok_rows(case).filter(|r| &r.method == l && value(r).is_some()).collect();
                     let conv = rows.first().is_some_and(|r| r.converges);
                     Series {
                         label: if conv { l.clone() } else { format!("{l} (does not converge)") },
-                        points: rows.iter().map(|r| (r.t_total.unwrap(), r.error_x.unwrap())).collect(),
+                        points: rows.iter().map(|r| (r.t_total.unwrap(), value(r).unwrap())).collect(),
                         markers: true,
                     }
                 })
-                .collect();
-            charts.push(case);
-            all_series.push(series);
+                .collect()
+        };
+        let mut titles = Vec::new();
+        let mut all_series = Vec::new();
+        let mut y_labels = Vec::new();
+        for &case in &self.settings.cases {
+            titles.push(format!("{}: error vs CPU time", case.title()));
+            y_labels.push("max error / peak-to-peak");
+            all_series.push(series_of(case, &|r: &Row| r.error_x));
         }
-        let titles: Vec<String> = charts.iter().map(|c| format!("{}: error vs CPU time", c.title())).collect();
+        if self.settings.cases.contains(&Case::Rigid) {
+            titles.push(format!("{}: impulse error vs CPU time", Case::Rigid.title()));
+            y_labels.push("relative error of the impulse per period");
+            all_series.push(series_of(Case::Rigid, &|r: &Row| r.error_impulse));
+        }
         let chart_defs: Vec<Chart> = titles
             .iter()
-            .map(|t| Chart { title: t, x_label: "CPU time [s]", y_label: "max error / peak-to-peak", x_scale: Scale::Log, y_scale: Scale::Log })
+            .zip(&y_labels)
+            .map(|(t, y)| Chart { title: t, x_label: "CPU time [s] (one thread)", y_label: y, x_scale: Scale::Log, y_scale: Scale::Log })
             .collect();
         let panels: Vec<(&Chart, &[Series])> = chart_defs.iter().zip(&all_series).map(|(c, s)| (c, s.as_slice())).collect();
         let cols = panels.len().min(2);
