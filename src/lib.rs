@@ -34,6 +34,8 @@ pub mod periodic;
 pub mod response;
 /// Scene files (TOML).
 pub mod scene;
+/// Studies: accuracy against cost, warm starts (issue 6).
+pub mod study;
 /// Frequency sweeps, spectra, and the comparison with time marching.
 pub mod sweep;
 /// Time schemes as circulant symbols; pairing.

@@ -45,20 +45,60 @@ fn range(values: impl Iterator<Item = f64>, scale: Scale) -> (f64, f64) {
 /// Draws the series into a PNG of `width`×`height` pixels. Non-finite points (and
 /// non-positive ones on a log axis) are skipped.
 pub fn line_chart(path: &Path, chart: &Chart, series: &[Series], width: u32, height: u32) -> Result<(), String> {
+    panel_chart(path, &[(chart, series)], 1, width, height, Legend::Default)
+}
+
+/// Where the legend goes.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum Legend {
+    /// plotters' default (middle right).
+    Default,
+    UpperRight,
+    LowerLeft,
+}
+
+/// Several charts in one PNG, `columns` per row (each panel as [`line_chart`] draws it).
+pub fn panel_chart(path: &Path, panels: &[(&Chart, &[Series])], columns: usize, width: u32, height: u32, legend: Legend) -> Result<(), String> {
     let err = |e: &dyn std::fmt::Display| format!("{}: cannot draw the chart: {e}", path.display());
     let root = BitMapBackend::new(path, (width, height)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
+    let columns = columns.max(1);
+    let rows = panels.len().div_ceil(columns).max(1);
+    let areas = root.split_evenly((rows, columns));
+    for ((chart, series), area) in panels.iter().zip(&areas) {
+        draw_chart(area, chart, series, legend).map_err(|e| err(&e))?;
+    }
+    root.present().map_err(|e| err(&e))
+}
+
+fn draw_chart<DB: DrawingBackend>(area: &DrawingArea<DB, plotters::coord::Shift>, chart: &Chart, series: &[Series], legend: Legend) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    let err = |e: &dyn std::fmt::Display| e.to_string();
     let keep = |(x, y): &(f64, f64)| {
         x.is_finite() && y.is_finite() && (chart.x_scale == Scale::Linear || *x > 0.0) && (chart.y_scale == Scale::Linear || *y > 0.0)
     };
     let xs = range(series.iter().flat_map(|s| s.points.iter().map(|p| p.0)), chart.x_scale);
     let ys = range(series.iter().flat_map(|s| s.points.iter().map(|p| p.1)), chart.y_scale);
-    let mut builder = ChartBuilder::on(&root);
+    let mut builder = ChartBuilder::on(area);
     builder.caption(chart.title, ("sans-serif", 22)).margin(12).x_label_area_size(45).y_label_area_size(70);
     macro_rules! draw {
         ($ctx:expr) => {{
             let mut ctx = $ctx;
-            ctx.configure_mesh().x_desc(chart.x_label).y_desc(chart.y_label).draw().map_err(|e| err(&e))?;
+            {
+                // Log axes: ticks as 1e-3 rather than 0.0009999999.
+                let log_fmt = |v: &f64| format!("{v:.0e}");
+                let mut mesh = ctx.configure_mesh();
+                mesh.x_desc(chart.x_label).y_desc(chart.y_label);
+                if chart.x_scale == Scale::Log {
+                    mesh.x_label_formatter(&log_fmt);
+                }
+                if chart.y_scale == Scale::Log {
+                    mesh.y_label_formatter(&log_fmt);
+                }
+                mesh.draw().map_err(|e| err(&e))?;
+            }
             for (i, s) in series.iter().enumerate() {
                 let color = Palette99::pick(i).to_rgba();
                 let pts: Vec<(f64, f64)> = s.points.iter().copied().filter(keep).collect();
@@ -70,7 +110,18 @@ pub fn line_chart(path: &Path, chart: &Chart, series: &[Series], width: u32, hei
                     ctx.draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled()))).map_err(|e| err(&e))?;
                 }
             }
-            ctx.configure_series_labels().background_style(WHITE.mix(0.85)).border_style(BLACK).draw().map_err(|e| err(&e))?;
+            let mut labels = ctx.configure_series_labels();
+            labels.background_style(WHITE.mix(0.85)).border_style(BLACK);
+            match legend {
+                Legend::Default => {}
+                Legend::UpperRight => {
+                    labels.position(SeriesLabelPosition::UpperRight);
+                }
+                Legend::LowerLeft => {
+                    labels.position(SeriesLabelPosition::LowerLeft);
+                }
+            }
+            labels.draw().map_err(|e| err(&e))?;
         }};
     }
     match (chart.x_scale, chart.y_scale) {
@@ -79,5 +130,5 @@ pub fn line_chart(path: &Path, chart: &Chart, series: &[Series], width: u32, hei
         (Scale::Linear, Scale::Log) => draw!(builder.build_cartesian_2d(xs.0..xs.1, (ys.0..ys.1).log_scale()).map_err(|e| err(&e))?),
         (Scale::Log, Scale::Linear) => draw!(builder.build_cartesian_2d((xs.0..xs.1).log_scale(), ys.0..ys.1).map_err(|e| err(&e))?),
     }
-    root.present().map_err(|e| err(&e))
+    Ok(())
 }

@@ -115,6 +115,48 @@ impl BlockCirculant {
     }
 }
 
+impl BlockCirculant {
+    /// Recognises a dense matrix that is exactly block-circulant (tolerance 0: every entry equals
+    /// the one of the first block column it should repeat), trying block sizes m = 1..=max_m that
+    /// divide n with at least two blocks (k ≥ 2), smallest first. O(n²) per m tried, with an
+    /// early exit at the first mismatch.
+    pub fn detect(a: &DenseMatrix, max_m: usize) -> Option<BlockCirculant> {
+        let n = a.dim();
+        for m in 1..=max_m.min(n / 2) {
+            if n % m != 0 {
+                continue;
+            }
+            let k = n / m;
+            let first = |r: usize, b: usize| a.data[r * n + b];
+            let mut ok = true;
+            'rows: for i in 0..n {
+                let (ji, ai) = (i / m, i % m);
+                let row = a.row(i);
+                for (j, &v) in row.iter().enumerate() {
+                    let (l, b) = (j / m, j % m);
+                    let d = (ji + k - l) % k;
+                    if v != first(d * m + ai, b) {
+                        ok = false;
+                        break 'rows;
+                    }
+                }
+            }
+            if ok {
+                let mut blocks = vec![0.0; k * m * m];
+                for d in 0..k {
+                    for ai in 0..m {
+                        for b in 0..m {
+                            blocks[(d * m + ai) * m + b] = first(d * m + ai, b);
+                        }
+                    }
+                }
+                return Some(BlockCirculant { k, m, blocks });
+            }
+        }
+        None
+    }
+}
+
 impl LcpMatrix for BlockCirculant {
     fn dim(&self) -> usize {
         self.k * self.m

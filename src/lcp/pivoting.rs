@@ -126,6 +126,22 @@ impl BlockPivoting {
             // Infeasible: active with z < 0, or inactive with w < 0 (NaN counts as infeasible).
             let infeasible: Vec<usize> = (0..n).filter(|&i| if active[i] { !(z[i] >= -tol) } else { !(w[i] >= -tol) }).collect();
             if infeasible.is_empty() {
+                // Iterative refinement of z_F with the same LU (A_FF z_F = −q_F, residual −w_F):
+                // an ill-conditioned A_FF otherwise leaves z off by cond·eps.
+                if let Some(factor) = &lu {
+                    for _ in 0..2 {
+                        let rhs = Mat::from_fn(f.len(), 1, |c, _| -w[f[c]]);
+                        let dz = factor.solve(&rhs);
+                        if !(0..f.len()).all(|c| dz[(c, 0)].is_finite()) {
+                            break;
+                        }
+                        for (c, &i) in f.iter().enumerate() {
+                            z[i] += dz[(c, 0)];
+                        }
+                        a.mul_into(&z, &mut w);
+                        w.iter_mut().zip(q).for_each(|(wi, qi)| *wi += qi);
+                    }
+                }
                 // Active w and inactive z are zero by construction; clip round-off and certify.
                 for i in 0..n {
                     if active[i] {

@@ -389,48 +389,61 @@ impl PeriodicProblem {
     }
 
     fn solve_lcp_once(&self, a: &BlockCirculant, q: &[f64], warm_start: Option<&[usize]>) -> LcpSolution {
-        if q.is_empty() {
-            return LcpSolution { outcome: LcpOutcome::Solved, z: vec![], w: vec![], info: Default::default() };
-        }
-        let lemke = || {
-            let settings = LemkeSettings { certify_tol: self.solver.tolerance, warm_start: warm_start.map(<[usize]>::to_vec), ..LemkeSettings::default() };
-            Lemke::new(settings).solve(a, q)
-        };
-        let pivoting = || {
-            let settings = PivotingSettings { certify_tol: self.solver.tolerance, warm_start: warm_start.map(<[usize]>::to_vec), ..PivotingSettings::default() };
-            BlockPivoting::new(settings).solve(&CirculantOperator::new(a), q)
-        };
-        match self.solver.method {
-            LcpMethod::Lemke => lemke(),
-            LcpMethod::Pivoting => pivoting(),
-            LcpMethod::Auto if q.len() <= AUTO_LEMKE_MAX => lemke(),
-            LcpMethod::Auto => {
-                let fast = pivoting();
-                if fast.outcome == LcpOutcome::Solved {
-                    fast
-                } else {
-                    // The robust fallback: lexicographic Lemke; its pivots add to the fast path's.
-                    let mut sol = lemke();
-                    sol.info.pivots += fast.info.pivots;
-                    sol.info.time_s += fast.info.time_s;
-                    sol
-                }
-            }
-        }
+        solve_circulant_lcp(a, q, self.solver.method, self.solver.tolerance, warm_start)
+    }
+
+    /// The LCP (A, q) of the period without solving it (for exports and studies).
+    pub fn assemble_lcp(&self, fft: &PeriodFft) -> Result<(BlockCirculant, Vec<f64>), SolveError> {
+        let asm = assembly::assemble(&self.model, &self.disc, &[], fft, self.solver.parallel)?;
+        Ok(self.lcp(&asm, fft))
     }
 }
 
 /// The typed failure of an LCP solve, with the remedy to try.
 fn lcp_failure(sol: LcpSolution) -> SolveError {
-let hint = match sol.outcome {
-                LcpOutcome::RayTermination => {
-                    "no periodic solution was reached (the LCP matrix is not a P-matrix above the first resonance); remedies: make the contact compliant (stiffness = …), use cds or galerkin with pairing = \"forward\" or bds1, add damping, or opt in to [solver] regularization = 1e-4"
-                }
-                LcpOutcome::PivotLimit => "the pivot budget ran out (a degenerate or ill-posed LCP); remedies: make the contact compliant, use another scheme or pairing, add damping, or opt in to [solver] regularization = 1e-4",
-                LcpOutcome::NonFiniteData => "the assembled LCP holds NaN or infinite values; check the model for a singular operator",
-                LcpOutcome::Inaccurate => "the final basis is too ill-conditioned to certify the residual; remedies: add damping or make the contact compliant, reduce steps, or opt in to [solver] regularization = 1e-4",
-                LcpOutcome::Solved => unreachable!(),
-            };
+    let hint = match sol.outcome {
+        LcpOutcome::RayTermination => {
+            "no periodic solution was reached (the LCP matrix is not a P-matrix above the first resonance); remedies: make the contact compliant (stiffness = …), use cds or galerkin with pairing = \"forward\" or bds1, add damping, or opt in to [solver] regularization = 1e-4"
+        }
+        LcpOutcome::PivotLimit => "the pivot budget ran out (a degenerate or ill-posed LCP); remedies: make the contact compliant, use another scheme or pairing, add damping, or opt in to [solver] regularization = 1e-4",
+        LcpOutcome::NonFiniteData => "the assembled LCP holds NaN or infinite values; check the model for a singular operator",
+        LcpOutcome::Inaccurate => "the final basis is too ill-conditioned to certify the residual; remedies: add damping or make the contact compliant, reduce steps, or opt in to [solver] regularization = 1e-4",
+        LcpOutcome::Solved => unreachable!(),
+    };
     SolveError::Lcp { outcome: sol.outcome, info: sol.info, hint: hint.into() }
 }
 
+/// Solves a block-circulant LCP with `method` (the engine's logic: `auto` uses lexicographic
+/// Lemke up to [`AUTO_LEMKE_MAX`], above it block pivoting with FFT products, falling back to
+/// Lemke when that fails). Used by the engine and by `periodic-contact lcp` for a raw LCP whose
+/// matrix is block-circulant.
+pub fn solve_circulant_lcp(a: &BlockCirculant, q: &[f64], method: LcpMethod, tolerance: f64, warm_start: Option<&[usize]>) -> LcpSolution {
+    if q.is_empty() {
+        return LcpSolution { outcome: LcpOutcome::Solved, z: vec![], w: vec![], info: Default::default() };
+    }
+    let lemke = || {
+        let settings = LemkeSettings { certify_tol: tolerance, warm_start: warm_start.map(<[usize]>::to_vec), ..LemkeSettings::default() };
+        Lemke::new(settings).solve(a, q)
+    };
+    let pivoting = || {
+        let settings = PivotingSettings { certify_tol: tolerance, warm_start: warm_start.map(<[usize]>::to_vec), ..PivotingSettings::default() };
+        BlockPivoting::new(settings).solve(&CirculantOperator::new(a), q)
+    };
+    match method {
+        LcpMethod::Lemke => lemke(),
+        LcpMethod::Pivoting => pivoting(),
+        LcpMethod::Auto if q.len() <= AUTO_LEMKE_MAX => lemke(),
+        LcpMethod::Auto => {
+            let fast = pivoting();
+            if fast.outcome == LcpOutcome::Solved {
+                fast
+            } else {
+                // The robust fallback: lexicographic Lemke; its pivots add to the fast path's.
+                let mut sol = lemke();
+                sol.info.pivots += fast.info.pivots;
+                sol.info.time_s += fast.info.time_s;
+                sol
+            }
+        }
+    }
+}

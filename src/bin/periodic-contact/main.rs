@@ -6,6 +6,7 @@ mod cmd_lcp;
 mod cmd_modes;
 mod cmd_solve;
 mod cmd_sweep;
+mod cmd_study;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -64,11 +65,24 @@ enum Command {
         #[arg(long, hide = true)]
         single: Option<usize>,
     },
-    /// Solve a raw LCP in Siconos' dense .dat format.
+    /// Solve a raw LCP in Siconos' dense .dat format (block-circulant matrices are detected and
+    /// solved by the fast path).
     Lcp {
         file: PathBuf,
         #[arg(short, long, default_value = "-")]
         output: PathBuf,
+        /// auto (block-circulant detection, fast path above N = 256), lemke (dense lexicographic
+        /// Lemke) or pivoting.
+        #[arg(long, default_value = "auto")]
+        method: String,
+        /// Certification: ‖min(z, Az+q)‖∞ ≤ tolerance·max(1, ‖q‖∞).
+        #[arg(long, default_value_t = 1e-9)]
+        tolerance: f64,
+    },
+    /// Studies: accuracy against cost, warm starts.
+    Study {
+        #[command(subcommand)]
+        study: cmd_study::StudyCommand,
     },
 }
 
@@ -94,7 +108,8 @@ fn main() -> ExitCode {
         Some(Command::Solve { scene, output, frequency }) => cmd_solve::run(&scene, &output, frequency),
         Some(Command::Modes { scene, count }) => cmd_modes::run(&scene, count),
         Some(Command::Sweep(args)) => cmd_sweep::run(&args),
-        Some(Command::Lcp { file, output }) => cmd_lcp::run(&file, &output),
+        Some(Command::Lcp { file, output, method, tolerance }) => cmd_lcp::run(&file, &output, &method, tolerance),
+        Some(Command::Study { study }) => cmd_study::run(study),
         Some(Command::Fmu { scene, output, binary }) => cmd_fmu::run(&scene, &output, binary.as_deref()),
         Some(Command::Bench { steps, repeats, method, single }) => match single {
             Some(k) => cmd_bench::run_single(k, repeats, &method),

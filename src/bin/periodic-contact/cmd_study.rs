@@ -1,0 +1,133 @@
+//! `study accuracy` and `study warmstart` (issue 6): what accuracy costs, and warm starts.
+use crate::Failure;
+use clap::Subcommand;
+use periodic_contact::study::{Case, accuracy, warmstart};
+use std::path::PathBuf;
+
+#[derive(Subcommand)]
+pub enum StudyCommand {
+    /// Error against CPU time per scheme and pairing, k = 32 … 8192, on the exact references
+    /// (compliant stop, rigid stop with sticking, linear), with time marching on the same axes.
+    /// Writes DIR/accuracy.csv, accuracy.md and accuracy.png. Total run capped (see accuracy.md).
+    Accuracy {
+        #[arg(short, long, default_value = "study")]
+        output: PathBuf,
+        /// k = 32, 64, 128 only, for tests.
+        #[arg(long)]
+        quick: bool,
+        /// k values (default 32 … 8192, powers of two).
+        #[arg(long, value_delimiter = ',')]
+        steps: Option<Vec<usize>>,
+        /// Marcher steps per period (default as k).
+        #[arg(long, value_delimiter = ',')]
+        march_steps: Option<Vec<usize>>,
+        /// Cases: compliant, rigid, linear (default all).
+        #[arg(long, value_delimiter = ',')]
+        cases: Option<Vec<String>>,
+        /// Only these methods, e.g. cds/forward,bds1/same (default all).
+        #[arg(long, value_delimiter = ',')]
+        methods: Option<Vec<String>>,
+        /// Skip the time-marching reference.
+        #[arg(long)]
+        no_march: bool,
+        /// Total budget in seconds (larger k are skipped past it).
+        #[arg(long)]
+        budget: Option<f64>,
+        /// Export every LCP solved (up to --export-max unknowns) as Siconos .dat files here.
+        #[arg(long)]
+        export_lcp: Option<PathBuf>,
+        #[arg(long, default_value_t = 4096)]
+        export_max: usize,
+    },
+    /// Pivots and LCP time, cold against warm: a frequency sweep of the rigid stop and re-solves
+    /// after a small frequency change. Writes DIR/warmstart.csv, warmstart.md and warmstart.png.
+    Warmstart {
+        #[arg(short, long, default_value = "study")]
+        output: PathBuf,
+        #[arg(long)]
+        quick: bool,
+        /// k values (default 256, 1024, 4096).
+        #[arg(long, value_delimiter = ',')]
+        steps: Option<Vec<usize>>,
+    },
+}
+
+pub fn run(cmd: StudyCommand) -> Result<(), Failure> {
+    match cmd {
+        StudyCommand::Accuracy { output, quick, steps, march_steps, cases, methods, no_march, budget, export_lcp, export_max } => {
+            let mut s = if quick { accuracy::AccuracySettings::quick() } else { accuracy::AccuracySettings::full() };
+            if let Some(k) = steps {
+                if let Some(bad) = k.iter().find(|&&k| !(4..=1 << 22).contains(&k)) {
+                    return Err(Failure::input(format!("--steps: {bad} is out of 4..=4194304")));
+                }
+                s.steps = k;
+            }
+            if let Some(n) = march_steps {
+                s.march_steps = n;
+            }
+            if let Some(c) = cases {
+                s.cases = c.iter().map(|c| Case::parse(c)).collect::<Result<_, _>>().map_err(|e| Failure::input(format!("--cases: {e}")))?;
+            }
+            if let Some(m) = methods {
+                s.methods = m;
+            }
+            if no_march {
+                s.march = false;
+            }
+            if let Some(b) = budget {
+                s.budget_s = b;
+            }
+            s.export_lcp = export_lcp;
+            s.export_max = export_max;
+            let study = accuracy::run(&s, &mut |r| {
+                eprintln!(
+                    "{:<9} {:<16} {:>5}  {:<60} err {:>9}  imp {:>9}  t {:>9}",
+                    r.case.name(),
+                    r.method,
+                    r.steps,
+                    r.status.chars().take(60).collect::<String>(),
+                    r.error_x.map(|v| format!("{v:.2e}")).unwrap_or_default(),
+                    r.error_impulse.map(|v| format!("{v:.2e}")).unwrap_or_default(),
+                    r.t_total.map(|v| format!("{v:.2e}")).unwrap_or_default()
+                )
+            })
+            .map_err(Failure::solver)?;
+            let files = study.write(&output).map_err(Failure::input)?;
+            for f in files {
+                eprintln!("wrote {}", f.display());
+            }
+            if !study.exported.is_empty() {
+                eprintln!("exported {} LCPs to {}", study.exported.len(), s.export_lcp.as_ref().unwrap().display());
+            }
+            Ok(())
+        }
+        StudyCommand::Warmstart { output, quick, steps } => {
+            let mut s = if quick { warmstart::WarmSettings::quick() } else { warmstart::WarmSettings::full() };
+            if let Some(k) = steps {
+                s.steps = k;
+            }
+            let study = warmstart::run(&s, &mut |r| {
+                eprintln!(
+                    "{:<7} k {:>5} {:<6} ω {:.4}  pivots cold {:>6} warm {:>6}  lcp cold {:.2e} s warm {:.2e} s  used {} diff {:.1e} {}",
+                    r.kind,
+                    r.k,
+                    r.method.name(),
+                    r.omega,
+                    r.cold_pivots,
+                    r.warm_pivots,
+                    r.cold_lcp_s,
+                    r.warm_lcp_s,
+                    r.warm_start_used,
+                    r.same_solution,
+                    if r.status == "ok" { "" } else { &r.status }
+                )
+            })
+            .map_err(Failure::solver)?;
+            let files = study.write(&output).map_err(Failure::input)?;
+            for f in files {
+                eprintln!("wrote {}", f.display());
+            }
+            Ok(())
+        }
+    }
+}

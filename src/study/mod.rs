@@ -1,0 +1,192 @@
+//! Studies of what accuracy costs (issue 6): the accuracy–cost study against the exact references
+//! of notes §6 with the explicit time-marching reference on the same axes, and warm starts.
+//!
+//! Everything is measured on one thread (`SolverSettings::parallel = false`, the marcher is
+//! single-threaded), so that the times are CPU times.
+pub mod accuracy;
+pub mod warmstart;
+
+use crate::exact::{CompliantStopOrbit, LinearOrbit, Oscillator, RigidStopOrbit};
+use crate::model::{Compliance, Model};
+use crate::periodic::{LcpMethod, OutputSelection, PeriodicProblem, SolverSettings};
+use crate::time::{Discretization, Pairing, Scheme};
+
+/// The exact references of notes §6 used by the studies.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Case {
+    /// §6.2: m = 1, c = 0.05, k = 1, k_c = 10, g0 = 1, F = 1, Ω = 1.3.
+    Compliant,
+    /// §6.3: m = 1, c = 0.1, k = 1, F = 1, g0 = 0.5, Ω = 1 (sticking; plastic impact).
+    Rigid,
+    /// §6.1: the oscillator of the compliant case without the stop.
+    Linear,
+}
+
+/// The compliant-stop oscillator of notes §6.2 (also the linear case's).
+pub const COMPLIANT_OSC: Oscillator = Oscillator { mass: 1.0, damping: 0.05, stiffness: 1.0, force: 1.0, omega: 1.3 };
+/// Contact stiffness and gap of notes §6.2.
+pub const COMPLIANT_STIFFNESS: f64 = 10.0;
+pub const COMPLIANT_GAP: f64 = 1.0;
+/// The rigid stop with sticking of notes §6.3.
+pub const RIGID_OSC: Oscillator = Oscillator { mass: 1.0, damping: 0.1, stiffness: 1.0, force: 1.0, omega: 1.0 };
+pub const RIGID_GAP: f64 = 0.5;
+
+impl Case {
+    pub const ALL: [Case; 3] = [Case::Compliant, Case::Rigid, Case::Linear];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Case::Compliant => "compliant",
+            Case::Rigid => "rigid",
+            Case::Linear => "linear",
+        }
+    }
+
+    pub fn parse(s: &str) -> Result<Case, String> {
+        Case::ALL.into_iter().find(|c| c.name() == s).ok_or_else(|| format!("unknown case \"{s}\"; expected compliant, rigid or linear"))
+    }
+
+    pub fn title(self) -> &'static str {
+        match self {
+            Case::Compliant => "compliant stop (notes §6.2)",
+            Case::Rigid => "rigid stop with sticking (notes §6.3)",
+            Case::Linear => "linear oscillator (notes §6.1)",
+        }
+    }
+
+    pub fn oscillator(self) -> Oscillator {
+        match self {
+            Case::Compliant | Case::Linear => COMPLIANT_OSC,
+            Case::Rigid => RIGID_OSC,
+        }
+    }
+
+    /// The 1-DOF model of the case.
+    pub fn model(self) -> Model {
+        let osc = self.oscillator();
+        match self {
+            Case::Compliant => osc.model(vec![Oscillator::stop(COMPLIANT_GAP, Compliance::Compliant { stiffness: COMPLIANT_STIFFNESS })]),
+            Case::Rigid => osc.model(vec![Oscillator::stop(RIGID_GAP, Compliance::Rigid)]),
+            Case::Linear => osc.model(vec![]),
+        }
+    }
+
+    /// Whether the case has a contact (and so an LCP, a pairing and an impulse).
+    pub fn has_contact(self) -> bool {
+        self != Case::Linear
+    }
+
+    /// The schemes and pairings studied: every pairing for a contact case.
+    pub fn methods(self) -> Vec<(Scheme, Option<Pairing>)> {
+        let mut v = Vec::new();
+        for s in Scheme::ALL {
+            if self.has_contact() {
+                v.push((s, Some(Pairing::Same)));
+                v.push((s, Some(Pairing::Forward)));
+            } else {
+                v.push((s, None));
+            }
+        }
+        v
+    }
+
+    /// Whether (scheme, pairing) converges to the exact orbit (notes §3 findings; the README table).
+    pub fn converges(self, scheme: Scheme, pairing: Option<Pairing>) -> bool {
+        match self {
+            Case::Linear | Case::Compliant => true,
+            Case::Rigid => matches!(
+                (scheme, pairing),
+                (Scheme::Bds1, Some(Pairing::Same)) | (Scheme::Cds, Some(Pairing::Forward)) | (Scheme::Galerkin, Some(Pairing::Forward))
+            ),
+        }
+    }
+
+    /// The problem at k instants, one thread, `auto` LCP method unless told.
+    pub fn problem(self, scheme: Scheme, pairing: Option<Pairing>, k: usize, method: LcpMethod) -> Result<PeriodicProblem, String> {
+        let outputs = OutputSelection { displacement: vec![0], velocity: vec![], acceleration: vec![], contacts: self.has_contact() };
+        let solver = SolverSettings { method, tolerance: 1e-9, parallel: false, regularization: None };
+        PeriodicProblem::new(self.model(), Discretization { scheme, steps: k, pairing }, outputs, solver).map_err(|e| e.to_string())
+    }
+
+    /// The exact reference.
+    pub fn reference(self) -> Result<Reference, String> {
+        Ok(match self {
+            Case::Compliant => Reference::Compliant(CompliantStopOrbit::solve(&COMPLIANT_OSC, COMPLIANT_STIFFNESS, COMPLIANT_GAP, None)?),
+            Case::Rigid => Reference::Rigid(RigidStopOrbit::solve(&RIGID_OSC, RIGID_GAP)?),
+            Case::Linear => Reference::Linear(LinearOrbit::solve(&COMPLIANT_OSC)?),
+        })
+    }
+}
+
+/// A method label: "cds/forward", or "cds" without contact.
+pub fn method_label(scheme: Scheme, pairing: Option<Pairing>) -> String {
+    match pairing {
+        Some(p) => format!("{scheme}/{p}"),
+        None => scheme.to_string(),
+    }
+}
+
+/// An exact periodic orbit.
+#[derive(Clone, Debug)]
+pub enum Reference {
+    Compliant(CompliantStopOrbit),
+    Rigid(RigidStopOrbit),
+    Linear(LinearOrbit),
+}
+
+impl Reference {
+    pub fn displacement(&self, t: f64) -> f64 {
+        match self {
+            Reference::Compliant(o) => o.eval(t).0,
+            Reference::Rigid(o) => o.eval(t).0,
+            Reference::Linear(o) => o.eval(t).0,
+        }
+    }
+    pub fn peak_to_peak(&self) -> f64 {
+        match self {
+            Reference::Compliant(o) => o.peak_to_peak(),
+            Reference::Rigid(o) => o.peak_to_peak(),
+            Reference::Linear(o) => o.peak_to_peak(),
+        }
+    }
+    /// Impulse per period; None without contact.
+    pub fn impulse(&self) -> Option<f64> {
+        match self {
+            Reference::Compliant(o) => Some(o.impulse_per_period()),
+            Reference::Rigid(o) => Some(o.impulse_per_period()),
+            Reference::Linear(_) => None,
+        }
+    }
+
+    /// max_j |x_j − x(t_j)| / peak-to-peak over samples (t_j, x_j).
+    pub fn max_error(&self, t: &[f64], x: &[f64]) -> f64 {
+        let e = t.iter().zip(x).map(|(&t, &v)| (v - self.displacement(t)).abs()).fold(0.0, f64::max);
+        e / self.peak_to_peak()
+    }
+
+    /// |I − I_exact| / I_exact; None without contact.
+    pub fn impulse_error(&self, impulse: f64) -> Option<f64> {
+        self.impulse().map(|i| (impulse - i).abs() / i.abs())
+    }
+}
+
+/// Least-squares slope of −log e against log k (the observed order), over points with e > 0.
+pub fn fitted_order(points: &[(usize, f64)]) -> Option<f64> {
+    let pts: Vec<(f64, f64)> = points.iter().filter(|(_, e)| e.is_finite() && *e > 0.0).map(|&(k, e)| ((k as f64).ln(), -e.ln())).collect();
+    if pts.len() < 3 {
+        return None;
+    }
+    let n = pts.len() as f64;
+    let (mx, my) = (pts.iter().map(|p| p.0).sum::<f64>() / n, pts.iter().map(|p| p.1).sum::<f64>() / n);
+    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    Some(sxy / sxx)
+}
+
+/// "1.23e-4"-style formatting for tables; "—" for None or non-finite.
+pub fn sci(v: Option<f64>) -> String {
+    match v {
+        Some(v) if v.is_finite() => format!("{v:.2e}"),
+        _ => "—".to_string(),
+    }
+}
