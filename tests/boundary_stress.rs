@@ -856,10 +856,10 @@ fn a_long_run_keeps_its_resident_size() {
     assert_eq!(host_lines(&out, "nonfinite")[0][0], "0");
     println!("plain run: {steps} steps of chain-3dof-two-stops (10 Real outputs read per step): {rate:.0} steps/s; RSS [KiB] at step: {rss:?}");
     assert_eq!(rss.len(), 21);
-    // After the first sample period (first touches of stack and buffers), not one page more.
-    let settled: Vec<u64> = rss[1..].iter().map(|r| r.1).collect();
-    let (lo, hi) = (*settled.iter().min().unwrap(), *settled.iter().max().unwrap());
-    assert!(hi - lo <= 16, "RSS moved by {} KiB during plain stepping: {rss:?}", hi - lo);
+    // After the first sample period (first touches of stack and buffers): at most 4 pages more.
+    let settled = rss[1].1;
+    let hi = rss[1..].iter().map(|r| r.1).max().unwrap();
+    assert!(hi <= settled + 16, "RSS grew by {} KiB during plain stepping: {rss:?}", hi - settled);
 
     let steps = steps.min(1_000_000);
     let every = steps / 20;
