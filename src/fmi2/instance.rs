@@ -8,7 +8,8 @@ use std::ffi::{CString, c_char};
 use std::path::PathBuf;
 
 /// Marks live instances and FMU states, so that a stray pointer of the wrong kind is refused
-/// rather than used.
+/// rather than used. Both structs are `#[repr(C)]` with the tag as their first field, so the
+/// check on entry reads only the first 8 bytes behind a pointer, never past a smaller object.
 pub(crate) const INSTANCE_MAGIC: u64 = 0x5043_464d_4932_494e; // "PCFMI2IN"
 pub(crate) const STATE_MAGIC: u64 = 0x5043_464d_4932_5354; // "PCFMI2ST"
 const SERIAL_HEADER: &[u8; 8] = b"PCFMI2S1";
@@ -90,7 +91,8 @@ impl Clock {
     }
 }
 
-/// What `fmi2GetFMUstate` hands out (boxed, as an opaque `fmi2FMUstate`).
+/// What `fmi2GetFMUstate` hands out (boxed, as an opaque `fmi2FMUstate`). `magic` stays first.
+#[repr(C)]
 pub struct FmuState<S> {
     pub(crate) magic: u64,
     guid: String,
@@ -104,6 +106,8 @@ pub fn same_time(a: f64, b: f64, h: f64) -> bool {
     (a - b).abs() <= 1e-9 * a.abs().max(b.abs()).max(1.0) + 1e-6 * h.abs()
 }
 
+/// One instance (boxed, as an opaque `fmi2Component`). `magic` stays first.
+#[repr(C)]
 pub struct Instance<M: Fmi2Model> {
     pub(crate) magic: u64,
     model: M,
