@@ -27,9 +27,10 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 TOL = 1e-10
 # The targets per size.
 TARGETS = {1024: 10.0, 2048: 10.0, 4096: 20.0}
-# What is asserted: the targets themselves. Measured (2 cores shared with parallel builds, load
-# average 12): Siconos/ours = 73x at 1024, 188x at 2048, 201x at 4096 (validation/peers/README.md),
-# i.e. 7x, 19x and 10x above the targets; our solve is 0.03 / 0.13 / 1.1 s there.
+# What is asserted: the targets themselves. Measured in two runs (2 cores shared with parallel
+# builds, load average 12 and 6-7): Siconos/ours = 73x and 83x at 1024, 188x and 112x at 2048,
+# 201x and 204x at 4096 (validation/peers/README.md), i.e. at least 7x, 11x and 10x above the
+# targets.
 RATIO_FLOOR = dict(TARGETS)
 
 
