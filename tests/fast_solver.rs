@@ -88,6 +88,12 @@ fn fast_path_agrees_with_lemke_on_every_scene() {
     let mut fast_failures = Vec::new();
     for path in list {
         let name = path.file_stem().unwrap().to_string_lossy().into_owned();
+        // The blade scenes (3 stiff compliant contacts, N = 1536) are left out: dense Lemke itself
+        // ends on its pivot limit there (61 540 pivots on blade-casing), so there is no Lemke answer
+        // to agree with; `auto` solves them and tests/sweep.rs checks them against time marching.
+        if name.starts_with("blade-") {
+            continue;
+        }
         let p = load(&path);
         for k in [p.disc.steps, 2 * p.disc.steps, 4 * p.disc.steps] {
             let pk = with(&p, LcpMethod::Auto, Some(k));
