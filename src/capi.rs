@@ -224,9 +224,7 @@ pub unsafe extern "C" fn pc_problem_from_matrices(
 /// `p` is NULL or a live problem handle.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn pc_problem_add_force(p: *mut PcProblem, dof: usize, amplitude: f64, harmonic: u32, phase: f64) -> c_int {
-    guarded(|| {
-        unsafe { problem(p) }?.edit(|m, _| m.forces.push(Force { dof, term: Harmonic { amplitude, harmonic, phase } }))
-    })
+    guarded(|| unsafe { problem(p) }?.edit(|m, _| m.forces.push(Force { dof, term: Harmonic { amplitude, harmonic, phase } })))
 }
 
 /// Adds a unilateral contact on `dof`: direction +1 keeps x[dof] ≤ gap, −1 keeps x[dof] ≥ −gap;
@@ -443,7 +441,8 @@ macro_rules! dof_series {
         pub unsafe extern "C" fn $name(r: *const PcResult, dof: usize, out: *mut f64, len: usize) -> c_int {
             guarded(|| {
                 let r = unsafe { result(r) }?;
-                let s = r.response.$field.get(&dof.to_string()).ok_or_else(|| arg(format!(concat!("no ", $what, " for DOF {} in this result's outputs"), dof)))?;
+                let s =
+                    r.response.$field.get(&dof.to_string()).ok_or_else(|| arg(format!(concat!("no ", $what, " for DOF {} in this result's outputs"), dof)))?;
                 copy_out(s, out, len)
             })
         }

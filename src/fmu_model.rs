@@ -131,10 +131,17 @@ fn scheme_code(s: Scheme) -> i32 {
 #[derive(Clone, Debug, PartialEq)]
 enum Series {
     /// Cubic Hermite through (x_j, v_j); `level` 0 gives H, 1 gives H'.
-    Hermite { x: Vec<f64>, v: Vec<f64>, level: u8 },
+    Hermite {
+        x: Vec<f64>,
+        v: Vec<f64>,
+        level: u8,
+    },
     Linear(Vec<f64>),
     /// Re Σ c e^{i p ω τ} over the harmonics p kept.
-    Trig { p: Vec<usize>, c: Vec<C> },
+    Trig {
+        p: Vec<usize>,
+        c: Vec<C>,
+    },
     Constant(f64),
 }
 
@@ -267,23 +274,54 @@ impl ContactModel {
             roles.push(r);
         };
         use Variability::*;
-        add(&mut t, Variable::parameter("frequency", Tunable, real(Some(model.frequency), Some("rad/s")), "Fundamental angular frequency of the excitation and of the obstacle motion; period T = 2*pi/frequency"), Role::Frequency);
+        add(
+            &mut t,
+            Variable::parameter(
+                "frequency",
+                Tunable,
+                real(Some(model.frequency), Some("rad/s")),
+                "Fundamental angular frequency of the excitation and of the obstacle motion; period T = 2*pi/frequency",
+            ),
+            Role::Frequency,
+        );
         if has_forces {
             add(&mut t, Variable::parameter("force_scale", Tunable, real(Some(1.0), None), "Multiplies every force amplitude of the scene"), Role::ForceScale);
         }
         if m > 0 {
-            add(&mut t, Variable::parameter("gap_offset", Tunable, real(Some(0.0), None), "Added to every static clearance (length unit of the scene)"), Role::GapOffset);
+            add(
+                &mut t,
+                Variable::parameter("gap_offset", Tunable, real(Some(0.0), None), "Added to every static clearance (length unit of the scene)"),
+                Role::GapOffset,
+            );
         }
         if has_motion {
             add(&mut t, Variable::parameter("motion_scale", Tunable, real(Some(1.0), None), "Multiplies every obstacle-motion amplitude"), Role::MotionScale);
         }
         let k = problem.disc.steps;
-        add(&mut t, Variable::parameter("steps", Fixed, Kind::Integer { start: Some(k as i32), min: Some(MIN_STEPS as i32), max: None }, "Number of instants k per period"), Role::Steps);
+        add(
+            &mut t,
+            Variable::parameter(
+                "steps",
+                Fixed,
+                Kind::Integer { start: Some(k as i32), min: Some(MIN_STEPS as i32), max: None },
+                "Number of instants k per period",
+            ),
+            Role::Steps,
+        );
         // An Integer rather than an Enumeration: libcosim ignores FMI 2 Enumeration variables.
         let codes: Vec<String> = Scheme::ALL.iter().map(|s| format!("{} {}", scheme_code(*s), s)).collect();
         let scheme = Kind::Integer { start: Some(scheme_code(problem.disc.scheme)), min: Some(1), max: Some(Scheme::ALL.len() as i32) };
         add(&mut t, Variable::parameter("scheme", Fixed, scheme, &format!("Time scheme on the period: {}", codes.join(", "))), Role::Scheme);
-        add(&mut t, Variable::input("frequency_in", 0.0, Some("rad/s"), "Drives the frequency continuously: when > 0 it replaces the parameter frequency; 0 = not driven"), Role::FrequencyIn);
+        add(
+            &mut t,
+            Variable::input(
+                "frequency_in",
+                0.0,
+                Some("rad/s"),
+                "Drives the frequency continuously: when > 0 it replaces the parameter frequency; 0 = not driven",
+            ),
+            Role::FrequencyIn,
+        );
         if has_forces {
             add(&mut t, Variable::input("force_scale_in", 1.0, None, "Multiplies force_scale (1 = not driven)"), Role::ForceScaleIn);
         }
@@ -300,26 +338,75 @@ impl ContactModel {
         };
         let unique = |l: &[usize]| {
             let mut seen = Vec::new();
-            l.iter().filter(|d| if seen.contains(*d) { false } else { seen.push(**d); true }).copied().collect::<Vec<_>>()
+            l.iter()
+                .filter(|d| {
+                    if seen.contains(*d) {
+                        false
+                    } else {
+                        seen.push(**d);
+                        true
+                    }
+                })
+                .copied()
+                .collect::<Vec<_>>()
         };
         for d in unique(&shown.displacement) {
-            out(&mut t, Variable::output(&format!("displacement[{d}]"), Continuous, real(None, None), &format!("Displacement of DOF {d} (length unit of the scene)")), Quantity::Displacement(d));
+            out(
+                &mut t,
+                Variable::output(&format!("displacement[{d}]"), Continuous, real(None, None), &format!("Displacement of DOF {d} (length unit of the scene)")),
+                Quantity::Displacement(d),
+            );
         }
         for d in unique(&shown.velocity) {
-            out(&mut t, Variable::output(&format!("velocity[{d}]"), Continuous, real(None, None), &format!("Velocity of DOF {d} (length unit per second)")), Quantity::Velocity(d));
+            out(
+                &mut t,
+                Variable::output(&format!("velocity[{d}]"), Continuous, real(None, None), &format!("Velocity of DOF {d} (length unit per second)")),
+                Quantity::Velocity(d),
+            );
         }
         for d in unique(&shown.acceleration) {
-            out(&mut t, Variable::output(&format!("acceleration[{d}]"), Continuous, real(None, None), &format!("Acceleration of DOF {d} (length unit per second squared)")), Quantity::Acceleration(d));
+            out(
+                &mut t,
+                Variable::output(
+                    &format!("acceleration[{d}]"),
+                    Continuous,
+                    real(None, None),
+                    &format!("Acceleration of DOF {d} (length unit per second squared)"),
+                ),
+                Quantity::Acceleration(d),
+            );
         }
         if shown.contacts {
             for (i, c) in model.contacts.iter().enumerate() {
-                out(&mut t, Variable::output(&format!("contact[{i}].force"), Continuous, real(None, None), &format!("Compressive force >= 0 of contact {i} on DOF {} (force unit)", c.dof)), Quantity::Force(i));
-                out(&mut t, Variable::output(&format!("contact[{i}].gap"), Continuous, real(None, None), &format!("Clearance >= 0 of contact {i} on DOF {} (length unit)", c.dof)), Quantity::Gap(i));
+                out(
+                    &mut t,
+                    Variable::output(
+                        &format!("contact[{i}].force"),
+                        Continuous,
+                        real(None, None),
+                        &format!("Compressive force >= 0 of contact {i} on DOF {} (force unit)", c.dof),
+                    ),
+                    Quantity::Force(i),
+                );
+                out(
+                    &mut t,
+                    Variable::output(
+                        &format!("contact[{i}].gap"),
+                        Continuous,
+                        real(None, None),
+                        &format!("Clearance >= 0 of contact {i} on DOF {} (length unit)", c.dof),
+                    ),
+                    Quantity::Gap(i),
+                );
             }
         }
         // Always present, like the result's `lcp` (size 0, 0 pivots, residual 0 without contact).
         {
-            out(&mut t, Variable::output("lcp.pivots", Discrete, Kind::Integer { start: None, min: None, max: None }, "Pivots of the last LCP solve"), Quantity::Pivots);
+            out(
+                &mut t,
+                Variable::output("lcp.pivots", Discrete, Kind::Integer { start: None, min: None, max: None }, "Pivots of the last LCP solve"),
+                Quantity::Pivots,
+            );
             out(&mut t, Variable::output("lcp.residual", Discrete, real(None, None), "Residual max|min(z, Az+q)| of the last LCP solve"), Quantity::Residual);
         }
 

@@ -4,32 +4,32 @@
 //!
 //! Flow: [`scene`] (TOML) → [`model`] → [`time`] (circulant symbols) → [`periodic`] (assembly,
 //! LCP, recovery) → [`response`]. The [`lcp`] solvers know nothing of mechanics.
-#[cfg(feature = "plots")]
-/// PNG line charts.
-pub mod plot;
+/// The native C API (include/periodic_contact.h).
+#[cfg(feature = "capi")]
+pub mod capi;
 /// The built-in default scene.
 pub mod defaults;
-/// Finite elements: Matrix Market input, DOF clamping, the blade model.
-pub mod fe;
 /// Semi-analytic periodic orbits: the independent references of the tests.
 pub mod exact;
+/// Finite elements: Matrix Market input, DOF clamping, the blade model.
+pub mod fe;
 /// The FMI 2.0 co-simulation shell (knows nothing of contact).
 pub mod fmi2;
 /// The FMU's physics adapter: a scene as a quasi-steady co-simulation model.
 pub mod fmu_model;
-/// The native C API (include/periodic_contact.h).
-#[cfg(feature = "capi")]
-pub mod capi;
 /// LCP solvers; they know nothing of mechanics.
 pub mod lcp;
 /// Explicit time marching with forward-increment Lagrange multipliers (the paper's reference).
 pub mod marching;
 /// The mechanical model and its checks.
 pub mod model;
-/// Craig–Bampton reduction and modal analysis.
-pub mod reduction;
 /// Assembly in the frequency domain, the LCP of the period, recovery.
 pub mod periodic;
+#[cfg(feature = "plots")]
+/// PNG line charts.
+pub mod plot;
+/// Craig–Bampton reduction and modal analysis.
+pub mod reduction;
 /// The periodic response as written to JSON.
 pub mod response;
 /// Scene files (TOML).

@@ -27,9 +27,8 @@ pub struct Chart<'a> {
 }
 
 fn range(values: impl Iterator<Item = f64>, scale: Scale) -> (f64, f64) {
-    let (lo, hi) = values
-        .filter(|v| v.is_finite() && (scale == Scale::Linear || *v > 0.0))
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(v), h.max(v)));
+    let (lo, hi) =
+        values.filter(|v| v.is_finite() && (scale == Scale::Linear || *v > 0.0)).fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(v), h.max(v)));
     if !lo.is_finite() {
         return (if scale == Scale::Log { 1e-3 } else { 0.0 }, 1.0);
     }
@@ -76,9 +75,8 @@ where
     DB::ErrorType: 'static,
 {
     let err = |e: &dyn std::fmt::Display| e.to_string();
-    let keep = |(x, y): &(f64, f64)| {
-        x.is_finite() && y.is_finite() && (chart.x_scale == Scale::Linear || *x > 0.0) && (chart.y_scale == Scale::Linear || *y > 0.0)
-    };
+    let keep =
+        |(x, y): &(f64, f64)| x.is_finite() && y.is_finite() && (chart.x_scale == Scale::Linear || *x > 0.0) && (chart.y_scale == Scale::Linear || *y > 0.0);
     let xs = range(series.iter().flat_map(|s| s.points.iter().map(|p| p.0)), chart.x_scale);
     let ys = range(series.iter().flat_map(|s| s.points.iter().map(|p| p.1)), chart.y_scale);
     let mut builder = ChartBuilder::on(area);

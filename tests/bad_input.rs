@@ -196,7 +196,11 @@ fn matrix_of_the_wrong_type_says_what_is_expected() {
 
 /// GOOD as a 2-DOF model with these M, K and C rows.
 fn two_dof(mass: &str, stiffness: &str, damping: &str) -> String {
-    with("mass = [[1.0]]", &format!("mass = {mass}")).replacen("stiffness = [[1.0]]", &format!("stiffness = {stiffness}"), 1).replacen("matrix = [[0.1]]", &format!("matrix = {damping}"), 1)
+    with("mass = [[1.0]]", &format!("mass = {mass}")).replacen("stiffness = [[1.0]]", &format!("stiffness = {stiffness}"), 1).replacen(
+        "matrix = [[0.1]]",
+        &format!("matrix = {damping}"),
+        1,
+    )
 }
 
 const I2: &str = "[[1.0, 0.0], [0.0, 1.0]]";
@@ -214,8 +218,14 @@ fn structural_matrices() {
     refused(&with("stiffness = [[1.0]]", &format!("stiffness = {I2}")), &["structure.stiffness", "2×2", "expected 1×1"]);
     refused(&with("matrix = [[0.1]]", "matrix = [[0.1]]\nrayleigh = [0.1, 0.0]"), &["damping", "give one of matrix, rayleigh"]);
     // Rayleigh damping αM + βK is formed before the sizes are checked: it used to panic here.
-    refused(&with("mass = [[1.0]]", &format!("mass = {I2}")).replacen("matrix = [[0.1]]", "rayleigh = [0.1, 0.01]", 1), &["structure.stiffness", "1×1", "expected 2×2"]);
-    refused(&with("stiffness = [[1.0]]", &format!("stiffness = {I2}")).replacen("matrix = [[0.1]]", "rayleigh = [0.1, 0.01]", 1), &["structure.stiffness", "2×2", "expected 1×1"]);
+    refused(
+        &with("mass = [[1.0]]", &format!("mass = {I2}")).replacen("matrix = [[0.1]]", "rayleigh = [0.1, 0.01]", 1),
+        &["structure.stiffness", "1×1", "expected 2×2"],
+    );
+    refused(
+        &with("stiffness = [[1.0]]", &format!("stiffness = {I2}")).replacen("matrix = [[0.1]]", "rayleigh = [0.1, 0.01]", 1),
+        &["structure.stiffness", "2×2", "expected 1×1"],
+    );
 }
 
 #[test]
@@ -342,7 +352,8 @@ fn huge_sizes_are_refused_at_once() {
     refused_quickly(&two, &["discretization.steps", "16400 with 2 contact(s)", "32800 unknowns", "at most 32768"]);
     // Without contact a fine grid is only FFTs; on a dense model it is one LU per harmonic.
     let n = 100;
-    let identity = (0..n).map(|i| format!("[{}]", (0..n).map(|j| if i == j { "1.0" } else { "0" }).collect::<Vec<_>>().join(", "))).collect::<Vec<_>>().join(",\n");
+    let identity =
+        (0..n).map(|i| format!("[{}]", (0..n).map(|j| if i == j { "1.0" } else { "0" }).collect::<Vec<_>>().join(", "))).collect::<Vec<_>>().join(",\n");
     let dense = format!("[structure]\nmass = [{identity}]\nstiffness = [{identity}]\n[excitation]\nfrequency = 1.0\n[discretization]\nsteps = 4194304\n");
     refused_quickly(&dense, &["structure.mass", "dense 100×100", "steps = 4194304", "factorisations", "sparse"]);
 }
@@ -406,7 +417,12 @@ fn matrix_market_truncated_or_of_the_wrong_shape() {
     mtx_refused("%%MatrixMarket matrix coordinate real symmetric\n2 2 3\n1 1 2.0\n2 1 -1.0\n2 2", MtxErrorKind::Entry, 5, &["2 field(s)", "`2 2`"]);
     mtx_refused("%%MatrixMarket matrix coordinate real symmetric\n% only a comment\n", MtxErrorKind::Truncated, 3, &["size line"]);
     mtx_refused("", MtxErrorKind::Banner, 1, &["empty file"]);
-    mtx_refused("%%MatrixMarket matrix coordinate real symmetric\n2 2 3\n1 1 2.0\n2 1 -1.0\n2 2 2.0\n1 2 5.0\n", MtxErrorKind::TooManyEntries, 6, &["after the 3 entries"]);
+    mtx_refused(
+        "%%MatrixMarket matrix coordinate real symmetric\n2 2 3\n1 1 2.0\n2 1 -1.0\n2 2 2.0\n1 2 5.0\n",
+        MtxErrorKind::TooManyEntries,
+        6,
+        &["after the 3 entries"],
+    );
     // Wrong shape: not square, 0×0, an index outside the size, more entries than fit.
     mtx_refused("%%MatrixMarket matrix coordinate real general\n3 4 1\n1 1 1.0\n", MtxErrorKind::Size, 2, &["3×4", "square"]);
     mtx_refused("%%MatrixMarket matrix coordinate real general\n0 0 0\n", MtxErrorKind::Size, 2, &["0×0"]);
@@ -433,10 +449,25 @@ fn matrix_market_truncated_or_of_the_wrong_shape() {
 fn matrix_market_sizes_from_the_header_are_not_trusted() {
     // An announced entry count far beyond the content: refused when the file ends, without
     // reserving memory for it first (that was 320 GB and an abort).
-    mtx_refused("%%MatrixMarket matrix coordinate real general\n100000 100000 10000000000\n1 1 1.0\n", MtxErrorKind::Truncated, 4, &["after 1 of the 10000000000 entries"]);
-    mtx_refused("%%MatrixMarket matrix coordinate real symmetric\n100000 100000 5000050000\n1 1 1.0\n", MtxErrorKind::Truncated, 4, &["after 1 of the 5000050000"]);
+    mtx_refused(
+        "%%MatrixMarket matrix coordinate real general\n100000 100000 10000000000\n1 1 1.0\n",
+        MtxErrorKind::Truncated,
+        4,
+        &["after 1 of the 10000000000 entries"],
+    );
+    mtx_refused(
+        "%%MatrixMarket matrix coordinate real symmetric\n100000 100000 5000050000\n1 1 1.0\n",
+        MtxErrorKind::Truncated,
+        4,
+        &["after 1 of the 5000050000"],
+    );
     // An order no structural model has: refused before the column pointers are allocated.
-    mtx_refused("%%MatrixMarket matrix coordinate real general\n1000000000 1000000000 1\n1 1 1.0\n", MtxErrorKind::Size, 2, &["1000000000×1000000000", "at most"]);
+    mtx_refused(
+        "%%MatrixMarket matrix coordinate real general\n1000000000 1000000000 1\n1 1 1.0\n",
+        MtxErrorKind::Size,
+        2,
+        &["1000000000×1000000000", "at most"],
+    );
     mtx_refused("%%MatrixMarket matrix coordinate real general\n18446744073709551615 18446744073709551615 1\n1 1 1.0\n", MtxErrorKind::Size, 2, &["at most"]);
 }
 
@@ -507,7 +538,8 @@ fn a_solver_failure_writes_nothing_and_exits_1() {
     let dir = scratch();
     std::fs::write(dir.join("singular.toml"), &text).unwrap();
     std::fs::write(dir.join("r.json"), "previous result").unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_periodic-contact")).arg("solve").arg(dir.join("singular.toml")).arg("-o").arg(dir.join("r.json")).output().unwrap();
+    let o =
+        Command::new(env!("CARGO_BIN_EXE_periodic-contact")).arg("solve").arg(dir.join("singular.toml")).arg("-o").arg(dir.join("r.json")).output().unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(err.contains("singular at harmonic 1") && err.contains("add damping"), "{err}");

@@ -1,8 +1,8 @@
 //! Finite-element input and the built-in blade: Matrix Market round trips and errors, DOF
 //! clamping, element and assembly checks (symmetry, definiteness, rigid-body modes, mass), and
 //! the cantilever frequency against Euler–Bernoulli theory.
-use faer::sparse::{SparseColMat, Triplet};
 use faer::Side;
+use faer::sparse::{SparseColMat, Triplet};
 use periodic_contact::fe::hex8::{hex8_matrices, hex8_volume};
 use periodic_contact::fe::mtx::{matrix_market_string, parse_matrix_market};
 use periodic_contact::fe::sparse::{asymmetry, sparse_mul_vec};
@@ -360,10 +360,8 @@ fn blade_spec_from_toml() {
     struct Wrap {
         generator: BladeSpec,
     }
-    let w: Wrap = toml::from_str(
-        "generator = { preset = \"fine\", twist_deg = 10.0, taper = 1.0, span_elements = 12, poisson = 0.3, element = \"hex8\" }",
-    )
-    .unwrap();
+    let w: Wrap =
+        toml::from_str("generator = { preset = \"fine\", twist_deg = 10.0, taper = 1.0, span_elements = 12, poisson = 0.3, element = \"hex8\" }").unwrap();
     let p = w.generator.params().unwrap();
     assert_eq!(p.mesh, MeshDensity { span: 12, chord: 24, thickness: 4 });
     assert_eq!((p.twist_deg, p.taper, p.material.poisson, p.element), (10.0, 1.0, 0.3, ElementKind::Hex8));

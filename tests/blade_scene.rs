@@ -1,7 +1,7 @@
 //! Scenes with finite-element input: Matrix Market files, fixed DOFs, the blade generator with
 //! named nodes, the Craig–Bampton reduction (eigenfrequencies and periodic responses against the
 //! full model), the casing, and the error messages.
-use periodic_contact::fe::{write_matrix_market, Blade, BladeParams};
+use periodic_contact::fe::{Blade, BladeParams, write_matrix_market};
 use periodic_contact::model::Harmonic;
 use periodic_contact::reduction::sparse_modes;
 use periodic_contact::response::Response;

@@ -333,13 +333,38 @@ struct CApi {
 }
 
 const C_API_FUNCTIONS: [&str; 32] = [
-    "pc_version", "pc_last_error", "pc_problem_from_scene_file", "pc_problem_from_scene_text", "pc_problem_from_matrices",
-    "pc_problem_add_force", "pc_problem_add_contact", "pc_problem_add_contact_motion", "pc_problem_set_outputs",
-    "pc_problem_set_pairing", "pc_problem_set_parallel", "pc_problem_set_frequency", "pc_problem_set_force_scale",
-    "pc_problem_set_gap_offset", "pc_problem_set_motion_scale", "pc_problem_frequency", "pc_problem_solve", "pc_problem_free",
-    "pc_result_steps", "pc_result_period", "pc_result_time", "pc_result_displacement", "pc_result_velocity",
-    "pc_result_acceleration", "pc_result_contact_count", "pc_result_contact_force", "pc_result_contact_gap", "pc_result_lcp",
-    "pc_result_warning_count", "pc_result_warning", "pc_result_json", "pc_result_free",
+    "pc_version",
+    "pc_last_error",
+    "pc_problem_from_scene_file",
+    "pc_problem_from_scene_text",
+    "pc_problem_from_matrices",
+    "pc_problem_add_force",
+    "pc_problem_add_contact",
+    "pc_problem_add_contact_motion",
+    "pc_problem_set_outputs",
+    "pc_problem_set_pairing",
+    "pc_problem_set_parallel",
+    "pc_problem_set_frequency",
+    "pc_problem_set_force_scale",
+    "pc_problem_set_gap_offset",
+    "pc_problem_set_motion_scale",
+    "pc_problem_frequency",
+    "pc_problem_solve",
+    "pc_problem_free",
+    "pc_result_steps",
+    "pc_result_period",
+    "pc_result_time",
+    "pc_result_displacement",
+    "pc_result_velocity",
+    "pc_result_acceleration",
+    "pc_result_contact_count",
+    "pc_result_contact_force",
+    "pc_result_contact_gap",
+    "pc_result_lcp",
+    "pc_result_warning_count",
+    "pc_result_warning",
+    "pc_result_json",
+    "pc_result_free",
 ];
 
 const PC_OK: c_int = 0;
@@ -647,11 +672,7 @@ fn fmu_run(fmu: &Fmu, s: &Slave, (w, scale): (f64, f64)) -> Vec<u64> {
 #[test]
 fn fmu_eight_threads_with_different_parameters_are_bitwise_equal_to_sequential_runs() {
     let fmu = rigid();
-    let sequential: Vec<Vec<u64>> = CONFIGS
-        .iter()
-        .enumerate()
-        .map(|(i, &cfg)| fmu_run(fmu, &fmu.instantiate(&format!("seq-{i}")).unwrap(), cfg))
-        .collect();
+    let sequential: Vec<Vec<u64>> = CONFIGS.iter().enumerate().map(|(i, &cfg)| fmu_run(fmu, &fmu.instantiate(&format!("seq-{i}")).unwrap(), cfg)).collect();
     // The configurations differ from each other (the comparison below is not vacuous).
     for i in 1..8 {
         assert_ne!(sequential[i], sequential[0]);
@@ -901,7 +922,21 @@ fn under_valgrind(vg: &str, what: &str, cmd: &[&std::ffi::OsStr]) -> Vec<String>
     let err = String::from_utf8_lossy(&o.stderr);
     let summary: Vec<String> = err
         .lines()
-        .filter(|l| ["ERROR SUMMARY", "in use at exit", "total heap usage", "definitely lost", "indirectly lost", "possibly lost", "still reachable", "suppressed:", "All heap blocks"].iter().any(|k| l.contains(k)))
+        .filter(|l| {
+            [
+                "ERROR SUMMARY",
+                "in use at exit",
+                "total heap usage",
+                "definitely lost",
+                "indirectly lost",
+                "possibly lost",
+                "still reachable",
+                "suppressed:",
+                "All heap blocks",
+            ]
+            .iter()
+            .any(|k| l.contains(k))
+        })
         .map(|l| l.split_once("== ").map_or(l, |x| x.1).trim().to_string())
         .collect();
     assert!(o.status.success(), "valgrind {what}: exit {:?}\n{err}", o.status.code());
@@ -921,7 +956,11 @@ fn valgrind_on_the_c_example_and_on_the_fmu_driven_by_the_c_host() {
     };
     // The C API example, on a scene with a contact (LCP, warm-started re-solve).
     let lib_dir = c_library().parent().unwrap().to_path_buf();
-    let demo = compile("capi_demo", "examples/capi_demo.c", &[format!("-L{}", lib_dir.display()), "-lperiodic_contact".into(), format!("-Wl,-rpath,{}", lib_dir.display())]);
+    let demo = compile(
+        "capi_demo",
+        "examples/capi_demo.c",
+        &[format!("-L{}", lib_dir.display()), "-lperiodic_contact".into(), format!("-Wl,-rpath,{}", lib_dir.display())],
+    );
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("fmu/scenes/rigid-stop.toml");
     under_valgrind(vg, "capi_demo rigid-stop.toml", &[demo.as_os_str(), scene.as_os_str()]);
     // The FMU through the C host: dlopen, instantiate, initialise, two periods, outputs, free.
@@ -929,5 +968,9 @@ fn valgrind_on_the_c_example_and_on_the_fmu_driven_by_the_c_host() {
     under_valgrind(vg, "fmu_host rigid-stop (two periods)", &[fmu_host().as_os_str(), dir.as_os_str()]);
     // … and with re-solves (warm-started) on the two-contact chain.
     let dir = chain_fmu().dir.join("unzipped");
-    under_valgrind(vg, "fmu_host chain-3dof-two-stops (1500 steps, a re-solve every 300)", &[fmu_host().as_os_str(), dir.as_os_str(), "--steps".as_ref(), "1500".as_ref(), "--resolve-every".as_ref(), "300".as_ref()]);
+    under_valgrind(
+        vg,
+        "fmu_host chain-3dof-two-stops (1500 steps, a re-solve every 300)",
+        &[fmu_host().as_os_str(), dir.as_os_str(), "--steps".as_ref(), "1500".as_ref(), "--resolve-every".as_ref(), "300".as_ref()],
+    );
 }

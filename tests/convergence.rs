@@ -141,7 +141,8 @@ fn persistent_contact_follows_the_obstacle_and_the_force_converges() {
     let motion = vec![Harmonic { amplitude: 0.05, harmonic: 2, phase: 0.3 }];
     // A constant load of 1 keeps the mass pressed on the obstacle.
     let build = |k: usize| {
-        let mut model = osc.model(vec![periodic_contact::model::Contact { dof: 0, direction: 1.0, gap: 0.2, compliance: Compliance::Rigid, motion: motion.clone() }]);
+        let mut model =
+            osc.model(vec![periodic_contact::model::Contact { dof: 0, direction: 1.0, gap: 0.2, compliance: Compliance::Rigid, motion: motion.clone() }]);
         model.forces.push(periodic_contact::model::Force { dof: 0, term: Harmonic { amplitude: 1.0, harmonic: 0, phase: 0.0 } });
         let outputs = OutputSelection { displacement: vec![0], velocity: vec![], acceleration: vec![], contacts: true };
         PeriodicProblem::new(model, Discretization { scheme: Scheme::Cds, steps: k, pairing: None }, outputs, SolverSettings::default()).unwrap()
@@ -173,10 +174,7 @@ fn persistent_contact_follows_the_obstacle_and_the_force_converges() {
 #[test]
 fn cds_forward_equals_the_steady_state_of_explicit_time_marching() {
     use periodic_contact::marching::{MarchSettings, march};
-    let cases = [
-        ("pure impacts", Oscillator { mass: 1.0, damping: 0.1, stiffness: 1.0, force: 0.5, omega: 0.8 }, 0.6),
-        ("sticking", STICKING, 0.5),
-    ];
+    let cases = [("pure impacts", Oscillator { mass: 1.0, damping: 0.1, stiffness: 1.0, force: 0.5, omega: 0.8 }, 0.6), ("sticking", STICKING, 0.5)];
     for (name, osc, gap) in cases {
         for k in [256usize, 1024] {
             let model = osc.model(vec![Oscillator::stop(gap, Compliance::Rigid)]);

@@ -144,12 +144,8 @@ fn fast_path_agrees_with_lemke_on_the_rigid_stop_reference() {
 #[test]
 fn fast_path_agrees_with_lemke_with_two_contacts() {
     let osc = Oscillator { force: 1.2, ..STICKING };
-    let stops = || {
-        vec![
-            Oscillator::stop(0.5, Compliance::Rigid),
-            Contact { dof: 0, direction: -1.0, gap: 0.6, compliance: Compliance::Rigid, motion: Vec::new() },
-        ]
-    };
+    let stops =
+        || vec![Oscillator::stop(0.5, Compliance::Rigid), Contact { dof: 0, direction: -1.0, gap: 0.6, compliance: Compliance::Rigid, motion: Vec::new() }];
     for k in [128, 512, 1024] {
         for scheme in [Scheme::Cds, Scheme::Galerkin] {
             let p = osc_problem(&osc, stops(), scheme, k, None);
@@ -213,7 +209,8 @@ fn block_circulant_structure_is_detected_exactly() {
     assert_eq!(found.blocks(), a.blocks());
 
     let osc = Oscillator { force: 1.2, ..STICKING };
-    let stops = vec![Oscillator::stop(0.5, Compliance::Rigid), Contact { dof: 0, direction: -1.0, gap: 0.6, compliance: Compliance::Rigid, motion: Vec::new() }];
+    let stops =
+        vec![Oscillator::stop(0.5, Compliance::Rigid), Contact { dof: 0, direction: -1.0, gap: 0.6, compliance: Compliance::Rigid, motion: Vec::new() }];
     let p = osc_problem(&osc, stops, Scheme::Cds, 32, None);
     let (a2, _) = p.assemble_lcp(&PeriodFft::new(32)).unwrap();
     let d2 = DenseMatrix::from_matrix(&a2);
@@ -262,7 +259,10 @@ fn the_lcp_command_uses_the_fast_path_for_a_block_circulant_dat() {
     let (zf, zl) = (z(&fast), z(&lemke));
     let scale = max_abs(&zl).max(1.0);
     let d = zf.iter().zip(&zl).fold(0.0f64, |m, (x, y)| m.max((x - y).abs())) / scale;
-    eprintln!("lcp command N = 1024: fast {:.4} s ({} pivots), dense lemke {:.4} s ({} pivots), difference {d:.2e}", fast["time_s"], fast["pivots"], lemke["time_s"], lemke["pivots"]);
+    eprintln!(
+        "lcp command N = 1024: fast {:.4} s ({} pivots), dense lemke {:.4} s ({} pivots), difference {d:.2e}",
+        fast["time_s"], fast["pivots"], lemke["time_s"], lemke["pivots"]
+    );
     assert!(d <= AGREE);
     // A general (non-circulant) LCP still goes to dense Lemke.
     let small = dir.join("general.dat");

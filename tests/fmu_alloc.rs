@@ -65,7 +65,8 @@ fn do_step_allocates_nothing() {
         let model = ContactModel::from_scene_text(&text, "alloc").unwrap();
         let (_, guid) = xml::render(model.model_description());
         let (name, guid, uri) = (CString::new("alloc").unwrap(), CString::new(guid).unwrap(), CString::new(format!("file://{}", dir.display())).unwrap());
-        let cb = Fmi2CallbackFunctions { logger: None, allocate_memory: None, free_memory: None, step_finished: None, component_environment: std::ptr::null_mut() };
+        let cb =
+            Fmi2CallbackFunctions { logger: None, allocate_memory: None, free_memory: None, step_finished: None, component_environment: std::ptr::null_mut() };
         unsafe {
             let c = ffi::instantiate::<ContactModel>(name.as_ptr(), FMI2_CO_SIMULATION, guid.as_ptr(), uri.as_ptr(), &cb, 0, 0);
             assert!(!c.is_null());

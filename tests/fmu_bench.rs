@@ -29,7 +29,13 @@ fn do_step_throughput() {
     for (name, text) in [
         ("linear-2dof (cds)", std::fs::read_to_string(scene_path("linear-2dof.toml")).unwrap()),
         ("rigid-stop (cds)", std::fs::read_to_string(scene_path("rigid-stop.toml")).unwrap()),
-        ("stop k_c=100 (fourier)", std::fs::read_to_string(scene_path("rigid-stop.toml")).unwrap().replace("\"cds\"", "\"fourier\"").replace("[[contact]]\ndof = 0\ndirection = 1\ngap = 0.5", "[[contact]]\ndof = 0\ndirection = 1\ngap = 0.5\nstiffness = 100.0")),
+        (
+            "stop k_c=100 (fourier)",
+            std::fs::read_to_string(scene_path("rigid-stop.toml"))
+                .unwrap()
+                .replace("\"cds\"", "\"fourier\"")
+                .replace("[[contact]]\ndof = 0\ndirection = 1\ngap = 0.5", "[[contact]]\ndof = 0\ndirection = 1\ngap = 0.5\nstiffness = 100.0"),
+        ),
         ("chain-3dof-two-stops", std::fs::read_to_string(scene_path("chain-3dof-two-stops.toml")).unwrap()),
     ] {
         let tag = name.split_whitespace().next().unwrap().to_string() + if name.contains("fourier") { "-fourier" } else { "" };
@@ -37,7 +43,8 @@ fn do_step_throughput() {
         let s = fmu.instantiate("bench").unwrap();
         s.init(0.0);
         let outputs: Vec<u32> = {
-            let mut v: Vec<(u32, bool)> = fmu.vars.iter().filter(|(n, _)| fmu.xml.contains(&format!("name=\"{n}\""))).map(|(n, vr)| (*vr, is_real_output(&fmu.xml, n))).collect();
+            let mut v: Vec<(u32, bool)> =
+                fmu.vars.iter().filter(|(n, _)| fmu.xml.contains(&format!("name=\"{n}\""))).map(|(n, vr)| (*vr, is_real_output(&fmu.xml, n))).collect();
             v.sort();
             v.into_iter().filter(|(_, o)| *o).map(|(vr, _)| vr).collect()
         };
@@ -105,7 +112,8 @@ fn warm_started_re_solve_against_a_cold_solve() {
             let q = t.apply(&p, p.disc).unwrap();
             let (cold_t, cold) = best(5, || q.solve_with(&fft, None).unwrap());
             let (warm_t, warm) = best(5, || q.solve_with(&fft, Some(&r0.active_set)).unwrap());
-            let dx = cold.displacement.values().zip(warm.displacement.values()).flat_map(|(a, b)| a.iter().zip(b).map(|(x, y)| (x - y).abs())).fold(0.0, f64::max);
+            let dx =
+                cold.displacement.values().zip(warm.displacement.values()).flat_map(|(a, b)| a.iter().zip(b).map(|(x, y)| (x - y).abs())).fold(0.0, f64::max);
             println!(
                 "{:<22} {:>5} {:>6.0e} {:>10.5} {:>7} {:>10.5} {:>7} {:>5} {:>10.1e}",
                 name.trim_end_matches(".toml"),

@@ -49,7 +49,9 @@ fn variables_follow_the_effects() {
 
 #[test]
 fn model_description_order_outputs_and_initial_unknowns() {
-    let text = format!("{BASE}[[force]]\ndof = 0\namplitude = 1.0\n[[contact]]\ndof = 0\ngap = 0.5\nmotion = [{{ amplitude = 0.1 }}]\n[output]\ndisplacement = [0]\nvelocity = [0]\n");
+    let text = format!(
+        "{BASE}[[force]]\ndof = 0\namplitude = 1.0\n[[contact]]\ndof = 0\ngap = 0.5\nmotion = [{{ amplitude = 0.1 }}]\n[output]\ndisplacement = [0]\nvelocity = [0]\n"
+    );
     let m = ContactModel::from_scene_text(&text, "t").unwrap();
     let d = m.model_description();
     d.variables.check().unwrap();

@@ -8,8 +8,8 @@ mod common;
 
 use common::host::*;
 use std::collections::BTreeSet;
-use std::ffi::{CString, c_char, c_void};
 use std::f64::consts::PI;
+use std::ffi::{CString, c_char, c_void};
 use std::process::Command;
 use std::sync::OnceLock;
 
@@ -44,7 +44,8 @@ fn linear(scheme: &str, steps: usize) -> String {
 
 /// The linear scene with every force amplitude scaled and another frequency.
 fn linear_tuned(scale: f64, frequency: f64) -> String {
-    LINEAR.replace("amplitude = 0.8", &format!("amplitude = {}", 0.8 * scale))
+    LINEAR
+        .replace("amplitude = 0.8", &format!("amplitude = {}", 0.8 * scale))
         .replace("amplitude = 0.3", &format!("amplitude = {}", 0.3 * scale))
         .replace("frequency = 1.7", &format!("frequency = {frequency}"))
 }
@@ -164,8 +165,17 @@ fn only_the_effects_the_scene_calls_for_have_variables() {
     let fmu = cds();
     let names: BTreeSet<&str> = fmu.vars.keys().map(String::as_str).collect();
     let expected: BTreeSet<&str> = [
-        "frequency", "force_scale", "steps", "scheme", "frequency_in", "force_scale_in", "displacement[0]", "displacement[1]", "velocity[0]",
-        "lcp.pivots", "lcp.residual",
+        "frequency",
+        "force_scale",
+        "steps",
+        "scheme",
+        "frequency_in",
+        "force_scale_in",
+        "displacement[0]",
+        "displacement[1]",
+        "velocity[0]",
+        "lcp.pivots",
+        "lcp.residual",
     ]
     .into();
     assert_eq!(names, expected);
@@ -182,8 +192,10 @@ fn only_the_effects_the_scene_calls_for_have_variables() {
         assert_eq!(f.compression(), zip::CompressionMethod::Deflated, "{name}");
         members.insert(name);
     }
-    let want: BTreeSet<String> =
-        ["modelDescription.xml", "binaries/linux64/PeriodicContact.so", "resources/scene.toml", "documentation/index.html"].iter().map(|s| s.to_string()).collect();
+    let want: BTreeSet<String> = ["modelDescription.xml", "binaries/linux64/PeriodicContact.so", "resources/scene.toml", "documentation/index.html"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
     assert_eq!(members, want);
 }
 

@@ -174,7 +174,13 @@ fn ten_contacts_with_nearly_dependent_rows() {
 #[test]
 fn a_moving_obstacle_faster_than_the_structure() {
     let osc = oscillator(0.3, 1.0, 0.1);
-    let mut model = osc.model(vec![Contact { dof: 0, direction: 1.0, gap: 0.1, compliance: Compliance::Rigid, motion: vec![Harmonic { amplitude: 0.05, harmonic: 20, phase: 0.0 }] }]);
+    let mut model = osc.model(vec![Contact {
+        dof: 0,
+        direction: 1.0,
+        gap: 0.1,
+        compliance: Compliance::Rigid,
+        motion: vec![Harmonic { amplitude: 0.05, harmonic: 20, phase: 0.0 }],
+    }]);
     model.forces.push(Force { dof: 0, term: Harmonic { amplitude: 0.5, harmonic: 0, phase: 0.0 } });
     check("obstacle moving at 20× the forcing frequency (rigid)", &build(model.clone(), Scheme::Cds, 512, None));
     model.contacts[0].compliance = Compliance::Compliant { stiffness: 50.0 };

@@ -12,8 +12,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use periodic_contact::lcp::{
-    BlockCirculant, DatError, DenseMatrix, LcpMatrix, LcpOutcome, LcpSolution, Lemke, LemkeSettings, parse_dat, read_dat,
-    solve_by_enumeration, write_dat,
+    BlockCirculant, DatError, DenseMatrix, LcpMatrix, LcpOutcome, LcpSolution, Lemke, LemkeSettings, parse_dat, read_dat, solve_by_enumeration, write_dat,
 };
 use proptest::prelude::*;
 
@@ -124,9 +123,12 @@ fn random_matrix(rng: &mut Rng, n: usize, class: Class) -> DenseMatrix {
         Class::DiagDominant => {
             let off = u(rng, n);
             let extra: Vec<f64> = (0..n).map(|_| rng.uniform(0.1, 1.0)).collect();
-            DenseMatrix::from_fn(n, |i, j| {
-                if i == j { (0..n).filter(|&k| k != i).map(|k| off[i * n + k].abs()).sum::<f64>() + extra[i] } else { off[i * n + j] }
-            })
+            DenseMatrix::from_fn(
+                n,
+                |i, j| {
+                    if i == j { (0..n).filter(|&k| k != i).map(|k| off[i * n + k].abs()).sum::<f64>() + extra[i] } else { off[i * n + j] }
+                },
+            )
         }
         Class::PdNonsym => {
             let l = u(rng, n);
@@ -225,10 +227,7 @@ fn random_indefinite_never_wrongly_solved() {
                 assert_lcp_solution(&a, &q, &s.z, "random indefinite");
                 solved += 1;
             } else {
-                assert!(
-                    matches!(s.outcome, LcpOutcome::RayTermination | LcpOutcome::PivotLimit | LcpOutcome::Inaccurate),
-                    "{s:?}"
-                );
+                assert!(matches!(s.outcome, LcpOutcome::RayTermination | LcpOutcome::PivotLimit | LcpOutcome::Inaccurate), "{s:?}");
                 if sols.is_empty() { unsolvable += 1 } else { failed_solvable += 1 }
             }
             if sols.is_empty() {
@@ -315,7 +314,15 @@ fn murty_degenerate_3x3() {
 /// above; q_i = −Σ_{j=i..n} 2^j. The unique solution is z = 2ⁿ e_n (w_i = 2^{n+1} − Σ_{j≥i} 2^j
 /// = 2^i > 0 for i < n), and the complementary pivot method takes 2ⁿ pivots.
 fn murty_exponential(n: usize) -> (DenseMatrix, Vec<f64>) {
-    let a = DenseMatrix::from_fn(n, |i, j| if i == j { 1.0 } else if j > i { 2.0 } else { 0.0 });
+    let a = DenseMatrix::from_fn(n, |i, j| {
+        if i == j {
+            1.0
+        } else if j > i {
+            2.0
+        } else {
+            0.0
+        }
+    });
     let q: Vec<f64> = (1..=n).map(|i| -(i..=n).map(|j| 2f64.powi(j as i32)).sum::<f64>()).collect();
     (a, q)
 }
@@ -790,9 +797,8 @@ fn oscillator_lcp_with(k: usize, gap: f64, omega: f64, forward: bool) -> (BlockC
             (a / den, -b / den)
         })
         .collect();
-    let c: Vec<f64> = (0..k)
-        .map(|d| g.iter().enumerate().map(|(p, &(gr, gi))| gr * cosv[(p * d) % k] - gi * sinv[(p * d) % k]).sum::<f64>() / k as f64)
-        .collect();
+    let c: Vec<f64> =
+        (0..k).map(|d| g.iter().enumerate().map(|(p, &(gr, gi))| gr * cosv[(p * d) % k] - gi * sinv[(p * d) % k]).sum::<f64>() / k as f64).collect();
     let shift = usize::from(forward);
     let blocks: Vec<f64> = (0..k).map(|d| c[(d + shift) % k]).collect();
     let (dr, di) = (1.0 - omega * omega, 0.1 * omega);

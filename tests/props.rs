@@ -17,7 +17,9 @@
 //! test binary down, which fails the run as well.
 use periodic_contact::fe::mtx::matrix_market_string;
 use periodic_contact::fe::parse_matrix_market;
-use periodic_contact::lcp::{BlockCirculant, BlockPivoting, CirculantOperator, DenseMatrix, Lemke, LemkeSettings, LcpMatrix, LcpOutcome, LcpSolution, PivotingSettings, dat::parse_dat};
+use periodic_contact::lcp::{
+    BlockCirculant, BlockPivoting, CirculantOperator, DenseMatrix, LcpMatrix, LcpOutcome, LcpSolution, Lemke, LemkeSettings, PivotingSettings, dat::parse_dat,
+};
 use periodic_contact::model::{Compliance, Contact, Force, Harmonic, Matrix, Model, Structure};
 use periodic_contact::periodic::{LcpMethod, OutputSelection, PeriodicProblem, SolveError, SolverSettings};
 use periodic_contact::response::Response;
@@ -50,18 +52,20 @@ impl Tally {
     }
 }
 
-fn run_property<S>(name: &'static str, regressions: &'static str, default_cases: u32, strategy: S, tally: &Tally, test: impl Fn(S::Value) -> Result<(), TestCaseError>)
-where
+fn run_property<S>(
+    name: &'static str,
+    regressions: &'static str,
+    default_cases: u32,
+    strategy: S,
+    tally: &Tally,
+    test: impl Fn(S::Value) -> Result<(), TestCaseError>,
+) where
     S: Strategy,
     S::Value: Debug,
 {
     let cases = budget(default_cases);
-    let config = Config {
-        cases,
-        failure_persistence: Some(Box::new(FileFailurePersistence::Direct(regressions))),
-        max_shrink_iters: 4096,
-        ..Config::default()
-    };
+    let config =
+        Config { cases, failure_persistence: Some(Box::new(FileFailurePersistence::Direct(regressions))), max_shrink_iters: 4096, ..Config::default() };
     let mut runner = TestRunner::new(config);
     let start = Instant::now();
     let inputs = RefCell::new(0usize);
@@ -181,7 +185,14 @@ fn check_response(p: &PeriodicProblem, r: &Response, tally: &Tally) -> Result<()
     let factor = 100.0 * p.solver.tolerance.max(1e-9);
     if worst > factor * response_scale {
         let qmax = q_scale(p);
-        prop_assert!(worst <= factor * qmax.max(response_scale), "complementarity violated by {:e} (‖q‖∞ {:e}, response scale {:e}, lcp {:?})", worst, qmax, response_scale, r.lcp);
+        prop_assert!(
+            worst <= factor * qmax.max(response_scale),
+            "complementarity violated by {:e} (‖q‖∞ {:e}, response scale {:e}, lcp {:?})",
+            worst,
+            qmax,
+            response_scale,
+            r.lcp
+        );
         // Certified by the contract, but only because ‖q‖∞ ≫ the response: an ill-conditioned
         // case (a nearly free DOF under a static load, say); counted for the report.
         tally.add("solved, certified only relative to ‖q‖∞");
@@ -227,13 +238,85 @@ fn check_scene_text(text: &str, tally: &Tally) -> Result<(), TestCaseError> {
 
 /// Fragments of scene syntax, so that random text gets past the TOML layer often.
 const SCENE_TOKENS: &[&str] = &[
-    "[structure]\n", "[damping]\n", "[excitation]\n", "[[force]]\n", "[[contact]]\n", "[discretization]\n", "[output]\n", "[solver]\n",
-    "mass = ", "stiffness = ", "matrix = ", "rayleigh = ", "frequency = ", "dof = ", "amplitude = ", "harmonic = ", "phase = ",
-    "direction = ", "gap = ", "motion = ", "scheme = ", "steps = ", "pairing = ", "displacement = ", "velocity = ", "contacts = ",
-    "method = ", "tolerance = ", "[[1.0]]", "[[2.0, -1.0], [-1.0, 2.0]]", "[[1.0, 0.0], [0.0, 1.0]]", "[0.1, 0.01]", "[0]", "[1]",
-    "[]", "[[]]", "{ amplitude = 0.1, harmonic = 2 }", "\"cds\"", "\"bds1\"", "\"fourier\"", "\"same\"", "\"forward\"", "\"lemke\"",
-    "\"pivoting\"", "\"auto\"", "\"x\"", "0", "1", "-1", "2", "3", "8", "64", "256", "0.5", "1.0", "-0.5", "1e308", "-1e308", "1e-320",
-    "nan", "inf", "-inf", "true", "false", "\n", "\n", "\n", " ", "=", "[", "]", "{", "}", ",", "#", "\"", ".", "'",
+    "[structure]\n",
+    "[damping]\n",
+    "[excitation]\n",
+    "[[force]]\n",
+    "[[contact]]\n",
+    "[discretization]\n",
+    "[output]\n",
+    "[solver]\n",
+    "mass = ",
+    "stiffness = ",
+    "matrix = ",
+    "rayleigh = ",
+    "frequency = ",
+    "dof = ",
+    "amplitude = ",
+    "harmonic = ",
+    "phase = ",
+    "direction = ",
+    "gap = ",
+    "motion = ",
+    "scheme = ",
+    "steps = ",
+    "pairing = ",
+    "displacement = ",
+    "velocity = ",
+    "contacts = ",
+    "method = ",
+    "tolerance = ",
+    "[[1.0]]",
+    "[[2.0, -1.0], [-1.0, 2.0]]",
+    "[[1.0, 0.0], [0.0, 1.0]]",
+    "[0.1, 0.01]",
+    "[0]",
+    "[1]",
+    "[]",
+    "[[]]",
+    "{ amplitude = 0.1, harmonic = 2 }",
+    "\"cds\"",
+    "\"bds1\"",
+    "\"fourier\"",
+    "\"same\"",
+    "\"forward\"",
+    "\"lemke\"",
+    "\"pivoting\"",
+    "\"auto\"",
+    "\"x\"",
+    "0",
+    "1",
+    "-1",
+    "2",
+    "3",
+    "8",
+    "64",
+    "256",
+    "0.5",
+    "1.0",
+    "-0.5",
+    "1e308",
+    "-1e308",
+    "1e-320",
+    "nan",
+    "inf",
+    "-inf",
+    "true",
+    "false",
+    "\n",
+    "\n",
+    "\n",
+    " ",
+    "=",
+    "[",
+    "]",
+    "{",
+    "}",
+    ",",
+    "#",
+    "\"",
+    ".",
+    "'",
 ];
 
 fn scene_soup() -> impl Strategy<Value = String> {
@@ -243,11 +326,8 @@ fn scene_soup() -> impl Strategy<Value = String> {
 #[test]
 fn scene_parser_on_arbitrary_text() {
     let tally = Tally::default();
-    let strategy = prop_oneof![
-        any::<String>(),
-        prop::collection::vec(any::<u8>(), 0..400).prop_map(|b| String::from_utf8_lossy(&b).into_owned()),
-        scene_soup(),
-    ];
+    let strategy =
+        prop_oneof![any::<String>(), prop::collection::vec(any::<u8>(), 0..400).prop_map(|b| String::from_utf8_lossy(&b).into_owned()), scene_soup(),];
     run_property("scene_parser_on_arbitrary_text", "tests/proptest-regressions/scene_text.txt", 2000, strategy, &tally, |text| check_scene_text(&text, &tally));
 }
 
@@ -291,7 +371,12 @@ fn generated_scene() -> impl Strategy<Value = String> {
             matrix_literal(n).prop_map(|m| format!("[damping]\nmatrix = {m}\n")),
             (value(SMALL), value(SMALL)).prop_map(|(a, b)| format!("[damping]\nrayleigh = [{a}, {b}]\n")),
         ];
-        let force = (value(DOFS), value(&["1.0", "0.5", "-2.0", "0.0", "3.0"]), optional("harmonic", value(&["0", "1", "2", "3"])), optional("phase", value(&["0.0", "1.0", "-2.0"])))
+        let force = (
+            value(DOFS),
+            value(&["1.0", "0.5", "-2.0", "0.0", "3.0"]),
+            optional("harmonic", value(&["0", "1", "2", "3"])),
+            optional("phase", value(&["0.0", "1.0", "-2.0"])),
+        )
             .prop_map(|(d, a, h, p)| format!("[[force]]\ndof = {d}\namplitude = {a}\n{h}{p}"));
         let motion = (value(&["0.05", "0.1", "0.0"]), value(&["1", "2", "3"]), value(&["0.0", "0.5"]))
             .prop_map(|(a, h, p)| format!("{{ amplitude = {a}, harmonic = {h}, phase = {p} }}"));
@@ -316,10 +401,16 @@ fn generated_scene() -> impl Strategy<Value = String> {
         )
         .prop_map(|d| d.map_or(String::new(), |(a, b, c)| format!("[discretization]\n{a}{b}{c}")));
         let list = || value(&["[0]", "[0, 1]", "[]", "[2]", "[1, 1]"]);
-        let output = prop::option::weighted(0.4, (optional("displacement", list()), optional("velocity", list()), optional("acceleration", list()), optional("contacts", value(&["true", "false"]))))
-            .prop_map(|o| o.map_or(String::new(), |(a, b, c, d)| format!("[output]\n{a}{b}{c}{d}")));
-        let solver = prop::option::weighted(0.4, (optional("method", value(&["\"auto\"", "\"lemke\"", "\"pivoting\""])), optional("tolerance", value(&["1e-9", "1e-6", "1e-12"]))))
-            .prop_map(|o| o.map_or(String::new(), |(a, b)| format!("[solver]\n{a}{b}")));
+        let output = prop::option::weighted(
+            0.4,
+            (optional("displacement", list()), optional("velocity", list()), optional("acceleration", list()), optional("contacts", value(&["true", "false"]))),
+        )
+        .prop_map(|o| o.map_or(String::new(), |(a, b, c, d)| format!("[output]\n{a}{b}{c}{d}")));
+        let solver = prop::option::weighted(
+            0.4,
+            (optional("method", value(&["\"auto\"", "\"lemke\"", "\"pivoting\""])), optional("tolerance", value(&["1e-9", "1e-6", "1e-12"]))),
+        )
+        .prop_map(|o| o.map_or(String::new(), |(a, b)| format!("[solver]\n{a}{b}")));
         (
             matrix_literal(n),
             matrix_literal(n),
@@ -344,7 +435,9 @@ fn generated_scene() -> impl Strategy<Value = String> {
 #[test]
 fn scene_parser_on_generated_scenes() {
     let tally = Tally::default();
-    run_property("scene_parser_on_generated_scenes", "tests/proptest-regressions/scene_generated.txt", 1000, generated_scene(), &tally, |text| check_scene_text(&text, &tally));
+    run_property("scene_parser_on_generated_scenes", "tests/proptest-regressions/scene_generated.txt", 1000, generated_scene(), &tally, |text| {
+        check_scene_text(&text, &tally)
+    });
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -352,9 +445,43 @@ fn scene_parser_on_generated_scenes() {
 
 /// Replacement numbers: non-finite, huge, tiny, negative, zero, sizes at the limits.
 const BAD_NUMBERS: &[&str] = &[
-    "nan", "+nan", "-nan", "inf", "+inf", "-inf", "1e308", "-1e308", "1.7976931348623157e308", "1e-320", "5e-324", "0", "0.0", "-0.0",
-    "-1", "-1.5", "-0.001", "2", "3", "4", "5", "7", "100", "4194304", "4194305", "32768", "32769", "99999999999999999999",
-    "9223372036854775807", "-9223372036854775808", "4294967296", "1.5", "1e400", "1e-12", "1e12", "0x10", "1_000",
+    "nan",
+    "+nan",
+    "-nan",
+    "inf",
+    "+inf",
+    "-inf",
+    "1e308",
+    "-1e308",
+    "1.7976931348623157e308",
+    "1e-320",
+    "5e-324",
+    "0",
+    "0.0",
+    "-0.0",
+    "-1",
+    "-1.5",
+    "-0.001",
+    "2",
+    "3",
+    "4",
+    "5",
+    "7",
+    "100",
+    "4194304",
+    "4194305",
+    "32768",
+    "32769",
+    "99999999999999999999",
+    "9223372036854775807",
+    "-9223372036854775808",
+    "4294967296",
+    "1.5",
+    "1e400",
+    "1e-12",
+    "1e12",
+    "0x10",
+    "1_000",
 ];
 
 /// Replacement values of the wrong type or shape.
@@ -368,13 +495,36 @@ fn bad_value() -> impl Strategy<Value = &'static str> + Clone {
 
 /// Whole lines that may be inserted.
 const EXTRA_LINES: &[&str] = &[
-    "[[contact]]\ndof = 0\ngap = 0.1", "[[contact]]\ndof = 0\ngap = 0.0\nstiffness = 1e9", "[[contact]]\ndof = 1\ndirection = -1\ngap = 0.2",
-    "[[force]]\ndof = 0\namplitude = 2.0\nharmonic = 3", "[damping]\nrayleigh = [0.1, 0.0]", "[damping]\nmatrix = [[0.0]]",
-    "[discretization]\nscheme = \"bds2\"", "pairing = \"same\"", "pairing = \"forward\"", "scheme = \"fourier\"", "scheme = \"galerkin\"",
-    "scheme = \"bds1\"", "steps = 4", "steps = 5", "steps = 7", "[solver]\nmethod = \"pivoting\"", "[solver]\nmethod = \"lemke\"",
-    "[solver]\ntolerance = 1e-3", "[output]\ncontacts = false", "velocity = [0]", "acceleration = [0]", "displacement = [9]",
-    "motion = [{ amplitude = 0.5, harmonic = 1, phase = 1.0 }]", "stiffness = 1e-6", "direction = -1", "frequency = 1e-300",
-    "frequency = 1e300", "harmonic = 0", "[structure]", "[excitation]\nfrequency = 2.0",
+    "[[contact]]\ndof = 0\ngap = 0.1",
+    "[[contact]]\ndof = 0\ngap = 0.0\nstiffness = 1e9",
+    "[[contact]]\ndof = 1\ndirection = -1\ngap = 0.2",
+    "[[force]]\ndof = 0\namplitude = 2.0\nharmonic = 3",
+    "[damping]\nrayleigh = [0.1, 0.0]",
+    "[damping]\nmatrix = [[0.0]]",
+    "[discretization]\nscheme = \"bds2\"",
+    "pairing = \"same\"",
+    "pairing = \"forward\"",
+    "scheme = \"fourier\"",
+    "scheme = \"galerkin\"",
+    "scheme = \"bds1\"",
+    "steps = 4",
+    "steps = 5",
+    "steps = 7",
+    "[solver]\nmethod = \"pivoting\"",
+    "[solver]\nmethod = \"lemke\"",
+    "[solver]\ntolerance = 1e-3",
+    "[output]\ncontacts = false",
+    "velocity = [0]",
+    "acceleration = [0]",
+    "displacement = [9]",
+    "motion = [{ amplitude = 0.5, harmonic = 1, phase = 1.0 }]",
+    "stiffness = 1e-6",
+    "direction = -1",
+    "frequency = 1e-300",
+    "frequency = 1e300",
+    "harmonic = 0",
+    "[structure]",
+    "[excitation]\nfrequency = 2.0",
 ];
 
 #[derive(Clone, Debug)]
@@ -544,14 +694,40 @@ fn dat_text(c: &DatCase) -> String {
 
 fn dat_case() -> impl Strategy<Value = DatCase> {
     (1usize..7).prop_flat_map(|n| {
-        (Just(n), prop::collection::vec(wide_value(), n * n), prop::collection::vec(wide_value(), n), any::<bool>())
-            .prop_map(|(n, m, q, comment)| DatCase { n, m, q, comment })
+        (Just(n), prop::collection::vec(wide_value(), n * n), prop::collection::vec(wide_value(), n), any::<bool>()).prop_map(|(n, m, q, comment)| DatCase {
+            n,
+            m,
+            q,
+            comment,
+        })
     })
 }
 
 const DAT_TOKENS: &[&str] = &[
-    "0", "1", "2", "3", "-1", "0.5", "1e308", "1e400", "nan", "inf", "-inf", "x", "1000000000", "4294967296", "18446744073709551615",
-    "99999999999999999999999", "\n", "\n", "\n", " ", "\t", "\r\n", "#", "3\t3",
+    "0",
+    "1",
+    "2",
+    "3",
+    "-1",
+    "0.5",
+    "1e308",
+    "1e400",
+    "nan",
+    "inf",
+    "-inf",
+    "x",
+    "1000000000",
+    "4294967296",
+    "18446744073709551615",
+    "99999999999999999999999",
+    "\n",
+    "\n",
+    "\n",
+    " ",
+    "\t",
+    "\r\n",
+    "#",
+    "3\t3",
 ];
 
 fn check_dat(text: &str, valid: Option<&DatCase>) -> Result<(), TestCaseError> {
@@ -633,9 +809,37 @@ fn mtx_text(c: &MtxCase) -> String {
 }
 
 const MTX_TOKENS: &[&str] = &[
-    "%%MatrixMarket", " matrix", " coordinate", " array", " real", " integer", " complex", " pattern", " general", " symmetric",
-    " skew-symmetric", " hermitian", "\n", "\n", "\n", "%", " ", "1", "2", "3", "0", "-1", "0.5", "nan", "inf", "1e400", "x",
-    "4000000000", "18446744073709551615", "100000", "1e308",
+    "%%MatrixMarket",
+    " matrix",
+    " coordinate",
+    " array",
+    " real",
+    " integer",
+    " complex",
+    " pattern",
+    " general",
+    " symmetric",
+    " skew-symmetric",
+    " hermitian",
+    "\n",
+    "\n",
+    "\n",
+    "%",
+    " ",
+    "1",
+    "2",
+    "3",
+    "0",
+    "-1",
+    "0.5",
+    "nan",
+    "inf",
+    "1e400",
+    "x",
+    "4000000000",
+    "18446744073709551615",
+    "100000",
+    "1e308",
 ];
 
 fn check_mtx(bytes: &[u8], valid: Option<&MtxCase>) -> Result<(), TestCaseError> {
@@ -756,8 +960,16 @@ fn entry(class: Class, u: f64, e: f64, zero: bool) -> f64 {
 fn lcp_case() -> impl Strategy<Value = LcpCase> {
     (class(), 1usize..=30, any::<bool>(), 1usize..=3).prop_flat_map(|(class, n0, circ, m)| {
         // Block-circulant: n = k·m with k = ceil(n0/m).
-        let (n, circulant) = if circ { let k = n0.div_ceil(m); (k * m, Some((k, m))) } else { (n0, None) };
-        let na = match circulant { Some((k, m)) => k * m * m, None => n * n };
+        let (n, circulant) = if circ {
+            let k = n0.div_ceil(m);
+            (k * m, Some((k, m)))
+        } else {
+            (n0, None)
+        };
+        let na = match circulant {
+            Some((k, m)) => k * m * m,
+            None => n * n,
+        };
         (
             prop::collection::vec((-1.0f64..1.0, 0.0f64..1.0, prop::bool::weighted(0.15)), na),
             prop::collection::vec((-1.0f64..1.0, 0.0f64..1.0, prop::bool::weighted(0.1)), n),
@@ -967,21 +1179,8 @@ fn model_case() -> impl Strategy<Value = ModelCase> {
             (0.1f64..3.0, prop::collection::vec(force, 0..4), prop::collection::vec(contact, 1..=3)),
             (scheme(), pairing, steps, method),
         )
-            .prop_map(move |((lm, lk, mass_exp, stiffness_exp, singular_k, damping), (omega, forces, contacts), (scheme, pairing, steps, method))| ModelCase {
-                n,
-                lm,
-                lk,
-                mass_exp,
-                stiffness_exp,
-                singular_k,
-                damping,
-                omega,
-                forces,
-                contacts,
-                scheme,
-                pairing,
-                steps,
-                method,
+            .prop_map(move |((lm, lk, mass_exp, stiffness_exp, singular_k, damping), (omega, forces, contacts), (scheme, pairing, steps, method))| {
+                ModelCase { n, lm, lk, mass_exp, stiffness_exp, singular_k, damping, omega, forces, contacts, scheme, pairing, steps, method }
             })
     })
 }
@@ -1072,10 +1271,22 @@ fn regression_subnormal_frequency() {
 #[test]
 fn regression_pivoting_overflow_gives_finite_iterates() {
     let a = vec![
-        0.0, 0.0, 0.0, 0.0, //
-        0.0, 0.0, 0.0, 0.0, //
-        0.0, 0.0, 0.0, -8.647581108803679e122, //
-        6.735355114879248e-13, 0.0, 2.0392110557097704e-58, 3.440498550146966e-80,
+        0.0,
+        0.0,
+        0.0,
+        0.0, //
+        0.0,
+        0.0,
+        0.0,
+        0.0, //
+        0.0,
+        0.0,
+        0.0,
+        -8.647581108803679e122, //
+        6.735355114879248e-13,
+        0.0,
+        2.0392110557097704e-58,
+        3.440498550146966e-80,
     ];
     let c = LcpCase { class: Class::Magnitudes(-102, 140), n: 4, a, q: vec![0.0, 0.0, 0.0, -4.1573272532236174e110], circulant: None, warm_start: None };
     check_lcp_case(&c, &Tally::default()).unwrap();

@@ -112,7 +112,17 @@ fn linear_orbit_satisfies_its_ode_and_matches_dense_helper() {
     let t = osc.period();
     for i in 0..50 {
         let ti = t * i as f64 / 50.0;
-        assert!(ode_residual(&osc, |s| { let (x, v, _) = o.eval(s); (x, v, 0.0) }, ti, 1e-4) < 1e-6);
+        assert!(
+            ode_residual(
+                &osc,
+                |s| {
+                    let (x, v, _) = o.eval(s);
+                    (x, v, 0.0)
+                },
+                ti,
+                1e-4
+            ) < 1e-6
+        );
         let (x, _, a) = o.eval(ti);
         assert!((a + osc.omega * osc.omega * x).abs() < 1e-14);
     }
@@ -149,11 +159,7 @@ fn chain2() -> Model {
 fn dense_linear_response_satisfies_equation_of_motion() {
     let model = chain2();
     let lr = LinearResponse::from_model(&model).unwrap();
-    let (mm, kk, cc) = (
-        model.structure.mass.to_dense(),
-        model.structure.stiffness.to_dense(),
-        model.structure.damping.as_ref().unwrap().to_dense(),
-    );
+    let (mm, kk, cc) = (model.structure.mass.to_dense(), model.structure.stiffness.to_dense(), model.structure.damping.as_ref().unwrap().to_dense());
     let mut f = vec![0.0; 2];
     for i in 0..30 {
         let t = 0.21 * i as f64;
@@ -292,10 +298,7 @@ fn rigid_pure_impact_orbit() {
 fn persistent_contact_force_and_persistence() {
     // Mass pressed against an obstacle at mean −1 (harmonic-0 term) that moves by 0.3 cos(Ωt + 0.4).
     let osc = Oscillator::new(1.0, 0.1, 1.0, 0.5, 1.3);
-    let motion = [
-        Harmonic { amplitude: -1.0, harmonic: 0, phase: 0.0 },
-        Harmonic { amplitude: 0.3, harmonic: 1, phase: 0.4 },
-    ];
+    let motion = [Harmonic { amplitude: -1.0, harmonic: 0, phase: 0.0 }, Harmonic { amplitude: 0.3, harmonic: 1, phase: 0.4 }];
     let p = PersistentContact::solve(&osc, 1.0, 0.0, &motion).unwrap();
     assert!(p.is_persistent(), "min force {:?}", p.min_force());
     // z = F cos Ωt − (m x'' + c x' + k x): check with finite differences of eval.
@@ -370,7 +373,14 @@ fn march_linear_is_the_discrete_cds_orbit_and_second_order() {
         let h = model.period() / n as f64;
         let x0 = cont.displacement(0.0);
         let v0 = cont.velocity(0.0);
-        let s = MarchSettings { steps_per_period: n, tolerance: 1e-13, max_periods: 3000, initial_displacement: Some(x0), initial_velocity: Some(v0), ..Default::default() };
+        let s = MarchSettings {
+            steps_per_period: n,
+            tolerance: 1e-13,
+            max_periods: 3000,
+            initial_displacement: Some(x0),
+            initial_velocity: Some(v0),
+            ..Default::default()
+        };
         let r = march(&model, &s).unwrap();
         assert!(r.converged, "n {n}: defect {:e}", r.defect);
         // Discrete steady state (notes §6.1): Z(θ) = K + σ2 M + σ1 C with σ2 = −(2 sin(θ/2)/h)²,
@@ -396,10 +406,15 @@ fn march_linear_is_the_discrete_cds_orbit_and_second_order() {
         }
         let ed = r.displacement.iter().zip(&disc).flat_map(|(a, b)| [(a[0] - b[0]).abs(), (a[1] - b[1]).abs()]).fold(0.0, f64::max);
         assert!(ed < 1e-10, "n {n}: marcher vs discrete orbit {ed:e}");
-        let ec = r.time.iter().zip(&r.displacement).flat_map(|(t, a)| {
-            let b = cont.displacement(*t);
-            [(a[0] - b[0]).abs(), (a[1] - b[1]).abs()]
-        }).fold(0.0, f64::max);
+        let ec = r
+            .time
+            .iter()
+            .zip(&r.displacement)
+            .flat_map(|(t, a)| {
+                let b = cont.displacement(*t);
+                [(a[0] - b[0]).abs(), (a[1] - b[1]).abs()]
+            })
+            .fold(0.0, f64::max);
         errs.push(ec);
     }
     let p = fitted_order(&ns, &errs);
@@ -489,10 +504,7 @@ fn march_rigid_stop_pure_impacts_first_order() {
 #[test]
 fn march_persistent_contact_with_moving_obstacle() {
     let osc = Oscillator::new(1.0, 0.1, 1.0, 0.5, 1.3);
-    let motion = vec![
-        Harmonic { amplitude: -1.0, harmonic: 0, phase: 0.0 },
-        Harmonic { amplitude: 0.3, harmonic: 1, phase: 0.4 },
-    ];
+    let motion = vec![Harmonic { amplitude: -1.0, harmonic: 0, phase: 0.0 }, Harmonic { amplitude: 0.3, harmonic: 1, phase: 0.4 }];
     let p = PersistentContact::solve(&osc, 1.0, 0.0, &motion).unwrap();
     let contact = Contact { dof: 0, direction: 1.0, gap: 0.0, compliance: Compliance::Rigid, motion };
     let model = osc.model(vec![contact]);

@@ -2,7 +2,7 @@
 //! the resonance, warm against cold starts, spectra, the CLI, and agreement with time marching.
 use periodic_contact::periodic::{PeriodFft, PeriodicProblem};
 use periodic_contact::scene::Scene;
-use periodic_contact::sweep::{self, marching, SweepSettings};
+use periodic_contact::sweep::{self, SweepSettings, marching};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
@@ -144,7 +144,17 @@ fn cli_sweep_writes_the_csv_the_curves_and_the_spectra() {
     let mut lines = text.lines();
     let head: Vec<&str> = lines.next().unwrap().split(',').collect();
     assert_eq!(head[0], "frequency");
-    for col in ["amplitude_1903", "linear_amplitude_1868", "max_force_c0_dof1868", "contact_fraction_c2_dof1940", "lcp_size", "pivots", "warm_start_used", "time_s", "status"] {
+    for col in [
+        "amplitude_1903",
+        "linear_amplitude_1868",
+        "max_force_c0_dof1868",
+        "contact_fraction_c2_dof1940",
+        "lcp_size",
+        "pivots",
+        "warm_start_used",
+        "time_s",
+        "status",
+    ] {
         assert!(head.contains(&col), "{col} missing from {head:?}");
     }
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();

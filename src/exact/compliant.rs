@@ -179,9 +179,7 @@ impl CompliantStopOrbit {
                 "gap: is {g0}; the linear response exceeds it (max x = {}) but the simulated steady state never touches the stop: no one-contact orbit from the default seed, give a seed",
                 self.linear.amplitude()
             )),
-            (Some(u), _) => Err(format!(
-                "gap: is {g0}; the simulated steady state has {u} contact phases per period: not a one-contact orbit"
-            )),
+            (Some(u), _) => Err(format!("gap: is {g0}; the simulated steady state has {u} contact phases per period: not a one-contact orbit")),
             // No period-T attractor (subharmonic, chaotic, undamped): an unstable period-T orbit
             // may still exist; let Newton try from the last contact phase.
             (None, Some((t0, v0, t1))) => Ok([t0, t1, v0]),
@@ -216,11 +214,7 @@ impl CompliantStopOrbit {
         let dse_dt1 = [b[0] - c[0], b[1] - c[1]];
         let dse_dv0 = mul(&pf, ds1_dv0);
         let r = [s1[0] - g0, se[0] - g0, se[1] - v0];
-        let j = [
-            [ds1_dt0[0], ds1_dt1[0], ds1_dv0[0]],
-            [dse_dt0[0], dse_dt1[0], dse_dv0[0]],
-            [dse_dt0[1], dse_dt1[1], dse_dv0[1] - 1.0],
-        ];
+        let j = [[ds1_dt0[0], ds1_dt1[0], ds1_dv0[0]], [dse_dt0[0], dse_dt1[0], dse_dv0[0]], [dse_dt0[1], dse_dt1[1], dse_dv0[1] - 1.0]];
         (r, j)
     }
 
@@ -381,10 +375,7 @@ impl CompliantStopOrbit {
     pub fn impulse_per_period(&self) -> f64 {
         match &self.phases {
             None => 0.0,
-            Some(p) => {
-                self.contact_stiffness
-                    * (p.contact.integral_x(p.t0, [self.gap, p.v0], p.t1) - self.gap * (p.t1 - p.t0))
-            }
+            Some(p) => self.contact_stiffness * (p.contact.integral_x(p.t0, [self.gap, p.v0], p.t1) - self.gap * (p.t1 - p.t0)),
         }
     }
     pub fn period(&self) -> f64 {

@@ -107,8 +107,7 @@ impl PhaseFlow {
         // y'' + 2α y' + ω0² y = 0 integrated: ∫y = −([y'] + 2α [y]) / ω0².
         let hom = -(u[1] + 2.0 * self.alpha * u[0]) / self.w0sq;
         let iw = C64::new(0.0, self.omega);
-        let part = (self.amp * (C64::from_polar(1.0, self.omega * t) - C64::from_polar(1.0, self.omega * t0)) / iw).re
-            + self.static_offset() * (t - t0);
+        let part = (self.amp * (C64::from_polar(1.0, self.omega * t) - C64::from_polar(1.0, self.omega * t0)) / iw).re + self.static_offset() * (t - t0);
         hom + part
     }
 }
@@ -191,7 +190,13 @@ mod tests {
             let mut s = 0.0;
             for i in 0..=n {
                 let t = a + (b - a) * i as f64 / n as f64;
-                let w = if i == 0 || i == n { 1.0 } else if i % 2 == 1 { 4.0 } else { 2.0 };
+                let w = if i == 0 || i == n {
+                    1.0
+                } else if i % 2 == 1 {
+                    4.0
+                } else {
+                    2.0
+                };
                 s += w * fl.propagate(t0, s0, t)[0];
             }
             s *= (b - a) / n as f64 / 3.0;

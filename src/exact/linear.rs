@@ -20,10 +20,7 @@ impl LinearOrbit {
         let den = C64::new(osc.stiffness - osc.omega * osc.omega * osc.mass, osc.omega * osc.damping);
         let scale = osc.stiffness + osc.omega * osc.omega * osc.mass + osc.omega * osc.damping;
         if den.norm() <= 1e-14 * scale {
-            return Err(format!(
-                "omega: is {}, an undamped resonance (k = Ω² m = {}, c = 0): no periodic steady state",
-                osc.omega, osc.stiffness
-            ));
+            return Err(format!("omega: is {}, an undamped resonance (k = Ω² m = {}, c = 0): no periodic steady state", osc.omega, osc.stiffness));
         }
         Ok(LinearOrbit { osc: *osc, amp: osc.force / den })
     }
@@ -121,9 +118,7 @@ pub fn linear_response_dense(
         let bn = (0..n).map(|i| rhs[(i, 0)].norm()).fold(0.0, f64::max);
         let rn = (0..n).map(|i| r[(i, 0)].norm()).fold(0.0, f64::max);
         if !(xn.is_finite() && rn <= 1e-8 * (zn * xn + bn)) || (bn > 0.0 && zn * xn > 1e12 * bn) {
-            return Err(format!(
-                "omega: harmonic {h} of ω = {omega} makes K − (hω)²M + i hω C singular (resonance or rigid-body mode)"
-            ));
+            return Err(format!("omega: harmonic {h} of ω = {omega} makes K − (hω)²M + i hω C singular (resonance or rigid-body mode)"));
         }
         harmonics.push((h, (0..n).map(|i| x[(i, 0)]).collect()));
     }

@@ -63,11 +63,7 @@ impl Oscillator {
     }
 
     pub(crate) fn require_stiffness(&self) -> Result<(), String> {
-        if self.stiffness > 0.0 {
-            Ok(())
-        } else {
-            Err(format!("stiffness: is {}, the contact orbits need k > 0", self.stiffness))
-        }
+        if self.stiffness > 0.0 { Ok(()) } else { Err(format!("stiffness: is {}, the contact orbits need k > 0", self.stiffness)) }
     }
 
     /// T = 2π/Ω.

@@ -42,14 +42,7 @@ impl PersistentContact {
             check_finite(&format!("motion[{i}].amplitude"), h.amplitude)?;
             check_finite(&format!("motion[{i}].phase"), h.phase)?;
         }
-        let mut p = PersistentContact {
-            osc: *osc,
-            direction,
-            gap,
-            motion: motion.to_vec(),
-            min_force: 0.0,
-            min_force_time: 0.0,
-        };
+        let mut p = PersistentContact { osc: *osc, direction, gap, motion: motion.to_vec(), min_force: 0.0, min_force_time: 0.0 };
         // Minimum of z: samples, then bisection on the sign changes of z'.
         let period = osc.period();
         let hmax = motion.iter().map(|h| h.harmonic).max().unwrap_or(1).max(1) as usize;

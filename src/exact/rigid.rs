@@ -34,9 +34,17 @@ enum Kind {
     NoContact,
     Stuck,
     /// Departure t_d ∈ [0, T), impact t_h ∈ (t_d, t_d + T], incoming velocity v_h.
-    Sticking { t_d: f64, t_h: f64, v_h: f64 },
+    Sticking {
+        t_d: f64,
+        t_h: f64,
+        v_h: f64,
+    },
     /// Impact (and immediate departure) at t0 ∈ [0, T), incoming velocity v_in, multiplier μ.
-    Impacting { t0: f64, v_in: f64, multiplier: f64 },
+    Impacting {
+        t0: f64,
+        v_in: f64,
+        multiplier: f64,
+    },
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -63,15 +71,7 @@ impl RigidStopOrbit {
         }
         let linear = LinearOrbit::solve(osc)?;
         let free = PhaseFlow::new(osc.mass, osc.damping, osc.stiffness, osc.force, osc.omega, 0.0)?;
-        let mut orbit = RigidStopOrbit {
-            osc: *osc,
-            gap,
-            kind: Kind::NoContact,
-            free,
-            linear,
-            min_x: -linear.amplitude(),
-            max_x: linear.amplitude(),
-        };
+        let mut orbit = RigidStopOrbit { osc: *osc, gap, kind: Kind::NoContact, free, linear, min_x: -linear.amplitude(), max_x: linear.amplitude() };
         if linear.amplitude() <= gap {
             return Ok(orbit);
         }
@@ -105,10 +105,7 @@ impl RigidStopOrbit {
                     ));
                 }
                 None => {
-                    sticking_failure = Some(format!(
-                        "the free flight from the departure Ωt_d = {:.6} does not return to the stop within two periods",
-                        w * t_d
-                    ))
+                    sticking_failure = Some(format!("the free flight from the departure Ωt_d = {:.6} does not return to the stop within two periods", w * t_d))
                 }
             }
         }

@@ -20,7 +20,7 @@
 //! 3·node + {0, 1, 2} for (x, y, z). The clamped model removes the root nodes (i_span = 0), so
 //! its DOF k is unclamped DOF `dofs.new_to_old[k]` = 3·node + c with nodes numbered from the
 //! first span station: clamped DOF = unclamped DOF − 3·(root node count).
-use super::hex8::{hex8_matrices, ElementKind, Mat24, Material, CORNERS};
+use super::hex8::{CORNERS, ElementKind, Mat24, Material, hex8_matrices};
 use super::sparse::DofMap;
 use crate::model::{Matrix, Structure};
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
@@ -130,10 +130,7 @@ impl BladeParams {
             return bad("mesh.chord", format!("must be even and ≥ 2 (a mid-chord node is needed), got {}", self.mesh.chord));
         }
         if self.mesh.thickness < 2 || self.mesh.thickness % 2 != 0 {
-            return bad(
-                "mesh.thickness",
-                format!("must be even and ≥ 2 (mid-thickness tip nodes are needed), got {}", self.mesh.thickness),
-            );
+            return bad("mesh.thickness", format!("must be even and ≥ 2 (mid-thickness tip nodes are needed), got {}", self.mesh.thickness));
         }
         Ok(())
     }
@@ -244,11 +241,7 @@ impl Blade {
     }
     /// Total mass ρ·V [kg] of the mesh (every node, root included), from the element volumes.
     pub fn total_mass(&self) -> f64 {
-        self.elements
-            .iter()
-            .map(|e| super::hex8::hex8_volume(&e.map(|a| self.nodes[a])))
-            .sum::<f64>()
-            * self.params.material.density
+        self.elements.iter().map(|e| super::hex8::hex8_volume(&e.map(|a| self.nodes[a]))).sum::<f64>() * self.params.material.density
     }
 }
 
@@ -285,10 +278,7 @@ fn build(params: &BladeParams, clamp_root: bool) -> Result<Blade, BladeError> {
     let mats: Vec<(Mat24, Mat24)> = elements
         .par_iter()
         .enumerate()
-        .map(|(e, conn)| {
-            hex8_matrices(&conn.map(|a| nodes[a]), &params.material, params.element)
-                .map_err(|source| BladeError::Element { element: e, source })
-        })
+        .map(|(e, conn)| hex8_matrices(&conn.map(|a| nodes[a]), &params.material, params.element).map_err(|source| BladeError::Element { element: e, source }))
         .collect::<Result<_, _>>()?;
 
     // Sparse pattern: node-to-node adjacency through elements, 3×3 blocks, free nodes only.

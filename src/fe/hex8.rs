@@ -16,16 +16,8 @@
 use nalgebra::{Matrix3, SMatrix, Vector3};
 
 /// Corner signs of the 8 local nodes.
-pub const CORNERS: [[f64; 3]; 8] = [
-    [-1.0, -1.0, -1.0],
-    [1.0, -1.0, -1.0],
-    [1.0, 1.0, -1.0],
-    [-1.0, 1.0, -1.0],
-    [-1.0, -1.0, 1.0],
-    [1.0, -1.0, 1.0],
-    [1.0, 1.0, 1.0],
-    [-1.0, 1.0, 1.0],
-];
+pub const CORNERS: [[f64; 3]; 8] =
+    [[-1.0, -1.0, -1.0], [1.0, -1.0, -1.0], [1.0, 1.0, -1.0], [-1.0, 1.0, -1.0], [-1.0, -1.0, 1.0], [1.0, -1.0, 1.0], [1.0, 1.0, 1.0], [-1.0, 1.0, 1.0]];
 
 /// Isotropic linear-elastic material, SI units.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -7,5 +7,5 @@ pub mod sparse;
 
 pub use blade::{Blade, BladeError, BladeParams, BladeSpec, MeshDensity, Preset, TIP_NODES};
 pub use hex8::{ElementKind, Material};
-pub use mtx::{parse_matrix_market, read_matrix_market, write_matrix_market, MtxError, MtxErrorKind};
-pub use sparse::{clamp, clamp_structure, ClampError, DofMap};
+pub use mtx::{MtxError, MtxErrorKind, parse_matrix_market, read_matrix_market, write_matrix_market};
+pub use sparse::{ClampError, DofMap, clamp, clamp_structure};

@@ -90,26 +90,16 @@ pub fn parse_matrix_market<R: Read>(reader: R, name: &str) -> Result<SparseColMa
                 *lineno += 1;
                 Ok(Some(s))
             }
-            Some(Err(e)) => Err(MtxError {
-                file: name.to_string(),
-                line: *lineno + 1,
-                message: format!("cannot read this line: {e}"),
-                kind: MtxErrorKind::Io,
-            }),
+            Some(Err(e)) => Err(MtxError { file: name.to_string(), line: *lineno + 1, message: format!("cannot read this line: {e}"), kind: MtxErrorKind::Io }),
         }
     };
 
     // Banner.
-    let banner = next_line(&mut lineno)?.ok_or_else(|| {
-        err(1, MtxErrorKind::Banner, "empty file; expected the banner `%%MatrixMarket matrix coordinate real symmetric`".into())
-    })?;
+    let banner = next_line(&mut lineno)?
+        .ok_or_else(|| err(1, MtxErrorKind::Banner, "empty file; expected the banner `%%MatrixMarket matrix coordinate real symmetric`".into()))?;
     let words: Vec<String> = banner.split_whitespace().map(|w| w.to_ascii_lowercase()).collect();
     if words.first().map(String::as_str) != Some("%%matrixmarket") {
-        return Err(err(
-            1,
-            MtxErrorKind::Banner,
-            format!("expected the banner `%%MatrixMarket matrix coordinate real symmetric`, found `{}`", banner.trim()),
-        ));
+        return Err(err(1, MtxErrorKind::Banner, format!("expected the banner `%%MatrixMarket matrix coordinate real symmetric`, found `{}`", banner.trim())));
     }
     if words.len() != 5 {
         return Err(err(
@@ -123,23 +113,13 @@ pub fn parse_matrix_market<R: Read>(reader: R, name: &str) -> Result<SparseColMa
     }
     match words[2].as_str() {
         "coordinate" => {}
-        "array" => {
-            return Err(err(
-                1,
-                MtxErrorKind::Unsupported,
-                "format `array` (dense) is not supported; expected `coordinate` (sparse)".into(),
-            ))
-        }
+        "array" => return Err(err(1, MtxErrorKind::Unsupported, "format `array` (dense) is not supported; expected `coordinate` (sparse)".into())),
         other => return Err(err(1, MtxErrorKind::Unsupported, format!("format `{other}` is not supported; expected `coordinate`"))),
     }
     match words[3].as_str() {
         "real" | "double" | "integer" => {}
         "complex" | "pattern" => {
-            return Err(err(
-                1,
-                MtxErrorKind::Unsupported,
-                format!("field `{}` is not supported; expected `real` (or `integer`)", words[3]),
-            ))
+            return Err(err(1, MtxErrorKind::Unsupported, format!("field `{}` is not supported; expected `real` (or `integer`)", words[3])));
         }
         other => return Err(err(1, MtxErrorKind::Unsupported, format!("field `{other}` is not supported; expected `real`"))),
     }
@@ -147,28 +127,16 @@ pub fn parse_matrix_market<R: Read>(reader: R, name: &str) -> Result<SparseColMa
         "general" => Symmetry::General,
         "symmetric" => Symmetry::Symmetric,
         "skew-symmetric" => Symmetry::Skew,
-        "hermitian" => {
-            return Err(err(1, MtxErrorKind::Unsupported, "symmetry `hermitian` is for complex matrices; expected `symmetric` or `general`".into()))
-        }
+        "hermitian" => return Err(err(1, MtxErrorKind::Unsupported, "symmetry `hermitian` is for complex matrices; expected `symmetric` or `general`".into())),
         other => {
-            return Err(err(
-                1,
-                MtxErrorKind::Unsupported,
-                format!("symmetry `{other}` is not supported; expected `symmetric`, `general` or `skew-symmetric`"),
-            ))
+            return Err(err(1, MtxErrorKind::Unsupported, format!("symmetry `{other}` is not supported; expected `symmetric`, `general` or `skew-symmetric`")));
         }
     };
 
     // Size line (after comments and blank lines).
     let (size_line, size_no) = loop {
         match next_line(&mut lineno)? {
-            None => {
-                return Err(err(
-                    lineno + 1,
-                    MtxErrorKind::Truncated,
-                    "file ends before the size line `rows columns entries`".into(),
-                ))
-            }
+            None => return Err(err(lineno + 1, MtxErrorKind::Truncated, "file ends before the size line `rows columns entries`".into())),
             Some(l) => {
                 let t = l.trim();
                 if t.is_empty() || t.starts_with('%') {
@@ -180,11 +148,7 @@ pub fn parse_matrix_market<R: Read>(reader: R, name: &str) -> Result<SparseColMa
     };
     let fields: Vec<&str> = size_line.split_whitespace().collect();
     if fields.len() != 3 {
-        return Err(err(
-            size_no,
-            MtxErrorKind::Size,
-            format!("expected the size line `rows columns entries` (3 integers), found `{}`", size_line.trim()),
-        ));
+        return Err(err(size_no, MtxErrorKind::Size, format!("expected the size line `rows columns entries` (3 integers), found `{}`", size_line.trim())));
     }
     let parse_count = |s: &str, what: &str| -> Result<usize, MtxError> {
         s.parse::<usize>().map_err(|_| err(size_no, MtxErrorKind::Size, format!("{what} `{s}` is not a non-negative integer")))
@@ -193,30 +157,18 @@ pub fn parse_matrix_market<R: Read>(reader: R, name: &str) -> Result<SparseColMa
     let ncols = parse_count(fields[1], "column count")?;
     let nnz = parse_count(fields[2], "entry count")?;
     if nrows != ncols {
-        return Err(err(
-            size_no,
-            MtxErrorKind::Size,
-            format!("the matrix is {nrows}×{ncols}; a structural matrix must be square"),
-        ));
+        return Err(err(size_no, MtxErrorKind::Size, format!("the matrix is {nrows}×{ncols}; a structural matrix must be square")));
     }
     let n = nrows;
     if n == 0 {
         return Err(err(size_no, MtxErrorKind::Size, "the matrix is 0×0; expected at least one row".into()));
     }
     if n > MAX_ORDER {
-        return Err(err(
-            size_no,
-            MtxErrorKind::Size,
-            format!("the matrix is {n}×{n}; at most {MAX_ORDER} rows are supported"),
-        ));
+        return Err(err(size_no, MtxErrorKind::Size, format!("the matrix is {n}×{n}; at most {MAX_ORDER} rows are supported")));
     }
     let max_nnz = if symmetry == Symmetry::General { n.saturating_mul(n) } else { n.saturating_mul(n + 1) / 2 };
     if nnz > max_nnz {
-        return Err(err(
-            size_no,
-            MtxErrorKind::Size,
-            format!("{nnz} entries announced, more than a {n}×{n} {} matrix can hold ({max_nnz})", words[4]),
-        ));
+        return Err(err(size_no, MtxErrorKind::Size, format!("{nnz} entries announced, more than a {n}×{n} {} matrix can hold ({max_nnz})", words[4])));
     }
 
     // Entries: (row, col, value, line).
@@ -237,11 +189,7 @@ pub fn parse_matrix_market<R: Read>(reader: R, name: &str) -> Result<SparseColMa
         }
         let f: Vec<&str> = t.split_whitespace().collect();
         if f.len() != 3 {
-            return Err(err(
-                lineno,
-                MtxErrorKind::Entry,
-                format!("expected an entry `row column value` (3 fields), found {} field(s): `{t}`", f.len()),
-            ));
+            return Err(err(lineno, MtxErrorKind::Entry, format!("expected an entry `row column value` (3 fields), found {} field(s): `{t}`", f.len())));
         }
         let index = |s: &str, what: &str| -> Result<usize, MtxError> {
             let v = s.parse::<i64>().map_err(|_| err(lineno, MtxErrorKind::Entry, format!("{what} index `{s}` is not an integer")))?;
@@ -257,11 +205,7 @@ pub fn parse_matrix_market<R: Read>(reader: R, name: &str) -> Result<SparseColMa
             return Err(err(lineno, MtxErrorKind::NotFinite, format!("value `{}` is not finite", f[2])));
         }
         if symmetry == Symmetry::Skew && i == j {
-            return Err(err(
-                lineno,
-                MtxErrorKind::OutOfRange,
-                format!("a skew-symmetric file has no diagonal entries, found ({}, {})", i + 1, j + 1),
-            ));
+            return Err(err(lineno, MtxErrorKind::OutOfRange, format!("a skew-symmetric file has no diagonal entries, found ({}, {})", i + 1, j + 1)));
         }
         entries.push((i, j, v, lineno));
     }
@@ -269,11 +213,7 @@ pub fn parse_matrix_market<R: Read>(reader: R, name: &str) -> Result<SparseColMa
     while let Some(l) = next_line(&mut lineno)? {
         let t = l.trim();
         if !(t.is_empty() || t.starts_with('%')) {
-            return Err(err(
-                lineno,
-                MtxErrorKind::TooManyEntries,
-                format!("unexpected data after the {nnz} entries announced on line {size_no}: `{t}`"),
-            ));
+            return Err(err(lineno, MtxErrorKind::TooManyEntries, format!("unexpected data after the {nnz} entries announced on line {size_no}: `{t}`")));
         }
     }
 
@@ -312,8 +252,7 @@ pub fn parse_matrix_market<R: Read>(reader: R, name: &str) -> Result<SparseColMa
             }
         }
     }
-    SparseColMat::try_new_from_triplets(n, n, &triplets)
-        .map_err(|e| err(size_no, MtxErrorKind::Size, format!("cannot build the sparse matrix: {e:?}")))
+    SparseColMat::try_new_from_triplets(n, n, &triplets).map_err(|e| err(size_no, MtxErrorKind::Size, format!("cannot build the sparse matrix: {e:?}")))
 }
 
 /// Writes `a` as Matrix Market coordinate real. With `symmetric`, only the lower triangle is

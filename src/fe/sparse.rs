@@ -80,13 +80,7 @@ pub fn clamp(a: &SparseColMat<usize, f64>, fixed: &[usize]) -> Result<(SparseCol
 }
 
 /// The sub-matrix with rows `row_map[i] = Some(new_i)` and columns `col_map[j] = Some(new_j)`.
-pub fn submatrix(
-    a: &SparseColMat<usize, f64>,
-    row_map: &[Option<usize>],
-    col_map: &[Option<usize>],
-    nrows: usize,
-    ncols: usize,
-) -> SparseColMat<usize, f64> {
+pub fn submatrix(a: &SparseColMat<usize, f64>, row_map: &[Option<usize>], col_map: &[Option<usize>], nrows: usize, ncols: usize) -> SparseColMat<usize, f64> {
     let mut t = Vec::new();
     for j in 0..a.ncols() {
         let Some(nj) = col_map[j] else { continue };

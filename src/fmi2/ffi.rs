@@ -152,7 +152,14 @@ pub unsafe fn free_instance<M: Fmi2Model>(c: Fmi2Component) {
 
 /// # Safety
 /// `c` as for every function: NULL or a live instance.
-pub unsafe fn setup_experiment<M: Fmi2Model>(c: Fmi2Component, tol_defined: Fmi2Boolean, tol: f64, start: f64, stop_defined: Fmi2Boolean, stop: f64) -> Fmi2Status {
+pub unsafe fn setup_experiment<M: Fmi2Model>(
+    c: Fmi2Component,
+    tol_defined: Fmi2Boolean,
+    tol: f64,
+    start: f64,
+    stop_defined: Fmi2Boolean,
+    stop: f64,
+) -> Fmi2Status {
     unsafe {
         call::<M>(c, "fmi2SetupExperiment", |i| {
             i.setup_experiment((tol_defined != FMI2_FALSE).then_some(tol), start, (stop_defined != FMI2_FALSE).then_some(stop))
@@ -531,7 +538,14 @@ macro_rules! export_fmi2 {
         /// # Safety
         /// FMI 2.0 contract.
         #[unsafe(no_mangle)]
-        pub unsafe extern "C" fn fmi2SetupExperiment(c: Fmi2Component, tol_defined: Fmi2Boolean, tol: f64, start: f64, stop_defined: Fmi2Boolean, stop: f64) -> Fmi2Status {
+        pub unsafe extern "C" fn fmi2SetupExperiment(
+            c: Fmi2Component,
+            tol_defined: Fmi2Boolean,
+            tol: f64,
+            start: f64,
+            stop_defined: Fmi2Boolean,
+            stop: f64,
+        ) -> Fmi2Status {
             unsafe { __ffi::setup_experiment::<$model>(c, tol_defined, tol, start, stop_defined, stop) }
         }
         /// # Safety

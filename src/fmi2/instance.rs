@@ -64,13 +64,7 @@ impl MachineState {
 }
 
 fn mask_names(mask: u8) -> String {
-    let all = [
-        MachineState::Instantiated,
-        MachineState::InitializationMode,
-        MachineState::StepComplete,
-        MachineState::StepFailed,
-        MachineState::Terminated,
-    ];
+    let all = [MachineState::Instantiated, MachineState::InitializationMode, MachineState::StepComplete, MachineState::StepFailed, MachineState::Terminated];
     all.iter().filter(|s| s.bit() & mask != 0).map(|s| s.name()).collect::<Vec<_>>().join(", ")
 }
 
@@ -296,7 +290,14 @@ impl<M: Fmi2Model> Instance<M> {
         Status::Ok
     }
 
-    fn set<T: Copy>(&mut self, f: &str, ty: BaseType, vrs: &[Fmi2ValueReference], values: &[T], write: impl Fn(&mut M, u32, T) -> Result<(), String>) -> Status {
+    fn set<T: Copy>(
+        &mut self,
+        f: &str,
+        ty: BaseType,
+        vrs: &[Fmi2ValueReference],
+        values: &[T],
+        write: impl Fn(&mut M, u32, T) -> Result<(), String>,
+    ) -> Status {
         if let Err(s) = self.allow(f, INST | INIT | COMPLETE) {
             return s;
         }
@@ -443,10 +444,8 @@ impl<M: Fmi2Model> Instance<M> {
             return self.fail(&format!("fmi2DoStep: currentCommunicationPoint {t} must be finite and communicationStepSize {h} finite and > 0"));
         }
         if !same_time(t, self.clock.time, h) {
-            return self.fail(&format!(
-                "fmi2DoStep: currentCommunicationPoint {t} does not match the FMU's time {} (the end of the previous step)",
-                self.clock.time
-            ));
+            return self
+                .fail(&format!("fmi2DoStep: currentCommunicationPoint {t} does not match the FMU's time {} (the end of the previous step)", self.clock.time));
         }
         if let Some(stop) = self.clock.stop_time {
             if t + h > stop && !same_time(t + h, stop, h) {

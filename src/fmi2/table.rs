@@ -246,12 +246,8 @@ impl VariableTable {
         let init = v.effective_initial();
         let ok = match phase {
             SetPhase::Instantiated => v.variability != Variability::Constant && matches!(init, Some(Initial::Exact | Initial::Approx)),
-            SetPhase::InitializationMode => {
-                v.causality == Causality::Input || (v.variability != Variability::Constant && init == Some(Initial::Exact))
-            }
-            SetPhase::Simulation => {
-                v.causality == Causality::Input || (v.causality == Causality::Parameter && v.variability == Variability::Tunable)
-            }
+            SetPhase::InitializationMode => v.causality == Causality::Input || (v.variability != Variability::Constant && init == Some(Initial::Exact)),
+            SetPhase::Simulation => v.causality == Causality::Input || (v.causality == Causality::Parameter && v.variability == Variability::Tunable),
         };
         if ok {
             return Ok(());
@@ -317,9 +313,7 @@ pub fn is_structured_name(name: &str) -> bool {
         let ident_ok = first_ok && chars.all(|c| c.is_ascii_alphanumeric() || c == '_');
         let index_ok = match rest {
             None => true,
-            Some(r) => {
-                r.len() > 2 && r.ends_with(']') && r[1..r.len() - 1].split(',').all(|n| !n.is_empty() && n.chars().all(|c| c.is_ascii_digit()))
-            }
+            Some(r) => r.len() > 2 && r.ends_with(']') && r[1..r.len() - 1].split(',').all(|n| !n.is_empty() && n.chars().all(|c| c.is_ascii_digit())),
         };
         ident_ok && index_ok
     })

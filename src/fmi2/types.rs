@@ -58,8 +58,7 @@ impl Status {
 }
 
 /// The variadic, printf-style logger. The shell always calls it with the format `"%s"`.
-pub type Fmi2CallbackLogger =
-    Option<unsafe extern "C" fn(Fmi2ComponentEnvironment, Fmi2String, Fmi2Status, Fmi2String, Fmi2String, ...)>;
+pub type Fmi2CallbackLogger = Option<unsafe extern "C" fn(Fmi2ComponentEnvironment, Fmi2String, Fmi2Status, Fmi2String, Fmi2String, ...)>;
 pub type Fmi2CallbackAllocateMemory = Option<unsafe extern "C" fn(usize, usize) -> *mut c_void>;
 pub type Fmi2CallbackFreeMemory = Option<unsafe extern "C" fn(*mut c_void)>;
 pub type Fmi2StepFinished = Option<unsafe extern "C" fn(Fmi2ComponentEnvironment, Fmi2Status)>;

@@ -231,7 +231,17 @@ mod tests {
     #[test]
     fn schema_order_escaping_and_structure() {
         let (doc, guid) = render(&description());
-        let order = ["<CoSimulation", "<UnitDefinitions", "<TypeDefinitions", "<LogCategories", "<DefaultExperiment", "<ModelVariables", "<ModelStructure", "<Outputs", "<InitialUnknowns"];
+        let order = [
+            "<CoSimulation",
+            "<UnitDefinitions",
+            "<TypeDefinitions",
+            "<LogCategories",
+            "<DefaultExperiment",
+            "<ModelVariables",
+            "<ModelStructure",
+            "<Outputs",
+            "<InitialUnknowns",
+        ];
         let pos: Vec<usize> = order.iter().map(|e| doc.find(e).unwrap_or_else(|| panic!("{e}"))).collect();
         assert!(pos.windows(2).all(|w| w[0] < w[1]), "{doc}");
         assert!(doc.contains("description=\"a &lt;mode&gt; &amp; &quot;more&quot;\""), "{doc}");

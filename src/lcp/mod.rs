@@ -11,12 +11,12 @@ mod pivoting;
 mod refine;
 mod warm_lemke;
 
-pub use circulant_fft::CirculantOperator;
-pub use lemke::{Lemke, LemkeSettings};
 pub use brute::solve_by_enumeration;
+pub use circulant_fft::CirculantOperator;
 pub use dat::{DatError, parse_dat, read_dat, write_dat};
-pub use pivoting::{BlockPivoting, PivotingSettings};
+pub use lemke::{Lemke, LemkeSettings};
 pub use matrix::{BlockCirculant, DenseMatrix, LcpMatrix};
+pub use pivoting::{BlockPivoting, PivotingSettings};
 
 use serde::Serialize;
 

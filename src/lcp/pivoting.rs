@@ -12,8 +12,8 @@
 //! of infeasible indices, Lemke takes over from the best basis (`warm_lemke`), one cheap pivot
 //! per wrong index.
 use super::{LcpInfo, LcpMatrix, LcpOutcome, LcpSolution, residuals, warm_lemke};
-use faer::linalg::solvers::PartialPivLu;
 use faer::Mat;
+use faer::linalg::solvers::PartialPivLu;
 use faer::linalg::solvers::Solve;
 use std::time::Instant;
 
@@ -74,7 +74,12 @@ impl BlockPivoting {
         let s = &self.settings;
         let fail = |outcome, iterations, z: Vec<f64>, w: Vec<f64>| {
             let (residual, relative_error) = residuals(q, &z, &w);
-            LcpSolution { outcome, z, w, info: LcpInfo { pivots: iterations, residual, relative_error, time_s: start.elapsed().as_secs_f64(), warm_start_used: false } }
+            LcpSolution {
+                outcome,
+                z,
+                w,
+                info: LcpInfo { pivots: iterations, residual, relative_error, time_s: start.elapsed().as_secs_f64(), warm_start_used: false },
+            }
         };
         let (_, finite) = a.max_abs();
         if !finite || q.iter().any(|v| !v.is_finite()) {
@@ -156,7 +161,13 @@ impl BlockPivoting {
                     outcome,
                     z,
                     w,
-                    info: LcpInfo { pivots: iteration, residual, relative_error, time_s: start.elapsed().as_secs_f64(), warm_start_used: s.warm_start.is_some() && iteration == 1 },
+                    info: LcpInfo {
+                        pivots: iteration,
+                        residual,
+                        relative_error,
+                        time_s: start.elapsed().as_secs_f64(),
+                        warm_start_used: s.warm_start.is_some() && iteration == 1,
+                    },
                 };
             }
             if best.as_ref().is_none_or(|b| infeasible.len() < b.0) {

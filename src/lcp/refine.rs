@@ -115,22 +115,13 @@ pub(super) fn evaluate(a: &dyn LcpMatrix, q: &[f64], mut z: Vec<f64>, clip: f64)
 
 /// Polishes the basis α by safeguarded block principal pivoting, starting from its evaluated
 /// candidate `start`. Returns the first certified candidate (residual ≤ cert), or None.
-pub(super) fn polish(
-    a: &dyn LcpMatrix,
-    q: &[f64],
-    alpha: &[usize],
-    start: &Candidate,
-    steps: usize,
-    cert: f64,
-    max_rounds: usize,
-) -> Option<Candidate> {
+pub(super) fn polish(a: &dyn LcpMatrix, q: &[f64], alpha: &[usize], start: &Candidate, steps: usize, cert: f64, max_rounds: usize) -> Option<Candidate> {
     let n = a.dim();
     let mut in_alpha = vec![false; n];
     alpha.iter().for_each(|&i| in_alpha[i] = true);
     // Violations: z_i < −cert on α, w_i < −cert off α (round-off negatives were clipped already).
-    let violations = |c: &Candidate, in_alpha: &[bool]| -> Vec<usize> {
-        (0..n).filter(|&i| if in_alpha[i] { c.z[i] < -cert } else { c.w[i] < -cert }).collect()
-    };
+    let violations =
+        |c: &Candidate, in_alpha: &[bool]| -> Vec<usize> { (0..n).filter(|&i| if in_alpha[i] { c.z[i] < -cert } else { c.w[i] < -cert }).collect() };
     let mut viol = violations(start, &in_alpha);
     let mut best_count = viol.len();
     let mut stalls = 0;
@@ -173,7 +164,15 @@ mod tests {
     #[test]
     fn polish_repairs_a_nearly_right_basis() {
         let n = 12;
-        let a = DenseMatrix::from_fn(n, |i, j| if i == j { 2.0 } else if i.abs_diff(j) == 1 { -1.0 } else { 0.0 });
+        let a = DenseMatrix::from_fn(n, |i, j| {
+            if i == j {
+                2.0
+            } else if i.abs_diff(j) == 1 {
+                -1.0
+            } else {
+                0.0
+            }
+        });
         let q: Vec<f64> = (0..n).map(|i| 0.3 - (2.0 * std::f64::consts::PI * i as f64 / n as f64).cos()).collect();
         let sols = solve_by_enumeration(&a, &q, 1e-12);
         assert_eq!(sols.len(), 1);

@@ -190,7 +190,16 @@ const FINAL_REFINEMENT: usize = 2;
 /// Reads z, w off the final basis (after iterative refinement of the basic values against the
 /// original data), clips round-off, and certifies on the original data.
 #[allow(clippy::too_many_arguments)]
-fn finish(a: &dyn LcpMatrix, q: &[f64], basis: &mut Basis<'_>, basic: &[Var], x: &mut [f64], pivots: usize, certify_tol: f64, start: std::time::Instant) -> LcpSolution {
+fn finish(
+    a: &dyn LcpMatrix,
+    q: &[f64],
+    basis: &mut Basis<'_>,
+    basic: &[Var],
+    x: &mut [f64],
+    pivots: usize,
+    certify_tol: f64,
+    start: std::time::Instant,
+) -> LcpSolution {
     let n = q.len();
     if !basic.contains(&Var::Z0) {
         // Basis equation: w − A z = q over the basic variables (non-basic ones are 0).

@@ -47,14 +47,7 @@ pub struct MarchSettings {
 
 impl Default for MarchSettings {
     fn default() -> Self {
-        MarchSettings {
-            steps_per_period: 1000,
-            max_periods: 10_000,
-            min_periods: 2,
-            tolerance: 1e-8,
-            initial_displacement: None,
-            initial_velocity: None,
-        }
+        MarchSettings { steps_per_period: 1000, max_periods: 10_000, min_periods: 2, tolerance: 1e-8, initial_displacement: None, initial_velocity: None }
     }
 }
 
@@ -109,9 +102,7 @@ pub fn omega_max_dense(mass: &Mat<f64>, stiffness: &Mat<f64>) -> Result<f64, Str
     l.solve_lower_triangular_in_place(s.as_mut());
     let n = s.nrows();
     let sym = Mat::<f64>::from_fn(n, n, |i, j| 0.5 * (s[(i, j)] + s[(j, i)]));
-    let ev = sym
-        .self_adjoint_eigenvalues(Side::Lower)
-        .map_err(|e| format!("structure.stiffness: eigenvalues of M⁻¹K failed ({e:?})"))?;
+    let ev = sym.self_adjoint_eigenvalues(Side::Lower).map_err(|e| format!("structure.stiffness: eigenvalues of M⁻¹K failed ({e:?})"))?;
     let lmax = ev.iter().copied().fold(0.0f64, f64::max);
     if !lmax.is_finite() {
         return Err(format!("structure.stiffness: largest eigenvalue of M⁻¹K is {lmax}"));

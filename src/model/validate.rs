@@ -21,10 +21,7 @@ const SYMMETRY_TOL: f64 = 1e-10;
 
 fn check_square(name: &str, a: &Matrix, n: usize) -> Result<(), ModelError> {
     if a.nrows() != n || a.ncols() != n {
-        return Err(ModelError::new(
-            name,
-            format!("is {}×{}, expected {n}×{n} (the size of structure.mass)", a.nrows(), a.ncols()),
-        ));
+        return Err(ModelError::new(name, format!("is {}×{}, expected {n}×{n} (the size of structure.mass)", a.nrows(), a.ncols())));
     }
     let mut bad = None;
     let mut scale = 0.0f64;
@@ -47,10 +44,7 @@ fn check_square(name: &str, a: &Matrix, n: usize) -> Result<(), ModelError> {
         }
     });
     if let Some((i, j, v, t)) = asym {
-        return Err(ModelError::new(
-            name,
-            format!("is not symmetric: [{i}][{j}] = {v} but [{j}][{i}] = {t}"),
-        ));
+        return Err(ModelError::new(name, format!("is not symmetric: [{i}][{j}] = {v} but [{j}][{i}] = {t}")));
     }
     Ok(())
 }
@@ -65,11 +59,7 @@ fn check_positive_definite(name: &str, a: &Matrix) -> Result<(), ModelError> {
         Matrix::Dense(m) => m.llt(faer::Side::Lower).is_ok(),
         Matrix::Sparse(s) => s.sp_cholesky(faer::Side::Lower).is_ok(),
     };
-    if ok {
-        Ok(())
-    } else {
-        Err(ModelError::new(name, "is not positive definite (every DOF must carry mass)"))
-    }
+    if ok { Ok(()) } else { Err(ModelError::new(name, "is not positive definite (every DOF must carry mass)")) }
 }
 
 impl Model {
@@ -87,10 +77,7 @@ impl Model {
         }
         check_positive_definite("structure.mass", &s.mass)?;
         if !(self.frequency.is_finite() && self.frequency > 0.0) {
-            return Err(ModelError::new(
-                "excitation.frequency",
-                format!("is {}, must be a finite angular frequency > 0 [rad/s]", self.frequency),
-            ));
+            return Err(ModelError::new("excitation.frequency", format!("is {}, must be a finite angular frequency > 0 [rad/s]", self.frequency)));
         }
         // A subnormal ω (e.g. 1e-320) passes the test above but its period 2π/ω overflows, and
         // the instants t_j = j·T/k would start with 0·∞ = NaN (found by tests/props.rs).
@@ -116,17 +103,11 @@ impl Model {
             }
             check_finite(format!("contact[{i}].gap"), c.gap)?;
             if c.gap < 0.0 {
-                return Err(ModelError::new(
-                    format!("contact[{i}].gap"),
-                    format!("is {}, a static clearance must be ≥ 0 (move the reference instead)", c.gap),
-                ));
+                return Err(ModelError::new(format!("contact[{i}].gap"), format!("is {}, a static clearance must be ≥ 0 (move the reference instead)", c.gap)));
             }
             if let Compliance::Compliant { stiffness } = c.compliance {
                 if !(stiffness.is_finite() && stiffness > 0.0) {
-                    return Err(ModelError::new(
-                        format!("contact[{i}].stiffness"),
-                        format!("is {stiffness}, a contact stiffness must be finite and > 0"),
-                    ));
+                    return Err(ModelError::new(format!("contact[{i}].stiffness"), format!("is {stiffness}, a contact stiffness must be finite and > 0")));
                 }
                 // The LCP holds the compliance 1/k: a subnormal k (1e-320) makes it infinite.
                 if !(1.0 / stiffness).is_finite() {

@@ -2,14 +2,14 @@
 //! p = 0..=k/2 of Ẑ_p = σ2_p M + σ1_p C + w_p K, never the kn×kn system.
 //! From it: the receptance between contacts Ĝ_p = B Ẑ_p⁻¹ Bᵀ, the contact-free response
 //! X̂lin_p = Ẑ_p⁻¹ w_p F̂_p, and Ẑ_p⁻¹ Bᵀ at the DOFs that are output.
-use super::fft::PeriodFft;
 use super::SolveError;
+use super::fft::PeriodFft;
 use crate::model::{Matrix, Model};
 use crate::time::{Discretization, Symbols};
 use faer::Mat;
+use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::SymbolicLu;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat, Triplet};
-use faer::linalg::solvers::Solve;
 use num_complex::Complex64 as C;
 
 /// Pivot ratio below which Ẑ_p counts as singular (undamped resonance, rigid-body mode).
@@ -229,7 +229,16 @@ pub fn assemble(model: &Model, disc: &Discretization, dofs: &[usize], fft: &Peri
     } else {
         (0..nh).map(one).collect::<Result<_, _>>()?
     };
-    let mut asm = Assembly { k, m, dofs: dofs.to_vec(), symbols, g_hat: Vec::with_capacity(nh * m * m), xlin_hat: Vec::with_capacity(nh * nd), bxlin_hat: Vec::with_capacity(nh * m), h_hat: Vec::with_capacity(nh * nd * m) };
+    let mut asm = Assembly {
+        k,
+        m,
+        dofs: dofs.to_vec(),
+        symbols,
+        g_hat: Vec::with_capacity(nh * m * m),
+        xlin_hat: Vec::with_capacity(nh * nd),
+        bxlin_hat: Vec::with_capacity(nh * m),
+        h_hat: Vec::with_capacity(nh * nd * m),
+    };
     for b in blocks {
         asm.g_hat.extend(b.g);
         asm.bxlin_hat.extend(b.bx);

@@ -405,9 +405,13 @@ fn lcp_failure(sol: LcpSolution) -> SolveError {
         LcpOutcome::RayTermination => {
             "no periodic solution was reached (the LCP matrix is not a P-matrix above the first resonance); remedies: make the contact compliant (stiffness = …), use cds or galerkin with pairing = \"forward\" or bds1, add damping, or opt in to [solver] regularization = 1e-4"
         }
-        LcpOutcome::PivotLimit => "the pivot budget ran out (a degenerate or ill-posed LCP); remedies: make the contact compliant, use another scheme or pairing, add damping, or opt in to [solver] regularization = 1e-4",
+        LcpOutcome::PivotLimit => {
+            "the pivot budget ran out (a degenerate or ill-posed LCP); remedies: make the contact compliant, use another scheme or pairing, add damping, or opt in to [solver] regularization = 1e-4"
+        }
         LcpOutcome::NonFiniteData => "the assembled LCP holds NaN or infinite values; check the model for a singular operator",
-        LcpOutcome::Inaccurate => "the final basis is too ill-conditioned to certify the residual; remedies: add damping or make the contact compliant, reduce steps, or opt in to [solver] regularization = 1e-4",
+        LcpOutcome::Inaccurate => {
+            "the final basis is too ill-conditioned to certify the residual; remedies: add damping or make the contact compliant, reduce steps, or opt in to [solver] regularization = 1e-4"
+        }
         LcpOutcome::Solved => unreachable!(),
     };
     SolveError::Lcp { outcome: sol.outcome, info: sol.info, hint: hint.into() }

@@ -116,13 +116,7 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
         steps: k,
         scheme: problem.disc.scheme.name().to_string(),
         pairing,
-        effects: model
-            .effects()
-            .names()
-            .into_iter()
-            .map(String::from)
-            .chain(problem.output_map.iter().flat_map(|m| m.effects.iter().cloned()))
-            .collect(),
+        effects: model.effects().names().into_iter().map(String::from).chain(problem.output_map.iter().flat_map(|m| m.effects.iter().cloned())).collect(),
         time,
         displacement,
         velocity,

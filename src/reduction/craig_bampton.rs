@@ -14,7 +14,7 @@
 //! Storage: the basis Φ is kept dense, n_full × (n_b + η) doubles, in the **full model's
 //! numbering** (row d is full DOF d), so any full DOF can be recovered from q: x_d = Φ[d, :]·q.
 //! For the fine blade (30 000 DOFs, 3 boundary DOFs, η = 20) that is 5.5 MB.
-use super::eigen::{self, dense_modes, EigenError, LanczosOptions, Modes};
+use super::eigen::{self, EigenError, LanczosOptions, Modes, dense_modes};
 use crate::fe::sparse::{sparse_times_dense, submatrix};
 use crate::model::{Matrix, Structure};
 use faer::linalg::solvers::Solve;
@@ -66,7 +66,10 @@ impl Default for CraigBamptonOptions {
 pub enum Damping {
     None,
     /// C = αM + βK on the full model, projected: C_r = α M_r + β K_r (exact projection).
-    Rayleigh { alpha: f64, beta: f64 },
+    Rayleigh {
+        alpha: f64,
+        beta: f64,
+    },
     /// Modal damping ratios ζ_j on the modes of the reduced model (ascending frequency; the last
     /// ratio is repeated for the remaining modes): C_r = M_r Φ_r diag(2 ζ_j ω_j) Φ_rᵀ M_r.
     ModalRatios(Vec<f64>),
@@ -157,17 +160,10 @@ impl ReducedModel {
     pub fn set_damping(&mut self, damping: &Damping) -> Result<(), ReductionError> {
         self.damping = match damping {
             Damping::None => None,
-            Damping::Rayleigh { alpha, beta } => {
-                Some(Mat::from_fn(self.n(), self.n(), |i, j| alpha * self.mass[(i, j)] + beta * self.stiffness[(i, j)]))
-            }
+            Damping::Rayleigh { alpha, beta } => Some(Mat::from_fn(self.n(), self.n(), |i, j| alpha * self.mass[(i, j)] + beta * self.stiffness[(i, j)])),
             Damping::Matrix(c) => {
                 if c.nrows() != self.n_full || c.ncols() != self.n_full {
-                    return Err(ReductionError::Damping(format!(
-                        "the damping matrix is {}×{}, the model has {} DOFs",
-                        c.nrows(),
-                        c.ncols(),
-                        self.n_full
-                    )));
+                    return Err(ReductionError::Damping(format!("the damping matrix is {}×{}, the model has {} DOFs", c.nrows(), c.ncols(), self.n_full)));
                 }
                 Some(self.project_matrix(c))
             }
@@ -181,13 +177,7 @@ impl ReducedModel {
                 let modes = dense_modes(self.stiffness.as_ref(), self.mass.as_ref(), self.n())?;
                 let n = self.n();
                 let mphi = &self.mass * &modes.shapes;
-                let d = Mat::from_fn(n, n, |i, j| {
-                    if i == j {
-                        2.0 * z[i.min(z.len() - 1)] * modes.omega[i]
-                    } else {
-                        0.0
-                    }
-                });
+                let d = Mat::from_fn(n, n, |i, j| if i == j { 2.0 * z[i.min(z.len() - 1)] * modes.omega[i] } else { 0.0 });
                 Some(symmetric(&mphi * d * mphi.transpose()))
             }
         };
@@ -195,11 +185,7 @@ impl ReducedModel {
     }
     /// The reduced structure for the engine (dense M_r, K_r, C_r).
     pub fn structure(&self) -> Structure {
-        Structure {
-            mass: Matrix::Dense(self.mass.clone()),
-            stiffness: Matrix::Dense(self.stiffness.clone()),
-            damping: self.damping.clone().map(Matrix::Dense),
-        }
+        Structure { mass: Matrix::Dense(self.mass.clone()), stiffness: Matrix::Dense(self.stiffness.clone()), damping: self.damping.clone().map(Matrix::Dense) }
     }
     /// Bytes held by the basis.
     pub fn basis_bytes(&self) -> usize {
@@ -301,17 +287,7 @@ pub fn craig_bampton(
     let stiffness = symmetric(basis.transpose() * sparse_times_dense(k, basis.as_ref()));
     timings.projection = t3.elapsed().as_secs_f64();
     timings.total = t0.elapsed().as_secs_f64();
-    Ok(ReducedModel {
-        n_full: n,
-        boundary: boundary.to_vec(),
-        mass,
-        stiffness,
-        damping: None,
-        interface_omega,
-        interface_residual,
-        timings,
-        basis,
-    })
+    Ok(ReducedModel { n_full: n, boundary: boundary.to_vec(), mass, stiffness, damping: None, interface_omega, interface_residual, timings, basis })
 }
 
 /// Converts the engine's matrix to sparse (dense input is scanned for non-zeros).
@@ -334,12 +310,7 @@ pub fn to_sparse(a: &Matrix) -> SparseColMat<usize, f64> {
 
 /// Reduces an engine [`Structure`]. Its damping matrix, if any, is projected (Φᵀ C Φ) unless
 /// `damping` is given, which then replaces it.
-pub fn reduce_structure(
-    s: &Structure,
-    boundary: &[usize],
-    opts: &CraigBamptonOptions,
-    damping: Option<&Damping>,
-) -> Result<ReducedModel, ReductionError> {
+pub fn reduce_structure(s: &Structure, boundary: &[usize], opts: &CraigBamptonOptions, damping: Option<&Damping>) -> Result<ReducedModel, ReductionError> {
     let k = to_sparse(&s.stiffness);
     let m = to_sparse(&s.mass);
     let mut red = craig_bampton(&k, &m, boundary, opts)?;

@@ -12,8 +12,8 @@
 //! entry is positive.
 use crate::fe::sparse::sparse_times_dense;
 use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::Llt;
 use faer::sparse::SparseColMat;
+use faer::sparse::linalg::solvers::Llt;
 use faer::{Mat, MatRef, Side};
 
 /// Why modes could not be computed.
@@ -124,13 +124,7 @@ fn random_block(n: usize, p: usize, seed: u64) -> Mat<f64> {
 /// the orthonormal block V, its M-image MV, and the triangular factor R with W = V R (rows =
 /// kept columns). Columns whose norm falls below `drop_tol` times their norm after the block
 /// projection are dropped (deflation). Two sparse products with M per call.
-fn m_orthonormalise(
-    m: &SparseColMat<usize, f64>,
-    q: &[Mat<f64>],
-    mq: &[Mat<f64>],
-    w: &mut Mat<f64>,
-    drop_tol: f64,
-) -> (Mat<f64>, Mat<f64>, Mat<f64>) {
+fn m_orthonormalise(m: &SparseColMat<usize, f64>, q: &[Mat<f64>], mq: &[Mat<f64>], w: &mut Mat<f64>, drop_tol: f64) -> (Mat<f64>, Mat<f64>, Mat<f64>) {
     let p = w.ncols();
     let n = w.nrows();
     for _pass in 0..2 {
@@ -249,8 +243,7 @@ pub fn lanczos(
         t = t2;
         dim = new_dim;
         last_block_len = pb;
-        let (vn, mvn, r) =
-            if dim < n { m_orthonormalise(m, &q, &mq, &mut w, 1e-10) } else { (Mat::zeros(n, 0), Mat::zeros(n, 0), Mat::zeros(0, pb)) };
+        let (vn, mvn, r) = if dim < n { m_orthonormalise(m, &q, &mq, &mut w, 1e-10) } else { (Mat::zeros(n, 0), Mat::zeros(n, 0), Mat::zeros(0, pb)) };
         last_r = r;
         v = vn;
         mv = mvn;
@@ -347,15 +340,7 @@ pub fn symmetric_eigen(a: MatRef<'_, f64>) -> Result<(Vec<f64>, Mat<f64>), Eigen
     Ok((vals, e.U().to_owned()))
 }
 
-fn finish(
-    k: &SparseColMat<usize, f64>,
-    m: &SparseColMat<usize, f64>,
-    q: &[Mat<f64>],
-    theta: &[f64],
-    s: &Mat<f64>,
-    count: usize,
-    dim: usize,
-) -> Modes {
+fn finish(k: &SparseColMat<usize, f64>, m: &SparseColMat<usize, f64>, q: &[Mat<f64>], theta: &[f64], s: &Mat<f64>, count: usize, dim: usize) -> Modes {
     let n = k.nrows();
     // Ritz coefficients of the wanted modes (largest θ first).
     let sel = Mat::from_fn(dim, count, |i, j| s[(i, dim - 1 - j)]);

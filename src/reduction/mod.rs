@@ -2,11 +2,8 @@
 pub mod craig_bampton;
 pub mod eigen;
 
-pub use craig_bampton::{
-    craig_bampton, reduce_structure, to_sparse, CraigBamptonOptions, Damping, ReducedModel, ReductionError, Timings,
-    DEFAULT_MODES,
-};
-pub use eigen::{dense_modes, lanczos, sparse_modes, symmetric_eigen, EigenError, LanczosOptions, Modes};
+pub use craig_bampton::{CraigBamptonOptions, DEFAULT_MODES, Damping, ReducedModel, ReductionError, Timings, craig_bampton, reduce_structure, to_sparse};
+pub use eigen::{EigenError, LanczosOptions, Modes, dense_modes, lanczos, sparse_modes, symmetric_eigen};
 
 use crate::model::Matrix;
 use std::f64::consts::PI;

@@ -11,7 +11,7 @@ pub use spec::*;
 use crate::fe::{Blade, BladeSpec, DofMap};
 use crate::model::{Compliance, Contact, Force, Harmonic, Matrix, Model, Structure};
 use crate::periodic::{OutputMap, OutputSelection, PeriodicProblem, SolverSettings};
-use crate::reduction::{CraigBamptonOptions, Damping, ReducedModel, ReductionError, DEFAULT_MODES};
+use crate::reduction::{CraigBamptonOptions, DEFAULT_MODES, Damping, ReducedModel, ReductionError};
 use crate::time::{Discretization, Pairing, Scheme};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -125,7 +125,9 @@ impl Scene {
                 return Err(err("damping: give one of matrix, rayleigh or modal_ratios, not several".into()));
             }
             if given == 0 {
-                return Err(err("damping: the section needs matrix = [[…]] (or { matrix_market = … }), rayleigh = [alpha, beta] or modal_ratios = [ζ, …]".into()));
+                return Err(err(
+                    "damping: the section needs matrix = [[…]] (or { matrix_market = … }), rayleigh = [alpha, beta] or modal_ratios = [ζ, …]".into()
+                ));
             }
             if let Some(m) = &d.matrix {
                 full.damping = Some(load_matrix("damping.matrix", m, dir).map_err(err)?);
@@ -328,10 +330,7 @@ impl Scene {
                         rforces.push(Force { dof: q, term: Harmonic { amplitude: f.term.amplitude * c, ..f.term.clone() } });
                     }
                 }
-                let rcontacts = contacts
-                    .iter()
-                    .map(|c| Contact { dof: red.reduced_dof(c.dof).expect("contacts are boundary DOFs"), ..c.clone() })
-                    .collect();
+                let rcontacts = contacts.iter().map(|c| Contact { dof: red.reduced_dof(c.dof).expect("contacts are boundary DOFs"), ..c.clone() }).collect();
                 let model = Model { structure: red.structure(), forces: rforces, contacts: rcontacts, frequency };
                 let rows = outputs.dofs().into_iter().map(|u| (u, row(dofs.new_index(u).expect("checked")))).collect();
                 let map = OutputMap { rows, contact_dofs: contact_dofs.clone(), effects: vec!["reduction".into()] };
@@ -378,9 +377,7 @@ impl Scene {
     fn structure_source(&self, dir: &Path) -> Result<(Source, Structure), String> {
         let s = &self.structure;
         match (&s.generator, &s.mass, &s.stiffness) {
-            (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
-                Err("structure: give either generator = { … } or mass and stiffness, not both".into())
-            }
+            (Some(_), Some(_), _) | (Some(_), _, Some(_)) => Err("structure: give either generator = { … } or mass and stiffness, not both".into()),
             (Some(table), None, None) => {
                 let mut table = table.clone();
                 let kind = table.remove("kind");
@@ -499,4 +496,3 @@ impl Resolver<'_> {
         self.output_pair(field, d).map(|(u, _)| u)
     }
 }
-

@@ -375,9 +375,7 @@ impl AccuracyStudy {
     /// among the rows of converging methods that pass `filter` (a choice that does not converge
     /// can be close at one k by chance; it is not a method one can pick for an accuracy).
     pub fn cheapest(&self, case: Case, target: f64, filter: impl Fn(&Row) -> bool) -> Option<&Row> {
-        self.ok_rows(case)
-            .filter(|r| r.converges && filter(r) && r.error_x.unwrap() <= target)
-            .min_by(|a, b| a.t_total.unwrap().total_cmp(&b.t_total.unwrap()))
+        self.ok_rows(case).filter(|r| r.converges && filter(r) && r.error_x.unwrap() <= target).min_by(|a, b| a.t_total.unwrap().total_cmp(&b.t_total.unwrap()))
     }
 
     /// The accuracy targets of the summary.
@@ -410,7 +408,8 @@ impl AccuracyStudy {
             let _ = writeln!(s, "## {}\n", case.title());
             // Cheapest for a given accuracy.
             let _ = writeln!(s, "### Cheapest method for a given accuracy (among the choices that converge)\n");
-            let _ = writeln!(s, "| error ≤ | cheapest overall | CPU [s] | cheapest periodic LCP | CPU [s] | time marching | CPU [s] | marching / best periodic |");
+            let _ =
+                writeln!(s, "| error ≤ | cheapest overall | CPU [s] | cheapest periodic LCP | CPU [s] | time marching | CPU [s] | marching / best periodic |");
             let _ = writeln!(s, "|---:|---|---:|---|---:|---|---:|---:|");
             let mut winners: BTreeMap<String, usize> = BTreeMap::new();
             for target in Self::TARGETS {
@@ -428,7 +427,8 @@ impl AccuracyStudy {
                     _ => "—".into(),
                 };
                 *winners.entry(all.unwrap().method.clone()).or_default() += 1;
-                let _ = writeln!(s, "| {target:.0e} | {} | {} | {} | {} | {} | {} | {ratio} |", name(all), time(all), name(per), time(per), name(mar), time(mar));
+                let _ =
+                    writeln!(s, "| {target:.0e} | {} | {} | {} | {} | {} | {} | {ratio} |", name(all), time(all), name(per), time(per), name(mar), time(mar));
             }
             let reached = winners.values().sum::<usize>();
             if reached > 0 {
@@ -439,7 +439,10 @@ impl AccuracyStudy {
             }
             // Per-method summary.
             let _ = writeln!(s, "### Per method\n");
-            let _ = writeln!(s, "| method | converges (notes §3) | largest k run | error there | impulse error there | CPU there [s] (assembly / LCP / recovery) | fitted order (k ≥ 128) | failed or skipped |");
+            let _ = writeln!(
+                s,
+                "| method | converges (notes §3) | largest k run | error there | impulse error there | CPU there [s] (assembly / LCP / recovery) | fitted order (k ≥ 128) | failed or skipped |"
+            );
             let _ = writeln!(s, "|---|---|---:|---:|---:|---|---:|---|");
             let mut labels: Vec<String> = Vec::new();
             for r in self.rows.iter().filter(|r| r.case == case) {

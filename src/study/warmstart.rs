@@ -209,7 +209,10 @@ impl WarmStudy {
             st.repeats
         );
         let _ = writeln!(s, "## Frequency sweep ω = {} … {} ({} points), each point warm-started from the previous one\n", st.sweep.0, st.sweep.1, st.sweep.2);
-        let _ = writeln!(s, "| k | method | points | pivots cold (total) | pivots warm (total) | LCP time cold [s] | LCP time warm [s] | time ratio cold/warm | max solution difference |");
+        let _ = writeln!(
+            s,
+            "| k | method | points | pivots cold (total) | pivots warm (total) | LCP time cold [s] | LCP time warm [s] | time ratio cold/warm | max solution difference |"
+        );
         let _ = writeln!(s, "|---:|---|---:|---:|---:|---:|---:|---:|---:|");
         for &k in &st.steps {
             for &m in &st.methods {
@@ -228,7 +231,8 @@ impl WarmStudy {
             let _ = writeln!(s, "\nFailed: k = {}, {}, ω = {:.4}: {}", r.k, r.method.name(), r.omega, r.status);
         }
         let _ = writeln!(s, "\n## Re-solve after a small frequency change from ω = {}\n", RIGID_OSC.omega);
-        let _ = writeln!(s, "| k | method | Δω/ω | pivots cold | pivots warm | LCP time cold [s] | LCP time warm [s] | ratio cold/warm | solution difference |");
+        let _ =
+            writeln!(s, "| k | method | Δω/ω | pivots cold | pivots warm | LCP time cold [s] | LCP time warm [s] | ratio cold/warm | solution difference |");
         let _ = writeln!(s, "|---:|---|---:|---:|---:|---:|---:|---:|---:|");
         for r in self.rows.iter().filter(|r| r.kind == "resolve") {
             let _ = writeln!(
@@ -259,11 +263,25 @@ impl WarmStudy {
                 if rs.is_empty() {
                     continue;
                 }
-                series.push(Series { label: format!("k = {k}, {}, cold", m.name()), points: rs.iter().map(|r| (r.omega, r.cold_lcp_s)).collect(), markers: false });
-                series.push(Series { label: format!("k = {k}, {}, warm", m.name()), points: rs.iter().map(|r| (r.omega, r.warm_lcp_s)).collect(), markers: true });
+                series.push(Series {
+                    label: format!("k = {k}, {}, cold", m.name()),
+                    points: rs.iter().map(|r| (r.omega, r.cold_lcp_s)).collect(),
+                    markers: false,
+                });
+                series.push(Series {
+                    label: format!("k = {k}, {}, warm", m.name()),
+                    points: rs.iter().map(|r| (r.omega, r.warm_lcp_s)).collect(),
+                    markers: true,
+                });
             }
         }
-        let chart = Chart { title: "Rigid stop sweep: LCP time per point, cold vs warm", x_label: "ω [rad/s]", y_label: "LCP time [s]", x_scale: Scale::Linear, y_scale: Scale::Log };
+        let chart = Chart {
+            title: "Rigid stop sweep: LCP time per point, cold vs warm",
+            x_label: "ω [rad/s]",
+            y_label: "LCP time [s]",
+            x_scale: Scale::Linear,
+            y_scale: Scale::Log,
+        };
         line_chart(path, &chart, &series, 1100, 750)
     }
 

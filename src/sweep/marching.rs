@@ -7,7 +7,7 @@
 //! modes of a Craig–Bampton model and the contact stiffness set) and a stopping tolerance on the
 //! periodicity defect. Errors are measured at the k instants of the LCP against the LCP with
 //! `reference_factor`·k instants, and divided by the reference amplitude (peak-to-peak/2).
-use crate::marching::{march, omega_max_dense, MarchSettings};
+use crate::marching::{MarchSettings, march, omega_max_dense};
 use crate::model::Compliance;
 use crate::periodic::{PeriodFft, PeriodicProblem};
 use crate::response::Response;

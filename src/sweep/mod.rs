@@ -211,29 +211,30 @@ pub fn contact_labels(problem: &PeriodicProblem) -> Vec<usize> {
 
 /// The frequency of the largest value of `amplitude(point)` over the solved points, if any.
 pub fn peak(points: &[SweepPoint], amplitude: impl Fn(&SweepPoint) -> f64) -> Option<(f64, f64)> {
-    points
-        .iter()
-        .filter(|p| p.error.is_none())
-        .map(|p| (p.frequency, amplitude(p)))
-        .filter(|(_, a)| a.is_finite())
-        .fold(None, |best: Option<(f64, f64)>, (f, a)| match best {
+    points.iter().filter(|p| p.error.is_none()).map(|p| (p.frequency, amplitude(p))).filter(|(_, a)| a.is_finite()).fold(
+        None,
+        |best: Option<(f64, f64)>, (f, a)| match best {
             Some((_, b)) if b >= a => best,
             _ => Some((f, a)),
-        })
+        },
+    )
 }
 
 /// PNG of the frequency-response curve of displacement output `i`: with contact and linear.
 #[cfg(feature = "plots")]
-pub fn plot_frc(path: &std::path::Path, param: &str, values: &[f64], problem: &PeriodicProblem, points: &[SweepPoint], i: usize, title: &str) -> Result<(), String> {
-    use crate::plot::{line_chart, Chart, Scale, Series};
+pub fn plot_frc(
+    path: &std::path::Path,
+    param: &str,
+    values: &[f64],
+    problem: &PeriodicProblem,
+    points: &[SweepPoint],
+    i: usize,
+    title: &str,
+) -> Result<(), String> {
+    use crate::plot::{Chart, Scale, Series, line_chart};
     let d = problem.outputs.displacement[i];
     let pts = |lin: bool| -> Vec<(f64, f64)> {
-        values
-            .iter()
-            .zip(points)
-            .filter(|(_, p)| p.error.is_none())
-            .map(|(v, p)| (*v, if lin { p.linear_amplitude[i] } else { p.amplitude[i] }))
-            .collect()
+        values.iter().zip(points).filter(|(_, p)| p.error.is_none()).map(|(v, p)| (*v, if lin { p.linear_amplitude[i] } else { p.amplitude[i] })).collect()
     };
     let series = [
         Series { label: "with contact".into(), points: pts(false), markers: false },

@@ -75,7 +75,7 @@ pub fn to_csv(param: &str, values: &[f64], spectra: &[Spectrum]) -> String {
 /// displacement output and every contact force.
 #[cfg(feature = "plots")]
 pub fn plot(path: &std::path::Path, sp: &Spectrum, title: &str) -> Result<(), String> {
-    use crate::plot::{line_chart, Chart, Scale, Series};
+    use crate::plot::{Chart, Scale, Series, line_chart};
     let rel = |a: &[f64]| -> (f64, Vec<(f64, f64)>) {
         let max = a.iter().copied().fold(0.0, f64::max);
         let pts = a.iter().enumerate().skip(1).map(|(p, v)| (p as f64, if max > 0.0 { v / max } else { 0.0 })).collect();

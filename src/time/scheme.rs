@@ -110,10 +110,7 @@ impl fmt::Display for Scheme {
 impl FromStr for Scheme {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        Scheme::ALL
-            .into_iter()
-            .find(|x| x.name() == s)
-            .ok_or_else(|| format!("unknown scheme \"{s}\"; expected one of bds1, bds2, cds, galerkin, fourier"))
+        Scheme::ALL.into_iter().find(|x| x.name() == s).ok_or_else(|| format!("unknown scheme \"{s}\"; expected one of bds1, bds2, cds, galerkin, fourier"))
     }
 }
 

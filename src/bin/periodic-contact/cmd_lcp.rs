@@ -5,7 +5,7 @@
 //! LCPs (`auto`: Lemke up to N = 256, above it block pivoting with FFT products, Lemke as the
 //! fallback). Otherwise (or with `--method lemke`) dense lexicographic Lemke.
 use crate::{Failure, write_output};
-use periodic_contact::lcp::{BlockCirculant, BlockPivoting, Lemke, LemkeSettings, LcpOutcome, PivotingSettings, dat};
+use periodic_contact::lcp::{BlockCirculant, BlockPivoting, LcpOutcome, Lemke, LemkeSettings, PivotingSettings, dat};
 use periodic_contact::periodic::{LcpMethod, solve_circulant_lcp};
 use std::path::Path;
 use std::time::Instant;

@@ -1,6 +1,6 @@
 //! `modes`: eigenfrequencies of the full model and of its Craig–Bampton reduction.
 use crate::Failure;
-use periodic_contact::reduction::{modes, ModeTable};
+use periodic_contact::reduction::{ModeTable, modes};
 use periodic_contact::scene::Scene;
 use std::f64::consts::PI;
 use std::path::Path;

@@ -1,10 +1,10 @@
 //! `sweep`: a frequency sweep of a scene, warm-started and parallel, with its CSV, the
 //! frequency-response PNG, spectra at chosen points and the comparison with time marching.
-use crate::{write_output, Failure};
+use crate::{Failure, write_output};
 use indicatif::{ProgressBar, ProgressStyle};
-use periodic_contact::scene::Scene;
-use periodic_contact::sweep::{self, marching::MarchOptions, SweepSettings};
 use periodic_contact::periodic::PeriodFft;
+use periodic_contact::scene::Scene;
+use periodic_contact::sweep::{self, SweepSettings, marching::MarchOptions};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -78,7 +78,11 @@ pub fn run(a: &Args) -> Result<(), Failure> {
     let to_frequency: Box<dyn Fn(f64) -> f64> = match a.param.as_str() {
         "frequency" => Box::new(|v| v),
         "speed" => {
-            let lobes = built.casing.as_ref().map(|c| c.lobes).ok_or_else(|| Failure::input(format!("{file}: --param speed needs a [casing] section (ω = lobes·Ω)")))?;
+            let lobes = built
+                .casing
+                .as_ref()
+                .map(|c| c.lobes)
+                .ok_or_else(|| Failure::input(format!("{file}: --param speed needs a [casing] section (ω = lobes·Ω)")))?;
             Box::new(move |v| lobes as f64 * v)
         }
         other => return Err(Failure::input(format!("--param: is \"{other}\", expected frequency or speed"))),
@@ -100,7 +104,9 @@ pub fn run(a: &Args) -> Result<(), Failure> {
     let freqs: Vec<f64> = values.iter().map(|&v| to_frequency(v)).collect();
     let settings = SweepSettings { warm_start: !a.cold, threads: a.threads, chunks_per_thread: a.chunks_per_thread };
     let bar = if a.quiet { ProgressBar::hidden() } else { ProgressBar::new(a.points as u64) };
-    bar.set_style(ProgressStyle::with_template("{spinner} sweep [{bar:40}] {pos}/{len} points, {elapsed_precise} elapsed, ETA {eta}").unwrap().progress_chars("=> "));
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} sweep [{bar:40}] {pos}/{len} points, {elapsed_precise} elapsed, ETA {eta}").unwrap().progress_chars("=> "),
+    );
     let t = Instant::now();
     let points = sweep::run(problem, &freqs, &settings, &|| bar.inc(1)).map_err(Failure::input)?;
     let wall = t.elapsed().as_secs_f64();
@@ -176,7 +182,8 @@ pub fn run(a: &Args) -> Result<(), Failure> {
 
     if !a.march_at.is_empty() {
         let per_point = wall / points.len() as f64;
-        let opts = MarchOptions { steps_per_period: a.march_steps, tolerances: a.march_tol.clone(), reference_factor: a.reference_factor, ..Default::default() };
+        let opts =
+            MarchOptions { steps_per_period: a.march_steps, tolerances: a.march_tol.clone(), reference_factor: a.reference_factor, ..Default::default() };
         let k = problem.disc.steps;
         println!(
             "time marching (explicit central differences with penalty contacts, from rest) against the periodic LCP (k = {k}); errors: max over the {k} instants of |x − x_ref| / amplitude, per displacement output ({}); reference: the LCP with k = {}",

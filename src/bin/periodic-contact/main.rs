@@ -5,8 +5,8 @@ mod cmd_fmu;
 mod cmd_lcp;
 mod cmd_modes;
 mod cmd_solve;
-mod cmd_sweep;
 mod cmd_study;
+mod cmd_sweep;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
