@@ -9,8 +9,8 @@
 //! No panic crosses the boundary: every function runs inside `catch_unwind` and reports
 //! `PC_ERROR_INTERNAL`. Handles are not thread-safe; different handles may be used from
 //! different threads.
-use crate::fmu_model::Tuning;
 use crate::model::{Compliance, Contact, Force, Harmonic, Matrix, Model, Structure};
+use crate::periodic::Tuning;
 use crate::periodic::{OutputSelection, PeriodFft, PeriodicProblem, SolveError, SolverSettings};
 use crate::response::Response;
 use crate::scene::Scene;
@@ -78,10 +78,8 @@ fn input(e: impl ToString) -> (c_int, String) {
     (PC_ERROR_INPUT, e.to_string())
 }
 fn solver_error(e: SolveError) -> (c_int, String) {
-    match e {
-        SolveError::Invalid(m) => (PC_ERROR_INPUT, m),
-        other => (PC_ERROR_SOLVER, other.to_string()),
-    }
+    let status = if e.kind() == crate::ErrorKind::Solve { PC_ERROR_SOLVER } else { PC_ERROR_INPUT };
+    (status, e.to_string())
 }
 
 unsafe fn c_str<'a>(p: *const c_char, what: &str) -> Result<&'a str, (c_int, String)> {

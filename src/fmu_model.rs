@@ -21,7 +21,8 @@
 use crate::fmi2::bytes::{ByteReader, ByteWriter};
 use crate::fmi2::table::{Kind, UnitDefinition, Variability, Variable, VariableTable};
 use crate::fmi2::{DefaultExperiment, Fmi2Model, Logger, ModelDescription};
-use crate::periodic::{MAX_STEPS, MIN_STEPS, PeriodFft, PeriodicProblem, SolveError};
+pub use crate::periodic::Tuning;
+use crate::periodic::{MAX_STEPS, MIN_STEPS, PeriodFft, PeriodicProblem};
 use crate::response::Response;
 use crate::scene::Scene;
 use crate::time::{Discretization, Scheme};
@@ -32,37 +33,6 @@ use std::sync::Arc;
 pub const MODEL_IDENTIFIER: &str = "PeriodicContact";
 /// The scene inside the FMU's `resources/`.
 pub const SCENE_FILE: &str = "scene.toml";
-
-/// The tunable knobs applied to a scene's problem.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Tuning {
-    /// ω [rad/s].
-    pub frequency: f64,
-    /// Multiplies every force amplitude.
-    pub force_scale: f64,
-    /// Added to every static clearance.
-    pub gap_offset: f64,
-    /// Multiplies every obstacle-motion amplitude.
-    pub motion_scale: f64,
-}
-
-impl Tuning {
-    /// The scene's own values (scales 1, offset 0).
-    pub fn of(p: &PeriodicProblem) -> Self {
-        Tuning { frequency: p.model.frequency, force_scale: 1.0, gap_offset: 0.0, motion_scale: 1.0 }
-    }
-    /// `base` with these values and discretisation `disc`, validated again.
-    pub fn apply(&self, base: &PeriodicProblem, disc: Discretization) -> Result<PeriodicProblem, SolveError> {
-        let mut model = base.model.clone();
-        model.frequency = self.frequency;
-        model.forces.iter_mut().for_each(|f| f.term.amplitude *= self.force_scale);
-        for c in &mut model.contacts {
-            c.gap += self.gap_offset;
-            c.motion.iter_mut().for_each(|h| h.amplitude *= self.motion_scale);
-        }
-        PeriodicProblem::new(model, disc, base.outputs.clone(), base.solver.clone())
-    }
-}
 
 /// What a value reference stands for.
 #[derive(Clone, Copy, Debug, PartialEq)]

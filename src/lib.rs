@@ -9,6 +9,8 @@
 pub mod capi;
 /// The built-in default scene.
 pub mod defaults;
+/// The crate error: kinds every front end maps to its statuses.
+pub mod error;
 /// Semi-analytic periodic orbits: the independent references of the tests.
 pub mod exact;
 /// Finite elements: Matrix Market input, DOF clamping, the blade model.
@@ -40,3 +42,5 @@ pub mod study;
 pub mod sweep;
 /// Time schemes as circulant symbols; pairing.
 pub mod time;
+
+pub use error::{Error, ErrorKind};

@@ -1,7 +1,7 @@
 //! The C API from C: examples/capi_demo.c is compiled with `cc` against the root cdylib
 //! (libperiodic_contact.so, next to the CLI in target/<profile>/), run on a scene, and every
 //! number it prints is checked against the Rust API for the same problem.
-use periodic_contact::fmu_model::Tuning;
+use periodic_contact::periodic::Tuning;
 use periodic_contact::scene::Scene;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};

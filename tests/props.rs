@@ -114,7 +114,7 @@ fn check_solve(p: &PeriodicProblem, tally: &Tally) -> Result<(), TestCaseError> 
         }
         Err(e) => {
             tally.add(match &e {
-                SolveError::Invalid(_) => "refused by the solve (input)",
+                SolveError::Invalid(_) | SolveError::Model(_) | SolveError::Limit(_) => "refused by the solve (input)",
                 SolveError::SingularOperator { .. } => "refused: singular operator",
                 SolveError::Lcp { outcome: LcpOutcome::RayTermination, .. } => "refused: LCP ray termination",
                 SolveError::Lcp { outcome: LcpOutcome::PivotLimit, .. } => "refused: LCP pivot limit",

@@ -8,6 +8,7 @@ pub mod dat;
 mod lemke;
 mod matrix;
 mod pivoting;
+mod policy;
 mod refine;
 mod warm_lemke;
 
@@ -17,6 +18,7 @@ pub use dat::{DatError, parse_dat, read_dat, write_dat};
 pub use lemke::{Lemke, LemkeSettings};
 pub use matrix::{BlockCirculant, DenseMatrix, LcpMatrix};
 pub use pivoting::{BlockPivoting, PivotingSettings};
+pub use policy::{AUTO_LEMKE_MAX, LcpMethod, solve_circulant_lcp};
 
 use serde::Serialize;
 

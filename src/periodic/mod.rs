@@ -3,12 +3,16 @@
 mod assembly;
 mod fft;
 mod recovery;
+mod tuning;
 
 pub use assembly::Assembly;
 pub use fft::PeriodFft;
+pub use tuning::Tuning;
 
-use crate::lcp::{BlockCirculant, BlockPivoting, CirculantOperator, LcpMatrix, LcpOutcome, LcpSolution, Lemke, LemkeSettings, PivotingSettings};
-use crate::model::{Contact, Model};
+use crate::error::{Error, ErrorKind};
+pub use crate::lcp::{AUTO_LEMKE_MAX, LcpMethod, solve_circulant_lcp};
+use crate::lcp::{BlockCirculant, LcpMatrix, LcpOutcome, LcpSolution};
+use crate::model::{Contact, Model, ModelError};
 use crate::response::Response;
 use crate::time::{Discretization, Pairing};
 use std::time::Instant;
@@ -44,27 +48,6 @@ pub struct OutputMap {
     pub contact_dofs: Vec<usize>,
     /// Effects named in the result besides the model's own (e.g. `reduction`).
     pub effects: Vec<String>,
-}
-
-/// Which LCP method to use.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum LcpMethod {
-    /// Picks by size and falls back on failure.
-    Auto,
-    /// Lexicographic Lemke.
-    Lemke,
-    /// Block principal pivoting on the active set, FFT products (the fast path for large k).
-    Pivoting,
-}
-
-impl LcpMethod {
-    pub fn name(self) -> &'static str {
-        match self {
-            LcpMethod::Auto => "auto",
-            LcpMethod::Lemke => "lemke",
-            LcpMethod::Pivoting => "pivoting",
-        }
-    }
 }
 
 /// Solver settings with defaults.
@@ -116,8 +99,15 @@ impl SolverSettings {
 /// Why a problem could not be set up or solved. Every message says what to change.
 #[derive(Debug, Clone, thiserror::Error)]
 pub enum SolveError {
+    /// The model fails its checks (the field and the value are named).
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    /// A setting of the problem is not usable (field: value: remedy).
     #[error("{0}")]
     Invalid(String),
+    /// Legal, but larger than accepted (LCP size, dense work): the message gives the limit.
+    #[error("{0}")]
+    Limit(String),
     #[error(
         "the dynamic operator is singular at harmonic {harmonic} (frequency {frequency} rad/s): an undamped resonance or a rigid-body mode falls on a sampled harmonic; add damping, change steps or the frequency, or clamp the structure"
     )]
@@ -126,6 +116,23 @@ pub enum SolveError {
     Lcp { outcome: LcpOutcome, info: crate::lcp::LcpInfo, hint: String },
     #[error("the recovered response is not finite at {0}; the problem is too ill-conditioned to report")]
     NonFinite(String),
+}
+
+impl SolveError {
+    /// Input and limits are the caller's to change; the rest is the solver's outcome.
+    pub fn kind(&self) -> ErrorKind {
+        match self {
+            SolveError::Model(_) | SolveError::Invalid(_) => ErrorKind::Input,
+            SolveError::Limit(_) => ErrorKind::Limit,
+            SolveError::SingularOperator { .. } | SolveError::Lcp { .. } | SolveError::NonFinite(_) => ErrorKind::Solve,
+        }
+    }
+}
+
+impl From<SolveError> for Error {
+    fn from(e: SolveError) -> Self {
+        Error::new(e.kind(), e.to_string())
+    }
 }
 
 /// A model with its discretisation, outputs and solver settings, checked and ready to solve.
@@ -138,10 +145,6 @@ pub struct PeriodicProblem {
     /// `Some`: `outputs` are user DOFs (labels), computed through the map.
     pub output_map: Option<OutputMap>,
 }
-
-/// Up to this LCP size `auto` uses lexicographic Lemke directly; above, block pivoting finished
-/// by Lemke from its best basis, with full lexicographic Lemke as the fallback.
-pub const AUTO_LEMKE_MAX: usize = 256;
 
 /// Fewest instants per period that any scheme needs.
 pub const MIN_STEPS: usize = 4;
@@ -167,7 +170,7 @@ impl PeriodicProblem {
         }
         let m = model.contacts.len();
         if k.saturating_mul(m) > MAX_LCP_SIZE {
-            return Err(SolveError::Invalid(format!(
+            return Err(SolveError::Limit(format!(
                 "discretization.steps: is {k} with {m} contact(s), an LCP of {} unknowns (steps × contacts); at most {MAX_LCP_SIZE} are accepted: reduce steps",
                 k.saturating_mul(m)
             )));
@@ -177,12 +180,12 @@ impl PeriodicProblem {
         let n = model.n();
         let flops = (k / 2 + 1) as f64 * (8.0 / 3.0) * (n as f64).powi(3);
         if dense && flops > MAX_DENSE_FLOPS {
-            return Err(SolveError::Invalid(format!(
+            return Err(SolveError::Limit(format!(
                 "structure.mass: a dense {n}×{n} model with steps = {k} needs {} complex {n}×{n} factorisations (≈ {flops:.1e} flops, at most {MAX_DENSE_FLOPS:.0e} accepted): give the matrices in sparse form, reduce the model (Craig–Bampton), or reduce steps",
                 k / 2 + 1
             )));
         }
-        model.validate().map_err(|e| SolveError::Invalid(e.to_string()))?;
+        model.validate()?;
         // The difference operators divide by h²: a time step whose 1/h² overflows (ω = 1e308)
         // gives σ2 = 0/0 = NaN at harmonic 0 (found by tests/props.rs).
         let h = model.period() / k as f64;
@@ -415,39 +418,4 @@ fn lcp_failure(sol: LcpSolution) -> SolveError {
         LcpOutcome::Solved => unreachable!(),
     };
     SolveError::Lcp { outcome: sol.outcome, info: sol.info, hint: hint.into() }
-}
-
-/// Solves a block-circulant LCP with `method` (the engine's logic: `auto` uses lexicographic
-/// Lemke up to [`AUTO_LEMKE_MAX`], above it block pivoting with FFT products, falling back to
-/// Lemke when that fails). Used by the engine and by `periodic-contact lcp` for a raw LCP whose
-/// matrix is block-circulant.
-pub fn solve_circulant_lcp(a: &BlockCirculant, q: &[f64], method: LcpMethod, tolerance: f64, warm_start: Option<&[usize]>) -> LcpSolution {
-    if q.is_empty() {
-        return LcpSolution { outcome: LcpOutcome::Solved, z: vec![], w: vec![], info: Default::default() };
-    }
-    let lemke = || {
-        let settings = LemkeSettings { certify_tol: tolerance, warm_start: warm_start.map(<[usize]>::to_vec), ..LemkeSettings::default() };
-        Lemke::new(settings).solve(a, q)
-    };
-    let pivoting = || {
-        let settings = PivotingSettings { certify_tol: tolerance, warm_start: warm_start.map(<[usize]>::to_vec), ..PivotingSettings::default() };
-        BlockPivoting::new(settings).solve(&CirculantOperator::new(a), q)
-    };
-    match method {
-        LcpMethod::Lemke => lemke(),
-        LcpMethod::Pivoting => pivoting(),
-        LcpMethod::Auto if q.len() <= AUTO_LEMKE_MAX => lemke(),
-        LcpMethod::Auto => {
-            let fast = pivoting();
-            if fast.outcome == LcpOutcome::Solved {
-                fast
-            } else {
-                // The robust fallback: lexicographic Lemke; its pivots add to the fast path's.
-                let mut sol = lemke();
-                sol.info.pivots += fast.info.pivots;
-                sol.info.time_s += fast.info.time_s;
-                sol
-            }
-        }
-    }
 }

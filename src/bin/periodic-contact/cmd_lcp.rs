@@ -6,7 +6,7 @@
 //! fallback). Otherwise (or with `--method lemke`) dense lexicographic Lemke.
 use crate::{Failure, write_output};
 use periodic_contact::lcp::{BlockCirculant, BlockPivoting, LcpOutcome, Lemke, LemkeSettings, PivotingSettings, dat};
-use periodic_contact::periodic::{LcpMethod, solve_circulant_lcp};
+use periodic_contact::lcp::{LcpMethod, solve_circulant_lcp};
 use std::path::Path;
 use std::time::Instant;
 

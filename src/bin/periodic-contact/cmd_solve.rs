@@ -1,6 +1,6 @@
 //! `solve` and the default run.
 use crate::{Failure, write_output};
-use periodic_contact::periodic::{PeriodicProblem, SolveError};
+use periodic_contact::periodic::PeriodicProblem;
 use periodic_contact::response::Response;
 use periodic_contact::scene::Scene;
 use std::path::Path;
@@ -9,10 +9,7 @@ fn solve(problem: &PeriodicProblem) -> Result<Response, Failure> {
     for w in problem.warnings() {
         eprintln!("warning: {w}");
     }
-    problem.solve().map_err(|e| match e {
-        SolveError::Invalid(m) => Failure::input(m),
-        other => Failure::solver(other.to_string()),
-    })
+    problem.solve().map_err(|e| Failure::from(periodic_contact::Error::from(e)))
 }
 
 pub fn load(scene: &Path, frequency: Option<f64>) -> Result<PeriodicProblem, Failure> {

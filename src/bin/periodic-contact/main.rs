@@ -92,6 +92,12 @@ pub struct Failure {
     pub message: String,
 }
 
+impl From<periodic_contact::Error> for Failure {
+    fn from(e: periodic_contact::Error) -> Self {
+        Failure { status: e.kind().exit_status(), message: e.to_string() }
+    }
+}
+
 impl Failure {
     pub fn input(message: impl Into<String>) -> Self {
         Failure { status: 2, message: message.into() }
