@@ -21,6 +21,8 @@ pub mod fmi2;
 pub mod fmu_model;
 /// LCP solvers; they know nothing of mechanics.
 pub mod lcp;
+/// Numerical building blocks shared by mechanics and LCP (the FFT plans); no mechanics.
+pub mod linalg;
 /// Explicit time marching with forward-increment Lagrange multipliers (the paper's reference).
 pub mod marching;
 /// The mechanical model and its checks.
