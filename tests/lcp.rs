@@ -434,7 +434,7 @@ enum Expect {
 #[test]
 fn siconos_problems() {
     use Expect::*;
-    // M is stored column by column in these files (see src/lcp/dat.rs).
+    // M is stored column by column in these files (see src/lcp/io/dat.rs).
     let table: Vec<(&str, Expect)> = vec![
         // M = [[1,1],[1,1]], q = −e: every z ≥ 0 with z1 + z2 = 1 (CPS 2009, Remark 4.1.14).
         ("lcp_CPS_1", Continuum(|z| (z[0] + z[1] - 1.0).abs() <= 1e-12)),

@@ -9,9 +9,12 @@
 //! Measured on the rigid stop with forward-paired cds (k = 1024): two full exchanges bring the
 //! active set within two indices, then the front walks two instants per iteration (the odd–even
 //! coupling of central differences): O(k) LUs. So once full exchanges stop reducing the number
-//! of infeasible indices, Lemke takes over from the best basis (`warm_lemke`), one cheap pivot
+//! of infeasible indices, Lemke takes over from the best basis (`lemke::warm`), one cheap pivot
 //! per wrong index.
-use super::{LcpInfo, LcpMatrix, LcpOutcome, LcpSolution, residuals, warm_lemke};
+use super::lemke::warm;
+use super::principal::well_conditioned;
+use super::status::{finite_or_zero, recheck_exactly, residuals};
+use super::{LcpInfo, LcpMatrix, LcpOutcome, LcpSolution};
 use faer::Mat;
 use faer::linalg::solvers::PartialPivLu;
 use faer::linalg::solvers::Solve;
@@ -44,22 +47,13 @@ pub struct BlockPivoting {
     pub settings: PivotingSettings,
 }
 
-/// Pivot ratio below which A_FF counts as singular (the fast path then gives up).
-const SINGULAR_RATIO: f64 = 1e-14;
-
-/// The LU's U has no pivot below SINGULAR_RATIO of the largest (NaN counts as singular).
-pub(crate) fn well_conditioned(u: faer::MatRef<'_, f64>) -> bool {
-    let (lo, hi) = (0..u.nrows()).fold((f64::INFINITY, 0.0f64), |(l, h), i| (l.min(u[(i, i)].abs()), h.max(u[(i, i)].abs())));
-    lo > SINGULAR_RATIO * hi || u.nrows() == 0
-}
-
 impl BlockPivoting {
     pub fn new(settings: PivotingSettings) -> Self {
         BlockPivoting { settings }
     }
 
     /// Full exchanges while they reduce the number of infeasible indices; then Lemke from the
-    /// best basis found (`warm_lemke`), which repairs the last few indices pivot by pivot.
+    /// best basis found (`lemke::warm`), which repairs the last few indices pivot by pivot.
     /// z and w are always finite: an iterate that overflowed is reported as z = 0, w = q. A
     /// `Solved` answer is certified with w = A z + q formed exactly when a fast (FFT) product's
     /// round-off could hide a violation.
@@ -185,68 +179,11 @@ impl BlockPivoting {
             return fail(LcpOutcome::Inaccurate, 0, vec![0.0; n], q.to_vec());
         };
         let exchanges = iterations;
-        let mut sol = warm_lemke::solve_from_basis(a, q, &basis, lu, s.max_lemke_pivots, s.certify_tol);
+        let mut sol = warm::solve_from_basis(a, q, &basis, lu, s.max_lemke_pivots, s.certify_tol);
         // Pivots: the block exchanges (one LU each) plus Lemke's single pivots.
         sol.info.pivots += exchanges;
         sol.info.time_s = start.elapsed().as_secs_f64();
         sol.info.warm_start_used = s.warm_start.is_some();
         sol
     }
-}
-
-/// The [`LcpSolution`] contract: z and w finite. An overflowed iterate (A_FF⁻¹q beyond f64 on data
-/// spanning hundreds of decades, found by tests/props.rs) becomes z = 0, w = q, never `Solved`.
-pub(crate) fn finite_or_zero(mut sol: LcpSolution, q: &[f64]) -> LcpSolution {
-    if sol.z.iter().chain(&sol.w).all(|v| v.is_finite()) {
-        return sol;
-    }
-    sol.z = vec![0.0; q.len()];
-    sol.w = q.to_vec();
-    let (residual, relative_error) = residuals(q, &sol.z, &sol.w);
-    sol.info.residual = residual;
-    sol.info.relative_error = relative_error;
-    if sol.outcome == LcpOutcome::Solved {
-        sol.outcome = LcpOutcome::Inaccurate;
-    }
-    sol
-}
-
-/// Re-certifies a `Solved` answer with w = A z + q summed column by column from A's entries, when
-/// the round-off of `mul_into` could exceed a hundredth of the certification tolerance.
-///
-/// Why: the FFT product of a block-circulant A has a normwise error, about
-/// eps·log₂N·max|A|·‖z‖₁, not a componentwise one. On data spanning hundreds of decades that
-/// swamps the small components of w: tests/props.rs found a 9×9 block-circulant LCP "solved" with
-/// w₃ = −2.8e161 when summed exactly. The exact sum costs O(N·nnz(z)) column reads; it runs only
-/// when the bound says the fast product cannot be trusted to the tolerance.
-pub(crate) fn recheck_exactly(mut sol: LcpSolution, a: &dyn LcpMatrix, q: &[f64], certify_tol: f64) -> LcpSolution {
-    if sol.outcome != LcpOutcome::Solved || q.is_empty() {
-        return sol;
-    }
-    let n = q.len();
-    let qmax = q.iter().fold(1.0f64, |m, v| m.max(v.abs()));
-    let cert = certify_tol * qmax;
-    let z1: f64 = sol.z.iter().map(|v| v.abs()).sum();
-    let bound = 8.0 * f64::EPSILON * ((n as f64).log2() + 1.0) * a.max_abs().0 * z1;
-    if bound <= 0.01 * cert {
-        return sol;
-    }
-    let mut w = q.to_vec();
-    let mut col = vec![0.0; n];
-    for (j, &zj) in sol.z.iter().enumerate() {
-        if zj != 0.0 {
-            a.column_into(j, &mut col);
-            w.iter_mut().zip(&col).for_each(|(wi, c)| *wi += c * zj);
-        }
-    }
-    let (residual, relative_error) = residuals(q, &sol.z, &w);
-    if !(residual <= cert) || !w.iter().all(|v| v.is_finite()) {
-        sol.outcome = LcpOutcome::Inaccurate;
-    }
-    sol.info.residual = residual;
-    sol.info.relative_error = relative_error;
-    if w.iter().all(|v| v.is_finite()) {
-        sol.w = w;
-    }
-    sol
 }

@@ -7,7 +7,9 @@
 //! the LU of A_FF and one product with A (an FFT away for a block-circulant A), then the
 //! product-form etas of the pivots made since: O(|F|² + N log N + N·pivots) per pivot, and
 //! memory O(|F|² + N·pivots) — never the N² tableau.
-use super::{LcpInfo, LcpMatrix, LcpOutcome, LcpSolution, residuals};
+use crate::lcp::principal::well_conditioned;
+use crate::lcp::status::{finite_or_zero, residuals};
+use crate::lcp::{LcpInfo, LcpMatrix, LcpOutcome, LcpSolution};
 use faer::Mat;
 use faer::linalg::solvers::{PartialPivLu, Solve};
 
@@ -49,7 +51,7 @@ impl<'a> Basis<'a> {
                     }
                 }
                 let lu = aff.partial_piv_lu();
-                if !super::pivoting::well_conditioned(lu.U()) {
+                if !well_conditioned(lu.U()) {
                     return None;
                 }
                 Some(lu)
@@ -242,5 +244,5 @@ fn finish(
     let qmax = q.iter().fold(1.0f64, |m, v| m.max(v.abs()));
     let outcome = if residual <= certify_tol * qmax { LcpOutcome::Solved } else { LcpOutcome::Inaccurate };
     let sol = LcpSolution { outcome, z, w, info: LcpInfo { pivots, residual, relative_error, time_s: start.elapsed().as_secs_f64(), warm_start_used: false } };
-    super::pivoting::finite_or_zero(sol, q)
+    finite_or_zero(sol, q)
 }

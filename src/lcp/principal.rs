@@ -1,5 +1,7 @@
-//! The final solve of a complementary basis on the original data, its evaluation, and a
-//! safeguarded polish of a nearly-right basis.
+//! Principal-block solves: the LU of A_αα and its conditioning check, the final solve of a
+//! complementary basis on the original data, and a safeguarded polish of a nearly-right basis.
+//! Shared by Lemke (`lemke/`) and block pivoting (`pivoting.rs`); depends on the matrix trait and
+//! on the certification helpers of `status.rs` only.
 //!
 //! Lemke's pivots run on an explicitly updated B⁻¹, whose round-off grows with the number of
 //! pivots and the conditioning of the bases. On near-degenerate problems (a contact force grazing
@@ -13,12 +15,22 @@
 use faer::Mat;
 use faer::linalg::solvers::Solve;
 
-use super::{LcpMatrix, residuals};
+use super::LcpMatrix;
+use super::status::{Candidate, evaluate};
+
+/// Pivot ratio below which A_FF counts as singular (the fast path then gives up).
+const SINGULAR_RATIO: f64 = 1e-14;
+
+/// The LU's U has no pivot below SINGULAR_RATIO of the largest (NaN counts as singular).
+pub(crate) fn well_conditioned(u: faer::MatRef<'_, f64>) -> bool {
+    let (lo, hi) = (0..u.nrows()).fold((f64::INFINITY, 0.0f64), |(l, h), i| (l.min(u[(i, i)].abs()), h.max(u[(i, i)].abs())));
+    lo > SINGULAR_RATIO * hi || u.nrows() == 0
+}
 
 /// Solves A_αα z_α = −q_α by LU with partial pivoting and `steps` of iterative refinement (the
 /// residual recomputed from the original entries each step). Returns the full z (zero off α), or
 /// None if the solve is not finite (singular A_αα).
-pub(super) fn solve_principal(a: &dyn LcpMatrix, q: &[f64], alpha: &[usize], steps: usize) -> Option<Vec<f64>> {
+pub(crate) fn solve_principal(a: &dyn LcpMatrix, q: &[f64], alpha: &[usize], steps: usize) -> Option<Vec<f64>> {
     let n = a.dim();
     let m = alpha.len();
     let mut z = vec![0.0; n];
@@ -68,54 +80,9 @@ pub(super) fn solve_principal(a: &dyn LcpMatrix, q: &[f64], alpha: &[usize], ste
     Some(z)
 }
 
-/// A candidate answer evaluated on the original data.
-pub(super) struct Candidate {
-    pub z: Vec<f64>,
-    pub w: Vec<f64>,
-    pub residual: f64,
-    pub relative_error: f64,
-}
-
-impl Candidate {
-    /// z = w = 0 with infinite residuals: "nothing better".
-    pub fn zeros(n: usize) -> Self {
-        Candidate { z: vec![0.0; n], w: vec![0.0; n], residual: f64::INFINITY, relative_error: f64::INFINITY }
-    }
-}
-
-/// Clips z_i ∈ [−clip, 0) to 0, computes w = A z + q and the residuals on the original data, then
-/// clips w_i ∈ [−clip, 0) to 0 for the report. Why: a negative within the certification
-/// tolerance is round-off of a zero; anything larger is left visible (and fails certification).
-pub(super) fn evaluate(a: &dyn LcpMatrix, q: &[f64], mut z: Vec<f64>, clip: f64) -> Candidate {
-    let n = q.len();
-    if !z.iter().all(|v| v.is_finite()) {
-        return Candidate::zeros(n);
-    }
-    for v in z.iter_mut() {
-        if *v < 0.0 && *v >= -clip {
-            *v = 0.0;
-        }
-    }
-    let mut w = vec![0.0; n];
-    a.mul_into(&z, &mut w);
-    for (wi, qi) in w.iter_mut().zip(q) {
-        *wi += qi;
-    }
-    if !w.iter().all(|v| v.is_finite()) {
-        return Candidate::zeros(n);
-    }
-    let (residual, relative_error) = residuals(q, &z, &w);
-    for v in w.iter_mut() {
-        if *v < 0.0 && *v >= -clip {
-            *v = 0.0;
-        }
-    }
-    Candidate { z, w, residual, relative_error }
-}
-
 /// Polishes the basis α by safeguarded block principal pivoting, starting from its evaluated
 /// candidate `start`. Returns the first certified candidate (residual ≤ cert), or None.
-pub(super) fn polish(a: &dyn LcpMatrix, q: &[f64], alpha: &[usize], start: &Candidate, steps: usize, cert: f64, max_rounds: usize) -> Option<Candidate> {
+pub(crate) fn polish(a: &dyn LcpMatrix, q: &[f64], alpha: &[usize], start: &Candidate, steps: usize, cert: f64, max_rounds: usize) -> Option<Candidate> {
     let n = a.dim();
     let mut in_alpha = vec![false; n];
     alpha.iter().for_each(|&i| in_alpha[i] = true);

@@ -26,7 +26,7 @@ use std::fmt::Write as _;
 use std::io;
 use std::path::Path;
 
-use super::{DenseMatrix, LcpMatrix};
+use crate::lcp::{DenseMatrix, LcpMatrix};
 
 /// A `.dat` file that cannot be read or parsed.
 #[derive(Debug, thiserror::Error)]

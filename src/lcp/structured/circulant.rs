@@ -1,6 +1,6 @@
 //! Products with a block-circulant matrix by FFT: O(m²·k log k) instead of O(m²k²).
 //! A z = IDFT(Ĝ_p ẑ_p) per harmonic, with Ĝ the DFT of the first block column.
-use super::{BlockCirculant, LcpMatrix};
+use crate::lcp::{BlockCirculant, LcpMatrix};
 use num_complex::Complex64 as C;
 use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
 use std::sync::Arc;

@@ -1,0 +1,2 @@
+//! Reading and writing LCPs in exchange formats (no solver, no mechanics).
+pub mod dat;

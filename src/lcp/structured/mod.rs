@@ -1,0 +1,19 @@
+//! Solvers and operators that use the structure of A instead of its entries.
+//!
+//! The period's LCP matrix is block-circulant (k blocks of m×m, m = number of contacts): products
+//! cost O(m²·k log k) by FFT, and a banded or low-rank structure of the blocks could be used too.
+//! This is the room for everything that exploits such structure:
+//!
+//! - operators: types implementing [`LcpMatrix`](super::LcpMatrix) with a fast `mul_into`
+//!   ([`CirculantOperator`]); any solver written against the trait uses them unchanged;
+//! - structured solver families (none yet), e.g. an active-block revised Lemke whose basis solves
+//!   use the circulant spectrum, or a state-space cyclic banded MLCP. A new family lives in its
+//!   own file here, exposes `Settings` + `solve(&self, a, q) -> LcpSolution` like the general
+//!   solvers, and is offered through a new [`LcpMethod`](super::LcpMethod) variant in
+//!   `policy.rs` (and, if it should be tried automatically, a branch of the `auto` policy).
+//!
+//! Rules of the room: it depends on the rest of `lcp` (matrices, status) and on `crate::linalg`
+//! only; hot paths own or receive their scratch buffers (nothing allocated per product or pivot).
+mod circulant;
+
+pub use circulant::CirculantOperator;
