@@ -123,7 +123,7 @@ impl BlockCirculant {
     pub fn detect(a: &DenseMatrix, max_m: usize) -> Option<BlockCirculant> {
         let n = a.dim();
         for m in 1..=max_m.min(n / 2) {
-            if n % m != 0 {
+            if !n.is_multiple_of(m) {
                 continue;
             }
             let k = n / m;

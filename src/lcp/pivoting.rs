@@ -123,6 +123,7 @@ impl BlockPivoting {
             a.mul_into(&z, &mut w);
             w.iter_mut().zip(q).for_each(|(wi, qi)| *wi += qi);
             // Infeasible: active with z < 0, or inactive with w < 0 (NaN counts as infeasible).
+            #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(x >= -tol)` is true for NaN on purpose
             let infeasible: Vec<usize> = (0..n).filter(|&i| if active[i] { !(z[i] >= -tol) } else { !(w[i] >= -tol) }).collect();
             if infeasible.is_empty() {
                 // Iterative refinement of z_F with the same LU (A_FF z_F = −q_F, residual −w_F):

@@ -67,7 +67,7 @@ impl PeriodFft {
     /// 1/k. Panics on wrong lengths (a programming error).
     pub fn inverse_unscaled_with_scratch(&self, spectrum: &mut [C], out: &mut [f64], scratch: &mut [C]) {
         spectrum[0].im = 0.0;
-        if self.k % 2 == 0 {
+        if self.k.is_multiple_of(2) {
             spectrum[self.k / 2].im = 0.0;
         }
         self.inverse.process_with_scratch(spectrum, out, scratch).expect("c2r lengths match the plan");

@@ -114,12 +114,12 @@ impl Lemke {
             let mut alpha: Vec<usize> = active.clone();
             alpha.sort_unstable();
             alpha.dedup();
-            if alpha.iter().all(|&i| i < n) {
-                if let Some(z) = solve_principal(a, q, &alpha, s.refinement_steps) {
-                    let c = evaluate(a, q, z, cert);
-                    if certified(&c) {
-                        return done(LcpOutcome::Solved, c, 0, true);
-                    }
+            if alpha.iter().all(|&i| i < n)
+                && let Some(z) = solve_principal(a, q, &alpha, s.refinement_steps)
+            {
+                let c = evaluate(a, q, z, cert);
+                if certified(&c) {
+                    return done(LcpOutcome::Solved, c, 0, true);
                 }
             }
         }
