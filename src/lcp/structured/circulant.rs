@@ -1,41 +1,94 @@
 //! Products with a block-circulant matrix by FFT: O(m²·k log k) instead of O(m²k²).
 //! A z = IDFT(Ĝ_p ẑ_p) per harmonic, with Ĝ the DFT of the first block column.
+//!
+//! The operator owns its FFT plans ([`PeriodFft`], shared with the engine through the one planner)
+//! and the work buffers of a product, so `mul_into` allocates nothing. The buffers sit behind a
+//! mutex because [`LcpMatrix`] takes `&self` and must be `Sync`: the solvers call it from one
+//! thread, so the lock is uncontended; a concurrent caller that finds it taken gets buffers of
+//! its own for that product rather than waiting.
+use std::sync::Mutex;
+
 use crate::lcp::{BlockCirculant, LcpMatrix};
+use crate::linalg::fft::PeriodFft;
 use num_complex::Complex64 as C;
-use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
-use std::sync::Arc;
 
 /// A [`BlockCirculant`] with its block spectrum and FFT plans, for fast products.
 pub struct CirculantOperator<'a> {
     a: &'a BlockCirculant,
     /// Ĝ_p row-major m×m for p = 0..=k/2.
     spectrum: Vec<C>,
-    forward: Arc<dyn RealToComplex<f64>>,
-    inverse: Arc<dyn ComplexToReal<f64>>,
+    fft: PeriodFft,
+    work: Mutex<Work>,
+}
+
+/// The buffers of one product.
+struct Work {
+    /// One real series of length k.
+    series: Vec<f64>,
+    /// ẑ_p for p = 0..=k/2, m values each.
+    zh: Vec<C>,
+    /// One spectrum of k/2 + 1 bins.
+    buf: Vec<C>,
+    scratch: Vec<C>,
+}
+
+impl Work {
+    fn new(fft: &PeriodFft, m: usize) -> Self {
+        Work { series: vec![0.0; fft.k()], zh: vec![C::ZERO; fft.bins() * m], buf: vec![C::ZERO; fft.bins()], scratch: fft.make_scratch() }
+    }
 }
 
 impl<'a> CirculantOperator<'a> {
+    /// Plans (or takes from the planner's cache) the FFTs of length k and transforms the blocks.
     pub fn new(a: &'a BlockCirculant) -> Self {
+        Self::with_fft(a, &PeriodFft::new(a.k()))
+    }
+
+    /// The same with plans the caller already has. Panics if `fft.k() != a.k()`.
+    pub fn with_fft(a: &'a BlockCirculant, fft: &PeriodFft) -> Self {
         let (k, m) = (a.k(), a.m());
-        let mut planner = RealFftPlanner::<f64>::new();
-        let forward = planner.plan_fft_forward(k);
-        let inverse = planner.plan_fft_inverse(k);
-        let nh = k / 2 + 1;
+        assert_eq!(fft.k(), k, "CirculantOperator: FFT of length {} for k = {k}", fft.k());
+        let fft = fft.clone();
+        let nh = fft.bins();
+        let mut work = Work::new(&fft, m);
         let mut spectrum = vec![C::ZERO; nh * m * m];
-        let mut series = vec![0.0; k];
-        let mut out = forward.make_output_vec();
         for i in 0..m {
             for j in 0..m {
-                for (d, s) in series.iter_mut().enumerate() {
+                for (d, s) in work.series.iter_mut().enumerate() {
                     *s = a.blocks()[(d * m + i) * m + j];
                 }
-                forward.process(&mut series, &mut out).expect("plan length");
+                fft.forward_with_scratch(&mut work.series, &mut work.buf, &mut work.scratch);
                 for p in 0..nh {
-                    spectrum[(p * m + i) * m + j] = out[p];
+                    spectrum[(p * m + i) * m + j] = work.buf[p];
                 }
             }
         }
-        CirculantOperator { a, spectrum, forward, inverse }
+        CirculantOperator { a, spectrum, fft, work: Mutex::new(work) }
+    }
+
+    /// out = A z with the buffers `w`.
+    fn product(&self, z: &[f64], out: &mut [f64], w: &mut Work) {
+        let (k, m) = (self.a.k(), self.a.m());
+        let nh = self.fft.bins();
+        let Work { series, zh, buf, scratch } = w;
+        for b in 0..m {
+            for (j, s) in series.iter_mut().enumerate() {
+                *s = z[j * m + b];
+            }
+            self.fft.forward_with_scratch(series, buf, scratch);
+            for p in 0..nh {
+                zh[p * m + b] = buf[p];
+            }
+        }
+        for a in 0..m {
+            for p in 0..nh {
+                buf[p] = (0..m).map(|b| self.spectrum[(p * m + a) * m + b] * zh[p * m + b]).sum();
+            }
+            self.fft.inverse_unscaled_with_scratch(buf, series, scratch);
+            for j in 0..k {
+                out[j * m + a] = series[j] / k as f64;
+            }
+        }
     }
 }
 
@@ -50,32 +103,10 @@ impl LcpMatrix for CirculantOperator<'_> {
         self.a.column_into(j, out)
     }
     fn mul_into(&self, z: &[f64], out: &mut [f64]) {
-        let (k, m) = (self.a.k(), self.a.m());
-        let nh = k / 2 + 1;
-        let mut series = vec![0.0; k];
-        let mut zh = vec![C::ZERO; nh * m];
-        let mut buf = self.forward.make_output_vec();
-        for b in 0..m {
-            for (j, s) in series.iter_mut().enumerate() {
-                *s = z[j * m + b];
-            }
-            self.forward.process(&mut series, &mut buf).expect("plan length");
-            for p in 0..nh {
-                zh[p * m + b] = buf[p];
-            }
-        }
-        for a in 0..m {
-            for p in 0..nh {
-                buf[p] = (0..m).map(|b| self.spectrum[(p * m + a) * m + b] * zh[p * m + b]).sum();
-            }
-            buf[0].im = 0.0;
-            if k % 2 == 0 {
-                buf[k / 2].im = 0.0;
-            }
-            self.inverse.process(&mut buf, &mut series).expect("plan length");
-            for j in 0..k {
-                out[j * m + a] = series[j] / k as f64;
-            }
+        match self.work.try_lock() {
+            Ok(mut w) => self.product(z, out, &mut w),
+            // Taken by another thread (or poisoned by a panic in one): buffers of our own.
+            Err(_) => self.product(z, out, &mut Work::new(&self.fft, self.a.m())),
         }
     }
     fn max_abs(&self) -> (f64, bool) {
