@@ -91,10 +91,14 @@ impl BlockPivoting {
         let mut best: Option<(usize, Vec<bool>, Option<PartialPivLu<f64>>)> = None;
         let mut stalls = 0;
         let mut col = vec![0.0; n];
+        // The active indices and the infeasible ones, refilled every iteration (no allocation).
+        let mut f: Vec<usize> = Vec::with_capacity(n);
+        let mut infeasible: Vec<usize> = Vec::with_capacity(n);
         let mut iterations = 0;
         for iteration in 1..=s.max_iterations {
             iterations = iteration;
-            let f: Vec<usize> = (0..n).filter(|&i| active[i]).collect();
+            f.clear();
+            f.extend((0..n).filter(|&i| active[i]));
             z.iter_mut().for_each(|v| *v = 0.0);
             let mut lu = None;
             if !f.is_empty() {
@@ -124,7 +128,9 @@ impl BlockPivoting {
             w.iter_mut().zip(q).for_each(|(wi, qi)| *wi += qi);
             // Infeasible: active with z < 0, or inactive with w < 0 (NaN counts as infeasible).
             #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(x >= -tol)` is true for NaN on purpose
-            let infeasible: Vec<usize> = (0..n).filter(|&i| if active[i] { !(z[i] >= -tol) } else { !(w[i] >= -tol) }).collect();
+            let is_infeasible = |i: usize| if active[i] { !(z[i] >= -tol) } else { !(w[i] >= -tol) };
+            infeasible.clear();
+            infeasible.extend((0..n).filter(|&i| is_infeasible(i)));
             if infeasible.is_empty() {
                 // Iterative refinement of z_F with the same LU (A_FF z_F = −q_F, residual −w_F):
                 // an ill-conditioned A_FF otherwise leaves z off by cond·eps.

@@ -12,8 +12,10 @@
 //! exchange (Murty 1974) when full exchanges stop reducing the number of violations. It is
 //! finite for P-matrices; for other matrices a round cap bounds it, and only a certified answer
 //! is ever accepted.
-use faer::Mat;
-use faer::linalg::solvers::Solve;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::lu::partial_pivoting;
+use faer::linalg::solvers::PartialPivLu;
+use faer::{Conj, Mat, MatMut};
 
 use super::LcpMatrix;
 use super::status::{Candidate, evaluate};
@@ -25,6 +27,31 @@ const SINGULAR_RATIO: f64 = 1e-14;
 pub(crate) fn well_conditioned(u: faer::MatRef<'_, f64>) -> bool {
     let (lo, hi) = (0..u.nrows()).fold((f64::INFINITY, 0.0f64), |(l, h), i| (l.min(u[(i, i)].abs()), h.max(u[(i, i)].abs())));
     lo > SINGULAR_RATIO * hi || u.nrows() == 0
+}
+
+/// The workspace of solves with a [`PartialPivLu`] of one size, allocated once.
+///
+/// Why: faer's `Solve::solve_in_place` allocates its row-permutation scratch on every call; in a
+/// pivot loop that is one allocation per pivot. This calls the same kernel
+/// (`lu::partial_pivoting::solve::solve_in_place_with_conj`, same parallelism) with a stack
+/// that lives as long as the solver, as faer's own low-level API intends.
+pub(crate) struct LuScratch {
+    n: usize,
+    buf: MemBuffer,
+}
+
+impl LuScratch {
+    /// For an n×n LU and one right-hand side.
+    pub(crate) fn new(n: usize) -> Self {
+        let req = partial_pivoting::solve::solve_in_place_scratch::<usize, f64>(n, 1, faer::get_global_parallelism());
+        LuScratch { n, buf: MemBuffer::new(req) }
+    }
+    /// rhs ← A⁻¹ rhs (rhs n×1). Panics if the sizes differ from the LU's (a programming error).
+    pub(crate) fn solve_in_place(&mut self, lu: &PartialPivLu<f64>, rhs: MatMut<'_, f64>) {
+        assert!(lu.U().nrows() == self.n && rhs.nrows() == self.n && rhs.ncols() == 1, "LuScratch: sizes differ from the LU");
+        let stack = MemStack::new(&mut self.buf);
+        partial_pivoting::solve::solve_in_place_with_conj(lu.L(), lu.U(), lu.P(), Conj::No, rhs, faer::get_global_parallelism(), stack);
+    }
 }
 
 /// Solves A_αα z_α = −q_α by LU with partial pivoting and `steps` of iterative refinement (the
@@ -46,8 +73,9 @@ pub(crate) fn solve_principal(a: &dyn LcpMatrix, q: &[f64], alpha: &[usize], ste
         }
     }
     let lu = sub.partial_piv_lu();
+    let mut scratch = LuScratch::new(m);
     let mut rhs = Mat::<f64>::from_fn(m, 1, |i, _| -q[alpha[i]]);
-    lu.solve_in_place(&mut rhs);
+    scratch.solve_in_place(&lu, rhs.as_mut());
     let mut za: Vec<f64> = (0..m).map(|i| rhs[(i, 0)]).collect();
     if !za.iter().all(|v| v.is_finite()) {
         return None;
@@ -66,7 +94,7 @@ pub(crate) fn solve_principal(a: &dyn LcpMatrix, q: &[f64], alpha: &[usize], ste
                 }
             }
         }
-        lu.solve_in_place(&mut res);
+        scratch.solve_in_place(&lu, res.as_mut());
         if !(0..m).all(|i| res[(i, 0)].is_finite()) {
             break;
         }

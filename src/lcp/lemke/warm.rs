@@ -7,11 +7,11 @@
 //! the LU of A_FF and one product with A (an FFT away for a block-circulant A), then the
 //! product-form etas of the pivots made since: O(|F|² + N log N + N·pivots) per pivot, and
 //! memory O(|F|² + N·pivots) — never the N² tableau.
-use crate::lcp::principal::well_conditioned;
+use crate::lcp::principal::{LuScratch, well_conditioned};
 use crate::lcp::status::{finite_or_zero, residuals};
 use crate::lcp::{LcpInfo, LcpMatrix, LcpOutcome, LcpSolution};
 use faer::Mat;
-use faer::linalg::solvers::{PartialPivLu, Solve};
+use faer::linalg::solvers::PartialPivLu;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Var {
@@ -21,15 +21,25 @@ enum Var {
 }
 
 /// B⁻¹ = E_t ⋯ E_1 B_F⁻¹, B_F = [−A_{:,F} | e_G] (columns in row order: row i holds z_i or w_i).
+///
+/// Every buffer of a basis solve is owned here, so [`Basis::apply_inverse`] allocates nothing;
+/// the etas are one flat array that grows amortised (no allocation per pivot).
 struct Basis<'a> {
     a: &'a dyn LcpMatrix,
+    n: usize,
     f: Vec<usize>,
     /// Position of index i in `f`, or usize::MAX.
     pos: Vec<usize>,
     lu: Option<PartialPivLu<f64>>,
-    /// (pivot row, B⁻¹·entering column before the pivot).
-    etas: Vec<(usize, Vec<f64>)>,
-    scratch: Vec<f64>,
+    /// Pivot rows of the etas, and their columns (B⁻¹·entering column before the pivot), n each.
+    eta_rows: Vec<usize>,
+    eta_cols: Vec<f64>,
+    /// −v_F, then y_F (|F|×1).
+    rhs: Mat<f64>,
+    /// y_F padded with zeros to length n, and A times it.
+    padded: Vec<f64>,
+    product: Vec<f64>,
+    lu_scratch: LuScratch,
 }
 
 impl<'a> Basis<'a> {
@@ -57,29 +67,50 @@ impl<'a> Basis<'a> {
                 Some(lu)
             }
         };
-        Some(Basis { a, f, pos, lu, etas: Vec::new(), scratch: vec![0.0; n] })
+        let r = f.len();
+        Some(Basis {
+            a,
+            n,
+            f,
+            pos,
+            lu,
+            eta_rows: Vec::new(),
+            eta_cols: Vec::new(),
+            rhs: Mat::zeros(r, 1),
+            padded: vec![0.0; n],
+            product: vec![0.0; n],
+            lu_scratch: LuScratch::new(r),
+        })
+    }
+
+    /// Appends the eta of a pivot on row r with column `col` (B⁻¹·entering column).
+    fn push_eta(&mut self, r: usize, col: &[f64]) {
+        self.eta_rows.push(r);
+        self.eta_cols.extend_from_slice(col);
     }
 
     /// v ← B⁻¹ v.
     fn apply_inverse(&mut self, v: &mut [f64]) {
-        let n = v.len();
+        let n = self.n;
         // B_F⁻¹: −A_FF y_F = v_F, then y_G = v_G + A_GF y_F.
         if let Some(lu) = &self.lu {
-            let rhs = Mat::from_fn(self.f.len(), 1, |c, _| -v[self.f[c]]);
-            let yf = lu.solve(&rhs);
-            let mut padded = vec![0.0; n];
-            self.f.iter().enumerate().for_each(|(c, &i)| padded[i] = yf[(c, 0)]);
-            self.a.mul_into(&padded, &mut self.scratch);
-            for i in 0..n {
-                v[i] = if self.pos[i] != usize::MAX { padded[i] } else { v[i] + self.scratch[i] };
+            for (c, &i) in self.f.iter().enumerate() {
+                self.rhs[(c, 0)] = -v[i];
+            }
+            self.lu_scratch.solve_in_place(lu, self.rhs.as_mut());
+            self.padded.fill(0.0);
+            self.f.iter().enumerate().for_each(|(c, &i)| self.padded[i] = self.rhs[(c, 0)]);
+            self.a.mul_into(&self.padded, &mut self.product);
+            for (i, vi) in v.iter_mut().enumerate() {
+                *vi = if self.pos[i] != usize::MAX { self.padded[i] } else { *vi + self.product[i] };
             }
         }
-        for (r, col) in &self.etas {
-            let yr = v[*r] / col[*r];
+        for (&r, col) in self.eta_rows.iter().zip(self.eta_cols.chunks_exact(n)) {
+            let yr = v[r] / col[r];
             for (vi, ci) in v.iter_mut().zip(col) {
                 *vi -= ci * yr;
             }
-            v[*r] = yr;
+            v[r] = yr;
         }
     }
 
@@ -134,10 +165,10 @@ pub fn solve_from_basis(a: &dyn LcpMatrix, q: &[f64], active: &[bool], lu: Optio
     let t = -xmin;
     x.iter_mut().for_each(|v| *v += t);
     x[r0] = t;
-    basis.etas.push((r0, vec![-1.0; n]));
+    let mut col = vec![-1.0; n];
+    basis.push_eta(r0, &col);
     let mut leaving = basic[r0];
     basic[r0] = Var::Z0;
-    let mut col = vec![0.0; n];
     loop {
         pivots += 1;
         if pivots > max_pivots {
@@ -176,7 +207,7 @@ pub fn solve_from_basis(a: &dyn LcpMatrix, q: &[f64], active: &[bool], lu: Optio
         x[r] = t;
         leaving = basic[r];
         basic[r] = entering;
-        basis.etas.push((r, col.clone()));
+        basis.push_eta(r, &col);
         if leaving == Var::Z0 {
             return finish(a, q, &mut basis, &basic, &mut x, pivots, certify_tol, start);
         }
