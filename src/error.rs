@@ -91,6 +91,12 @@ impl From<crate::lcp::DatError> for Error {
     }
 }
 
+impl From<crate::lcp::LcpMethodError> for Error {
+    fn from(e: crate::lcp::LcpMethodError) -> Self {
+        Error::input(e.to_string())
+    }
+}
+
 impl From<crate::fe::MtxError> for Error {
     fn from(e: crate::fe::MtxError) -> Self {
         Error::input(e.to_string())

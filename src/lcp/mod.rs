@@ -32,7 +32,7 @@ pub use io::dat::{DatError, parse_dat, read_dat, write_dat};
 pub use lemke::{Lemke, LemkeSettings};
 pub use matrix::{BlockCirculant, DenseMatrix, LcpMatrix};
 pub use pivoting::{BlockPivoting, PivotingSettings};
-pub use policy::{AUTO_LEMKE_MAX, LcpMethod, solve_circulant_lcp};
+pub use policy::{AUTO_LEMKE_MAX, LcpMethod, LcpMethodError, solve_circulant_lcp};
 pub use reference::solve_by_enumeration;
 pub use status::{LcpInfo, LcpOutcome, LcpSolution, residuals};
 pub use structured::CirculantOperator;

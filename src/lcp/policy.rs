@@ -65,9 +65,17 @@ pub fn solve_circulant_lcp(a: &BlockCirculant, q: &[f64], method: LcpMethod, tol
     }
 }
 
+/// Why a method name was not accepted.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum LcpMethodError {
+    /// Not one of [`LcpMethod::ALL`]'s names.
+    #[error("unknown method \"{0}\"; expected auto, lemke or pivoting")]
+    Unknown(String),
+}
+
 impl std::str::FromStr for LcpMethod {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        LcpMethod::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| format!("unknown method \"{s}\"; expected auto, lemke or pivoting"))
+    type Err = LcpMethodError;
+    fn from_str(s: &str) -> Result<Self, LcpMethodError> {
+        LcpMethod::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| LcpMethodError::Unknown(s.to_string()))
     }
 }

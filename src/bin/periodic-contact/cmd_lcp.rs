@@ -14,12 +14,7 @@ use std::time::Instant;
 const MAX_BLOCK: usize = 8;
 
 pub fn run(file: &Path, output: &Path, method: &str, tolerance: f64) -> Result<(), Failure> {
-    let method = match method {
-        "auto" => LcpMethod::Auto,
-        "lemke" => LcpMethod::Lemke,
-        "pivoting" => LcpMethod::Pivoting,
-        other => return Err(Failure::input(format!("--method: unknown method \"{other}\"; expected auto, lemke or pivoting"))),
-    };
+    let method: LcpMethod = method.parse().map_err(|e| Failure::input(format!("--method: {e}")))?;
     if !(tolerance.is_finite() && tolerance > 0.0 && tolerance < 1.0) {
         return Err(Failure::input(format!("--tolerance: is {tolerance}, must be in (0, 1)")));
     }
