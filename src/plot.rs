@@ -41,9 +41,37 @@ fn range(values: impl Iterator<Item = f64>, scale: Scale) -> (f64, f64) {
     }
 }
 
+/// A chart that could not be drawn or written: the file and plotters' reason.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{file}: cannot draw the chart: {reason}")]
+pub struct PlotError {
+    pub file: String,
+    pub reason: String,
+}
+
+impl PlotError {
+    fn new(path: &Path, reason: &dyn std::fmt::Display) -> Self {
+        PlotError { file: path.display().to_string(), reason: reason.to_string() }
+    }
+}
+
+impl From<PlotError> for crate::Error {
+    fn from(e: PlotError) -> Self {
+        crate::Error::io(e.to_string())
+    }
+}
+
+/// Until the sweep and study rooms' errors are typed: they return these as `String`.
+impl From<PlotError> for String {
+    fn from(e: PlotError) -> Self {
+        e.to_string()
+    }
+}
+
 /// Draws the series into a PNG of `width`×`height` pixels. Non-finite points (and
-/// non-positive ones on a log axis) are skipped.
-pub fn line_chart(path: &Path, chart: &Chart, series: &[Series], width: u32, height: u32) -> Result<(), String> {
+/// non-positive ones on a log axis) are skipped. The error is a [`PlotError`], in the caller's
+/// error type.
+pub fn line_chart<E: From<PlotError>>(path: &Path, chart: &Chart, series: &[Series], width: u32, height: u32) -> Result<(), E> {
     panel_chart(path, &[(chart, series)], 1, width, height, Legend::Default)
 }
 
@@ -57,24 +85,35 @@ pub enum Legend {
 }
 
 /// Several charts in one PNG, `columns` per row (each panel as [`line_chart`] draws it).
-pub fn panel_chart(path: &Path, panels: &[(&Chart, &[Series])], columns: usize, width: u32, height: u32, legend: Legend) -> Result<(), String> {
-    let err = |e: &dyn std::fmt::Display| format!("{}: cannot draw the chart: {e}", path.display());
+/// The error is a [`PlotError`], in the caller's error type.
+pub fn panel_chart<E: From<PlotError>>(path: &Path, panels: &[(&Chart, &[Series])], columns: usize, width: u32, height: u32, legend: Legend) -> Result<(), E> {
+    draw_panels(path, panels, columns, width, height, legend).map_err(E::from)
+}
+
+fn draw_panels(path: &Path, panels: &[(&Chart, &[Series])], columns: usize, width: u32, height: u32, legend: Legend) -> Result<(), PlotError> {
+    let err = |e: &dyn std::fmt::Display| PlotError::new(path, e);
     let root = BitMapBackend::new(path, (width, height)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
     let columns = columns.max(1);
     let rows = panels.len().div_ceil(columns).max(1);
     let areas = root.split_evenly((rows, columns));
     for ((chart, series), area) in panels.iter().zip(&areas) {
-        draw_chart(area, chart, series, legend).map_err(|e| err(&e))?;
+        draw_chart(area, chart, series, legend, path)?;
     }
     root.present().map_err(|e| err(&e))
 }
 
-fn draw_chart<DB: DrawingBackend>(area: &DrawingArea<DB, plotters::coord::Shift>, chart: &Chart, series: &[Series], legend: Legend) -> Result<(), String>
+fn draw_chart<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    chart: &Chart,
+    series: &[Series],
+    legend: Legend,
+    path: &Path,
+) -> Result<(), PlotError>
 where
     DB::ErrorType: 'static,
 {
-    let err = |e: &dyn std::fmt::Display| e.to_string();
+    let err = |e: &dyn std::fmt::Display| PlotError::new(path, e);
     let keep =
         |(x, y): &(f64, f64)| x.is_finite() && y.is_finite() && (chart.x_scale == Scale::Linear || *x > 0.0) && (chart.y_scale == Scale::Linear || *y > 0.0);
     let xs = range(series.iter().flat_map(|s| s.points.iter().map(|p| p.0)), chart.x_scale);

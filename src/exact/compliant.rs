@@ -15,7 +15,7 @@
 //! x_c(t1) = g0, x_f(t0 + T) = g0, v_f(t0 + T) = v0, solved by Newton with the analytic
 //! Jacobian, seeded by an event-driven simulation of the same exact flows (or a given seed).
 use super::flow::{PhaseFlow, State, extrema};
-use super::{LinearOrbit, Oscillator, check_finite};
+use super::{ExactError, LinearOrbit, Oscillator, check_finite};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Phases {
@@ -55,11 +55,11 @@ impl CompliantStopOrbit {
     /// contact phases per period, and when Newton does not converge or its answer is not a
     /// one-contact orbit (x > g0 in the free phase, x < g0 in the contact phase,
     /// t1 − t0 ∉ (0, T), v0 ≤ 0).
-    pub fn solve(osc: &Oscillator, contact_stiffness: f64, gap: f64, seed: Option<[f64; 3]>) -> Result<Self, String> {
+    pub fn solve(osc: &Oscillator, contact_stiffness: f64, gap: f64, seed: Option<[f64; 3]>) -> Result<Self, ExactError> {
         osc.validate()?;
         osc.require_stiffness()?;
         if !(contact_stiffness.is_finite() && contact_stiffness > 0.0) {
-            return Err(format!("contact_stiffness: is {contact_stiffness}, must be finite and > 0"));
+            return Err(ExactError::param("contact_stiffness", format!("is {contact_stiffness}, must be finite and > 0")));
         }
         check_finite("gap", gap)?;
         if let Some(s) = seed {
@@ -108,7 +108,7 @@ impl CompliantStopOrbit {
 
     /// Event-driven simulation of the exact piecewise-linear flows, started on the linear orbit,
     /// until the state at the start of a period settles; returns the last (t0, t1, v0).
-    fn simulation_seed(&self, free: &PhaseFlow, contact: &PhaseFlow) -> Result<[f64; 3], String> {
+    fn simulation_seed(&self, free: &PhaseFlow, contact: &PhaseFlow) -> Result<[f64; 3], ExactError> {
         let g0 = self.gap;
         let period = self.osc.period();
         let steps = 400;
@@ -175,16 +175,22 @@ impl CompliantStopOrbit {
         }
         match (settled, last) {
             (Some(1), Some((t0, v0, t1))) => Ok([t0, t1, v0]),
-            (Some(0), _) => Err(format!(
-                "gap: is {g0}; the linear response exceeds it (max x = {}) but the simulated steady state never touches the stop: no one-contact orbit from the default seed, give a seed",
-                self.linear.amplitude()
+            (Some(0), _) => Err(ExactError::param(
+                "gap",
+                format!(
+                    "is {g0}; the linear response exceeds it (max x = {}) but the simulated steady state never touches the stop: no one-contact orbit from the default seed, give a seed",
+                    self.linear.amplitude()
+                ),
             )),
-            (Some(u), _) => Err(format!("gap: is {g0}; the simulated steady state has {u} contact phases per period: not a one-contact orbit")),
+            (Some(u), _) => {
+                Err(ExactError::param("gap", format!("is {g0}; the simulated steady state has {u} contact phases per period: not a one-contact orbit")))
+            }
             // No period-T attractor (subharmonic, chaotic, undamped): an unstable period-T orbit
             // may still exist; let Newton try from the last contact phase.
             (None, Some((t0, v0, t1))) => Ok([t0, t1, v0]),
-            (None, None) => Err(format!(
-                "gap: is {g0}; the simulated response did not settle to a period-T orbit within {max_periods} periods and made no contact: give a seed"
+            (None, None) => Err(ExactError::param(
+                "gap",
+                format!("is {g0}; the simulated response did not settle to a period-T orbit within {max_periods} periods and made no contact: give a seed"),
             )),
         }
     }
@@ -218,7 +224,7 @@ impl CompliantStopOrbit {
         (r, j)
     }
 
-    fn newton(&self, free: &PhaseFlow, contact: &PhaseFlow, seed: [f64; 3]) -> Result<([f64; 3], usize, f64), String> {
+    fn newton(&self, free: &PhaseFlow, contact: &PhaseFlow, seed: [f64; 3]) -> Result<([f64; 3], usize, f64), ExactError> {
         let period = self.osc.period();
         let xs = self.linear.amplitude().max(self.gap.abs()).max(f64::MIN_POSITIVE);
         let vs = xs * self.osc.omega;
@@ -230,7 +236,7 @@ impl CompliantStopOrbit {
             if nr < 1e-14 {
                 return Ok((x, it, nr));
             }
-            let dx = solve3(j, r).ok_or_else(|| format!("seed: Newton met a singular Jacobian at (t0, t1, v0) = {x:?}"))?;
+            let dx = solve3(j, r).ok_or_else(|| ExactError::param("seed", format!("Newton met a singular Jacobian at (t0, t1, v0) = {x:?}")))?;
             let mut lam = 1.0;
             let mut accepted = false;
             for _ in 0..40 {
@@ -251,32 +257,32 @@ impl CompliantStopOrbit {
                 if nr < 1e-11 {
                     return Ok((x, it, nr));
                 }
-                return Err(format!("seed: Newton stalled at (t0, t1, v0) = {x:?} with residual {nr:e}"));
+                return Err(ExactError::param("seed", format!("Newton stalled at (t0, t1, v0) = {x:?} with residual {nr:e}")));
             }
         }
         let nr = norm(r);
-        if nr < 1e-11 { Ok((x, 100, nr)) } else { Err(format!("seed: Newton did not converge, residual {nr:e}")) }
+        if nr < 1e-11 { Ok((x, 100, nr)) } else { Err(ExactError::param("seed", format!("Newton did not converge, residual {nr:e}"))) }
     }
 
     /// Checks that the Newton answer is a one-contact orbit and records min/max x.
-    fn check(&mut self) -> Result<(), String> {
+    fn check(&mut self) -> Result<(), ExactError> {
         let p = self.phases.expect("phases set");
         let period = self.osc.period();
         let g0 = self.gap;
         let tol = 1e-9 * self.linear.amplitude().max(g0.abs());
         if !(p.t1 > p.t0 && p.t1 - p.t0 < period) {
-            return Err(format!("seed: converged to t0 = {}, t1 = {}: not a contact phase shorter than T = {period}", p.t0, p.t1));
+            return Err(ExactError::param("seed", format!("converged to t0 = {}, t1 = {}: not a contact phase shorter than T = {period}", p.t0, p.t1)));
         }
         if !(p.v0 > 0.0 && p.v1 < 0.0) {
-            return Err(format!("seed: converged to entry velocity {} and exit velocity {}: not a one-contact orbit", p.v0, p.v1));
+            return Err(ExactError::param("seed", format!("converged to entry velocity {} and exit velocity {}: not a one-contact orbit", p.v0, p.v1)));
         }
         let (cmin, cmax) = extrema(|t| p.contact.propagate(p.t0, [g0, p.v0], t), p.t0, p.t1, 512);
         let (fmin, fmax) = extrema(|t| p.free.propagate(p.t1, [g0, p.v1], t), p.t1, p.t0 + period, 1024);
         if cmin < g0 - tol {
-            return Err(format!("seed: the converged contact phase leaves the stop (min x = {cmin} < gap {g0}): not a one-contact orbit"));
+            return Err(ExactError::param("seed", format!("the converged contact phase leaves the stop (min x = {cmin} < gap {g0}): not a one-contact orbit")));
         }
         if fmax > g0 + tol {
-            return Err(format!("seed: the converged free phase crosses the stop (max x = {fmax} > gap {g0}): not a one-contact orbit"));
+            return Err(ExactError::param("seed", format!("the converged free phase crosses the stop (max x = {fmax} > gap {g0}): not a one-contact orbit")));
         }
         self.min_x = cmin.min(fmin);
         self.max_x = cmax.max(fmax);

@@ -9,6 +9,7 @@
 //! e^{Aτ} = e^{−ατ} [ C(τ) I + S(τ) (A + αI) ] with
 //! C = cosh(√δ τ), S = sinh(√δ τ)/√δ (over-damped), C = cos(√−δ τ), S = sin(√−δ τ)/√−δ
 //! (under-damped) and C = 1, S = τ (critically damped). One formula covers the three cases.
+use super::ExactError;
 use num_complex::Complex64 as C64;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -31,17 +32,17 @@ pub(crate) type Mat2 = [[f64; 2]; 2];
 
 impl PhaseFlow {
     /// `m > 0`, `c ≥ 0`, `κ ≥ 0` (κ > 0 when b ≠ 0), Ω > 0 are checked by the callers.
-    pub fn new(m: f64, c: f64, kappa: f64, f: f64, omega: f64, b: f64) -> Result<Self, String> {
+    pub fn new(m: f64, c: f64, kappa: f64, f: f64, omega: f64, b: f64) -> Result<Self, ExactError> {
         let den = C64::new(kappa - omega * omega * m, omega * c);
         let scale = kappa.abs() + omega * omega * m + omega * c;
         if den.norm() <= 1e-14 * scale {
-            return Err(format!(
+            return Err(ExactError::NoSolution(format!(
                 "undamped resonance: stiffness {kappa} = Ω² m = {} with damping {c}; the periodic particular solution does not exist",
                 omega * omega * m
-            ));
+            )));
         }
         if b != 0.0 && kappa <= 0.0 {
-            return Err(format!("a constant load {b} needs a stiffness > 0, got {kappa}"));
+            return Err(ExactError::NoSolution(format!("a constant load {b} needs a stiffness > 0, got {kappa}")));
         }
         let alpha = c / (2.0 * m);
         let w0sq = kappa / m;

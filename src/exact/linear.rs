@@ -1,5 +1,5 @@
 //! Contact-free steady states (notes §6.1): x(t) = Re[(K − Ω²M + iΩC)⁻¹ F e^{iΩt}].
-use super::Oscillator;
+use super::{ExactError, Oscillator};
 use crate::model::{Force, Model};
 use faer::Mat;
 use faer::linalg::solvers::Solve;
@@ -15,12 +15,15 @@ pub struct LinearOrbit {
 
 impl LinearOrbit {
     /// Fails on invalid parameters and at an undamped resonance (c = 0, k = Ω² m).
-    pub fn solve(osc: &Oscillator) -> Result<Self, String> {
+    pub fn solve(osc: &Oscillator) -> Result<Self, ExactError> {
         osc.validate()?;
         let den = C64::new(osc.stiffness - osc.omega * osc.omega * osc.mass, osc.omega * osc.damping);
         let scale = osc.stiffness + osc.omega * osc.omega * osc.mass + osc.omega * osc.damping;
         if den.norm() <= 1e-14 * scale {
-            return Err(format!("omega: is {}, an undamped resonance (k = Ω² m = {}, c = 0): no periodic steady state", osc.omega, osc.stiffness));
+            return Err(ExactError::param(
+                "omega",
+                format!("is {}, an undamped resonance (k = Ω² m = {}, c = 0): no periodic steady state", osc.omega, osc.stiffness),
+            ));
         }
         Ok(LinearOrbit { osc: *osc, amp: osc.force / den })
     }
@@ -70,29 +73,29 @@ pub fn linear_response_dense(
     stiffness: &Mat<f64>,
     omega: f64,
     forces: &[Force],
-) -> Result<LinearResponse, String> {
+) -> Result<LinearResponse, ExactError> {
     let n = mass.nrows();
     if n == 0 || mass.ncols() != n {
-        return Err(format!("mass: is {}×{}, must be square and non-empty", mass.nrows(), mass.ncols()));
+        return Err(ExactError::param("mass", format!("is {}×{}, must be square and non-empty", mass.nrows(), mass.ncols())));
     }
     if stiffness.nrows() != n || stiffness.ncols() != n {
-        return Err(format!("stiffness: is {}×{}, expected {n}×{n}", stiffness.nrows(), stiffness.ncols()));
+        return Err(ExactError::param("stiffness", format!("is {}×{}, expected {n}×{n}", stiffness.nrows(), stiffness.ncols())));
     }
     if let Some(c) = damping {
         if c.nrows() != n || c.ncols() != n {
-            return Err(format!("damping: is {}×{}, expected {n}×{n}", c.nrows(), c.ncols()));
+            return Err(ExactError::param("damping", format!("is {}×{}, expected {n}×{n}", c.nrows(), c.ncols())));
         }
     }
     if !(omega.is_finite() && omega > 0.0) {
-        return Err(format!("omega: is {omega}, must be finite and > 0"));
+        return Err(ExactError::param("omega", format!("is {omega}, must be finite and > 0")));
     }
     let mut hs: Vec<u32> = Vec::new();
     for (i, f) in forces.iter().enumerate() {
         if f.dof >= n {
-            return Err(format!("forces[{i}].dof: is {}, the model has DOFs 0..{}", f.dof, n - 1));
+            return Err(ExactError::param(format!("forces[{i}].dof"), format!("is {}, the model has DOFs 0..{}", f.dof, n - 1)));
         }
         if !(f.term.amplitude.is_finite() && f.term.phase.is_finite()) {
-            return Err(format!("forces[{i}]: amplitude {} and phase {} must be finite", f.term.amplitude, f.term.phase));
+            return Err(ExactError::param(format!("forces[{i}]"), format!("amplitude {} and phase {} must be finite", f.term.amplitude, f.term.phase)));
         }
         if !hs.contains(&f.term.harmonic) {
             hs.push(f.term.harmonic);
@@ -118,7 +121,7 @@ pub fn linear_response_dense(
         let bn = (0..n).map(|i| rhs[(i, 0)].norm()).fold(0.0, f64::max);
         let rn = (0..n).map(|i| r[(i, 0)].norm()).fold(0.0, f64::max);
         if !(xn.is_finite() && rn <= 1e-8 * (zn * xn + bn)) || (bn > 0.0 && zn * xn > 1e12 * bn) {
-            return Err(format!("omega: harmonic {h} of ω = {omega} makes K − (hω)²M + i hω C singular (resonance or rigid-body mode)"));
+            return Err(ExactError::param("omega", format!("harmonic {h} of ω = {omega} makes K − (hω)²M + i hω C singular (resonance or rigid-body mode)")));
         }
         harmonics.push((h, (0..n).map(|i| x[(i, 0)]).collect()));
     }
@@ -127,7 +130,7 @@ pub fn linear_response_dense(
 
 impl LinearResponse {
     /// The contact-free response of a model (its contacts are ignored).
-    pub fn from_model(model: &Model) -> Result<Self, String> {
+    pub fn from_model(model: &Model) -> Result<Self, ExactError> {
         let s = &model.structure;
         let c = s.damping.as_ref().map(|c| c.to_dense());
         linear_response_dense(&s.mass.to_dense(), c.as_ref(), &s.stiffness.to_dense(), model.frequency, &model.forces)

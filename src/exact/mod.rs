@@ -22,6 +22,37 @@ pub use rigid::{RigidRegime, RigidStopOrbit};
 
 use crate::model::{Compliance, Contact, Force, Harmonic, Matrix, Model, Structure};
 
+/// Why a reference cannot be computed: the parameter, its value and why, or the orbit sought
+/// does not exist for these parameters.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ExactError {
+    /// A parameter (`mass`, `gap`, `seed`, …) is out of range or leads nowhere.
+    #[error("{field}: {message}")]
+    Param { field: String, message: String },
+    /// No periodic solution of the sought kind (resonance, no stable orbit).
+    #[error("{0}")]
+    NoSolution(String),
+}
+
+impl ExactError {
+    pub fn param(field: impl Into<String>, message: impl Into<String>) -> Self {
+        ExactError::Param { field: field.into(), message: message.into() }
+    }
+}
+
+impl From<ExactError> for crate::Error {
+    fn from(e: ExactError) -> Self {
+        crate::Error::input(e.to_string())
+    }
+}
+
+/// Until the study room's errors are typed: its `Result<_, String>` functions use `?` on these.
+impl From<ExactError> for String {
+    fn from(e: ExactError) -> Self {
+        e.to_string()
+    }
+}
+
 /// The forced 1-DOF oscillator m x'' + c x' + k x = F cos Ωt.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Oscillator {
@@ -43,27 +74,27 @@ impl Oscillator {
     }
 
     /// Every error names the parameter and its value.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), ExactError> {
         if !(self.mass.is_finite() && self.mass > 0.0) {
-            return Err(format!("mass: is {}, must be finite and > 0", self.mass));
+            return Err(ExactError::param("mass", format!("is {}, must be finite and > 0", self.mass)));
         }
         if !(self.damping.is_finite() && self.damping >= 0.0) {
-            return Err(format!("damping: is {}, must be finite and ≥ 0", self.damping));
+            return Err(ExactError::param("damping", format!("is {}, must be finite and ≥ 0", self.damping)));
         }
         if !(self.stiffness.is_finite() && self.stiffness >= 0.0) {
-            return Err(format!("stiffness: is {}, must be finite and ≥ 0", self.stiffness));
+            return Err(ExactError::param("stiffness", format!("is {}, must be finite and ≥ 0", self.stiffness)));
         }
         if !self.force.is_finite() {
-            return Err(format!("force: is {}, must be finite", self.force));
+            return Err(ExactError::param("force", format!("is {}, must be finite", self.force)));
         }
         if !(self.omega.is_finite() && self.omega > 0.0) {
-            return Err(format!("omega: is {}, must be finite and > 0", self.omega));
+            return Err(ExactError::param("omega", format!("is {}, must be finite and > 0", self.omega)));
         }
         Ok(())
     }
 
-    pub(crate) fn require_stiffness(&self) -> Result<(), String> {
-        if self.stiffness > 0.0 { Ok(()) } else { Err(format!("stiffness: is {}, the contact orbits need k > 0", self.stiffness)) }
+    pub(crate) fn require_stiffness(&self) -> Result<(), ExactError> {
+        if self.stiffness > 0.0 { Ok(()) } else { Err(ExactError::param("stiffness", format!("is {}, the contact orbits need k > 0", self.stiffness))) }
     }
 
     /// T = 2π/Ω.
@@ -93,6 +124,6 @@ impl Oscillator {
     }
 }
 
-pub(crate) fn check_finite(name: &str, v: f64) -> Result<(), String> {
-    if v.is_finite() { Ok(()) } else { Err(format!("{name}: is {v}, must be finite")) }
+pub(crate) fn check_finite(name: &str, v: f64) -> Result<(), ExactError> {
+    if v.is_finite() { Ok(()) } else { Err(ExactError::param(name, format!("is {v}, must be finite"))) }
 }

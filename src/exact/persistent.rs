@@ -8,7 +8,7 @@
 //!
 //! The orbit is physical only if z(t) ≥ 0 for all t ([`PersistentContact::is_persistent`]).
 use super::flow::{bisect, extrema};
-use super::{Oscillator, check_finite};
+use super::{ExactError, Oscillator, check_finite};
 use crate::model::Harmonic;
 
 #[derive(Clone, Debug, PartialEq)]
@@ -32,10 +32,10 @@ fn dn(h: &Harmonic, omega: f64, t: f64, n: u32) -> f64 {
 
 impl PersistentContact {
     /// `direction` ±1, `gap` the static clearance g0, `motion` the obstacle harmonics.
-    pub fn solve(osc: &Oscillator, direction: f64, gap: f64, motion: &[Harmonic]) -> Result<Self, String> {
+    pub fn solve(osc: &Oscillator, direction: f64, gap: f64, motion: &[Harmonic]) -> Result<Self, ExactError> {
         osc.validate()?;
         if direction != 1.0 && direction != -1.0 {
-            return Err(format!("direction: is {direction}, must be +1 or -1"));
+            return Err(ExactError::param("direction", format!("is {direction}, must be +1 or -1")));
         }
         check_finite("gap", gap)?;
         for (i, h) in motion.iter().enumerate() {

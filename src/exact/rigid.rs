@@ -18,7 +18,7 @@
 //!   stable root (|μ| < 1).
 //! - [`RigidRegime::Stuck`] (k g0 ≤ −F): the mass never leaves the stop.
 use super::flow::{PhaseFlow, State, bisect, extrema};
-use super::{LinearOrbit, Oscillator, check_finite};
+use super::{ExactError, LinearOrbit, Oscillator, check_finite};
 
 /// Which kind of periodic orbit was found.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -62,12 +62,12 @@ impl RigidStopOrbit {
     /// Fails (naming the parameter) on invalid input (F < 0, k = 0, non-finite gap) and when no
     /// one-impact periodic orbit exists (the free flight would cross the stop, the impact would
     /// fall outside the sticking window with no pure-impact orbit either, or no stable one).
-    pub fn solve(osc: &Oscillator, gap: f64) -> Result<Self, String> {
+    pub fn solve(osc: &Oscillator, gap: f64) -> Result<Self, ExactError> {
         osc.validate()?;
         osc.require_stiffness()?;
         check_finite("gap", gap)?;
         if osc.force < 0.0 {
-            return Err(format!("force: is {}, must be ≥ 0 (shift the time origin by T/2 instead)", osc.force));
+            return Err(ExactError::param("force", format!("is {}, must be ≥ 0 (shift the time origin by T/2 instead)", osc.force)));
         }
         let linear = LinearOrbit::solve(osc)?;
         let free = PhaseFlow::new(osc.mass, osc.damping, osc.stiffness, osc.force, osc.omega, 0.0)?;
@@ -130,7 +130,7 @@ impl RigidStopOrbit {
                     let list: Vec<String> = cands.iter().map(|c| format!("t0 = {:.6} (μ = {:.3})", c.0, c.2)).collect();
                     msg += &format!("; pure impacts: only unstable orbits {}", list.join(", "));
                 }
-                Err(msg)
+                Err(ExactError::NoSolution(msg))
             }
         }
     }

@@ -22,11 +22,55 @@
 //! bound for a 1-DOF or proportionally damped system.
 mod small_lcp;
 
-use crate::model::{Compliance, Model};
+use crate::error::ErrorKind;
+use crate::model::{Compliance, Model, ModelError};
 use faer::linalg::solvers::{DenseSolveCore, Solve};
 use faer::{Mat, Side};
+pub use small_lcp::StepLcpError;
 use small_lcp::solve_small_lcp;
 use std::time::Instant;
+
+/// Why a march could not run or ended without a state: a setting (field: value: remedy), the
+/// model's checks, a step LCP without solution, or a diverged state.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MarchError {
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    /// A setting or the structure is not usable (`settings.steps_per_period`, `structure.mass`, …).
+    #[error("{field}: {message}")]
+    Setting { field: String, message: String },
+    #[error("step {step} of period {period}: {error}")]
+    Step { step: usize, period: usize, error: small_lcp::StepLcpError },
+    #[error("the march diverged at step {step} of period {period} (non-finite displacement)")]
+    Diverged { step: usize, period: usize },
+}
+
+impl MarchError {
+    fn setting(field: impl Into<String>, message: impl Into<String>) -> Self {
+        MarchError::Setting { field: field.into(), message: message.into() }
+    }
+
+    /// Settings and the model are the caller's to change; the rest is the march's outcome.
+    pub fn kind(&self) -> ErrorKind {
+        match self {
+            MarchError::Model(_) | MarchError::Setting { .. } => ErrorKind::Input,
+            MarchError::Step { .. } | MarchError::Diverged { .. } => ErrorKind::Solve,
+        }
+    }
+}
+
+impl From<MarchError> for crate::Error {
+    fn from(e: MarchError) -> Self {
+        crate::Error::new(e.kind(), e.to_string())
+    }
+}
+
+/// Until the sweep room's errors are typed: its `Result<_, String>` functions use `?` on these.
+impl From<MarchError> for String {
+    fn from(e: MarchError) -> Self {
+        e.to_string()
+    }
+}
 
 /// Settings of [`march`].
 #[derive(Clone, Debug, PartialEq)]
@@ -93,8 +137,8 @@ impl MarchResult {
 }
 
 /// Largest undamped angular frequency of (K, M): M = L Lᵀ, eigenvalues of L⁻¹ K L⁻ᵀ.
-pub fn omega_max_dense(mass: &Mat<f64>, stiffness: &Mat<f64>) -> Result<f64, String> {
-    let llt = mass.llt(Side::Lower).map_err(|_| "structure.mass: is not positive definite".to_string())?;
+pub fn omega_max_dense(mass: &Mat<f64>, stiffness: &Mat<f64>) -> Result<f64, MarchError> {
+    let llt = mass.llt(Side::Lower).map_err(|_| MarchError::setting("structure.mass", "is not positive definite"))?;
     let l = llt.L();
     let mut x = stiffness.clone();
     l.solve_lower_triangular_in_place(x.as_mut());
@@ -102,10 +146,11 @@ pub fn omega_max_dense(mass: &Mat<f64>, stiffness: &Mat<f64>) -> Result<f64, Str
     l.solve_lower_triangular_in_place(s.as_mut());
     let n = s.nrows();
     let sym = Mat::<f64>::from_fn(n, n, |i, j| 0.5 * (s[(i, j)] + s[(j, i)]));
-    let ev = sym.self_adjoint_eigenvalues(Side::Lower).map_err(|e| format!("structure.stiffness: eigenvalues of M⁻¹K failed ({e:?})"))?;
+    let ev =
+        sym.self_adjoint_eigenvalues(Side::Lower).map_err(|e| MarchError::setting("structure.stiffness", format!("eigenvalues of M⁻¹K failed ({e:?})")))?;
     let lmax = ev.iter().copied().fold(0.0f64, f64::max);
     if !lmax.is_finite() {
-        return Err(format!("structure.stiffness: largest eigenvalue of M⁻¹K is {lmax}"));
+        return Err(MarchError::setting("structure.stiffness", format!("largest eigenvalue of M⁻¹K is {lmax}")));
     }
     Ok(lmax.sqrt())
 }
@@ -122,27 +167,27 @@ fn matvec_add(a: &[f64], x: &[f64], y: &mut [f64], n: usize) {
 /// below `settings.tolerance` (and at least `min_periods` periods ran) or `max_periods` is
 /// reached. Errors (naming the parameter and value) on an invalid model or settings, an unstable
 /// step, a failed step LCP or a non-finite state.
-pub fn march(model: &Model, settings: &MarchSettings) -> Result<MarchResult, String> {
+pub fn march(model: &Model, settings: &MarchSettings) -> Result<MarchResult, MarchError> {
     let start = Instant::now();
-    model.validate().map_err(|e| e.to_string())?;
+    model.validate()?;
     let n = model.n();
     let ns = settings.steps_per_period;
     if ns < 2 {
-        return Err(format!("settings.steps_per_period: is {ns}, must be ≥ 2"));
+        return Err(MarchError::setting("settings.steps_per_period", format!("is {ns}, must be ≥ 2")));
     }
     if settings.max_periods < 1 {
-        return Err(format!("settings.max_periods: is {}, must be ≥ 1", settings.max_periods));
+        return Err(MarchError::setting("settings.max_periods", format!("is {}, must be ≥ 1", settings.max_periods)));
     }
     if !(settings.tolerance.is_finite() && settings.tolerance > 0.0) {
-        return Err(format!("settings.tolerance: is {}, must be finite and > 0", settings.tolerance));
+        return Err(MarchError::setting("settings.tolerance", format!("is {}, must be finite and > 0", settings.tolerance)));
     }
     for (name, v) in [("settings.initial_displacement", &settings.initial_displacement), ("settings.initial_velocity", &settings.initial_velocity)] {
         if let Some(v) = v {
             if v.len() != n {
-                return Err(format!("{name}: has {} entries, the model has {n} DOFs", v.len()));
+                return Err(MarchError::setting(name, format!("has {} entries, the model has {n} DOFs", v.len())));
             }
             if let Some(i) = v.iter().position(|x| !x.is_finite()) {
-                return Err(format!("{name}[{i}]: is {}, must be finite", v[i]));
+                return Err(MarchError::setting(format!("{name}[{i}]"), format!("is {}, must be finite", v[i])));
             }
         }
     }
@@ -162,9 +207,12 @@ pub fn march(model: &Model, settings: &MarchSettings) -> Result<MarchResult, Str
     let omega_max = omega_max_dense(&mm, &kc)?;
     if omega_max * h >= 2.0 {
         let n_min = (period * omega_max / 2.0).floor() as usize + 1;
-        return Err(format!(
-            "settings.steps_per_period: is {ns}, h = T/N = {h:e} exceeds the central-difference stability limit 2/ω_max = {:e} (ω_max = {omega_max:e}); use more than {n_min} steps per period",
-            2.0 / omega_max
+        return Err(MarchError::setting(
+            "settings.steps_per_period",
+            format!(
+                "is {ns}, h = T/N = {h:e} exceeds the central-difference stability limit 2/ω_max = {:e} (ω_max = {omega_max:e}); use more than {n_min} steps per period",
+                2.0 / omega_max
+            ),
         ));
     }
 
@@ -178,7 +226,7 @@ pub fn march(model: &Model, settings: &MarchSettings) -> Result<MarchResult, Str
     let row_major = |a: &Mat<f64>| -> Vec<f64> { (0..n).flat_map(|i| (0..n).map(move |j| (i, j))).map(|(i, j)| a[(i, j)]).collect() };
     let (a1, a0, wr) = (row_major(&a1m), row_major(&a0m), row_major(&w_hat));
     if a1.iter().chain(&a0).chain(&wr).any(|v| !v.is_finite()) {
-        return Err("structure: M/h² + C/(2h) is singular".to_string());
+        return Err(MarchError::setting("structure", "M/h² + C/(2h) is singular"));
     }
 
     let nc = model.contacts.len();
@@ -263,7 +311,7 @@ pub fn march(model: &Model, settings: &MarchSettings) -> Result<MarchResult, Str
                     q[a] = c.gap_at(omega, t1) - c.direction * x_next[c.dof];
                 }
                 if q.iter().any(|&v| v < 0.0) {
-                    let lam = solve_small_lcp(&g, &q, mr).map_err(|e| format!("step {} of period {}: {e}", j, p + 1))?;
+                    let lam = solve_small_lcp(&g, &q, mr).map_err(|e| MarchError::Step { step: j, period: p + 1, error: e })?;
                     for (a, &i) in rigid.iter().enumerate() {
                         if lam[a] != 0.0 {
                             for r in 0..n {
@@ -275,7 +323,7 @@ pub fn march(model: &Model, settings: &MarchSettings) -> Result<MarchResult, Str
                 }
             }
             if x_next.iter().any(|v| !v.is_finite()) {
-                return Err(format!("the march diverged at step {j} of period {} (non-finite displacement)", p + 1));
+                return Err(MarchError::Diverged { step: j, period: p + 1 });
             }
             // Record sample j.
             for i in 0..n {

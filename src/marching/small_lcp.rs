@@ -67,8 +67,15 @@ fn basis_solution(g: &[f64], q: &[f64], m: usize, active: &[bool]) -> Option<(Ve
     Some((z, w))
 }
 
+/// The step LCP has no complementary solution.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("the {contacts}-contact step LCP has no complementary solution (G is not a P-matrix?)")]
+pub struct StepLcpError {
+    pub contacts: usize,
+}
+
 /// Returns z (clamped ≥ 0) or an error when no complementary solution is found.
-pub(crate) fn solve_small_lcp(g: &[f64], q: &[f64], m: usize) -> Result<Vec<f64>, String> {
+pub(crate) fn solve_small_lcp(g: &[f64], q: &[f64], m: usize) -> Result<Vec<f64>, StepLcpError> {
     if q.iter().all(|&v| v >= 0.0) {
         return Ok(vec![0.0; m]);
     }
@@ -96,7 +103,7 @@ pub(crate) fn solve_small_lcp(g: &[f64], q: &[f64], m: usize) -> Result<Vec<f64>
             }
         }
     }
-    Err(format!("the {m}-contact step LCP has no complementary solution (G is not a P-matrix?)"))
+    Err(StepLcpError { contacts: m })
 }
 
 #[cfg(test)]

@@ -68,34 +68,6 @@ impl Default for SolverSettings {
     }
 }
 
-impl SolverSettings {
-    pub fn from_spec(spec: Option<&crate::scene::SolverSpec>) -> Result<Self, String> {
-        let mut s = SolverSettings::default();
-        let Some(spec) = spec else { return Ok(s) };
-        if let Some(m) = &spec.method {
-            s.method = match m.as_str() {
-                "auto" => LcpMethod::Auto,
-                "lemke" => LcpMethod::Lemke,
-                "pivoting" => LcpMethod::Pivoting,
-                other => return Err(format!("solver.method: unknown method \"{other}\"; expected auto, lemke or pivoting")),
-            };
-        }
-        if let Some(t) = spec.tolerance {
-            if !(t.is_finite() && t > 0.0 && t < 1.0) {
-                return Err(format!("solver.tolerance: is {t}, must be in (0, 1)"));
-            }
-            s.tolerance = t;
-        }
-        if let Some(r) = spec.regularization {
-            if !(r.is_finite() && r > 0.0 && r < 1.0) {
-                return Err(format!("solver.regularization: is {r}, must be in (0, 1) (relative to the largest entry of the LCP matrix)"));
-            }
-            s.regularization = Some(r);
-        }
-        Ok(s)
-    }
-}
-
 /// Why a problem could not be set up or solved. Every message says what to change.
 #[derive(Debug, Clone, thiserror::Error)]
 pub enum SolveError {

@@ -28,6 +28,7 @@
 //! e_θ = −sin γ·u + cos γ·n and s = (x, y)·e_θ. For γ > 0 the leading edge (chord position
 //! −c/2) leads by (c/2)·sin γ: the compressor-rotor convention (chord LE→TE pointing downstream
 //! and against the rotation). Contacts on Matrix Market DOFs give s explicitly (`arc`).
+use super::BuildError;
 use crate::model::Harmonic;
 
 /// The checked `[casing]` section.
@@ -44,32 +45,25 @@ pub struct Casing {
 
 impl Casing {
     /// Checks the section against the excitation frequency ω (= EO·Ω when `speed` is given).
-    pub fn from_spec(spec: &super::CasingSpec, frequency: f64) -> Result<Casing, String> {
+    pub fn from_spec(spec: &super::CasingSpec, frequency: f64) -> Result<Casing, BuildError> {
         if spec.lobes < 1 {
-            return Err(format!("casing.lobes: is {}, must be ≥ 1 (the engine order)", spec.lobes));
+            return Err(BuildError::field("casing.lobes", format!("is {}, must be ≥ 1 (the engine order)", spec.lobes)));
         }
+        // The negated comparisons below refuse NaN as well.
         if !(spec.depth.is_finite() && spec.depth >= 0.0) {
-            return Err(format!("casing.depth: is {}, must be finite and ≥ 0", spec.depth));
+            return Err(BuildError::field("casing.depth", format!("is {}, must be finite and ≥ 0", spec.depth)));
         }
         if !(spec.radius.is_finite() && spec.radius > 0.0) {
-            return Err(format!("casing.radius: is {}, must be finite and > 0", spec.radius));
+            return Err(BuildError::field("casing.radius", format!("is {}, must be finite and > 0", spec.radius)));
         }
         if !(spec.stagger.is_finite() && spec.stagger.abs() <= 90.0) {
-            return Err(format!("casing.stagger: is {}, must be an angle within ±90 degrees", spec.stagger));
+            return Err(BuildError::field("casing.stagger", format!("is {}, must be an angle within ±90 degrees", spec.stagger)));
         }
         if !spec.phase.is_finite() {
-            return Err(format!("casing.phase: is {}, must be finite", spec.phase));
+            return Err(BuildError::field("casing.phase", format!("is {}, must be finite", spec.phase)));
         }
         if let Some(speed) = spec.speed {
-            if !(speed.is_finite() && speed > 0.0) {
-                return Err(format!("casing.speed: is {speed}, must be a finite angular speed > 0 [rad/s]"));
-            }
-            let expected = spec.lobes as f64 * speed;
-            if (expected - frequency).abs() > 1e-9 * expected {
-                return Err(format!(
-                    "casing.speed: is {speed} rad/s, so the lobe-passing frequency lobes·speed = {expected} rad/s, but excitation.frequency is {frequency}; set excitation.frequency = {expected} or drop casing.speed"
-                ));
-            }
+            check_speed(speed, spec.lobes, frequency)?;
         }
         Ok(Casing { lobes: spec.lobes, depth: spec.depth, radius: spec.radius, stagger: spec.stagger.to_radians(), phase: spec.phase })
     }
@@ -93,4 +87,19 @@ impl Casing {
     pub fn motion(&self, arc: f64) -> Harmonic {
         Harmonic { amplitude: -self.depth, harmonic: 1, phase: self.phase_at(arc) }
     }
+}
+
+/// `casing.speed`, when given, must be excitation.frequency / lobes.
+fn check_speed(speed: f64, lobes: u32, frequency: f64) -> Result<(), BuildError> {
+    if !(speed.is_finite() && speed > 0.0) {
+        return Err(BuildError::field("casing.speed", format!("is {speed}, must be a finite angular speed > 0 [rad/s]")));
+    }
+    let expected = lobes as f64 * speed;
+    if (expected - frequency).abs() > 1e-9 * expected {
+        let message = format!(
+            "is {speed} rad/s, so the lobe-passing frequency lobes·speed = {expected} rad/s, but excitation.frequency is {frequency}; set excitation.frequency = {expected} or drop casing.speed"
+        );
+        return Err(BuildError::field("casing.speed", message));
+    }
+    Ok(())
 }

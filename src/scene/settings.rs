@@ -1,0 +1,40 @@
+//! The `[discretization]` and `[solver]` sections: the scene owns their conversion into the
+//! engine's [`Discretization`] and [`SolverSettings`].
+use super::{BuildError, DiscretizationSpec, SolverSpec};
+use crate::lcp::LcpMethod;
+use crate::periodic::SolverSettings;
+use crate::time::{Discretization, Pairing, Scheme};
+
+/// `[discretization]`: the scheme, the steps per period and the optional pairing.
+pub fn discretization(spec: &DiscretizationSpec) -> Result<Discretization, BuildError> {
+    let scheme: Scheme = spec.scheme.parse().map_err(|m| BuildError::field("discretization.scheme", format!("{m}")))?;
+    let pairing = match &spec.pairing {
+        Some(p) => Some(p.parse::<Pairing>().map_err(|m| BuildError::field("discretization.pairing", format!("{m}")))?),
+        None => None,
+    };
+    Ok(Discretization { scheme, steps: spec.steps, pairing })
+}
+
+/// `[solver]`: the defaults of [`SolverSettings`] with the given method, tolerance and
+/// regularization, each checked.
+pub fn solver_settings(spec: Option<&SolverSpec>) -> Result<SolverSettings, BuildError> {
+    let mut s = SolverSettings::default();
+    let Some(spec) = spec else { return Ok(s) };
+    if let Some(m) = &spec.method {
+        s.method = m.parse::<LcpMethod>().map_err(|e| BuildError::field("solver.method", format!("{e}")))?;
+    }
+    // The negated comparisons below refuse NaN as well.
+    if let Some(t) = spec.tolerance {
+        if !(t.is_finite() && t > 0.0 && t < 1.0) {
+            return Err(BuildError::field("solver.tolerance", format!("is {t}, must be in (0, 1)")));
+        }
+        s.tolerance = t;
+    }
+    if let Some(r) = spec.regularization {
+        if !(r.is_finite() && r > 0.0 && r < 1.0) {
+            return Err(BuildError::field("solver.regularization", format!("is {r}, must be in (0, 1) (relative to the largest entry of the LCP matrix)")));
+        }
+        s.regularization = Some(r);
+    }
+    Ok(s)
+}
