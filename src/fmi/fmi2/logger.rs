@@ -119,3 +119,12 @@ impl Logger {
 pub fn to_cstring(s: &str) -> CString {
     CString::new(s.replace('\0', "\\0")).expect("no interior NUL left")
 }
+
+impl crate::fmi::EventLog for Logger {
+    fn events_enabled(&self) -> bool {
+        self.enabled(Category::Events)
+    }
+    fn event(&self, message: &str) {
+        self.log(Category::Events, message)
+    }
+}

@@ -1,9 +1,11 @@
 //! One FMU instance: the state machine of FMI 2.0 co-simulation (notes §1.3) over a model.
-use super::bytes::{ByteReader, ByteWriter};
 use super::logger::{Logger, to_cstring};
-use super::table::{BaseType, Causality, SetPhase};
+use super::machine::*;
 use super::types::*;
-use super::{Fmi2Model, uri, xml};
+use super::xml;
+use crate::fmi::state::{StateReader, StateWriter};
+use crate::fmi::table::{BaseType, Causality, SetPhase};
+use crate::fmi::{CoSimModel, uri};
 use std::ffi::{CString, c_char};
 use std::path::PathBuf;
 
@@ -14,77 +16,6 @@ pub(crate) const INSTANCE_MAGIC: u64 = 0x5043_464d_4932_494e; // "PCFMI2IN"
 pub(crate) const STATE_MAGIC: u64 = 0x5043_464d_4932_5354; // "PCFMI2ST"
 const SERIAL_HEADER: &[u8; 8] = b"PCFMI2S1";
 
-/// The co-simulation states we can be in (we never return fmi2Pending, so *stepInProgress* and
-/// *stepCanceled* do not occur).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum MachineState {
-    Instantiated,
-    InitializationMode,
-    StepComplete,
-    StepFailed,
-    Terminated,
-    Error,
-}
-
-const INST: u8 = 1;
-const INIT: u8 = 2;
-const COMPLETE: u8 = 4;
-const FAILED: u8 = 8;
-const TERMINATED: u8 = 16;
-const ERROR: u8 = 32;
-const ANY: u8 = INST | INIT | COMPLETE | FAILED | TERMINATED | ERROR;
-
-impl MachineState {
-    fn bit(self) -> u8 {
-        match self {
-            MachineState::Instantiated => INST,
-            MachineState::InitializationMode => INIT,
-            MachineState::StepComplete => COMPLETE,
-            MachineState::StepFailed => FAILED,
-            MachineState::Terminated => TERMINATED,
-            MachineState::Error => ERROR,
-        }
-    }
-    pub fn name(self) -> &'static str {
-        match self {
-            MachineState::Instantiated => "instantiated",
-            MachineState::InitializationMode => "initializationMode",
-            MachineState::StepComplete => "stepComplete",
-            MachineState::StepFailed => "stepFailed",
-            MachineState::Terminated => "terminated",
-            MachineState::Error => "error",
-        }
-    }
-    fn code(self) -> u64 {
-        self.bit().trailing_zeros() as u64
-    }
-    fn from_code(c: u64) -> Option<Self> {
-        [Self::Instantiated, Self::InitializationMode, Self::StepComplete, Self::StepFailed, Self::Terminated, Self::Error].into_iter().find(|s| s.code() == c)
-    }
-}
-
-fn mask_names(mask: u8) -> String {
-    let all = [MachineState::Instantiated, MachineState::InitializationMode, MachineState::StepComplete, MachineState::StepFailed, MachineState::Terminated];
-    all.iter().filter(|s| s.bit() & mask != 0).map(|s| s.name()).collect::<Vec<_>>().join(", ")
-}
-
-/// The shell's part of an FMU state.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Clock {
-    pub state: MachineState,
-    pub time: f64,
-    pub start_time: f64,
-    pub stop_time: Option<f64>,
-    pub last_successful_time: f64,
-    pub terminate_requested: bool,
-}
-
-impl Clock {
-    fn new() -> Self {
-        Clock { state: MachineState::Instantiated, time: 0.0, start_time: 0.0, stop_time: None, last_successful_time: 0.0, terminate_requested: false }
-    }
-}
-
 /// What `fmi2GetFMUstate` hands out (boxed, as an opaque `fmi2FMUstate`). `magic` stays first.
 #[repr(C)]
 pub struct FmuState<S> {
@@ -94,15 +25,9 @@ pub struct FmuState<S> {
     model: S,
 }
 
-/// Communication points are the master's: accept round-off (fmpy computes start + n·h, ecos
-/// accumulates t += h, Dymola is off by 3e-12), never compare with `==`.
-pub fn same_time(a: f64, b: f64, h: f64) -> bool {
-    (a - b).abs() <= 1e-9 * a.abs().max(b.abs()).max(1.0) + 1e-6 * h.abs()
-}
-
 /// One instance (boxed, as an opaque `fmi2Component`). `magic` stays first.
 #[repr(C)]
-pub struct Instance<M: Fmi2Model> {
+pub struct Instance<M: CoSimModel> {
     pub(crate) magic: u64,
     model: M,
     guid: String,
@@ -113,7 +38,7 @@ pub struct Instance<M: Fmi2Model> {
     resources: Option<PathBuf>,
 }
 
-impl<M: Fmi2Model> Instance<M> {
+impl<M: CoSimModel> Instance<M> {
     /// `fmi2Instantiate`. `None` after logging why (a missing name, the wrong fmuType, a bad
     /// resource location, a model that cannot be built, a missing or wrong GUID).
     pub fn new(name: Option<&str>, fmu_type: i32, guid: Option<&str>, resource_location: Option<&str>, logger: Logger) -> Option<Box<Self>> {
@@ -393,7 +318,7 @@ impl<M: Fmi2Model> Instance<M> {
     }
 
     pub fn serialize_fmu_state(&self, state: &FmuState<M::Snapshot>) -> Vec<u8> {
-        let mut w = ByteWriter::default();
+        let mut w = StateWriter::default();
         w.buf.extend_from_slice(SERIAL_HEADER);
         w.str(&state.guid);
         let c = &state.clock;
@@ -414,7 +339,7 @@ impl<M: Fmi2Model> Instance<M> {
             if bytes.len() < SERIAL_HEADER.len() || &bytes[..SERIAL_HEADER.len()] != SERIAL_HEADER {
                 return Err("the bytes are not a serialized state of this FMU (bad header)".into());
             }
-            let mut r = ByteReader::new(&bytes[SERIAL_HEADER.len()..]);
+            let mut r = StateReader::new(&bytes[SERIAL_HEADER.len()..]);
             let guid = r.str()?;
             if guid != self.guid {
                 return Err(format!("the state belongs to a model with GUID {guid}, this instance has {}", self.guid));

@@ -18,9 +18,9 @@
 //!
 //!   `fmi2GetRealOutputDerivatives` (order 1) is the exact time derivative of the interpolant:
 //!   for `displacement[d]` it is the velocity.
-use crate::fmi2::bytes::{ByteReader, ByteWriter};
-use crate::fmi2::table::{Kind, UnitDefinition, Variability, Variable, VariableTable};
-use crate::fmi2::{DefaultExperiment, Fmi2Model, Logger, ModelDescription};
+use crate::fmi::state::{StateReader, StateWriter};
+use crate::fmi::table::{Kind, UnitDefinition, Variability, Variable, VariableTable};
+use crate::fmi::{CoSimModel, DefaultExperiment, EventLog, ModelDescription};
 pub use crate::periodic::Tuning;
 use crate::periodic::{MAX_STEPS, MIN_STEPS, PeriodFft, PeriodicProblem};
 use crate::response::Response;
@@ -561,7 +561,7 @@ impl ContactModel {
         let mut rows = String::new();
         for (vr, v) in self.desc.variables.iter() {
             let (ty, start, unit) = match &v.kind {
-                Kind::Real { start, unit, .. } => ("Real", start.map(crate::fmi2::xml::real), unit.clone()),
+                Kind::Real { start, unit, .. } => ("Real", start.map(crate::fmi::fmi2::xml::real), unit.clone()),
                 Kind::Integer { start, .. } => ("Integer", start.map(|s| s.to_string()), None),
                 Kind::Enumeration { start, .. } => ("Enumeration", start.map(|s| s.to_string()), None),
                 Kind::Boolean { start } => ("Boolean", start.map(|s| s.to_string()), None),
@@ -647,7 +647,7 @@ fn scheme_doc(s: Scheme) -> &'static str {
     }
 }
 
-impl Fmi2Model for ContactModel {
+impl CoSimModel for ContactModel {
     type Snapshot = ContactSnapshot;
 
     fn instantiate(resources: Option<&Path>) -> Result<Self, String> {
@@ -740,7 +740,7 @@ impl Fmi2Model for ContactModel {
         })
     }
 
-    fn exit_initialization(&mut self, start_time: f64, log: &Logger) -> Result<Vec<String>, String> {
+    fn exit_initialization(&mut self, start_time: f64, log: &dyn EventLog) -> Result<Vec<String>, String> {
         self.start_time = start_time;
         self.ensure_outputs()?;
         self.initialized = true;
@@ -749,7 +749,7 @@ impl Fmi2Model for ContactModel {
         Ok(sol.warnings.clone())
     }
 
-    fn do_step(&mut self, t: f64, h: f64, log: &Logger) -> Result<(), String> {
+    fn do_step(&mut self, t: f64, h: f64, log: &dyn EventLog) -> Result<(), String> {
         let cfg = self.values.config();
         if self.solution.as_ref().is_none_or(|s| s.config != cfg) {
             let sol = self.solve(cfg)?;
@@ -793,8 +793,8 @@ impl Fmi2Model for ContactModel {
         self.solution = s.solution.clone();
     }
 
-    fn serialize(s: &ContactSnapshot, w: &mut ByteWriter) {
-        let values = |w: &mut ByteWriter, t: &Tuning| [t.frequency, t.force_scale, t.gap_offset, t.motion_scale].iter().for_each(|v| w.f64(*v));
+    fn serialize(s: &ContactSnapshot, w: &mut StateWriter) {
+        let values = |w: &mut StateWriter, t: &Tuning| [t.frequency, t.force_scale, t.gap_offset, t.motion_scale].iter().for_each(|v| w.f64(*v));
         values(w, &s.values.params);
         values(w, &s.values.inputs);
         w.u64(s.values.steps as u64);
@@ -844,11 +844,11 @@ impl Fmi2Model for ContactModel {
         }
     }
 
-    fn deserialize(&self, r: &mut ByteReader<'_>) -> Result<ContactSnapshot, String> {
-        let tuning = |r: &mut ByteReader<'_>| -> Result<Tuning, String> {
+    fn deserialize(&self, r: &mut StateReader<'_>) -> Result<ContactSnapshot, String> {
+        let tuning = |r: &mut StateReader<'_>| -> Result<Tuning, String> {
             Ok(Tuning { frequency: r.f64()?, force_scale: r.f64()?, gap_offset: r.f64()?, motion_scale: r.f64()? })
         };
-        let scheme = |r: &mut ByteReader<'_>| -> Result<Scheme, String> {
+        let scheme = |r: &mut StateReader<'_>| -> Result<Scheme, String> {
             let c = r.i32()?;
             Scheme::ALL.get((c - 1) as usize).copied().ok_or(format!("bad scheme code {c}"))
         };
@@ -915,18 +915,18 @@ pub fn package(scene_path: &Path, binary: &Path, out: &Path) -> Result<String, S
     let text = std::fs::read_to_string(scene_path).map_err(|e| format!("{}: cannot read the scene: {e}", scene_path.display()))?;
     let model = ContactModel::from_scene_text(&text, &scene_path.display().to_string())?;
     model.desc.variables.check().map_err(|m| format!("internal error, the variable table is invalid: {m}"))?;
-    let (xml, guid) = crate::fmi2::xml::render(&model.desc);
+    let (xml, guid) = crate::fmi::fmi2::xml::render(&model.desc);
     let so = std::fs::read(binary).map_err(|e| format!("{}: cannot read the FMU binary: {e}", binary.display()))?;
     if !so.starts_with(b"\x7fELF") {
         return Err(format!("{}: is not an ELF shared library", binary.display()));
     }
-    let platform = crate::fmi2::package::platform().ok_or("this platform has no FMI 2.0 platform folder name")?;
+    let platform = crate::fmi::package::platform().ok_or("this platform has no FMI 2.0 platform folder name")?;
     let name = scene_path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let entries = vec![
-        crate::fmi2::package::Entry { name: format!("binaries/{platform}/{MODEL_IDENTIFIER}.so"), data: so, mode: 0o755 },
-        crate::fmi2::package::Entry { name: format!("resources/{SCENE_FILE}"), data: text.into_bytes(), mode: 0o644 },
-        crate::fmi2::package::Entry { name: "documentation/index.html".into(), data: model.documentation_html(&name).into_bytes(), mode: 0o644 },
+        crate::fmi::package::Entry { name: format!("binaries/{platform}/{MODEL_IDENTIFIER}.so"), data: so, mode: 0o755 },
+        crate::fmi::package::Entry { name: format!("resources/{SCENE_FILE}"), data: text.into_bytes(), mode: 0o644 },
+        crate::fmi::package::Entry { name: "documentation/index.html".into(), data: model.documentation_html(&name).into_bytes(), mode: 0o644 },
     ];
-    crate::fmi2::package::write_fmu(out, &xml, &entries)?;
+    crate::fmi::package::write_fmu(out, &xml, &entries)?;
     Ok(guid)
 }

@@ -1,11 +1,11 @@
 //! A tiny little-endian codec for serialized FMU states.
 
 #[derive(Default)]
-pub struct ByteWriter {
+pub struct StateWriter {
     pub buf: Vec<u8>,
 }
 
-impl ByteWriter {
+impl StateWriter {
     pub fn u64(&mut self, v: u64) {
         self.buf.extend_from_slice(&v.to_le_bytes());
     }
@@ -35,14 +35,14 @@ impl ByteWriter {
     }
 }
 
-pub struct ByteReader<'a> {
+pub struct StateReader<'a> {
     buf: &'a [u8],
     pos: usize,
 }
 
-impl<'a> ByteReader<'a> {
+impl<'a> StateReader<'a> {
     pub fn new(buf: &'a [u8]) -> Self {
-        ByteReader { buf, pos: 0 }
+        StateReader { buf, pos: 0 }
     }
     fn take(&mut self, n: usize) -> Result<&'a [u8], String> {
         if self.buf.len() - self.pos < n {
@@ -102,7 +102,7 @@ mod tests {
     use super::*;
     #[test]
     fn round_trip_and_truncation() {
-        let mut w = ByteWriter::default();
+        let mut w = StateWriter::default();
         w.u64(7);
         w.f64(-1.5);
         w.i32(-3);
@@ -110,7 +110,7 @@ mod tests {
         w.str("héllo");
         w.f64s(&[1.0, f64::MAX]);
         w.usizes(&[4, 5]);
-        let mut r = ByteReader::new(&w.buf);
+        let mut r = StateReader::new(&w.buf);
         assert_eq!(r.u64().unwrap(), 7);
         assert_eq!(r.f64().unwrap(), -1.5);
         assert_eq!(r.i32().unwrap(), -3);
@@ -120,7 +120,7 @@ mod tests {
         assert_eq!(r.usizes().unwrap(), vec![4, 5]);
         r.finish().unwrap();
         let cut = &w.buf[..w.buf.len() - 3];
-        let mut r = ByteReader::new(cut);
+        let mut r = StateReader::new(cut);
         let all = (|| -> Result<(), String> {
             r.u64()?;
             r.f64()?;
@@ -133,8 +133,8 @@ mod tests {
         })();
         assert!(all.is_err());
         // A huge length is refused before allocating.
-        let mut w = ByteWriter::default();
+        let mut w = StateWriter::default();
         w.u64(u64::MAX);
-        assert!(ByteReader::new(&w.buf).f64s().is_err());
+        assert!(StateReader::new(&w.buf).f64s().is_err());
     }
 }
