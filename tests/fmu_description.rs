@@ -98,5 +98,6 @@ fn the_guid_is_derived_from_the_content() {
 #[test]
 fn invalid_scenes_are_refused_with_the_field() {
     let e = ContactModel::from_scene_text(&BASE.replace("stiffness = [[1.0]]", "stiffness = [[-1.0, 2.0]]"), "bad.toml").err().unwrap();
+    let e = e.to_string();
     assert!(e.contains("bad.toml") && e.contains("stiffness"), "{e}");
 }

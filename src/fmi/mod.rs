@@ -23,8 +23,25 @@ pub mod state;
 pub mod table;
 pub mod uri;
 
+use crate::error::{Error, ErrorKind, Result};
 use std::path::Path;
 use table::{EnumerationType, UnitDefinition, VariableTable};
+
+/// How a shell names the kind of an error in its log ("input error: …", "solver failure: …"):
+/// the status stays the one the standard asks for, the kind tells the user what to change.
+pub fn kind_label(kind: ErrorKind) -> &'static str {
+    match kind {
+        ErrorKind::Input => "input error",
+        ErrorKind::Limit => "size limit",
+        ErrorKind::Io => "I/O error",
+        ErrorKind::Solve => "solver failure",
+    }
+}
+
+/// `"<kind>: <message>"`, for a log line.
+pub fn describe(e: &Error) -> String {
+    format!("{}: {}", kind_label(e.kind()), e.message())
+}
 
 /// Where a model reports its events (solves, re-solves). Each shell passes its own logger.
 pub trait EventLog {
@@ -64,43 +81,46 @@ pub struct ModelDescription {
 pub trait CoSimModel: Sized {
     /// Everything an FMU state (FMI 2 `fmi2GetFMUstate`) must capture of the model.
     type Snapshot: Clone;
+    /// The version of the model's part of a serialized state (see [`state`]); raise it when
+    /// [`serialize`](Self::serialize) changes, so that older states are refused by name.
+    const STATE_VERSION: u16;
 
     /// Builds the model from the unpacked `resources` folder (`None`: the importer gave none).
-    fn instantiate(resources: Option<&Path>) -> Result<Self, String>;
+    fn instantiate(resources: Option<&Path>) -> Result<Self>;
     fn description(&self) -> &ModelDescription;
     /// Back to the start values, nothing solved (a reset of the instance).
     fn reset(&mut self);
     /// Entering initialisation mode (outputs read in initialisation mode are at `start_time`).
     fn enter_initialization(&mut self, _start_time: f64) {}
 
-    fn set_real(&mut self, vr: u32, value: f64) -> Result<(), String>;
-    fn set_integer(&mut self, vr: u32, value: i32) -> Result<(), String>;
-    fn set_boolean(&mut self, vr: u32, _value: bool) -> Result<(), String> {
-        Err(format!("value reference {vr} cannot be set as Boolean"))
+    fn set_real(&mut self, vr: u32, value: f64) -> Result<()>;
+    fn set_integer(&mut self, vr: u32, value: i32) -> Result<()>;
+    fn set_boolean(&mut self, vr: u32, _value: bool) -> Result<()> {
+        Err(Error::input(format!("value reference {vr} cannot be set as Boolean")))
     }
-    fn set_string(&mut self, vr: u32, _value: &str) -> Result<(), String> {
-        Err(format!("value reference {vr} cannot be set as String"))
+    fn set_string(&mut self, vr: u32, _value: &str) -> Result<()> {
+        Err(Error::input(format!("value reference {vr} cannot be set as String")))
     }
     /// Getters may compute (e.g. outputs read in initialisation mode).
-    fn get_real(&mut self, vr: u32) -> Result<f64, String>;
-    fn get_integer(&mut self, vr: u32) -> Result<i32, String>;
-    fn get_boolean(&mut self, vr: u32) -> Result<bool, String> {
-        Err(format!("value reference {vr} cannot be read as Boolean"))
+    fn get_real(&mut self, vr: u32) -> Result<f64>;
+    fn get_integer(&mut self, vr: u32) -> Result<i32>;
+    fn get_boolean(&mut self, vr: u32) -> Result<bool> {
+        Err(Error::input(format!("value reference {vr} cannot be read as Boolean")))
     }
-    fn get_string(&mut self, vr: u32) -> Result<String, String> {
-        Err(format!("value reference {vr} cannot be read as String"))
+    fn get_string(&mut self, vr: u32) -> Result<String> {
+        Err(Error::input(format!("value reference {vr} cannot be read as String")))
     }
 
     /// Leaving initialisation mode: the heavy work. `Ok(warnings)`: each is logged and the call
     /// returns a warning status; `Err`: an error status.
-    fn exit_initialization(&mut self, start_time: f64, log: &dyn EventLog) -> Result<Vec<String>, String>;
+    fn exit_initialization(&mut self, start_time: f64, log: &dyn EventLog) -> Result<Vec<String>>;
     /// A step from `t` to `t + h`. `Err`: the step is discarded; the model must then be unchanged.
-    fn do_step(&mut self, t: f64, h: f64, log: &dyn EventLog) -> Result<(), String>;
+    fn do_step(&mut self, t: f64, h: f64, log: &dyn EventLog) -> Result<()>;
     /// The `order`-th time derivative of output `vr` at the current time (order ≥ 1).
-    fn output_derivative(&self, vr: u32, order: i32) -> Result<f64, String>;
+    fn output_derivative(&self, vr: u32, order: i32) -> Result<f64>;
 
     fn snapshot(&self) -> Self::Snapshot;
     fn restore(&mut self, snapshot: &Self::Snapshot);
     fn serialize(snapshot: &Self::Snapshot, out: &mut state::StateWriter);
-    fn deserialize(&self, input: &mut state::StateReader<'_>) -> Result<Self::Snapshot, String>;
+    fn deserialize(&self, input: &mut state::StateReader<'_>) -> Result<Self::Snapshot>;
 }

@@ -1,5 +1,6 @@
 //! The `.fmu` archive: a zip (deflate, forward slashes, no leading `/` or `./`) with
 //! `modelDescription.xml` at the root, written to a temporary file and renamed into place.
+use crate::error::{Error, Result};
 use std::io::Write;
 use std::path::Path;
 use zip::write::SimpleFileOptions;
@@ -27,32 +28,35 @@ pub fn platform() -> Option<&'static str> {
 }
 
 /// Writes `out` with `modelDescription.xml` first, then `entries`.
-pub fn write_fmu(out: &Path, model_description: &str, entries: &[Entry]) -> Result<(), String> {
+pub fn write_fmu(out: &Path, model_description: &str, entries: &[Entry]) -> Result<()> {
     for e in entries {
         if e.name.starts_with('/') || e.name.starts_with("./") || e.name.contains('\\') || e.name.split('/').any(|p| p == ".." || p.is_empty()) {
-            return Err(format!("archive path {:?} is not a clean relative path with forward slashes", e.name));
+            return Err(Error::input(format!("archive path {:?} is not a clean relative path with forward slashes", e.name)));
         }
     }
     let tmp = out.with_extension("fmu.tmp~");
-    let write = || -> Result<(), String> {
-        let file = std::fs::File::create(&tmp).map_err(|e| format!("{}: cannot create: {e}", tmp.display()))?;
-        let mut zip = ZipWriter::new(file);
-        let options = SimpleFileOptions::default().compression_method(CompressionMethod::Deflated);
-        let z = |e: zip::result::ZipError| format!("{}: {e}", out.display());
-        zip.start_file("modelDescription.xml", options.unix_permissions(0o644)).map_err(z)?;
-        zip.write_all(model_description.as_bytes()).map_err(|e| format!("{}: {e}", out.display()))?;
-        for e in entries {
-            zip.start_file(e.name.as_str(), options.unix_permissions(e.mode)).map_err(z)?;
-            zip.write_all(&e.data).map_err(|err| format!("{}: {err}", out.display()))?;
-        }
-        zip.finish().map_err(z)?;
-        Ok(())
-    };
-    match write() {
-        Ok(()) => std::fs::rename(&tmp, out).map_err(|e| format!("{}: cannot write: {e}", out.display())),
-        Err(m) => {
+    match write_zip(&tmp, out, model_description, entries) {
+        Ok(()) => std::fs::rename(&tmp, out).map_err(|e| Error::io(format!("{}: cannot write: {e}", out.display()))),
+        Err(e) => {
             let _ = std::fs::remove_file(&tmp);
-            Err(m)
+            Err(e)
         }
     }
+}
+
+/// The archive into `tmp` (`out` names it in messages).
+fn write_zip(tmp: &Path, out: &Path, model_description: &str, entries: &[Entry]) -> Result<()> {
+    let file = std::fs::File::create(tmp).map_err(|e| Error::io(format!("{}: cannot create: {e}", tmp.display())))?;
+    let mut zip = ZipWriter::new(file);
+    let options = SimpleFileOptions::default().compression_method(CompressionMethod::Deflated);
+    let z = |e: zip::result::ZipError| Error::io(format!("{}: {e}", out.display()));
+    let w = |e: std::io::Error| Error::io(format!("{}: {e}", out.display()));
+    zip.start_file("modelDescription.xml", options.unix_permissions(0o644)).map_err(z)?;
+    zip.write_all(model_description.as_bytes()).map_err(w)?;
+    for e in entries {
+        zip.start_file(e.name.as_str(), options.unix_permissions(e.mode)).map_err(z)?;
+        zip.write_all(&e.data).map_err(w)?;
+    }
+    zip.finish().map_err(z)?;
+    Ok(())
 }

@@ -18,6 +18,7 @@
 //!
 //!   `fmi2GetRealOutputDerivatives` (order 1) is the exact time derivative of the interpolant:
 //!   for `displacement[d]` it is the velocity.
+use crate::error::{Error, Result};
 use crate::fmi::state::{StateReader, StateWriter};
 use crate::fmi::table::{Kind, UnitDefinition, Variability, Variable, VariableTable};
 use crate::fmi::{CoSimModel, DefaultExperiment, EventLog, ModelDescription};
@@ -29,6 +30,12 @@ use crate::time::{Discretization, Scheme};
 use num_complex::Complex64 as C;
 use std::path::Path;
 use std::sync::Arc;
+
+mod series;
+mod state;
+
+use series::{Series, Solution};
+pub use state::ContactSnapshot;
 
 pub const MODEL_IDENTIFIER: &str = "PeriodicContact";
 /// The scene inside the FMU's `resources/`.
@@ -97,99 +104,6 @@ fn scheme_code(s: Scheme) -> i32 {
     Scheme::ALL.iter().position(|x| *x == s).expect("listed") as i32 + 1
 }
 
-/// One output over the period with its interpolant.
-#[derive(Clone, Debug, PartialEq)]
-enum Series {
-    /// Cubic Hermite through (x_j, v_j); `level` 0 gives H, 1 gives H'.
-    Hermite {
-        x: Vec<f64>,
-        v: Vec<f64>,
-        level: u8,
-    },
-    Linear(Vec<f64>),
-    /// Re Σ c e^{i p ω τ} over the harmonics p kept.
-    Trig {
-        p: Vec<usize>,
-        c: Vec<C>,
-    },
-    Constant(f64),
-}
-
-impl Series {
-    /// Value and first time derivative at sample j (next j1) and fraction s of the step h.
-    #[inline]
-    fn eval(&self, j: usize, j1: usize, s: f64, h: f64, omega: f64, powers: &[C]) -> (f64, f64) {
-        match self {
-            Series::Hermite { x, v, level } => {
-                let (x0, x1, v0, v1) = (x[j], x[j1], v[j] * h, v[j1] * h);
-                let (s2, s3) = (s * s, s * s * s);
-                let d1 = ((6.0 * s2 - 6.0 * s) * (x0 - x1) + (3.0 * s2 - 4.0 * s + 1.0) * v0 + (3.0 * s2 - 2.0 * s) * v1) / h;
-                if *level == 0 {
-                    let val = (2.0 * s3 - 3.0 * s2 + 1.0) * x0 + (s3 - 2.0 * s2 + s) * v0 + (-2.0 * s3 + 3.0 * s2) * x1 + (s3 - s2) * v1;
-                    (val, d1)
-                } else {
-                    let d2 = ((12.0 * s - 6.0) * (x0 - x1) + (6.0 * s - 4.0) * v0 + (6.0 * s - 2.0) * v1) / (h * h);
-                    (d1, d2)
-                }
-            }
-            Series::Linear(y) => ((1.0 - s) * y[j] + s * y[j1], (y[j1] - y[j]) / h),
-            Series::Trig { p, c } => {
-                let (mut val, mut der) = (0.0, 0.0);
-                for (&p, c) in p.iter().zip(c) {
-                    let z = c * powers[p];
-                    val += z.re;
-                    der -= p as f64 * omega * z.im;
-                }
-                (val, der)
-            }
-            Series::Constant(v) => (*v, 0.0),
-        }
-    }
-
-    /// Trigonometric interpolant of real samples: c_0 = X̂_0/k, c_p = 2X̂_p/k, c_{k/2} = X̂_{k/2}/k,
-    /// times `factor(p)` (i p ω for a derivative); negligible harmonics dropped.
-    fn trig(samples: &[f64], fft: &PeriodFft, factor: impl Fn(usize) -> C) -> Series {
-        let k = samples.len();
-        let spec = fft.forward(samples);
-        let coef: Vec<C> = spec
-            .iter()
-            .enumerate()
-            .map(|(p, x)| {
-                let w = if p == 0 || (k % 2 == 0 && p == k / 2) { 1.0 } else { 2.0 };
-                let mut c = x * w / k as f64;
-                if p == 0 || (k % 2 == 0 && p == k / 2) {
-                    c.im = 0.0;
-                }
-                c * factor(p)
-            })
-            .collect();
-        let big = coef.iter().map(|c| c.norm()).fold(0.0, f64::max);
-        let keep: Vec<usize> = (0..coef.len()).filter(|&p| coef[p].norm() > 1e-15 * big).collect();
-        Series::Trig { c: keep.iter().map(|&p| coef[p]).collect(), p: keep }
-    }
-}
-
-/// A solved configuration: one series per output slot.
-#[derive(Clone, Debug, PartialEq)]
-struct Solution {
-    config: Config,
-    period: f64,
-    h: f64,
-    omega: f64,
-    k: usize,
-    series: Vec<Series>,
-    pivots: i32,
-    residual: f64,
-    active_set: Vec<usize>,
-    warnings: Vec<String>,
-}
-
-impl Solution {
-    fn max_harmonic(&self) -> usize {
-        self.series.iter().filter_map(|s| if let Series::Trig { p, .. } = s { p.last().copied() } else { None }).max().unwrap_or(0)
-    }
-}
-
 /// The model of one FMU instance.
 pub struct ContactModel {
     desc: ModelDescription,
@@ -213,23 +127,11 @@ pub struct ContactModel {
     powers: Vec<C>,
 }
 
-/// What `fmi2GetFMUstate` keeps of a [`ContactModel`].
-#[derive(Clone)]
-pub struct ContactSnapshot {
-    values: Values,
-    solution: Option<Arc<Solution>>,
-    phase_offset: f64,
-    initialized: bool,
-    start_time: f64,
-    out: Vec<f64>,
-    der: Vec<f64>,
-}
-
 impl ContactModel {
     /// Builds the model of a scene. `file` names the source in messages only.
-    pub fn from_scene_text(text: &str, file: &str) -> Result<Self, String> {
-        let scene = Scene::parse(text, file).map_err(|e| e.to_string())?;
-        let problem = scene.to_problem(file).map_err(|e| e.to_string())?;
+    pub fn from_scene_text(text: &str, file: &str) -> Result<Self> {
+        let scene = Scene::parse(text, file)?;
+        let problem = scene.to_problem(file)?;
         let shown = problem.outputs.clone();
         let model = &problem.model;
         let (n, m) = (model.n(), model.contacts.len());
@@ -441,20 +343,20 @@ impl ContactModel {
         &self.desc
     }
 
-    fn role(&self, vr: u32) -> Result<Role, String> {
-        self.roles.get(vr as usize).copied().ok_or_else(|| format!("unknown value reference {vr}"))
+    fn role(&self, vr: u32) -> Result<Role> {
+        self.roles.get(vr as usize).copied().ok_or_else(|| Error::input(format!("unknown value reference {vr}")))
     }
 
     /// Solves `cfg`, warm-started from the current solution when the grid is the same.
-    fn solve(&mut self, cfg: Config) -> Result<Solution, String> {
+    fn solve(&mut self, cfg: Config) -> Result<Solution> {
         let disc = Discretization { scheme: cfg.scheme, steps: cfg.steps, pairing: self.base.disc.pairing };
-        let problem = cfg.tuning.apply(&self.base, disc).map_err(|e| e.to_string())?;
+        let problem = cfg.tuning.apply(&self.base, disc)?;
         if self.fft.as_ref().is_none_or(|f| f.k() != cfg.steps) {
             self.fft = Some(PeriodFft::new(cfg.steps));
         }
         let fft = self.fft.as_ref().expect("planned above");
         let warm = self.solution.as_ref().filter(|s| s.k == cfg.steps).map(|s| s.active_set.as_slice());
-        let r = problem.solve_with(fft, warm).map_err(|e| e.to_string())?;
+        let r = problem.solve_with(fft, warm)?;
         Ok(self.solution_of(cfg, &problem, &r, fft))
     }
 
@@ -540,7 +442,7 @@ impl ContactModel {
     }
 
     /// In initialisation mode outputs are computed on demand for the current values.
-    fn ensure_outputs(&mut self) -> Result<(), String> {
+    fn ensure_outputs(&mut self) -> Result<()> {
         if self.initialized {
             return Ok(());
         }
@@ -649,11 +551,12 @@ fn scheme_doc(s: Scheme) -> &'static str {
 
 impl CoSimModel for ContactModel {
     type Snapshot = ContactSnapshot;
+    const STATE_VERSION: u16 = state::STATE_VERSION;
 
-    fn instantiate(resources: Option<&Path>) -> Result<Self, String> {
-        let dir = resources.ok_or("no resource location was given; this FMU needs its resources/scene.toml")?;
+    fn instantiate(resources: Option<&Path>) -> Result<Self> {
+        let dir = resources.ok_or_else(|| Error::input("no resource location was given; this FMU needs its resources/scene.toml"))?;
         let path = dir.join(SCENE_FILE);
-        let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: cannot read the scene: {e}", path.display()))?;
+        let text = std::fs::read_to_string(&path).map_err(|e| Error::io(format!("{}: cannot read the scene: {e}", path.display())))?;
         ContactModel::from_scene_text(&text, &path.display().to_string())
     }
 
@@ -675,41 +578,41 @@ impl CoSimModel for ContactModel {
         self.start_time = start_time;
     }
 
-    fn set_real(&mut self, vr: u32, v: f64) -> Result<(), String> {
+    fn set_real(&mut self, vr: u32, v: f64) -> Result<()> {
         let role = self.role(vr)?;
         let name = &self.desc.variables.get(vr).expect("role exists").name;
         if !v.is_finite() {
-            return Err(format!("{name} = {v}: must be finite"));
+            return Err(Error::input(format!("{name} = {v}: must be finite")));
         }
         let (p, i) = (&mut self.values.params, &mut self.values.inputs);
         match role {
             Role::Frequency if v > 0.0 => p.frequency = v,
-            Role::Frequency => return Err(format!("frequency = {v}: must be > 0 (rad/s)")),
+            Role::Frequency => return Err(Error::input(format!("frequency = {v}: must be > 0 (rad/s)"))),
             Role::FrequencyIn if v >= 0.0 => i.frequency = v,
-            Role::FrequencyIn => return Err(format!("frequency_in = {v}: must be >= 0 (0 = not driven)")),
+            Role::FrequencyIn => return Err(Error::input(format!("frequency_in = {v}: must be >= 0 (0 = not driven)"))),
             Role::ForceScale => p.force_scale = v,
             Role::GapOffset => p.gap_offset = v,
             Role::MotionScale => p.motion_scale = v,
             Role::ForceScaleIn => i.force_scale = v,
             Role::GapOffsetIn => i.gap_offset = v,
             Role::MotionScaleIn => i.motion_scale = v,
-            _ => return Err(format!("{name} cannot be set")),
+            _ => return Err(Error::input(format!("{name} cannot be set"))),
         }
         Ok(())
     }
 
-    fn set_integer(&mut self, vr: u32, v: i32) -> Result<(), String> {
+    fn set_integer(&mut self, vr: u32, v: i32) -> Result<()> {
         match self.role(vr)? {
             Role::Steps if (MIN_STEPS as i64..=MAX_STEPS as i64).contains(&(v as i64)) => self.values.steps = v as usize,
-            Role::Steps => return Err(format!("steps = {v}: must be in {MIN_STEPS}..={MAX_STEPS}")),
+            Role::Steps => return Err(Error::input(format!("steps = {v}: must be in {MIN_STEPS}..={MAX_STEPS}"))),
             Role::Scheme if (1..=Scheme::ALL.len() as i32).contains(&v) => self.values.scheme = Scheme::ALL[(v - 1) as usize],
-            Role::Scheme => return Err(format!("scheme = {v}: must be 1..=5 (bds1, bds2, cds, galerkin, fourier)")),
-            _ => return Err(format!("value reference {vr} cannot be set as Integer")),
+            Role::Scheme => return Err(Error::input(format!("scheme = {v}: must be 1..=5 (bds1, bds2, cds, galerkin, fourier)"))),
+            _ => return Err(Error::input(format!("value reference {vr} cannot be set as Integer"))),
         }
         Ok(())
     }
 
-    fn get_real(&mut self, vr: u32) -> Result<f64, String> {
+    fn get_real(&mut self, vr: u32) -> Result<f64> {
         let (p, i) = (&self.values.params, &self.values.inputs);
         Ok(match self.role(vr)? {
             Role::Frequency => p.frequency,
@@ -724,11 +627,11 @@ impl CoSimModel for ContactModel {
                 self.ensure_outputs()?;
                 self.out[slot]
             }
-            Role::Steps | Role::Scheme => return Err(format!("value reference {vr} is not Real")),
+            Role::Steps | Role::Scheme => return Err(Error::input(format!("value reference {vr} is not Real"))),
         })
     }
 
-    fn get_integer(&mut self, vr: u32) -> Result<i32, String> {
+    fn get_integer(&mut self, vr: u32) -> Result<i32> {
         Ok(match self.role(vr)? {
             Role::Steps => self.values.steps as i32,
             Role::Scheme => scheme_code(self.values.scheme),
@@ -736,11 +639,11 @@ impl CoSimModel for ContactModel {
                 self.ensure_outputs()?;
                 self.out[slot] as i32
             }
-            _ => return Err(format!("value reference {vr} is not Integer")),
+            _ => return Err(Error::input(format!("value reference {vr} is not Integer"))),
         })
     }
 
-    fn exit_initialization(&mut self, start_time: f64, log: &dyn EventLog) -> Result<Vec<String>, String> {
+    fn exit_initialization(&mut self, start_time: f64, log: &dyn EventLog) -> Result<Vec<String>> {
         self.start_time = start_time;
         self.ensure_outputs()?;
         self.initialized = true;
@@ -749,7 +652,7 @@ impl CoSimModel for ContactModel {
         Ok(sol.warnings.clone())
     }
 
-    fn do_step(&mut self, t: f64, h: f64, log: &dyn EventLog) -> Result<(), String> {
+    fn do_step(&mut self, t: f64, h: f64, log: &dyn EventLog) -> Result<()> {
         let cfg = self.values.config();
         if self.solution.as_ref().is_none_or(|s| s.config != cfg) {
             let sol = self.solve(cfg)?;
@@ -760,10 +663,10 @@ impl CoSimModel for ContactModel {
         Ok(())
     }
 
-    fn output_derivative(&self, vr: u32, order: i32) -> Result<f64, String> {
+    fn output_derivative(&self, vr: u32, order: i32) -> Result<f64> {
         match (self.role(vr)?, order) {
             (Role::Output(slot), 1) => Ok(self.der[slot]),
-            _ => Err(format!("no derivative of order {order} for value reference {vr}")),
+            _ => Err(Error::input(format!("no derivative of order {order} for value reference {vr}"))),
         }
     }
 
@@ -794,133 +697,25 @@ impl CoSimModel for ContactModel {
     }
 
     fn serialize(s: &ContactSnapshot, w: &mut StateWriter) {
-        let values = |w: &mut StateWriter, t: &Tuning| [t.frequency, t.force_scale, t.gap_offset, t.motion_scale].iter().for_each(|v| w.f64(*v));
-        values(w, &s.values.params);
-        values(w, &s.values.inputs);
-        w.u64(s.values.steps as u64);
-        w.i32(scheme_code(s.values.scheme));
-        w.f64(s.phase_offset);
-        w.bool(s.initialized);
-        w.f64(s.start_time);
-        w.f64s(&s.out);
-        w.f64s(&s.der);
-        w.bool(s.solution.is_some());
-        if let Some(sol) = &s.solution {
-            values(w, &sol.config.tuning);
-            w.u64(sol.config.steps as u64);
-            w.i32(scheme_code(sol.config.scheme));
-            for v in [sol.period, sol.h, sol.omega, sol.residual] {
-                w.f64(v);
-            }
-            w.u64(sol.k as u64);
-            w.i32(sol.pivots);
-            w.usizes(&sol.active_set);
-            w.u64(sol.warnings.len() as u64);
-            sol.warnings.iter().for_each(|x| w.str(x));
-            w.u64(sol.series.len() as u64);
-            for series in &sol.series {
-                match series {
-                    Series::Hermite { x, v, level } => {
-                        w.u64(0);
-                        w.f64s(x);
-                        w.f64s(v);
-                        w.u64(*level as u64);
-                    }
-                    Series::Linear(y) => {
-                        w.u64(1);
-                        w.f64s(y);
-                    }
-                    Series::Trig { p, c } => {
-                        w.u64(2);
-                        w.usizes(p);
-                        w.f64s(&c.iter().flat_map(|z| [z.re, z.im]).collect::<Vec<_>>());
-                    }
-                    Series::Constant(v) => {
-                        w.u64(3);
-                        w.f64(*v);
-                    }
-                }
-            }
-        }
+        state::write(s, w)
     }
 
-    fn deserialize(&self, r: &mut StateReader<'_>) -> Result<ContactSnapshot, String> {
-        let tuning = |r: &mut StateReader<'_>| -> Result<Tuning, String> {
-            Ok(Tuning { frequency: r.f64()?, force_scale: r.f64()?, gap_offset: r.f64()?, motion_scale: r.f64()? })
-        };
-        let scheme = |r: &mut StateReader<'_>| -> Result<Scheme, String> {
-            let c = r.i32()?;
-            Scheme::ALL.get((c - 1) as usize).copied().ok_or(format!("bad scheme code {c}"))
-        };
-        let params = tuning(r)?;
-        let inputs = tuning(r)?;
-        let values = Values { params, inputs, steps: r.u64()? as usize, scheme: scheme(r)? };
-        let phase_offset = r.f64()?;
-        let initialized = r.bool()?;
-        let start_time = r.f64()?;
-        let out = r.f64s()?;
-        let der = r.f64s()?;
-        let n = self.outputs.len();
-        if out.len() != n || der.len() != n {
-            return Err(format!("the state has {} outputs, this model {n}", out.len()));
-        }
-        let solution = if r.bool()? {
-            let config = Config { tuning: tuning(r)?, steps: r.u64()? as usize, scheme: scheme(r)? };
-            let (period, h, omega, residual) = (r.f64()?, r.f64()?, r.f64()?, r.f64()?);
-            let k = r.u64()? as usize;
-            let pivots = r.i32()?;
-            let active_set = r.usizes()?;
-            let nw = r.u64()?;
-            let warnings = (0..nw.min(1 << 16)).map(|_| r.str()).collect::<Result<Vec<_>, _>>()?;
-            let ns = r.u64()? as usize;
-            if ns != n || k == 0 {
-                return Err(format!("the state has {ns} series over {k} instants, this model {n} outputs"));
-            }
-            let mut series = Vec::with_capacity(n);
-            for _ in 0..ns {
-                let s = match r.u64()? {
-                    0 => Series::Hermite { x: r.f64s()?, v: r.f64s()?, level: r.u64()? as u8 },
-                    1 => Series::Linear(r.f64s()?),
-                    2 => {
-                        let p = r.usizes()?;
-                        let c: Vec<C> = r.f64s()?.chunks(2).map(|z| C::new(z[0], z[1])).collect();
-                        if c.len() != p.len() || p.iter().any(|&p| p > k) {
-                            return Err("bad trigonometric series".into());
-                        }
-                        Series::Trig { p, c }
-                    }
-                    3 => Series::Constant(r.f64()?),
-                    t => return Err(format!("bad series tag {t}")),
-                };
-                let ok = match &s {
-                    Series::Hermite { x, v, .. } => x.len() == k && v.len() == k,
-                    Series::Linear(y) => y.len() == k,
-                    _ => true,
-                };
-                if !ok {
-                    return Err(format!("a series does not have {k} samples"));
-                }
-                series.push(s);
-            }
-            Some(Arc::new(Solution { config, period, h, omega, k, series, pivots, residual, active_set, warnings }))
-        } else {
-            None
-        };
-        Ok(ContactSnapshot { values, solution, phase_offset, initialized, start_time, out, der })
+    fn deserialize(&self, r: &mut StateReader<'_>) -> Result<ContactSnapshot> {
+        self.read_snapshot(r)
     }
 }
 
 /// Writes `out` (.fmu) for `scene_path`, with the FMU binary `binary`. Returns the GUID.
-pub fn package(scene_path: &Path, binary: &Path, out: &Path) -> Result<String, String> {
-    let text = std::fs::read_to_string(scene_path).map_err(|e| format!("{}: cannot read the scene: {e}", scene_path.display()))?;
+pub fn package(scene_path: &Path, binary: &Path, out: &Path) -> Result<String> {
+    let text = std::fs::read_to_string(scene_path).map_err(|e| Error::io(format!("{}: cannot read the scene: {e}", scene_path.display())))?;
     let model = ContactModel::from_scene_text(&text, &scene_path.display().to_string())?;
-    model.desc.variables.check().map_err(|m| format!("internal error, the variable table is invalid: {m}"))?;
+    model.desc.variables.check().map_err(|e| e.context("internal error, the variable table is invalid"))?;
     let (xml, guid) = crate::fmi::fmi2::xml::render(&model.desc);
-    let so = std::fs::read(binary).map_err(|e| format!("{}: cannot read the FMU binary: {e}", binary.display()))?;
+    let so = std::fs::read(binary).map_err(|e| Error::io(format!("{}: cannot read the FMU binary: {e}", binary.display())))?;
     if !so.starts_with(b"\x7fELF") {
-        return Err(format!("{}: is not an ELF shared library", binary.display()));
+        return Err(Error::input(format!("{}: is not an ELF shared library", binary.display())));
     }
-    let platform = crate::fmi::package::platform().ok_or("this platform has no FMI 2.0 platform folder name")?;
+    let platform = crate::fmi::package::platform().ok_or_else(|| Error::input("this platform has no FMI 2.0 platform folder name"))?;
     let name = scene_path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let entries = vec![
         crate::fmi::package::Entry { name: format!("binaries/{platform}/{MODEL_IDENTIFIER}.so"), data: so, mode: 0o755 },
