@@ -20,7 +20,7 @@
 //!   for `displacement[d]` it is the velocity.
 use crate::error::{Error, Result};
 use crate::fmi::state::{StateReader, StateWriter};
-use crate::fmi::table::{Kind, UnitDefinition, Variability, Variable, VariableTable};
+use crate::fmi::table::{Kind, UnitDefinition};
 use crate::fmi::{CoSimModel, DefaultExperiment, EventLog, ModelDescription};
 pub use crate::periodic::Tuning;
 use crate::periodic::{MAX_STEPS, MIN_STEPS, PeriodFft, PeriodicProblem};
@@ -33,41 +33,15 @@ use std::sync::Arc;
 
 mod series;
 mod state;
+mod variables;
 
 use series::{Series, Solution};
 pub use state::ContactSnapshot;
+use variables::{Quantity, Role, Variables, unique};
 
 pub const MODEL_IDENTIFIER: &str = "PeriodicContact";
 /// The scene inside the FMU's `resources/`.
 pub const SCENE_FILE: &str = "scene.toml";
-
-/// What a value reference stands for.
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Role {
-    Frequency,
-    ForceScale,
-    GapOffset,
-    MotionScale,
-    Steps,
-    Scheme,
-    FrequencyIn,
-    ForceScaleIn,
-    GapOffsetIn,
-    MotionScaleIn,
-    /// Index into the output slots.
-    Output(usize),
-}
-
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Quantity {
-    Displacement(usize),
-    Velocity(usize),
-    Acceleration(usize),
-    Force(usize),
-    Gap(usize),
-    Residual,
-    Pivots,
-}
 
 /// Current parameter and input values.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -134,154 +108,8 @@ impl ContactModel {
         let problem = scene.to_problem(file)?;
         let shown = problem.outputs.clone();
         let model = &problem.model;
-        let (n, m) = (model.n(), model.contacts.len());
-        let has_forces = !model.forces.is_empty();
-        let has_motion = model.contacts.iter().any(|c| !c.motion.is_empty());
-
-        let real = |start: Option<f64>, unit: Option<&str>| Kind::Real { start, unit: unit.map(String::from), min: None, max: None };
-        let mut t = VariableTable::new();
-        let mut roles = Vec::new();
-        let mut add = |t: &mut VariableTable, v: Variable, r: Role| {
-            t.push(v);
-            roles.push(r);
-        };
-        use Variability::*;
-        add(
-            &mut t,
-            Variable::parameter(
-                "frequency",
-                Tunable,
-                real(Some(model.frequency), Some("rad/s")),
-                "Fundamental angular frequency of the excitation and of the obstacle motion; period T = 2*pi/frequency",
-            ),
-            Role::Frequency,
-        );
-        if has_forces {
-            add(&mut t, Variable::parameter("force_scale", Tunable, real(Some(1.0), None), "Multiplies every force amplitude of the scene"), Role::ForceScale);
-        }
-        if m > 0 {
-            add(
-                &mut t,
-                Variable::parameter("gap_offset", Tunable, real(Some(0.0), None), "Added to every static clearance (length unit of the scene)"),
-                Role::GapOffset,
-            );
-        }
-        if has_motion {
-            add(&mut t, Variable::parameter("motion_scale", Tunable, real(Some(1.0), None), "Multiplies every obstacle-motion amplitude"), Role::MotionScale);
-        }
+        let Variables { table: t, roles, outputs } = Variables::of(&problem);
         let k = problem.disc.steps;
-        add(
-            &mut t,
-            Variable::parameter(
-                "steps",
-                Fixed,
-                Kind::Integer { start: Some(k as i32), min: Some(MIN_STEPS as i32), max: None },
-                "Number of instants k per period",
-            ),
-            Role::Steps,
-        );
-        // An Integer rather than an Enumeration: libcosim ignores FMI 2 Enumeration variables.
-        let codes: Vec<String> = Scheme::ALL.iter().map(|s| format!("{} {}", scheme_code(*s), s)).collect();
-        let scheme = Kind::Integer { start: Some(scheme_code(problem.disc.scheme)), min: Some(1), max: Some(Scheme::ALL.len() as i32) };
-        add(&mut t, Variable::parameter("scheme", Fixed, scheme, &format!("Time scheme on the period: {}", codes.join(", "))), Role::Scheme);
-        add(
-            &mut t,
-            Variable::input(
-                "frequency_in",
-                0.0,
-                Some("rad/s"),
-                "Drives the frequency continuously: when > 0 it replaces the parameter frequency; 0 = not driven",
-            ),
-            Role::FrequencyIn,
-        );
-        if has_forces {
-            add(&mut t, Variable::input("force_scale_in", 1.0, None, "Multiplies force_scale (1 = not driven)"), Role::ForceScaleIn);
-        }
-        if m > 0 {
-            add(&mut t, Variable::input("gap_offset_in", 0.0, None, "Added to gap_offset (0 = not driven)"), Role::GapOffsetIn);
-        }
-        if has_motion {
-            add(&mut t, Variable::input("motion_scale_in", 1.0, None, "Multiplies motion_scale (1 = not driven)"), Role::MotionScaleIn);
-        }
-        let mut outputs = Vec::new();
-        let mut out = |t: &mut VariableTable, v: Variable, q: Quantity| {
-            add(t, v, Role::Output(outputs.len()));
-            outputs.push(q);
-        };
-        let unique = |l: &[usize]| {
-            let mut seen = Vec::new();
-            l.iter()
-                .filter(|d| {
-                    if seen.contains(*d) {
-                        false
-                    } else {
-                        seen.push(**d);
-                        true
-                    }
-                })
-                .copied()
-                .collect::<Vec<_>>()
-        };
-        for d in unique(&shown.displacement) {
-            out(
-                &mut t,
-                Variable::output(&format!("displacement[{d}]"), Continuous, real(None, None), &format!("Displacement of DOF {d} (length unit of the scene)")),
-                Quantity::Displacement(d),
-            );
-        }
-        for d in unique(&shown.velocity) {
-            out(
-                &mut t,
-                Variable::output(&format!("velocity[{d}]"), Continuous, real(None, None), &format!("Velocity of DOF {d} (length unit per second)")),
-                Quantity::Velocity(d),
-            );
-        }
-        for d in unique(&shown.acceleration) {
-            out(
-                &mut t,
-                Variable::output(
-                    &format!("acceleration[{d}]"),
-                    Continuous,
-                    real(None, None),
-                    &format!("Acceleration of DOF {d} (length unit per second squared)"),
-                ),
-                Quantity::Acceleration(d),
-            );
-        }
-        if shown.contacts {
-            for (i, c) in model.contacts.iter().enumerate() {
-                out(
-                    &mut t,
-                    Variable::output(
-                        &format!("contact[{i}].force"),
-                        Continuous,
-                        real(None, None),
-                        &format!("Compressive force >= 0 of contact {i} on DOF {} (force unit)", c.dof),
-                    ),
-                    Quantity::Force(i),
-                );
-                out(
-                    &mut t,
-                    Variable::output(
-                        &format!("contact[{i}].gap"),
-                        Continuous,
-                        real(None, None),
-                        &format!("Clearance >= 0 of contact {i} on DOF {} (length unit)", c.dof),
-                    ),
-                    Quantity::Gap(i),
-                );
-            }
-        }
-        // Always present, like the result's `lcp` (size 0, 0 pivots, residual 0 without contact).
-        {
-            out(
-                &mut t,
-                Variable::output("lcp.pivots", Discrete, Kind::Integer { start: None, min: None, max: None }, "Pivots of the last LCP solve"),
-                Quantity::Pivots,
-            );
-            out(&mut t, Variable::output("lcp.residual", Discrete, real(None, None), "Residual max|min(z, Az+q)| of the last LCP solve"), Quantity::Residual);
-        }
-
         let mut base = problem.clone();
         // No rayon inside an FMU: its global pool would outlive the instance and keep the
         // library mapped (notes, rust-crates §faer).
@@ -292,23 +120,10 @@ impl ContactModel {
         base.outputs.velocity = recovered;
 
         let period = model.period();
-        let effects = model.effects().names().join(", ");
         let desc = ModelDescription {
             model_name: MODEL_IDENTIFIER.into(),
             model_identifier: MODEL_IDENTIFIER.into(),
-            description: if m == 0 {
-                format!(
-                    "Steady-state periodic response of a {n}-DOF linear structure without contact (effects: {}), solved over one period ({}, {k} instants); a quasi-steady co-simulation component",
-                    if effects.is_empty() { "none" } else { &effects },
-                    problem.disc.scheme
-                )
-            } else {
-                format!(
-                    "Steady-state periodic response of a {n}-DOF structure with {m} unilateral contact(s) (effects: {}), solved over one period as one LCP ({}, {k} instants); a quasi-steady co-simulation component",
-                    if effects.is_empty() { "none" } else { &effects },
-                    problem.disc.scheme
-                )
-            },
+            description: summary(&problem),
             generation_tool: format!("periodic-contact {}", env!("CARGO_PKG_VERSION")),
             variables: t,
             units: vec![UnitDefinition { name: "rad/s".into(), base: vec![("s", -1), ("rad", 1)] }],
@@ -702,6 +517,26 @@ impl CoSimModel for ContactModel {
 
     fn deserialize(&self, r: &mut StateReader<'_>) -> Result<ContactSnapshot> {
         self.read_snapshot(r)
+    }
+}
+
+/// The model description's one-line summary of the scene.
+fn summary(problem: &PeriodicProblem) -> String {
+    let model = &problem.model;
+    let (n, m, k) = (model.n(), model.contacts.len(), problem.disc.steps);
+    let effects = model.effects().names().join(", ");
+    if m == 0 {
+        format!(
+            "Steady-state periodic response of a {n}-DOF linear structure without contact (effects: {}), solved over one period ({}, {k} instants); a quasi-steady co-simulation component",
+            if effects.is_empty() { "none" } else { &effects },
+            problem.disc.scheme
+        )
+    } else {
+        format!(
+            "Steady-state periodic response of a {n}-DOF structure with {m} unilateral contact(s) (effects: {}), solved over one period as one LCP ({}, {k} instants); a quasi-steady co-simulation component",
+            if effects.is_empty() { "none" } else { &effects },
+            problem.disc.scheme
+        )
     }
 }
 
