@@ -36,7 +36,7 @@ thread_local! {
 }
 
 fn set_error(code: c_int, message: &str) -> c_int {
-    let c = crate::fmi2::logger::to_cstring(message);
+    let c = crate::fmi::fmi2::logger::to_cstring(message);
     LAST_ERROR.with(|e| *e.borrow_mut() = c);
     code
 }
@@ -366,7 +366,7 @@ pub unsafe extern "C" fn pc_problem_solve(p: *mut PcProblem) -> *mut PcResult {
         let warm = (!p.active_set.is_empty()).then_some(p.active_set.as_slice());
         let response = problem.solve_with(p.fft.as_ref().expect("planned"), warm).map_err(solver_error)?;
         p.active_set = response.active_set.clone();
-        let warnings = response.warnings.iter().map(|w| crate::fmi2::logger::to_cstring(w)).collect();
+        let warnings = response.warnings.iter().map(|w| crate::fmi::fmi2::logger::to_cstring(w)).collect();
         Ok(Box::new(PcResult { response, warnings, json: None }))
     })
 }
@@ -542,7 +542,7 @@ pub unsafe extern "C" fn pc_result_json(r: *mut PcResult) -> *const c_char {
         let r = unsafe { r.as_mut() }.ok_or_else(|| arg("the result handle is NULL"))?;
         if r.json.is_none() {
             let text = serde_json::to_string_pretty(&r.response).map_err(|e| (PC_ERROR_INTERNAL, e.to_string()))?;
-            r.json = Some(crate::fmi2::logger::to_cstring(&text));
+            r.json = Some(crate::fmi::fmi2::logger::to_cstring(&text));
         }
         out = r.json.as_ref().expect("set above").as_ptr();
         Ok(())

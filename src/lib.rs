@@ -16,7 +16,7 @@ pub mod exact;
 /// Finite elements: Matrix Market input, DOF clamping, the blade model.
 pub mod fe;
 /// The FMI 2.0 co-simulation shell (knows nothing of contact).
-pub mod fmi2;
+pub mod fmi;
 /// The FMU's physics adapter: a scene as a quasi-steady co-simulation model.
 pub mod fmu_model;
 /// LCP solvers; they know nothing of mechanics.

@@ -2,9 +2,9 @@
 //! allocator around 20 000 steps (and output reads) of the generic shell with the contact model,
 //! for a Hermite (cds) and a trigonometric (fourier) interpolant. One test in this binary, so
 //! no other thread allocates meanwhile.
-use periodic_contact::fmi2::table::BaseType;
-use periodic_contact::fmi2::types::*;
-use periodic_contact::fmi2::{ffi, xml};
+use periodic_contact::fmi::fmi2::types::*;
+use periodic_contact::fmi::fmi2::{ffi, xml};
+use periodic_contact::fmi::table::BaseType;
 use periodic_contact::fmu_model::ContactModel;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::ffi::CString;

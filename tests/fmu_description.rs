@@ -1,8 +1,8 @@
 //! The variable table and modelDescription.xml of the contact model, without the FMU binary:
 //! only the effects a scene calls for have variables; the XML follows the schema's element
 //! order with Outputs and InitialUnknowns consistent; the GUID is derived from the content.
-use periodic_contact::fmi2::table::Causality;
-use periodic_contact::fmi2::xml;
+use periodic_contact::fmi::fmi2::xml;
+use periodic_contact::fmi::table::Causality;
 use periodic_contact::fmu_model::ContactModel;
 use std::collections::BTreeSet;
 
@@ -76,8 +76,8 @@ fn model_description_order_outputs_and_initial_unknowns() {
     // Outputs have no start; parameters and inputs have one.
     for (_, v) in d.variables.iter() {
         let start = match &v.kind {
-            periodic_contact::fmi2::table::Kind::Real { start, .. } => start.is_some(),
-            periodic_contact::fmi2::table::Kind::Integer { start, .. } | periodic_contact::fmi2::table::Kind::Enumeration { start, .. } => start.is_some(),
+            periodic_contact::fmi::table::Kind::Real { start, .. } => start.is_some(),
+            periodic_contact::fmi::table::Kind::Integer { start, .. } | periodic_contact::fmi::table::Kind::Enumeration { start, .. } => start.is_some(),
             _ => unreachable!(),
         };
         assert_eq!(start, v.causality != Causality::Output, "{}", v.name);
@@ -98,5 +98,6 @@ fn the_guid_is_derived_from_the_content() {
 #[test]
 fn invalid_scenes_are_refused_with_the_field() {
     let e = ContactModel::from_scene_text(&BASE.replace("stiffness = [[1.0]]", "stiffness = [[-1.0, 2.0]]"), "bad.toml").err().unwrap();
+    let e = e.to_string();
     assert!(e.contains("bad.toml") && e.contains("stiffness"), "{e}");
 }

@@ -285,6 +285,15 @@ fn fmu_state_get_set_and_serialize_restore_the_run() {
     let mut st3: *mut c_void = std::ptr::null_mut();
     assert_eq!(unsafe { (a.deserialize_fmu_state)(other.c, bytes.as_ptr(), size / 2, &mut st3) }, ERROR);
     assert!(st3.is_null());
+    // A state of another format version is refused by name (bytes 8..10: the format version).
+    let mut old = bytes.clone();
+    old[8] = 1;
+    old[9] = 0;
+    assert_eq!(unsafe { (a.deserialize_fmu_state)(other.c, old.as_ptr(), size, &mut st3) }, ERROR);
+    assert!(st3.is_null());
+    let lines = other.log.all();
+    assert!(lines.iter().any(|l| l.message.contains("fmi2DeSerializeFMUstate") && l.message.contains("truncated")), "{lines:?}");
+    assert!(lines.iter().any(|l| l.status == ERROR && l.message.contains("format version 1 is not readable")), "{lines:?}");
     for (c, p) in [(s.c, &mut st), (other.c, &mut st2)] {
         assert_eq!(unsafe { (a.free_fmu_state)(c, p) }, OK);
         assert!(p.is_null());

@@ -31,7 +31,7 @@ fn find_binary(explicit: Option<&Path>) -> Result<PathBuf, Failure> {
 
 pub fn run(scene: &Path, output: &Path, binary: Option<&Path>) -> Result<(), Failure> {
     let so = find_binary(binary)?;
-    let guid = fmu_model::package(scene, &so, output).map_err(Failure::input)?;
+    let guid = fmu_model::package(scene, &so, output)?;
     eprintln!("packaged {} with {} → {} (GUID {guid})", scene.display(), so.display(), output.display());
     Ok(())
 }

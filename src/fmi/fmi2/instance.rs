@@ -1,9 +1,12 @@
 //! One FMU instance: the state machine of FMI 2.0 co-simulation (notes §1.3) over a model.
-use super::bytes::{ByteReader, ByteWriter};
 use super::logger::{Logger, to_cstring};
-use super::table::{BaseType, Causality, SetPhase};
+use super::machine::*;
 use super::types::*;
-use super::{Fmi2Model, uri, xml};
+use super::xml;
+use crate::error::Error;
+use crate::fmi::state::{StateReader, StateWriter};
+use crate::fmi::table::{BaseType, Causality, SetPhase};
+use crate::fmi::{CoSimModel, describe, uri};
 use std::ffi::{CString, c_char};
 use std::path::PathBuf;
 
@@ -12,78 +15,6 @@ use std::path::PathBuf;
 /// check on entry reads only the first 8 bytes behind a pointer, never past a smaller object.
 pub(crate) const INSTANCE_MAGIC: u64 = 0x5043_464d_4932_494e; // "PCFMI2IN"
 pub(crate) const STATE_MAGIC: u64 = 0x5043_464d_4932_5354; // "PCFMI2ST"
-const SERIAL_HEADER: &[u8; 8] = b"PCFMI2S1";
-
-/// The co-simulation states we can be in (we never return fmi2Pending, so *stepInProgress* and
-/// *stepCanceled* do not occur).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum MachineState {
-    Instantiated,
-    InitializationMode,
-    StepComplete,
-    StepFailed,
-    Terminated,
-    Error,
-}
-
-const INST: u8 = 1;
-const INIT: u8 = 2;
-const COMPLETE: u8 = 4;
-const FAILED: u8 = 8;
-const TERMINATED: u8 = 16;
-const ERROR: u8 = 32;
-const ANY: u8 = INST | INIT | COMPLETE | FAILED | TERMINATED | ERROR;
-
-impl MachineState {
-    fn bit(self) -> u8 {
-        match self {
-            MachineState::Instantiated => INST,
-            MachineState::InitializationMode => INIT,
-            MachineState::StepComplete => COMPLETE,
-            MachineState::StepFailed => FAILED,
-            MachineState::Terminated => TERMINATED,
-            MachineState::Error => ERROR,
-        }
-    }
-    pub fn name(self) -> &'static str {
-        match self {
-            MachineState::Instantiated => "instantiated",
-            MachineState::InitializationMode => "initializationMode",
-            MachineState::StepComplete => "stepComplete",
-            MachineState::StepFailed => "stepFailed",
-            MachineState::Terminated => "terminated",
-            MachineState::Error => "error",
-        }
-    }
-    fn code(self) -> u64 {
-        self.bit().trailing_zeros() as u64
-    }
-    fn from_code(c: u64) -> Option<Self> {
-        [Self::Instantiated, Self::InitializationMode, Self::StepComplete, Self::StepFailed, Self::Terminated, Self::Error].into_iter().find(|s| s.code() == c)
-    }
-}
-
-fn mask_names(mask: u8) -> String {
-    let all = [MachineState::Instantiated, MachineState::InitializationMode, MachineState::StepComplete, MachineState::StepFailed, MachineState::Terminated];
-    all.iter().filter(|s| s.bit() & mask != 0).map(|s| s.name()).collect::<Vec<_>>().join(", ")
-}
-
-/// The shell's part of an FMU state.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Clock {
-    pub state: MachineState,
-    pub time: f64,
-    pub start_time: f64,
-    pub stop_time: Option<f64>,
-    pub last_successful_time: f64,
-    pub terminate_requested: bool,
-}
-
-impl Clock {
-    fn new() -> Self {
-        Clock { state: MachineState::Instantiated, time: 0.0, start_time: 0.0, stop_time: None, last_successful_time: 0.0, terminate_requested: false }
-    }
-}
 
 /// What `fmi2GetFMUstate` hands out (boxed, as an opaque `fmi2FMUstate`). `magic` stays first.
 #[repr(C)]
@@ -94,15 +25,9 @@ pub struct FmuState<S> {
     model: S,
 }
 
-/// Communication points are the master's: accept round-off (fmpy computes start + n·h, ecos
-/// accumulates t += h, Dymola is off by 3e-12), never compare with `==`.
-pub fn same_time(a: f64, b: f64, h: f64) -> bool {
-    (a - b).abs() <= 1e-9 * a.abs().max(b.abs()).max(1.0) + 1e-6 * h.abs()
-}
-
 /// One instance (boxed, as an opaque `fmi2Component`). `magic` stays first.
 #[repr(C)]
-pub struct Instance<M: Fmi2Model> {
+pub struct Instance<M: CoSimModel> {
     pub(crate) magic: u64,
     model: M,
     guid: String,
@@ -113,7 +38,7 @@ pub struct Instance<M: Fmi2Model> {
     resources: Option<PathBuf>,
 }
 
-impl<M: Fmi2Model> Instance<M> {
+impl<M: CoSimModel> Instance<M> {
     /// `fmi2Instantiate`. `None` after logging why (a missing name, the wrong fmuType, a bad
     /// resource location, a model that cannot be built, a missing or wrong GUID).
     pub fn new(name: Option<&str>, fmu_type: i32, guid: Option<&str>, resource_location: Option<&str>, logger: Logger) -> Option<Box<Self>> {
@@ -130,14 +55,14 @@ impl<M: Fmi2Model> Instance<M> {
         }
         let resources = match uri::resource_dir(resource_location) {
             Ok(r) => r,
-            Err(m) => return fail(m),
+            Err(e) => return fail(describe(&e)),
         };
         let model = match M::instantiate(resources.as_deref()) {
             Ok(m) => m,
-            Err(m) => return fail(m),
+            Err(e) => return fail(describe(&e)),
         };
         if let Err(m) = model.description().variables.check() {
-            return fail(format!("the variable table is invalid: {m}"));
+            return fail(format!("the variable table is invalid: {}", describe(&m)));
         }
         let (_, expected) = xml::render(model.description());
         match guid {
@@ -200,8 +125,8 @@ impl<M: Fmi2Model> Instance<M> {
     pub fn set_debug_logging(&mut self, on: bool, categories: &[String]) -> Status {
         match self.logger.set_debug_logging(on, categories) {
             Ok(()) => Status::Ok,
-            Err(m) => {
-                self.logger.error(&format!("fmi2SetDebugLogging: {m}"));
+            Err(e) => {
+                self.logger.error(&format!("fmi2SetDebugLogging: {}", describe(&e)));
                 Status::Error
             }
         }
@@ -214,10 +139,10 @@ impl<M: Fmi2Model> Instance<M> {
         if !start_time.is_finite() {
             return self.fail(&format!("fmi2SetupExperiment: startTime {start_time} is not finite"));
         }
-        if let Some(stop) = stop_time {
-            if stop.is_nan() || stop < start_time {
-                return self.fail(&format!("fmi2SetupExperiment: stopTime {stop} is before startTime {start_time}"));
-            }
+        if let Some(stop) = stop_time
+            && (stop.is_nan() || stop < start_time)
+        {
+            return self.fail(&format!("fmi2SetupExperiment: stopTime {stop} is before startTime {start_time}"));
         }
         if let Some(t) = tolerance {
             self.logger.event(&format!("fmi2SetupExperiment: tolerance {t} is not used (the periodic solve is direct)"));
@@ -252,7 +177,7 @@ impl<M: Fmi2Model> Instance<M> {
                 }
                 if warnings.is_empty() { Status::Ok } else { Status::Warning }
             }
-            Err(m) => self.fail(&format!("fmi2ExitInitializationMode: {m}")),
+            Err(e) => self.fail(&format!("fmi2ExitInitializationMode: {}", describe(&e))),
         }
     }
 
@@ -274,17 +199,17 @@ impl<M: Fmi2Model> Instance<M> {
     }
 
     /// Checks a whole get call's references up front, then reads.
-    fn get<T>(&mut self, f: &str, ty: BaseType, vrs: &[Fmi2ValueReference], out: &mut [T], read: impl Fn(&mut M, u32) -> Result<T, String>) -> Status {
+    fn get<T>(&mut self, f: &str, ty: BaseType, vrs: &[Fmi2ValueReference], out: &mut [T], read: impl Fn(&mut M, u32) -> crate::error::Result<T>) -> Status {
         if let Err(s) = self.allow(f, INIT | COMPLETE | FAILED | TERMINATED | ERROR) {
             return s;
         }
         for (vr, slot) in vrs.iter().zip(out.iter_mut()) {
             if let Err(m) = self.model.description().variables.lookup(*vr, ty) {
-                return self.fail(&format!("{f}: {m}"));
+                return self.fail(&format!("{f}: {}", describe(&m)));
             }
             match read(&mut self.model, *vr) {
                 Ok(v) => *slot = v,
-                Err(m) => return self.fail(&format!("{f}: {m}")),
+                Err(e) => return self.fail(&format!("{f}: {}", describe(&e))),
             }
         }
         Status::Ok
@@ -296,7 +221,7 @@ impl<M: Fmi2Model> Instance<M> {
         ty: BaseType,
         vrs: &[Fmi2ValueReference],
         values: &[T],
-        write: impl Fn(&mut M, u32, T) -> Result<(), String>,
+        write: impl Fn(&mut M, u32, T) -> crate::error::Result<()>,
     ) -> Status {
         if let Err(s) = self.allow(f, INST | INIT | COMPLETE) {
             return s;
@@ -308,10 +233,10 @@ impl<M: Fmi2Model> Instance<M> {
         };
         for (vr, v) in vrs.iter().zip(values) {
             if let Err(m) = self.model.description().variables.check_settable(*vr, ty, phase) {
-                return self.fail(&format!("{f}: {m}"));
+                return self.fail(&format!("{f}: {}", describe(&m)));
             }
             if let Err(m) = write(&mut self.model, *vr, *v) {
-                return self.fail(&format!("{f}: {m}"));
+                return self.fail(&format!("{f}: {}", describe(&m)));
             }
         }
         Status::Ok
@@ -393,45 +318,27 @@ impl<M: Fmi2Model> Instance<M> {
     }
 
     pub fn serialize_fmu_state(&self, state: &FmuState<M::Snapshot>) -> Vec<u8> {
-        let mut w = ByteWriter::default();
-        w.buf.extend_from_slice(SERIAL_HEADER);
+        let mut w = StateWriter::new(M::STATE_VERSION);
         w.str(&state.guid);
-        let c = &state.clock;
-        w.u64(c.state.code());
-        w.f64(c.time);
-        w.f64(c.start_time);
-        w.bool(c.stop_time.is_some());
-        w.f64(c.stop_time.unwrap_or(0.0));
-        w.f64(c.last_successful_time);
-        w.bool(c.terminate_requested);
+        state.clock.write(&mut w);
         M::serialize(&state.model, &mut w);
-        w.buf
+        w.into_bytes()
     }
 
     pub fn deserialize_fmu_state(&mut self, bytes: &[u8]) -> Result<Box<FmuState<M::Snapshot>>, Status> {
         self.allow("fmi2DeSerializeFMUstate", Self::STATE_FNS)?;
-        let parsed = (|| -> Result<FmuState<M::Snapshot>, String> {
-            if bytes.len() < SERIAL_HEADER.len() || &bytes[..SERIAL_HEADER.len()] != SERIAL_HEADER {
-                return Err("the bytes are not a serialized state of this FMU (bad header)".into());
-            }
-            let mut r = ByteReader::new(&bytes[SERIAL_HEADER.len()..]);
+        let parsed = (|| -> crate::error::Result<FmuState<M::Snapshot>> {
+            let mut r = StateReader::new(bytes, M::STATE_VERSION)?;
             let guid = r.str()?;
             if guid != self.guid {
-                return Err(format!("the state belongs to a model with GUID {guid}, this instance has {}", self.guid));
+                return Err(Error::input(format!("the state belongs to a model with GUID {guid}, this instance has {}", self.guid)));
             }
-            let state = MachineState::from_code(r.u64()?).ok_or("bad machine state code")?;
-            let time = r.f64()?;
-            let start_time = r.f64()?;
-            let has_stop = r.bool()?;
-            let stop = r.f64()?;
-            let last_successful_time = r.f64()?;
-            let terminate_requested = r.bool()?;
+            let clock = Clock::read(&mut r)?;
             let model = self.model.deserialize(&mut r)?;
             r.finish()?;
-            let clock = Clock { state, time, start_time, stop_time: has_stop.then_some(stop), last_successful_time, terminate_requested };
             Ok(FmuState { magic: STATE_MAGIC, guid, clock, model })
         })();
-        parsed.map(Box::new).map_err(|m| self.fail(&format!("fmi2DeSerializeFMUstate: {m}")))
+        parsed.map(Box::new).map_err(|e| self.fail(&format!("fmi2DeSerializeFMUstate: {}", describe(&e))))
     }
 
     // --- co-simulation --------------------------------------------------------------------
@@ -447,10 +354,11 @@ impl<M: Fmi2Model> Instance<M> {
             return self
                 .fail(&format!("fmi2DoStep: currentCommunicationPoint {t} does not match the FMU's time {} (the end of the previous step)", self.clock.time));
         }
-        if let Some(stop) = self.clock.stop_time {
-            if t + h > stop && !same_time(t + h, stop, h) {
-                return self.fail(&format!("fmi2DoStep: the step to {} goes beyond stopTime {stop}", t + h));
-            }
+        if let Some(stop) = self.clock.stop_time
+            && t + h > stop
+            && !same_time(t + h, stop, h)
+        {
+            return self.fail(&format!("fmi2DoStep: the step to {} goes beyond stopTime {stop}", t + h));
         }
         match self.model.do_step(t, h, &self.logger) {
             Ok(()) => {
@@ -458,8 +366,8 @@ impl<M: Fmi2Model> Instance<M> {
                 self.clock.last_successful_time = t + h;
                 Status::Ok
             }
-            Err(m) => {
-                self.logger.discard(&format!("fmi2DoStep at t = {t}: {m}; the step was not taken (fmi2Terminated is true)"));
+            Err(e) => {
+                self.logger.discard(&format!("fmi2DoStep at t = {t}: {}; the step was not taken (fmi2Terminated is true)", describe(&e)));
                 self.clock.state = MachineState::StepFailed;
                 self.clock.time = t;
                 self.clock.last_successful_time = t;
@@ -478,7 +386,7 @@ impl<M: Fmi2Model> Instance<M> {
         for ((vr, order), slot) in vrs.iter().zip(orders).zip(out.iter_mut()) {
             let v = match self.model.description().variables.lookup(*vr, BaseType::Real) {
                 Ok(v) => v,
-                Err(m) => return self.fail(&format!("{f}: {m}")),
+                Err(e) => return self.fail(&format!("{f}: {}", describe(&e))),
             };
             if v.causality != Causality::Output {
                 let m = format!("{f}: {} (value reference {vr}) is not an output", v.name);
@@ -489,7 +397,7 @@ impl<M: Fmi2Model> Instance<M> {
             }
             match self.model.output_derivative(*vr, *order) {
                 Ok(d) => *slot = d,
-                Err(m) => return self.fail(&format!("{f}: {m}")),
+                Err(e) => return self.fail(&format!("{f}: {}", describe(&e))),
             }
         }
         Status::Ok

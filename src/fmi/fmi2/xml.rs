@@ -2,16 +2,16 @@
 //! element order: CoSimulation, UnitDefinitions, TypeDefinitions, LogCategories,
 //! DefaultExperiment, ModelVariables, ModelStructure (Outputs, InitialUnknowns).
 //! The GUID is the content hash of the document rendered with an empty guid.
-use super::ModelDescription;
 use super::logger::CATEGORIES;
-use super::table::Kind;
+use crate::fmi::ModelDescription;
+use crate::fmi::table::Kind;
 use quick_xml::Writer;
 use quick_xml::events::{BytesDecl, Event};
 use std::io;
 
 /// The document and its GUID.
 pub fn render(md: &ModelDescription) -> (String, String) {
-    let guid = super::guid::from_content(write(md, "").as_bytes());
+    let guid = crate::fmi::guid::from_content(write(md, "").as_bytes());
     (write(md, &guid), guid)
 }
 
@@ -206,8 +206,8 @@ fn type_element(w: &mut Writer<Vec<u8>>, kind: &Kind) -> io::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fmi2::DefaultExperiment;
-    use crate::fmi2::table::*;
+    use crate::fmi::DefaultExperiment;
+    use crate::fmi::table::*;
 
     fn description() -> ModelDescription {
         let mut t = VariableTable::new();
@@ -258,7 +258,7 @@ mod tests {
         assert!(doc.contains(&format!("guid=\"{guid}\"")));
         // Deterministic, and the guid is the hash of the document with an empty guid.
         assert_eq!(render(&description()), (doc.clone(), guid.clone()));
-        assert_eq!(guid, crate::fmi2::guid::from_content(doc.replace(&guid, "").as_bytes()));
+        assert_eq!(guid, crate::fmi::guid::from_content(doc.replace(&guid, "").as_bytes()));
     }
 
     #[test]

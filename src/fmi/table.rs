@@ -2,6 +2,7 @@
 //! exists, its type, where it may be set) and for `modelDescription.xml`.
 //!
 //! Value references are the positions in the table (0, 1, 2, …), so a lookup is an index.
+use crate::error::{Error, Result};
 use std::collections::HashSet;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -232,16 +233,16 @@ impl VariableTable {
     }
 
     /// The variable `vr` of base type `ty`, or why not.
-    pub fn lookup(&self, vr: u32, ty: BaseType) -> Result<&Variable, String> {
-        let v = self.get(vr).ok_or_else(|| format!("unknown value reference {vr} (this FMU has value references 0..{})", self.len()))?;
+    pub fn lookup(&self, vr: u32, ty: BaseType) -> Result<&Variable> {
+        let v = self.get(vr).ok_or_else(|| Error::input(format!("unknown value reference {vr} (this FMU has value references 0..{})", self.len())))?;
         if v.kind.base() != ty {
-            return Err(format!("value reference {vr} ({}) is a {} variable, not {}", v.name, v.kind.base().name(), ty.name()));
+            return Err(Error::input(format!("value reference {vr} ({}) is a {} variable, not {}", v.name, v.kind.base().name(), ty.name())));
         }
         Ok(v)
     }
 
     /// Whether `vr` may be set in `phase` (FMI 2.0 §2.2.7, the rule fmpy follows).
-    pub fn check_settable(&self, vr: u32, ty: BaseType, phase: SetPhase) -> Result<(), String> {
+    pub fn check_settable(&self, vr: u32, ty: BaseType, phase: SetPhase) -> Result<()> {
         let v = self.lookup(vr, ty)?;
         let init = v.effective_initial();
         let ok = match phase {
@@ -257,20 +258,20 @@ impl VariableTable {
             SetPhase::InitializationMode => "in initialisation mode",
             SetPhase::Simulation => "after initialisation (only inputs and tunable parameters can)",
         };
-        Err(format!("{} (causality {}, variability {}) cannot be set {when}", v.name, v.causality.name(), v.variability.name()))
+        Err(Error::input(format!("{} (causality {}, variability {}) cannot be set {when}", v.name, v.causality.name(), v.variability.name())))
     }
 
     /// Checks the table against the FMI 2.0 rules that the XML schema and fmpy enforce: unique
     /// names, legal (causality, variability, initial) combinations, start values where required
     /// and only there.
-    pub fn check(&self) -> Result<(), String> {
+    pub fn check(&self) -> Result<()> {
         let mut names = HashSet::new();
         for (vr, v) in self.iter() {
             if !names.insert(v.name.as_str()) {
-                return Err(format!("variable name {} is used twice", v.name));
+                return Err(Error::input(format!("variable name {} is used twice", v.name)));
             }
             if !is_structured_name(&v.name) {
-                return Err(format!("variable name {} does not follow the structured naming convention", v.name));
+                return Err(Error::input(format!("variable name {} does not follow the structured naming convention", v.name)));
             }
             use Causality::*;
             use Variability::*;
@@ -279,22 +280,27 @@ impl VariableTable {
                 (Parameter | CalculatedParameter, Fixed | Tunable) | (Input, Discrete | Continuous) | (Output | Local, _) | (Independent, Continuous)
             );
             if !legal {
-                return Err(format!("{} (vr {vr}): causality {} with variability {} is not allowed", v.name, v.causality.name(), v.variability.name()));
+                return Err(Error::input(format!(
+                    "{} (vr {vr}): causality {} with variability {} is not allowed",
+                    v.name,
+                    v.causality.name(),
+                    v.variability.name()
+                )));
             }
             if v.variability == Continuous && v.kind.base() != BaseType::Real {
-                return Err(format!("{}: only Real variables can be continuous", v.name));
+                return Err(Error::input(format!("{}: only Real variables can be continuous", v.name)));
             }
             let init = v.effective_initial();
             let needs_start = v.causality == Input || v.causality == Parameter || matches!(init, Some(Initial::Exact | Initial::Approx));
             let forbids_start = v.causality == Independent || init == Some(Initial::Calculated);
             if needs_start && !v.kind.has_start() {
-                return Err(format!("{}: a start value is required", v.name));
+                return Err(Error::input(format!("{}: a start value is required", v.name)));
             }
             if forbids_start && v.kind.has_start() {
-                return Err(format!("{}: a start value is not allowed (initial calculated)", v.name));
+                return Err(Error::input(format!("{}: a start value is not allowed (initial calculated)", v.name)));
             }
             if v.causality == Input && v.initial.is_some() {
-                return Err(format!("{}: an input takes no initial attribute", v.name));
+                return Err(Error::input(format!("{}: an input takes no initial attribute", v.name)));
             }
         }
         Ok(())
@@ -343,22 +349,22 @@ mod tests {
         }
         assert!(t.check_settable(0, BaseType::Real, SetPhase::Simulation).is_ok());
         let e = t.check_settable(1, BaseType::Integer, SetPhase::Simulation).unwrap_err();
-        assert!(e.contains("n (causality parameter, variability fixed) cannot be set after initialisation"), "{e}");
+        assert!(e.message().contains("n (causality parameter, variability fixed) cannot be set after initialisation"), "{e}");
         assert!(t.check_settable(2, BaseType::Real, SetPhase::Simulation).is_ok());
         assert!(t.check_settable(3, BaseType::Real, SetPhase::Simulation).is_err());
         assert!(t.check_settable(3, BaseType::Real, SetPhase::Instantiated).is_err());
-        assert!(t.check_settable(9, BaseType::Real, SetPhase::Instantiated).unwrap_err().contains("unknown value reference 9"));
-        assert!(t.check_settable(0, BaseType::Integer, SetPhase::Instantiated).unwrap_err().contains("is a Real variable"));
+        assert!(t.check_settable(9, BaseType::Real, SetPhase::Instantiated).unwrap_err().message().contains("unknown value reference 9"));
+        assert!(t.check_settable(0, BaseType::Integer, SetPhase::Instantiated).unwrap_err().message().contains("is a Real variable"));
     }
 
     #[test]
     fn check_refuses_illegal_tables() {
         let mut t = table();
         t.push(Variable::output("y[0]", Variability::Continuous, Kind::Real { start: None, unit: None, min: None, max: None }, ""));
-        assert!(t.check().unwrap_err().contains("used twice"));
+        assert!(t.check().unwrap_err().message().contains("used twice"));
         let mut t = table();
         t.push(Variable::output("z", Variability::Continuous, Kind::Real { start: Some(0.0), unit: None, min: None, max: None }, ""));
-        assert!(t.check().unwrap_err().contains("not allowed"));
+        assert!(t.check().unwrap_err().message().contains("not allowed"));
         let mut t = table();
         t.push(Variable::parameter("q", Variability::Continuous, Kind::Real { start: Some(0.0), unit: None, min: None, max: None }, ""));
         assert!(t.check().is_err());

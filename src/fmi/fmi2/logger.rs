@@ -1,6 +1,7 @@
 //! Logging through the importer's callback: always with the format `"%s"` (a `%` in a message is
 //! never a directive), the copied instance name, and the importer's componentEnvironment.
 use super::types::{Fmi2CallbackLogger, Fmi2ComponentEnvironment, Status};
+use crate::error::{Error, Result};
 use std::ffi::CString;
 
 /// The log categories declared in `<LogCategories>`: `(name, description)`.
@@ -66,10 +67,10 @@ impl Logger {
     }
 
     /// `fmi2SetDebugLogging`: `categories` empty = all. Unknown names are refused (nothing changes).
-    pub fn set_debug_logging(&mut self, on: bool, categories: &[String]) -> Result<(), String> {
+    pub fn set_debug_logging(&mut self, on: bool, categories: &[String]) -> Result<()> {
         if let Some(bad) = categories.iter().find(|c| !CATEGORIES.iter().any(|(n, _)| n == c)) {
             let known: Vec<&str> = CATEGORIES.iter().map(|(n, _)| *n).collect();
-            return Err(format!("unknown log category \"{bad}\"; known: {}", known.join(", ")));
+            return Err(Error::input(format!("unknown log category \"{bad}\"; known: {}", known.join(", "))));
         }
         self.logging_on = on;
         if categories.is_empty() || categories.iter().any(|c| c == "logAll") {
@@ -118,4 +119,13 @@ impl Logger {
 /// A C string of `s`, with interior NULs shown as `\0`.
 pub fn to_cstring(s: &str) -> CString {
     CString::new(s.replace('\0', "\\0")).expect("no interior NUL left")
+}
+
+impl crate::fmi::EventLog for Logger {
+    fn events_enabled(&self) -> bool {
+        self.enabled(Category::Events)
+    }
+    fn event(&self, message: &str) {
+        self.log(Category::Events, message)
+    }
 }

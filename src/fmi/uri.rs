@@ -3,10 +3,11 @@
 //! Accepted: `file:/abs`, `file:///abs`, `file:////abs` (fmi4cpp/ecos), `file://localhost/abs`,
 //! percent-encoding (`%20`, UTF-8 bytes), and a bare absolute path (non-conforming importers).
 //! NULL or `""` means "no resources". Nothing is chopped by a fixed count of characters.
+use crate::error::{Error, Result};
 use std::path::PathBuf;
 
 /// The folder named by `uri`, `Ok(None)` when the importer gave none.
-pub fn resource_dir(uri: Option<&str>) -> Result<Option<PathBuf>, String> {
+pub fn resource_dir(uri: Option<&str>) -> Result<Option<PathBuf>> {
     let Some(uri) = uri else { return Ok(None) };
     let uri = uri.trim();
     if uri.is_empty() {
@@ -21,22 +22,22 @@ pub fn resource_dir(uri: Option<&str>) -> Result<Option<PathBuf>, String> {
             let end = after.find('/').unwrap_or(after.len());
             let host = &after[..end];
             if !(host.is_empty() || host.eq_ignore_ascii_case("localhost")) {
-                return Err(format!("resource location {uri}: the host \"{host}\" is not this machine; only local file URIs are supported"));
+                return Err(Error::input(format!("resource location {uri}: the host \"{host}\" is not this machine; only local file URIs are supported")));
             }
             &after[end..]
         } else {
             rest
         };
         if !path.starts_with('/') {
-            return Err(format!("resource location {uri}: a file URI must hold an absolute path"));
+            return Err(Error::input(format!("resource location {uri}: a file URI must hold an absolute path")));
         }
         percent_decode(path)
     } else if uri.starts_with('/') {
         uri.as_bytes().to_vec()
     } else if let Some(i) = uri.find(':') {
-        return Err(format!("resource location {uri}: the scheme \"{}\" is not supported, only file:", &uri[..i]));
+        return Err(Error::input(format!("resource location {uri}: the scheme \"{}\" is not supported, only file:", &uri[..i])));
     } else {
-        return Err(format!("resource location {uri}: not a file URI and not an absolute path"));
+        return Err(Error::input(format!("resource location {uri}: not a file URI and not an absolute path")));
     };
     // Collapse repeated leading slashes (file:////tmp → /tmp).
     let start = path.iter().take_while(|&&b| b == b'/').count();
@@ -50,12 +51,13 @@ fn percent_decode(s: &str) -> Vec<u8> {
     let mut out = Vec::with_capacity(b.len());
     let mut i = 0;
     while i < b.len() {
-        if b[i] == b'%' && i + 2 < b.len() {
-            if let (Some(h), Some(l)) = (hex(b[i + 1]), hex(b[i + 2])) {
-                out.push(h * 16 + l);
-                i += 3;
-                continue;
-            }
+        if b[i] == b'%'
+            && i + 2 < b.len()
+            && let (Some(h), Some(l)) = (hex(b[i + 1]), hex(b[i + 2]))
+        {
+            out.push(h * 16 + l);
+            i += 3;
+            continue;
         }
         out.push(b[i]);
         i += 1;
@@ -125,9 +127,9 @@ mod tests {
 
     #[test]
     fn refused_forms_say_why() {
-        assert!(resource_dir(Some("file://server/share")).unwrap_err().contains("host \"server\""));
-        assert!(resource_dir(Some("http://example.com/r")).unwrap_err().contains("scheme \"http\""));
-        assert!(resource_dir(Some("file:relative/path")).unwrap_err().contains("absolute"));
-        assert!(resource_dir(Some("relative/path")).unwrap_err().contains("not a file URI"));
+        assert!(resource_dir(Some("file://server/share")).unwrap_err().message().contains("host \"server\""));
+        assert!(resource_dir(Some("http://example.com/r")).unwrap_err().message().contains("scheme \"http\""));
+        assert!(resource_dir(Some("file:relative/path")).unwrap_err().message().contains("absolute"));
+        assert!(resource_dir(Some("relative/path")).unwrap_err().message().contains("not a file URI"));
     }
 }
