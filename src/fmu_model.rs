@@ -230,8 +230,8 @@ impl ContactModel {
     pub fn from_scene_text(text: &str, file: &str) -> Result<Self, String> {
         let scene = Scene::parse(text, file).map_err(|e| e.to_string())?;
         let problem = scene.to_problem(file).map_err(|e| e.to_string())?;
-        let shown = problem.outputs.clone();
-        let model = &problem.model;
+        let shown = problem.outputs().clone();
+        let model = problem.model();
         let (n, m) = (model.n(), model.contacts.len());
         let has_forces = !model.forces.is_empty();
         let has_motion = model.contacts.iter().any(|c| !c.motion.is_empty());
@@ -267,7 +267,7 @@ impl ContactModel {
         if has_motion {
             add(&mut t, Variable::parameter("motion_scale", Tunable, real(Some(1.0), None), "Multiplies every obstacle-motion amplitude"), Role::MotionScale);
         }
-        let k = problem.disc.steps;
+        let k = problem.discretization().steps;
         add(
             &mut t,
             Variable::parameter(
@@ -280,7 +280,7 @@ impl ContactModel {
         );
         // An Integer rather than an Enumeration: libcosim ignores FMI 2 Enumeration variables.
         let codes: Vec<String> = Scheme::ALL.iter().map(|s| format!("{} {}", scheme_code(*s), s)).collect();
-        let scheme = Kind::Integer { start: Some(scheme_code(problem.disc.scheme)), min: Some(1), max: Some(Scheme::ALL.len() as i32) };
+        let scheme = Kind::Integer { start: Some(scheme_code(problem.discretization().scheme)), min: Some(1), max: Some(Scheme::ALL.len() as i32) };
         add(&mut t, Variable::parameter("scheme", Fixed, scheme, &format!("Time scheme on the period: {}", codes.join(", "))), Role::Scheme);
         add(
             &mut t,
@@ -383,11 +383,13 @@ impl ContactModel {
         let mut base = problem.clone();
         // No rayon inside an FMU: its global pool would outlive the instance and keep the
         // library mapped (notes, rust-crates §faer).
-        base.solver.parallel = false;
+        base.set_parallel(false);
         let mut recovered = unique(&[shown.displacement.clone(), shown.velocity.clone()].concat());
         recovered.sort_unstable();
-        base.outputs.displacement = recovered.clone();
-        base.outputs.velocity = recovered;
+        let mut selection = base.outputs().clone();
+        selection.displacement = recovered.clone();
+        selection.velocity = recovered;
+        base.set_outputs(selection).map_err(|e| e.to_string())?;
 
         let period = model.period();
         let effects = model.effects().names().join(", ");
@@ -398,13 +400,13 @@ impl ContactModel {
                 format!(
                     "Steady-state periodic response of a {n}-DOF linear structure without contact (effects: {}), solved over one period ({}, {k} instants); a quasi-steady co-simulation component",
                     if effects.is_empty() { "none" } else { &effects },
-                    problem.disc.scheme
+                    problem.discretization().scheme
                 )
             } else {
                 format!(
                     "Steady-state periodic response of a {n}-DOF structure with {m} unilateral contact(s) (effects: {}), solved over one period as one LCP ({}, {k} instants); a quasi-steady co-simulation component",
                     if effects.is_empty() { "none" } else { &effects },
-                    problem.disc.scheme
+                    problem.discretization().scheme
                 )
             },
             generation_tool: format!("periodic-contact {}", env!("CARGO_PKG_VERSION")),
@@ -416,7 +418,7 @@ impl ContactModel {
         };
         let scene_tuning = Tuning::of(&problem);
         let neutral = Tuning { frequency: 0.0, force_scale: 1.0, gap_offset: 0.0, motion_scale: 1.0 };
-        let start = Values { params: scene_tuning, inputs: neutral, steps: k, scheme: problem.disc.scheme };
+        let start = Values { params: scene_tuning, inputs: neutral, steps: k, scheme: problem.discretization().scheme };
         let nout = outputs.len();
         Ok(ContactModel {
             desc,
@@ -447,7 +449,7 @@ impl ContactModel {
 
     /// Solves `cfg`, warm-started from the current solution when the grid is the same.
     fn solve(&mut self, cfg: Config) -> Result<Solution, String> {
-        let disc = Discretization { scheme: cfg.scheme, steps: cfg.steps, pairing: self.base.disc.pairing };
+        let disc = Discretization { scheme: cfg.scheme, steps: cfg.steps, pairing: self.base.discretization().pairing };
         let problem = cfg.tuning.apply(&self.base, disc).map_err(|e| e.to_string())?;
         if self.fft.as_ref().is_none_or(|f| f.k() != cfg.steps) {
             self.fft = Some(PeriodFft::new(cfg.steps));
@@ -459,7 +461,7 @@ impl ContactModel {
     }
 
     fn solution_of(&self, config: Config, problem: &PeriodicProblem, r: &Response, fft: &PeriodFft) -> Solution {
-        let omega = problem.model.frequency;
+        let omega = problem.model().frequency;
         let fourier = config.scheme == Scheme::Fourier;
         let key = |d: usize| d.to_string();
         let series = self

@@ -246,7 +246,7 @@ fn periodic_point(
         }
     };
     let fft = PeriodFft::new(k);
-    row.lcp_size = if case.has_contact() { k * problem.model.contacts.len() } else { 0 };
+    row.lcp_size = if case.has_contact() { k * problem.model().contacts.len() } else { 0 };
     if let Some(dir) = &settings.export_lcp {
         if case.has_contact() && row.lcp_size <= settings.export_max {
             let (a, q) = problem.assemble_lcp(&fft).map_err(|e| e.to_string())?;

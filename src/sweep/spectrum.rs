@@ -37,7 +37,7 @@ pub fn spectrum(problem: &PeriodicProblem, response: &Response, max_harmonic: us
         v
     };
     let displacement = problem
-        .outputs
+        .outputs()
         .displacement
         .iter()
         .filter_map(|d| response.displacement.get(&d.to_string()).map(|s| (*d, cut(harmonic_amplitudes(&fft, s)))))
