@@ -11,6 +11,7 @@
 //! the resonance): a warm-started chunk follows the branch it starts on, and each chunk starts
 //! cold. For a strictly sequential continuation in the direction of the sweep, use one thread
 //! and one chunk (`--threads 1 --chunks-per-thread 1`).
+#[cfg(feature = "reference")]
 pub mod marching;
 pub mod spectrum;
 
