@@ -11,7 +11,7 @@ pub fn harmonic_amplitudes(fft: &PeriodFft, series: &[f64]) -> Vec<f64> {
     spec.iter()
         .enumerate()
         .map(|(p, v)| {
-            let twice = p != 0 && !(k % 2 == 0 && p == k / 2);
+            let twice = p != 0 && !(k.is_multiple_of(2) && p == k / 2);
             v.norm() * if twice { 2.0 } else { 1.0 } / k as f64
         })
         .collect()
