@@ -232,7 +232,7 @@ pub fn plot_frc(
     points: &[SweepPoint],
     i: usize,
     title: &str,
-) -> Result<(), String> {
+) -> Result<(), crate::Error> {
     use crate::plot::{Chart, Scale, Series, line_chart};
     let d = problem.outputs().displacement[i];
     let pts = |lin: bool| -> Vec<(f64, f64)> {
@@ -248,5 +248,5 @@ pub fn plot_frc(
     };
     let y_label = format!("amplitude of DOF {d} (peak-to-peak / 2)");
     let chart = Chart { title, x_label, y_label: &y_label, x_scale: Scale::Linear, y_scale: Scale::Linear };
-    line_chart(path, &chart, &series, 1000, 650)
+    line_chart(path, &chart, &series, 1000, 650).map_err(|e| crate::Error::io(format!("{}: {e}", path.display())))
 }

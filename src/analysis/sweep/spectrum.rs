@@ -74,7 +74,7 @@ pub fn to_csv(param: &str, values: &[f64], spectra: &[Spectrum]) -> String {
 /// PNG of one spectrum: each series relative to its largest harmonic (log scale), the first
 /// displacement output and every contact force.
 #[cfg(feature = "plots")]
-pub fn plot(path: &std::path::Path, sp: &Spectrum, title: &str) -> Result<(), String> {
+pub fn plot(path: &std::path::Path, sp: &Spectrum, title: &str) -> Result<(), crate::Error> {
     use crate::plot::{Chart, Scale, Series, line_chart};
     let rel = |a: &[f64]| -> (f64, Vec<(f64, f64)>) {
         let max = a.iter().copied().fold(0.0, f64::max);
@@ -91,5 +91,5 @@ pub fn plot(path: &std::path::Path, sp: &Spectrum, title: &str) -> Result<(), St
         series.push(Series { label: format!("force of contact {i} on DOF {d} (largest {max:.3e})"), points, markers: true });
     }
     let chart = Chart { title, x_label: "harmonic p of ω", y_label: "amplitude / largest harmonic", x_scale: Scale::Linear, y_scale: Scale::Log };
-    line_chart(path, &chart, &series, 1000, 650)
+    line_chart(path, &chart, &series, 1000, 650).map_err(|e| crate::Error::io(format!("{}: {e}", path.display())))
 }

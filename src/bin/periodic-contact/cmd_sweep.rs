@@ -146,7 +146,7 @@ pub fn run(a: &Args) -> Result<(), Failure> {
         for (i, d) in problem.outputs().displacement.iter().enumerate() {
             // The first output's curve is <csv stem>.png, the others <csv stem>-dof<d>.png.
             let png = if i == 0 { sibling(&a.output, "", "png") } else { sibling(&a.output, &format!("-dof{d}"), "png") };
-            sweep::plot_frc(&png, &a.param, &values, problem, &points, i, &format!("{stem}: frequency response")).map_err(Failure::solver)?;
+            sweep::plot_frc(&png, &a.param, &values, problem, &points, i, &format!("{stem}: frequency response")).map_err(Failure::from)?;
             eprintln!("frequency-response curve of DOF {d} → {}", png.display());
         }
     }
@@ -168,7 +168,7 @@ pub fn run(a: &Args) -> Result<(), Failure> {
             #[cfg(feature = "plots")]
             if !a.no_plot {
                 let png = sibling(&a.output, &format!("-spectrum-{v}"), "png");
-                sweep::spectrum::plot(&png, &sp, &format!("spectrum at {} = {v} (ω = {f:.4} rad/s)", a.param)).map_err(Failure::solver)?;
+                sweep::spectrum::plot(&png, &sp, &format!("spectrum at {} = {v} (ω = {f:.4} rad/s)", a.param)).map_err(Failure::from)?;
                 eprintln!("spectrum at {} = {v} → {}", a.param, png.display());
             }
             spectra.push(sp);
