@@ -11,7 +11,7 @@
 //! different threads.
 use crate::model::{Compliance, Contact, Force, Harmonic, Matrix, Model, Structure};
 use crate::periodic::Tuning;
-use crate::periodic::{OutputSelection, PeriodFft, PeriodicProblem, SolveError, SolverSettings};
+use crate::periodic::{OutputSelection, PeriodicProblem, PeriodicSolver, SolveError, SolverSettings};
 use crate::response::Response;
 use crate::scene::Scene;
 use crate::time::{Discretization, Pairing, Scheme};
@@ -36,7 +36,7 @@ thread_local! {
 }
 
 fn set_error(code: c_int, message: &str) -> c_int {
-    let c = crate::fmi::fmi2::logger::to_cstring(message);
+    let c = to_cstring(message);
     LAST_ERROR.with(|e| *e.borrow_mut() = c);
     code
 }
@@ -105,8 +105,8 @@ unsafe fn slice<'a, T>(p: *const T, n: usize, what: &str) -> Result<&'a [T], (c_
 pub struct PcProblem {
     base: PeriodicProblem,
     tuning: Tuning,
-    fft: Option<PeriodFft>,
-    active_set: Vec<usize>,
+    /// Built at the first solve.
+    session: Option<PeriodicSolver>,
 }
 
 /// An opaque result handle.
@@ -118,14 +118,16 @@ pub struct PcResult {
 
 impl PcProblem {
     fn new(base: PeriodicProblem) -> Box<Self> {
-        Box::new(PcProblem { tuning: Tuning::of(&base), base, fft: None, active_set: Vec::new() })
+        Box::new(PcProblem { tuning: Tuning::of(&base), base, session: None })
     }
     /// Rebuilds the base problem after an edit, keeping the old one if the edit is invalid.
     fn edit(&mut self, f: impl FnOnce(&mut Model, &mut OutputSelection)) -> Result<(), (c_int, String)> {
-        let mut model = self.base.model.clone();
-        let mut outputs = self.base.outputs.clone();
+        let mut model = self.base.model().clone();
+        let mut outputs = self.base.outputs().clone();
         f(&mut model, &mut outputs);
-        self.base = PeriodicProblem::new(model, self.base.disc, outputs, self.base.solver.clone()).map_err(solver_error)?;
+        let mut edited = self.base.with_model(model, self.base.discretization()).map_err(solver_error)?;
+        edited.set_outputs(outputs).map_err(solver_error)?;
+        self.base = edited;
         Ok(())
     }
 }
@@ -243,7 +245,7 @@ pub unsafe extern "C" fn pc_problem_add_contact(p: *mut PcProblem, dof: usize, d
         let compliance = if stiffness > 0.0 { Compliance::Compliant { stiffness } } else { Compliance::Rigid };
         p.edit(|m, _| m.contacts.push(Contact { dof, direction: direction as f64, gap, compliance, motion: vec![] }))?;
         if let Some(i) = unsafe { index.as_mut() } {
-            *i = p.base.model.contacts.len() - 1;
+            *i = p.base.model().contacts.len() - 1;
         }
         Ok(())
     })
@@ -257,7 +259,7 @@ pub unsafe extern "C" fn pc_problem_add_contact(p: *mut PcProblem, dof: usize, d
 pub unsafe extern "C" fn pc_problem_add_contact_motion(p: *mut PcProblem, contact: usize, amplitude: f64, harmonic: u32, phase: f64) -> c_int {
     guarded(|| {
         let p = unsafe { problem(p) }?;
-        let m = p.base.model.contacts.len();
+        let m = p.base.model().contacts.len();
         if contact >= m {
             return Err(arg(format!("contact {contact} does not exist ({m} contacts)")));
         }
@@ -297,7 +299,7 @@ pub unsafe extern "C" fn pc_problem_set_outputs(
 pub unsafe extern "C" fn pc_problem_set_pairing(p: *mut PcProblem, pairing: *const c_char) -> c_int {
     guarded(|| {
         let p = unsafe { problem(p) }?;
-        p.base.disc.pairing = if pairing.is_null() { None } else { Some(unsafe { c_str(pairing, "pairing") }?.parse::<Pairing>().map_err(input)?) };
+        p.base.set_pairing(if pairing.is_null() { None } else { Some(unsafe { c_str(pairing, "pairing") }?.parse::<Pairing>().map_err(input)?) });
         Ok(())
     })
 }
@@ -310,7 +312,7 @@ pub unsafe extern "C" fn pc_problem_set_pairing(p: *mut PcProblem, pairing: *con
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn pc_problem_set_parallel(p: *mut PcProblem, parallel: c_int) -> c_int {
     guarded(|| {
-        unsafe { problem(p) }?.base.solver.parallel = parallel != 0;
+        unsafe { problem(p) }?.base.set_parallel(parallel != 0);
         Ok(())
     })
 }
@@ -357,16 +359,14 @@ pub unsafe extern "C" fn pc_problem_frequency(p: *const PcProblem) -> f64 {
 pub unsafe extern "C" fn pc_problem_solve(p: *mut PcProblem) -> *mut PcResult {
     guarded_ptr(|| {
         let p = unsafe { problem(p) }?;
-        let problem = p.tuning.apply(&p.base, p.base.disc).map_err(solver_error)?;
-        let k = problem.disc.steps;
-        if p.fft.as_ref().is_none_or(|f| f.k() != k) {
-            p.fft = Some(PeriodFft::new(k));
-            p.active_set.clear();
+        let problem = p.tuning.apply(&p.base, p.base.discretization()).map_err(solver_error)?;
+        // The session keeps the plan and the active set across solves of the same grid.
+        match &mut p.session {
+            Some(s) => s.update_problem(problem),
+            None => p.session = Some(PeriodicSolver::new(problem)),
         }
-        let warm = (!p.active_set.is_empty()).then_some(p.active_set.as_slice());
-        let response = problem.solve_with(p.fft.as_ref().expect("planned"), warm).map_err(solver_error)?;
-        p.active_set = response.active_set.clone();
-        let warnings = response.warnings.iter().map(|w| crate::fmi::fmi2::logger::to_cstring(w)).collect();
+        let response = p.session.as_mut().expect("just set").solve().map_err(solver_error)?;
+        let warnings = response.warnings.iter().map(|w| to_cstring(w)).collect();
         Ok(Box::new(PcResult { response, warnings, json: None }))
     })
 }
@@ -542,10 +542,15 @@ pub unsafe extern "C" fn pc_result_json(r: *mut PcResult) -> *const c_char {
         let r = unsafe { r.as_mut() }.ok_or_else(|| arg("the result handle is NULL"))?;
         if r.json.is_none() {
             let text = serde_json::to_string_pretty(&r.response).map_err(|e| (PC_ERROR_INTERNAL, e.to_string()))?;
-            r.json = Some(crate::fmi::fmi2::logger::to_cstring(&text));
+            r.json = Some(to_cstring(&text));
         }
         out = r.json.as_ref().expect("set above").as_ptr();
         Ok(())
     });
     out
+}
+
+/// A C string of `s`; an interior NUL (which C cannot hold) is written as the two characters "\\0".
+fn to_cstring(s: &str) -> CString {
+    CString::new(s.replace('\0', "\\0")).expect("no interior NUL left")
 }

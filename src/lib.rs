@@ -4,14 +4,16 @@
 //!
 //! Flow: [`scene`] (TOML) → [`model`] → [`time`] (circulant symbols) → [`periodic`] (assembly,
 //! LCP, recovery) → [`response`]. The [`lcp`] solvers know nothing of mechanics.
+/// Sweeps, spectra and the comparison with time marching; the room for continuation,
+/// stability and polish.
+pub mod analysis;
 /// The native C API (include/periodic_contact.h).
 #[cfg(feature = "capi")]
 pub mod capi;
-/// The built-in default scene.
-pub mod defaults;
 /// The crate error: kinds every front end maps to its statuses.
 pub mod error;
 /// Semi-analytic periodic orbits: the independent references of the tests.
+#[cfg(feature = "reference")]
 pub mod exact;
 /// Finite elements: Matrix Market input, DOF clamping, the blade model.
 pub mod fe;
@@ -24,6 +26,7 @@ pub mod lcp;
 /// Numerical building blocks shared by mechanics and LCP (the FFT plans); no mechanics.
 pub mod linalg;
 /// Explicit time marching with forward-increment Lagrange multipliers (the paper's reference).
+#[cfg(feature = "reference")]
 pub mod marching;
 /// The mechanical model and its checks.
 pub mod model;
@@ -38,11 +41,11 @@ pub mod reduction;
 pub mod response;
 /// Scene files (TOML).
 pub mod scene;
-/// Studies: accuracy against cost, warm starts (issue 6).
+/// Studies: accuracy against cost, warm starts (`periodic-contact study`).
+#[cfg(feature = "studies")]
 pub mod study;
-/// Frequency sweeps, spectra, and the comparison with time marching.
-pub mod sweep;
 /// Time schemes as circulant symbols; pairing.
 pub mod time;
 
+pub use analysis::sweep;
 pub use error::{Error, ErrorKind};

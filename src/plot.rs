@@ -62,16 +62,10 @@ impl From<PlotError> for crate::Error {
 }
 
 /// Until the sweep and study rooms' errors are typed: they return these as `String`.
-impl From<PlotError> for String {
-    fn from(e: PlotError) -> Self {
-        e.to_string()
-    }
-}
-
 /// Draws the series into a PNG of `width`×`height` pixels. Non-finite points (and
 /// non-positive ones on a log axis) are skipped. The error is a [`PlotError`], in the caller's
 /// error type.
-pub fn line_chart<E: From<PlotError>>(path: &Path, chart: &Chart, series: &[Series], width: u32, height: u32) -> Result<(), E> {
+pub fn line_chart(path: &Path, chart: &Chart, series: &[Series], width: u32, height: u32) -> Result<(), PlotError> {
     panel_chart(path, &[(chart, series)], 1, width, height, Legend::Default)
 }
 
@@ -86,8 +80,8 @@ pub enum Legend {
 
 /// Several charts in one PNG, `columns` per row (each panel as [`line_chart`] draws it).
 /// The error is a [`PlotError`], in the caller's error type.
-pub fn panel_chart<E: From<PlotError>>(path: &Path, panels: &[(&Chart, &[Series])], columns: usize, width: u32, height: u32, legend: Legend) -> Result<(), E> {
-    draw_panels(path, panels, columns, width, height, legend).map_err(E::from)
+pub fn panel_chart(path: &Path, panels: &[(&Chart, &[Series])], columns: usize, width: u32, height: u32, legend: Legend) -> Result<(), PlotError> {
+    draw_panels(path, panels, columns, width, height, legend)
 }
 
 fn draw_panels(path: &Path, panels: &[(&Chart, &[Series])], columns: usize, width: u32, height: u32, legend: Legend) -> Result<(), PlotError> {

@@ -17,9 +17,9 @@ const AGREE: f64 = 1e-9;
 
 fn with(p: &PeriodicProblem, method: LcpMethod, steps: Option<usize>) -> PeriodicProblem {
     let mut q = p.clone();
-    q.solver.method = method;
+    q.set_solver_settings(SolverSettings { method, ..q.solver_settings().clone() }).unwrap();
     if let Some(k) = steps {
-        q.disc.steps = k;
+        q.set_discretization(Discretization { steps: k, ..q.discretization() }).unwrap();
     }
     q
 }
@@ -52,7 +52,7 @@ fn check_agreement(name: &str, p: &PeriodicProblem, method: LcpMethod) -> (Respo
     let d = difference(&fast, &lemke);
     eprintln!(
         "{name} k = {} {}: difference to lemke {d:.2e} (pivots {} vs lemke {}, residual {:.1e}, lcp {:.4} s vs lemke {:.4} s)",
-        p.disc.steps,
+        p.discretization().steps,
         method.name(),
         fast.lcp.pivots,
         lemke.lcp.pivots,
@@ -60,7 +60,7 @@ fn check_agreement(name: &str, p: &PeriodicProblem, method: LcpMethod) -> (Respo
         fast.timing_s.lcp,
         lemke.timing_s.lcp
     );
-    assert!(d <= AGREE, "{name} k = {}: {} differs from lemke by {d:.3e}", p.disc.steps, method.name());
+    assert!(d <= AGREE, "{name} k = {}: {} differs from lemke by {d:.3e}", p.discretization().steps, method.name());
     (fast, lemke)
 }
 
@@ -95,10 +95,10 @@ fn fast_path_agrees_with_lemke_on_every_scene() {
             continue;
         }
         let p = load(&path);
-        for k in [p.disc.steps, 2 * p.disc.steps, 4 * p.disc.steps] {
+        for k in [p.discretization().steps, 2 * p.discretization().steps, 4 * p.discretization().steps] {
             let pk = with(&p, LcpMethod::Auto, Some(k));
             check_agreement(&name, &pk, LcpMethod::Auto);
-            let single_rigid = pk.model.contacts.len() == 1 && pk.model.contacts[0].is_rigid();
+            let single_rigid = pk.model().contacts.len() == 1 && pk.model().contacts[0].is_rigid();
             match with(&pk, LcpMethod::Pivoting, None).solve() {
                 Ok(_) => {
                     check_agreement(&name, &pk, LcpMethod::Pivoting);

@@ -103,13 +103,13 @@ fn warm_started_re_solve_against_a_cold_solve() {
     for name in ["rigid-stop.toml", "compliant-stop.toml", "moving-obstacle.toml", "chain-3dof-two-stops.toml"] {
         let (scene, _) = Scene::load(&scene_path(name)).unwrap();
         let mut p = scene.to_problem(name).unwrap();
-        p.solver.parallel = false;
-        let fft = PeriodFft::new(p.disc.steps);
+        p.set_parallel(false);
+        let fft = PeriodFft::new(p.discretization().steps);
         let r0 = p.solve_with(&fft, None).unwrap();
         for delta in [1e-3, 1e-2] {
             let mut t = Tuning::of(&p);
             t.frequency *= 1.0 + delta;
-            let q = t.apply(&p, p.disc).unwrap();
+            let q = t.apply(&p, p.discretization()).unwrap();
             let (cold_t, cold) = best(5, || q.solve_with(&fft, None).unwrap());
             let (warm_t, warm) = best(5, || q.solve_with(&fft, Some(&r0.active_set)).unwrap());
             let dx =

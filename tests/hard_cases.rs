@@ -33,7 +33,7 @@ fn check(name: &str, p: &PeriodicProblem) -> Option<Response> {
             // Independent certificate: force ≥ 0, gap ≥ 0 and complementarity on the paired samples.
             let k = r.steps;
             let mut worst = 0.0f64;
-            for (c, contact) in r.contacts.iter().zip(&p.model.contacts) {
+            for (c, contact) in r.contacts.iter().zip(&p.model().contacts) {
                 let s = p.pairing_of(contact).offset();
                 // Compliance 1/k_c, plus the Tikhonov shift when the result records one.
                 let compliance = match contact.compliance {
@@ -207,12 +207,12 @@ fn regularization_is_opt_in_and_recorded() {
     let err = p.solve().expect_err("cds with same pairing ends without a solution");
     let msg = err.to_string();
     assert!(msg.contains("compliant") && msg.contains("regularization"), "the error suggests remedies: {msg}");
-    p.solver.regularization = Some(1e-4);
+    p.set_solver_settings(SolverSettings { regularization: Some(1e-4), ..p.solver_settings().clone() }).unwrap();
     let r = check("cds with same pairing, [solver] regularization = 1e-4", &p).expect("solved after regularisation");
     let shift = r.lcp.regularization.expect("recorded in the result");
     assert!(shift > 0.0);
     assert!(r.warnings.iter().any(|w| w.contains("regularization") && w.contains("not the rigid-contact answer")), "{:?}", r.warnings);
     // Without the opt-in the same scene still fails: nothing is regularised silently.
-    p.solver.regularization = None;
+    p.set_solver_settings(SolverSettings { regularization: None, ..p.solver_settings().clone() }).unwrap();
     assert!(p.solve().is_err());
 }

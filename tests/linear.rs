@@ -120,16 +120,17 @@ fn a_static_load_gives_the_static_solution() {
 fn the_sparse_path_equals_the_dense_path() {
     use periodic_contact::model::Matrix;
     let dense = Scene::parse(&scene("cds", 32, 1), "t").unwrap().to_problem("t").unwrap();
-    let mut sparse = dense.clone();
     let to_sparse = |m: &Matrix| {
         let mut t = Vec::new();
         m.for_each(|i, j, v| t.push(faer::sparse::Triplet::new(i, j, v)));
         Matrix::Sparse(faer::sparse::SparseColMat::try_new_from_triplets(2, 2, &t).unwrap())
     };
-    let s = &mut sparse.model.structure;
+    let mut model = dense.model().clone();
+    let s = &mut model.structure;
     s.mass = to_sparse(&s.mass);
     s.stiffness = to_sparse(&s.stiffness);
     s.damping = s.damping.as_ref().map(to_sparse);
+    let sparse = dense.with_model(model, dense.discretization()).unwrap();
     let (a, b) = (dense.solve().unwrap(), sparse.solve().unwrap());
     for d in ["0", "1"] {
         for (x, y) in a.displacement[d].iter().zip(&b.displacement[d]) {

@@ -133,11 +133,11 @@ fn check_solve(p: &PeriodicProblem, tally: &Tally) -> Result<(), TestCaseError> 
 /// ‖q‖∞ of the problem's LCP, rebuilt independently: q_j = gap(t_{j+s}) − direction·x_lin(t_{j+s})
 /// at each contact, with x_lin the contact-free response solved separately.
 fn q_scale(p: &PeriodicProblem) -> f64 {
-    let mut model = p.model.clone();
+    let mut model = p.model().clone();
     let contacts = std::mem::take(&mut model.contacts);
     let dofs: Vec<usize> = contacts.iter().map(|c| c.dof).collect();
     let outputs = OutputSelection { displacement: dofs, velocity: vec![], acceleration: vec![], contacts: false };
-    let Ok(free) = PeriodicProblem::new(model, p.disc, outputs, p.solver.clone()).and_then(|f| f.solve()) else { return 1.0 };
+    let Ok(free) = PeriodicProblem::new(model, p.discretization(), outputs, p.solver_settings().clone()).and_then(|f| f.solve()) else { return 1.0 };
     let k = free.steps;
     let mut qmax = 1.0f64;
     for c in &contacts {
@@ -145,7 +145,7 @@ fn q_scale(p: &PeriodicProblem) -> f64 {
         let x = &free.displacement[&c.dof.to_string()];
         for j in 0..k {
             let jj = (j + s) % k;
-            qmax = qmax.max((c.gap_at(p.model.frequency, free.time[jj]) - c.direction * x[jj]).abs());
+            qmax = qmax.max((c.gap_at(p.model().frequency, free.time[jj]) - c.direction * x[jj]).abs());
         }
     }
     qmax
@@ -170,7 +170,7 @@ fn check_response(p: &PeriodicProblem, r: &Response, tally: &Tally) -> Result<()
     let k = r.steps;
     let response_scale = r.contacts.iter().flat_map(|c| c.gap.iter().chain(&c.force)).fold(1.0f64, |m, v| m.max(v.abs()));
     let mut worst = 0.0f64;
-    for (c, contact) in r.contacts.iter().zip(&p.model.contacts) {
+    for (c, contact) in r.contacts.iter().zip(&p.model().contacts) {
         prop_assert!(finite(&c.force) && finite(&c.gap), "non-finite contact data");
         let s = p.pairing_of(contact).offset();
         let kc = match contact.compliance {
@@ -182,7 +182,7 @@ fn check_response(p: &PeriodicProblem, r: &Response, tally: &Tally) -> Result<()
             worst = worst.max(c.force[j].min(w).abs()).max((-c.force[j]).max(0.0)).max((-w).max(0.0));
         }
     }
-    let factor = 100.0 * p.solver.tolerance.max(1e-9);
+    let factor = 100.0 * p.solver_settings().tolerance.max(1e-9);
     if worst > factor * response_scale {
         let qmax = q_scale(p);
         prop_assert!(
@@ -226,7 +226,10 @@ fn check_scene_text(text: &str, tally: &Tally) -> Result<(), TestCaseError> {
             return Ok(());
         }
     };
-    if p.disc.steps * p.model.contacts.len() > FUZZ_SOLVE_MAX_LCP || p.disc.steps > FUZZ_SOLVE_MAX_STEPS || p.model.n() > FUZZ_SOLVE_MAX_DOFS {
+    if p.discretization().steps * p.model().contacts.len() > FUZZ_SOLVE_MAX_LCP
+        || p.discretization().steps > FUZZ_SOLVE_MAX_STEPS
+        || p.model().n() > FUZZ_SOLVE_MAX_DOFS
+    {
         tally.add("built, too large to solve here");
         return Ok(());
     }

@@ -84,7 +84,7 @@ fn spectrum_of_a_cosine_and_of_the_rubbing_blade() {
     assert!(a.iter().enumerate().filter(|(p, _)| *p != 0 && *p != 3).all(|(_, v)| v.abs() < 1e-12));
 
     let mut p = problem();
-    p.model.frequency = 2300.0;
+    p.set_frequency(2300.0).unwrap();
     let r = p.solve().unwrap();
     let s = sweep::spectrum::spectrum(&p, &r, 20);
     assert_eq!(s.displacement.len(), 3);

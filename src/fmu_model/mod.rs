@@ -23,7 +23,7 @@ use crate::fmi::state::{StateReader, StateWriter};
 use crate::fmi::table::{Kind, UnitDefinition};
 use crate::fmi::{CoSimModel, DefaultExperiment, EventLog, ModelDescription};
 pub use crate::periodic::Tuning;
-use crate::periodic::{MAX_STEPS, MIN_STEPS, PeriodFft, PeriodicProblem};
+use crate::periodic::{MAX_STEPS, MIN_STEPS, PeriodFft, PeriodicProblem, PeriodicSolver};
 use crate::response::Response;
 use crate::scene::Scene;
 use crate::time::{Discretization, Scheme};
@@ -88,7 +88,8 @@ pub struct ContactModel {
     outputs: Vec<Quantity>,
     start: Values,
     values: Values,
-    fft: Option<PeriodFft>,
+    /// The solver session: the FFT plan and the warm start, updated at each re-solve.
+    session: PeriodicSolver,
     solution: Option<Arc<Solution>>,
     /// τ(t) = t + phase_offset (mod T): keeps the phase continuous across frequency changes.
     phase_offset: f64,
@@ -106,18 +107,20 @@ impl ContactModel {
     pub fn from_scene_text(text: &str, file: &str) -> Result<Self> {
         let scene = Scene::parse(text, file)?;
         let problem = scene.to_problem(file)?;
-        let shown = problem.outputs.clone();
-        let model = &problem.model;
+        let shown = problem.outputs().clone();
+        let model = problem.model();
         let Variables { table: t, roles, outputs } = Variables::of(&problem);
-        let k = problem.disc.steps;
+        let k = problem.discretization().steps;
         let mut base = problem.clone();
         // No rayon inside an FMU: its global pool would outlive the instance and keep the
         // library mapped (notes, rust-crates §faer).
-        base.solver.parallel = false;
+        base.set_parallel(false);
         let mut recovered = unique(&[shown.displacement.clone(), shown.velocity.clone()].concat());
         recovered.sort_unstable();
-        base.outputs.displacement = recovered.clone();
-        base.outputs.velocity = recovered;
+        let mut selection = base.outputs().clone();
+        selection.displacement = recovered.clone();
+        selection.velocity = recovered;
+        base.set_outputs(selection)?;
 
         let period = model.period();
         let desc = ModelDescription {
@@ -133,16 +136,16 @@ impl ContactModel {
         };
         let scene_tuning = Tuning::of(&problem);
         let neutral = Tuning { frequency: 0.0, force_scale: 1.0, gap_offset: 0.0, motion_scale: 1.0 };
-        let start = Values { params: scene_tuning, inputs: neutral, steps: k, scheme: problem.disc.scheme };
+        let start = Values { params: scene_tuning, inputs: neutral, steps: k, scheme: problem.discretization().scheme };
         let nout = outputs.len();
         Ok(ContactModel {
             desc,
-            base,
             roles,
             outputs,
             start,
             values: start,
-            fft: None,
+            session: PeriodicSolver::new(base.clone()),
+            base,
             solution: None,
             phase_offset: 0.0,
             initialized: false,
@@ -164,19 +167,20 @@ impl ContactModel {
 
     /// Solves `cfg`, warm-started from the current solution when the grid is the same.
     fn solve(&mut self, cfg: Config) -> Result<Solution> {
-        let disc = Discretization { scheme: cfg.scheme, steps: cfg.steps, pairing: self.base.disc.pairing };
+        let disc = Discretization { scheme: cfg.scheme, steps: cfg.steps, pairing: self.base.discretization().pairing };
         let problem = cfg.tuning.apply(&self.base, disc)?;
-        if self.fft.as_ref().is_none_or(|f| f.k() != cfg.steps) {
-            self.fft = Some(PeriodFft::new(cfg.steps));
+        self.session.update_problem(problem);
+        // The warm start is the current solution's (which an FMU-state restore may have changed).
+        match self.solution.as_ref().filter(|s| s.k == cfg.steps) {
+            Some(s) => self.session.set_warm_start(&s.active_set),
+            None => self.session.reset_warm_start(),
         }
-        let fft = self.fft.as_ref().expect("planned above");
-        let warm = self.solution.as_ref().filter(|s| s.k == cfg.steps).map(|s| s.active_set.as_slice());
-        let r = problem.solve_with(fft, warm)?;
-        Ok(self.solution_of(cfg, &problem, &r, fft))
+        let r = self.session.solve()?;
+        Ok(self.solution_of(cfg, self.session.problem(), &r, self.session.fft()))
     }
 
     fn solution_of(&self, config: Config, problem: &PeriodicProblem, r: &Response, fft: &PeriodFft) -> Solution {
-        let omega = problem.model.frequency;
+        let omega = problem.model().frequency;
         let fourier = config.scheme == Scheme::Fourier;
         let key = |d: usize| d.to_string();
         let series = self
@@ -522,20 +526,20 @@ impl CoSimModel for ContactModel {
 
 /// The model description's one-line summary of the scene.
 fn summary(problem: &PeriodicProblem) -> String {
-    let model = &problem.model;
-    let (n, m, k) = (model.n(), model.contacts.len(), problem.disc.steps);
+    let model = problem.model();
+    let (n, m, k) = (model.n(), model.contacts.len(), problem.discretization().steps);
     let effects = model.effects().names().join(", ");
     if m == 0 {
         format!(
             "Steady-state periodic response of a {n}-DOF linear structure without contact (effects: {}), solved over one period ({}, {k} instants); a quasi-steady co-simulation component",
             if effects.is_empty() { "none" } else { &effects },
-            problem.disc.scheme
+            problem.discretization().scheme
         )
     } else {
         format!(
             "Steady-state periodic response of a {n}-DOF structure with {m} unilateral contact(s) (effects: {}), solved over one period as one LCP ({}, {k} instants); a quasi-steady co-simulation component",
             if effects.is_empty() { "none" } else { &effects },
-            problem.disc.scheme
+            problem.discretization().scheme
         )
     }
 }

@@ -139,7 +139,7 @@ impl ContactModel {
         }
         let pivots = r.i32()?;
         let active_set = r.usizes()?;
-        let lcp_size = self.base.model.contacts.len().saturating_mul(k);
+        let lcp_size = self.base.model().contacts.len().saturating_mul(k);
         if let Some(bad_index) = active_set.iter().find(|&&i| i >= lcp_size) {
             return Err(bad(format!("active-set index {bad_index} is outside the LCP of size {lcp_size}")));
         }

@@ -84,12 +84,12 @@ pub(super) fn unique(l: &[usize]) -> Vec<usize> {
 
 /// What the scene calls for: forces, the number of contacts, moving obstacles.
 fn effects(problem: &PeriodicProblem) -> (bool, usize, bool) {
-    let model = &problem.model;
+    let model = problem.model();
     (!model.forces.is_empty(), model.contacts.len(), model.contacts.iter().any(|c| !c.motion.is_empty()))
 }
 
 fn parameters(b: &mut Variables, problem: &PeriodicProblem) {
-    let model = &problem.model;
+    let model = problem.model();
     let (has_forces, m, has_motion) = effects(problem);
     b.add(
         Variable::parameter(
@@ -109,14 +109,14 @@ fn parameters(b: &mut Variables, problem: &PeriodicProblem) {
     if has_motion {
         b.add(Variable::parameter("motion_scale", Tunable, real(Some(1.0), None), "Multiplies every obstacle-motion amplitude"), Role::MotionScale);
     }
-    let k = problem.disc.steps;
+    let k = problem.discretization().steps;
     b.add(
         Variable::parameter("steps", Fixed, Kind::Integer { start: Some(k as i32), min: Some(MIN_STEPS as i32), max: None }, "Number of instants k per period"),
         Role::Steps,
     );
     // An Integer rather than an Enumeration: libcosim ignores FMI 2 Enumeration variables.
     let codes: Vec<String> = Scheme::ALL.iter().map(|s| format!("{} {}", scheme_code(*s), s)).collect();
-    let scheme = Kind::Integer { start: Some(scheme_code(problem.disc.scheme)), min: Some(1), max: Some(Scheme::ALL.len() as i32) };
+    let scheme = Kind::Integer { start: Some(scheme_code(problem.discretization().scheme)), min: Some(1), max: Some(Scheme::ALL.len() as i32) };
     b.add(Variable::parameter("scheme", Fixed, scheme, &format!("Time scheme on the period: {}", codes.join(", "))), Role::Scheme);
 }
 
@@ -138,7 +138,7 @@ fn inputs(b: &mut Variables, problem: &PeriodicProblem) {
 }
 
 fn outputs(b: &mut Variables, problem: &PeriodicProblem) {
-    let (model, shown) = (&problem.model, &problem.outputs);
+    let (model, shown) = (problem.model(), &problem.outputs());
     for d in unique(&shown.displacement) {
         b.output(
             Variable::output(&format!("displacement[{d}]"), Continuous, real(None, None), &format!("Displacement of DOF {d} (length unit of the scene)")),

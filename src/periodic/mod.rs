@@ -2,20 +2,21 @@
 //! recovery of the requested responses (notes §2–3).
 mod assembly;
 use crate::linalg::fft; // the crate's one FFT plan type, shared with lcp
+mod problem;
 mod recovery;
+mod session;
 mod tuning;
 
 pub use assembly::Assembly;
 pub use fft::PeriodFft;
+pub use problem::{MAX_DENSE_FLOPS, MAX_LCP_SIZE, MAX_STEPS, MIN_STEPS, PeriodicProblem};
+pub use session::{PeriodicSolver, WarmStart};
 pub use tuning::Tuning;
 
 use crate::error::{Error, ErrorKind};
 pub use crate::lcp::{AUTO_LEMKE_MAX, LcpMethod, solve_circulant_lcp};
-use crate::lcp::{BlockCirculant, LcpMatrix, LcpOutcome, LcpSolution};
-use crate::model::{Contact, Model, ModelError};
-use crate::response::Response;
-use crate::time::{Discretization, Pairing};
-use std::time::Instant;
+use crate::lcp::{LcpOutcome, LcpSolution};
+use crate::model::ModelError;
 
 /// Which responses to recover; nothing else is computed.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -107,275 +108,8 @@ impl From<SolveError> for Error {
     }
 }
 
-/// A model with its discretisation, outputs and solver settings, checked and ready to solve.
-#[derive(Clone, Debug)]
-pub struct PeriodicProblem {
-    pub model: Model,
-    pub disc: Discretization,
-    pub outputs: OutputSelection,
-    pub solver: SolverSettings,
-    /// `Some`: `outputs` are user DOFs (labels), computed through the map.
-    pub output_map: Option<OutputMap>,
-}
-
-/// Fewest instants per period that any scheme needs.
-pub const MIN_STEPS: usize = 4;
-/// Most instants per period we accept (memory of the recovery grows like k·outputs).
-pub const MAX_STEPS: usize = 1 << 22;
-/// Largest LCP accepted, k·m unknowns. Why: both LCP methods may store a dense block as large as
-/// the active set squared (Lemke's B⁻¹ columns, the pivoting LU): the rigid stop at k = 16384 peaks
-/// at 1.5 GiB, and 2^22 unknowns would ask for terabytes (a panic inside the allocator, found by
-/// the bad-input tests). 32768 keeps the worst case within a few GiB.
-pub const MAX_LCP_SIZE: usize = 1 << 15;
-/// Most floating-point operations the dense assembly may cost, ≈ (k/2+1)·(8/3)·n³ (one complex LU
-/// per distinct harmonic). Why: a 5000×5000 dense model at k = 256 would take hours; it must be
-/// refused at once with a remedy, not attempted. 10¹² is a few minutes on one core
-/// (n = 1000 at k = 256 is 3.4·10¹¹ and accepted).
-pub const MAX_DENSE_FLOPS: f64 = 1e12;
-
-impl PeriodicProblem {
-    pub fn new(model: Model, disc: Discretization, outputs: OutputSelection, solver: SolverSettings) -> Result<Self, SolveError> {
-        // Size limits first: they are O(1), the validation below factorises M.
-        let k = disc.steps;
-        if !(MIN_STEPS..=MAX_STEPS).contains(&k) {
-            return Err(SolveError::Invalid(format!("discretization.steps: is {k}, must be in {MIN_STEPS}..={MAX_STEPS}")));
-        }
-        let m = model.contacts.len();
-        if k.saturating_mul(m) > MAX_LCP_SIZE {
-            return Err(SolveError::Limit(format!(
-                "discretization.steps: is {k} with {m} contact(s), an LCP of {} unknowns (steps × contacts); at most {MAX_LCP_SIZE} are accepted: reduce steps",
-                k.saturating_mul(m)
-            )));
-        }
-        let s = &model.structure;
-        let dense = !(s.mass.is_sparse() || s.stiffness.is_sparse() || s.damping.as_ref().is_some_and(crate::model::Matrix::is_sparse));
-        let n = model.n();
-        let flops = (k / 2 + 1) as f64 * (8.0 / 3.0) * (n as f64).powi(3);
-        if dense && flops > MAX_DENSE_FLOPS {
-            return Err(SolveError::Limit(format!(
-                "structure.mass: a dense {n}×{n} model with steps = {k} needs {} complex {n}×{n} factorisations (≈ {flops:.1e} flops, at most {MAX_DENSE_FLOPS:.0e} accepted): give the matrices in sparse form, reduce the model (Craig–Bampton), or reduce steps",
-                k / 2 + 1
-            )));
-        }
-        model.validate()?;
-        // The difference operators divide by h²: a time step whose 1/h² overflows (ω = 1e308)
-        // gives σ2 = 0/0 = NaN at harmonic 0 (found by tests/props.rs).
-        let h = model.period() / k as f64;
-        if !(1.0 / (h * h)).is_finite() {
-            return Err(SolveError::Invalid(format!(
-                "excitation.frequency: is {:e} with steps = {k}: the time step T/k = {h:e} is too small for floating point (1/h² overflows); rescale the time unit",
-                model.frequency
-            )));
-        }
-        // A harmonic h is resolved by k samples only if h < k/2 (Nyquist).
-        for (i, f) in model.forces.iter().enumerate() {
-            if 2 * f.term.harmonic as usize >= k {
-                return Err(SolveError::Invalid(format!(
-                    "force[{i}].harmonic: is {}, not resolved by steps = {k} (needs steps > {})",
-                    f.term.harmonic,
-                    2 * f.term.harmonic
-                )));
-            }
-        }
-        for (i, c) in model.contacts.iter().enumerate() {
-            for (j, h) in c.motion.iter().enumerate() {
-                if 2 * h.harmonic as usize >= k {
-                    return Err(SolveError::Invalid(format!(
-                        "contact[{i}].motion[{j}].harmonic: is {}, not resolved by steps = {k} (needs steps > {})",
-                        h.harmonic,
-                        2 * h.harmonic
-                    )));
-                }
-            }
-        }
-        if let Some(d) = outputs.dofs().into_iter().find(|&d| d >= n) {
-            return Err(SolveError::Invalid(format!("output: DOF {d} does not exist, the model has DOFs 0..{}", n - 1)));
-        }
-        Ok(PeriodicProblem { model, disc, outputs, solver, output_map: None })
-    }
-
-    /// Names the outputs in the user's numbering: `outputs` lists labels of `map`.
-    pub fn with_output_map(mut self, outputs: OutputSelection, map: OutputMap) -> Result<Self, SolveError> {
-        let n = self.model.n();
-        if let Some(d) = outputs.dofs().into_iter().find(|d| !map.rows.contains_key(d)) {
-            return Err(SolveError::Invalid(format!("output: DOF {d} cannot be recovered (it is fixed or does not exist)")));
-        }
-        if let Some((l, _)) = map.rows.iter().find(|(_, r)| r.iter().any(|&(d, c)| d >= n || !c.is_finite())) {
-            return Err(SolveError::Invalid(format!("output: the recovery of DOF {l} names a model DOF out of 0..{n} or a non-finite coefficient")));
-        }
-        if !map.contact_dofs.is_empty() && map.contact_dofs.len() != self.model.contacts.len() {
-            return Err(SolveError::Invalid(format!("output: {} contact labels for {} contacts", map.contact_dofs.len(), self.model.contacts.len())));
-        }
-        self.outputs = outputs;
-        self.output_map = Some(map);
-        Ok(self)
-    }
-
-    /// The model DOFs whose responses the outputs need, sorted and unique.
-    pub fn recovery_dofs(&self) -> Vec<usize> {
-        match &self.output_map {
-            None => self.outputs.dofs(),
-            Some(map) => {
-                let mut d: Vec<usize> = self.outputs.dofs().iter().flat_map(|l| map.rows[l].iter().map(|&(d, _)| d)).collect();
-                d.sort_unstable();
-                d.dedup();
-                d
-            }
-        }
-    }
-
-    /// The pairing of one contact: the scene's, or the default that converges for it.
-    pub fn pairing_of(&self, c: &Contact) -> Pairing {
-        match self.disc.pairing {
-            Some(p) => p,
-            None => self.disc.scheme.default_pairing(c.is_rigid()),
-        }
-    }
-
-    /// Warnings about choices that do not converge, said before solving.
-    pub fn warnings(&self) -> Vec<String> {
-        let mut w = Vec::new();
-        for (i, c) in self.model.contacts.iter().enumerate() {
-            let p = self.pairing_of(c);
-            if c.is_rigid() {
-                if let Some(why) = self.disc.scheme.rigid_contact_warning(p) {
-                    w.push(format!("contact[{i}] (rigid, {} with pairing {p}): {why}", self.disc.scheme));
-                }
-            } else if p == Pairing::Forward {
-                w.push(format!(
-                    "contact[{i}] (compliant): forward pairing makes a compliant force lag one step, so the scheme is first order only; use pairing = \"same\""
-                ));
-            }
-        }
-        w
-    }
-
-    /// Solves with a fresh FFT plan and no warm start.
-    pub fn solve(&self) -> Result<Response, SolveError> {
-        self.solve_with(&PeriodFft::new(self.disc.steps), None)
-    }
-
-    /// Solves reusing `fft` (planned for k = steps), warm-started from a previous active set.
-    pub fn solve_with(&self, fft: &PeriodFft, warm_start: Option<&[usize]>) -> Result<Response, SolveError> {
-        let t_start = Instant::now();
-        let dofs = self.recovery_dofs();
-        let asm = assembly::assemble(&self.model, &self.disc, &dofs, fft, self.solver.parallel)?;
-        let (a, q) = self.lcp(&asm, fft);
-        self.check_lcp_finite(&a, &q)?;
-        let t_assembly = t_start.elapsed().as_secs_f64();
-
-        let t_lcp = Instant::now();
-        let (sol, regularization) = self.solve_lcp(&a, &q, warm_start)?;
-        let t_lcp = t_lcp.elapsed().as_secs_f64();
-
-        let t_rec = Instant::now();
-        let mut response = recovery::recover(self, &asm, fft, &sol)?;
-        if let Some(shift) = regularization {
-            response.lcp.regularization = Some(shift);
-            response.warnings.push(format!(
-                "the LCP of the scene ended without a solution; [solver] regularization solved A + {shift:.3e}·I instead: every contact then behaves as compliant with stiffness {:.3e}, so this is not the rigid-contact answer",
-                1.0 / shift
-            ));
-        }
-        response.timing_s.assembly = t_assembly;
-        response.timing_s.lcp = t_lcp;
-        response.timing_s.recovery = t_rec.elapsed().as_secs_f64();
-        response.timing_s.total = t_start.elapsed().as_secs_f64();
-        Ok(response)
-    }
-
-    /// The LCP of the period: A block-circulant from the inverse FFT of Ĝ, and q = gap − B xlin,
-    /// each contact row shifted by its pairing offset (λ_j ⊥ gap(t_{j+s})).
-    pub fn lcp(&self, asm: &Assembly, fft: &PeriodFft) -> (BlockCirculant, Vec<f64>) {
-        let (k, m) = (asm.k, asm.m);
-        let nh = k / 2 + 1;
-        let mut blocks = vec![0.0; k * m * m];
-        let mut q = vec![0.0; k * m];
-        let period = self.model.period();
-        let mut spec = vec![num_complex::Complex64::ZERO; nh];
-        for (a, ca) in self.model.contacts.iter().enumerate() {
-            let s = self.pairing_of(ca).offset();
-            for b in 0..m {
-                for (p, v) in spec.iter_mut().enumerate() {
-                    *v = asm.g_hat[(p * m + a) * m + b];
-                }
-                let col = fft.inverse(&spec);
-                for d in 0..k {
-                    blocks[(d * m + a) * m + b] = col[(d + s) % k];
-                }
-            }
-            for (p, v) in spec.iter_mut().enumerate() {
-                *v = asm.bxlin_hat[p * m + a];
-            }
-            let bx = fft.inverse(&spec);
-            for j in 0..k {
-                let jj = (j + s) % k;
-                let t = jj as f64 * period / k as f64;
-                q[j * m + a] = ca.gap_at(self.model.frequency, t) - bx[jj];
-            }
-            if let crate::model::Compliance::Compliant { stiffness } = ca.compliance {
-                blocks[a * m + a] += 1.0 / stiffness;
-            }
-        }
-        (BlockCirculant::new(k, m, blocks), q)
-    }
-
-    /// The LCP's data must be finite; when they are not, name the contact and the instant.
-    /// Why: values that pass validation one by one (a static gap plus obstacle motions near
-    /// 1e308, say) can still sum past f64, and a solver's "non-finite data" says nothing of where.
-    fn check_lcp_finite(&self, a: &BlockCirculant, q: &[f64]) -> Result<(), SolveError> {
-        let m = self.model.contacts.len().max(1);
-        let what = "gaps, obstacle motions, forces or compliances overflow floating point; rescale the units";
-        if let Some(i) = q.iter().position(|v| !v.is_finite()) {
-            return Err(SolveError::Invalid(format!("contact[{}]: the gap of the LCP at instant {} is {}: {what}", i % m, i / m, q[i])));
-        }
-        if let Some(i) = a.blocks().iter().position(|v| !v.is_finite()) {
-            let (d, ab) = (i / (m * m), i % (m * m));
-            return Err(SolveError::Invalid(format!(
-                "contact[{}]: the LCP matrix (its response to contact[{}] {d} instants earlier) is {}: {what}",
-                ab / m,
-                ab % m,
-                a.blocks()[i]
-            )));
-        }
-        Ok(())
-    }
-
-    /// Solves the LCP by the configured method; on failure, and only when the scene opted in
-    /// with `[solver] regularization = ε`, retries once on A + ε·max|A|·I (Tikhonov). The
-    /// second value is the regularization used, if any: the caller records it in the result.
-    fn solve_lcp(&self, a: &BlockCirculant, q: &[f64], warm_start: Option<&[usize]>) -> Result<(LcpSolution, Option<f64>), SolveError> {
-        let first = self.solve_lcp_once(a, q, warm_start);
-        if first.outcome == LcpOutcome::Solved {
-            return Ok((first, None));
-        }
-        if let (Some(eps), LcpOutcome::RayTermination | LcpOutcome::PivotLimit | LcpOutcome::Inaccurate) = (self.solver.regularization, first.outcome) {
-            let shift = eps * a.max_abs().0;
-            let mut regularized = a.clone();
-            regularized.add_block_diagonal(&vec![shift; a.m()]);
-            let mut second = self.solve_lcp_once(&regularized, q, None);
-            second.info.pivots += first.info.pivots;
-            second.info.time_s += first.info.time_s;
-            if second.outcome == LcpOutcome::Solved {
-                return Ok((second, Some(shift)));
-            }
-        }
-        Err(lcp_failure(first))
-    }
-
-    fn solve_lcp_once(&self, a: &BlockCirculant, q: &[f64], warm_start: Option<&[usize]>) -> LcpSolution {
-        solve_circulant_lcp(a, q, self.solver.method, self.solver.tolerance, warm_start)
-    }
-
-    /// The LCP (A, q) of the period without solving it (for exports and studies).
-    pub fn assemble_lcp(&self, fft: &PeriodFft) -> Result<(BlockCirculant, Vec<f64>), SolveError> {
-        let asm = assembly::assemble(&self.model, &self.disc, &[], fft, self.solver.parallel)?;
-        Ok(self.lcp(&asm, fft))
-    }
-}
-
 /// The typed failure of an LCP solve, with the remedy to try.
-fn lcp_failure(sol: LcpSolution) -> SolveError {
+pub(crate) fn lcp_failure(sol: LcpSolution) -> SolveError {
     let hint = match sol.outcome {
         LcpOutcome::RayTermination => {
             "no periodic solution was reached (the LCP matrix is not a P-matrix above the first resonance); remedies: make the contact compliant (stiffness = …), use cds or galerkin with pairing = \"forward\" or bds1, add damping, or opt in to [solver] regularization = 1e-4"

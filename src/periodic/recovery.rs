@@ -10,7 +10,7 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
     let (k, m) = (asm.k, asm.m);
     let nh = k / 2 + 1;
     let nd = asm.dofs.len();
-    let model = &problem.model;
+    let model = &problem.model();
     let period = model.period();
     let time: Vec<f64> = (0..k).map(|j| j as f64 * period / k as f64).collect();
 
@@ -26,10 +26,10 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
     let mut velocity = BTreeMap::new();
     let mut acceleration = BTreeMap::new();
     let mut linear_displacement = BTreeMap::new();
-    let out = &problem.outputs;
+    let out = &problem.outputs();
     // Each output label as (index into asm.dofs, coefficient) terms: the DOF itself, or the
     // user-numbered combination of the output map.
-    let rows: Vec<(usize, Vec<(usize, f64)>)> = match &problem.output_map {
+    let rows: Vec<(usize, Vec<(usize, f64)>)> = match &problem.output_map() {
         None => asm.dofs.iter().enumerate().map(|(r, &d)| (d, vec![(r, 1.0)])).collect(),
         Some(map) => out
             .dofs()
@@ -91,7 +91,7 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
             let gap: Vec<f64> = time.iter().zip(&bx).map(|(&t, &b)| ca.gap_at(model.frequency, t) - b).collect();
             let force: Vec<f64> = (0..k).map(|j| sol.z[j * m + a]).collect();
             contacts.push(ContactResponse {
-                dof: problem.output_map.as_ref().and_then(|m| m.contact_dofs.get(a).copied()).unwrap_or(ca.dof),
+                dof: problem.output_map().as_ref().and_then(|m| m.contact_dofs.get(a).copied()).unwrap_or(ca.dof),
                 direction: ca.direction as i32,
                 stiffness: match ca.compliance {
                     crate::model::Compliance::Rigid => None,
@@ -106,7 +106,7 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
 
     let pairings: Vec<&str> = model.contacts.iter().map(|c| problem.pairing_of(c).name()).collect();
     let pairing = match pairings.first() {
-        None => problem.disc.pairing.unwrap_or(crate::time::Pairing::Same).name().to_string(),
+        None => problem.discretization().pairing.unwrap_or(crate::time::Pairing::Same).name().to_string(),
         Some(first) if pairings.iter().all(|p| p == first) => first.to_string(),
         Some(_) => "mixed".to_string(),
     };
@@ -114,9 +114,15 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
     Ok(Response {
         period,
         steps: k,
-        scheme: problem.disc.scheme.name().to_string(),
+        scheme: problem.discretization().scheme.name().to_string(),
         pairing,
-        effects: model.effects().names().into_iter().map(String::from).chain(problem.output_map.iter().flat_map(|m| m.effects.iter().cloned())).collect(),
+        effects: model
+            .effects()
+            .names()
+            .into_iter()
+            .map(String::from)
+            .chain(problem.output_map().into_iter().flat_map(|m| m.effects.iter().cloned()))
+            .collect(),
         time,
         displacement,
         velocity,

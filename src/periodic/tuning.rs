@@ -18,17 +18,18 @@ pub struct Tuning {
 impl Tuning {
     /// The scene's own values (scales 1, offset 0).
     pub fn of(p: &PeriodicProblem) -> Self {
-        Tuning { frequency: p.model.frequency, force_scale: 1.0, gap_offset: 0.0, motion_scale: 1.0 }
+        Tuning { frequency: p.model().frequency, force_scale: 1.0, gap_offset: 0.0, motion_scale: 1.0 }
     }
     /// `base` with these values and discretisation `disc`, validated again.
     pub fn apply(&self, base: &PeriodicProblem, disc: Discretization) -> Result<PeriodicProblem, SolveError> {
-        let mut model = base.model.clone();
+        let mut model = base.model().clone();
         model.frequency = self.frequency;
         model.forces.iter_mut().for_each(|f| f.term.amplitude *= self.force_scale);
         for c in &mut model.contacts {
             c.gap += self.gap_offset;
             c.motion.iter_mut().for_each(|h| h.amplitude *= self.motion_scale);
         }
-        PeriodicProblem::new(model, disc, base.outputs.clone(), base.solver.clone())
+        // The output map stays: a reduced or clamped scene reports in the user's numbering.
+        base.with_model(model, disc)
     }
 }

@@ -10,6 +10,7 @@
 //! LCPs are degenerate and the fallback there is dense Lemke, O(N³)). Skipped points are listed in
 //! the CSV with their reason.
 use super::{Case, Reference, fitted_order, method_label, sci};
+use crate::Error;
 use crate::lcp::{LcpMatrix, dat::write_dat};
 use crate::marching::{MarchSettings, march};
 use crate::periodic::{LcpMethod, PeriodFft};
@@ -165,15 +166,15 @@ impl Track {
 }
 
 /// Runs the study. `progress` receives one line per point.
-pub fn run(settings: &AccuracySettings, progress: &mut dyn FnMut(&Row)) -> Result<AccuracyStudy, String> {
+pub fn run(settings: &AccuracySettings, progress: &mut dyn FnMut(&Row)) -> Result<AccuracyStudy, Error> {
     let start = Instant::now();
     let load0 = load_average();
     let mut refs = BTreeMap::new();
     for &case in &settings.cases {
-        refs.insert(case.name(), case.reference().map_err(|e| format!("{}: exact reference: {e}", case.name()))?);
+        refs.insert(case.name(), case.reference().map_err(|e| e.context(format!("{}: exact reference", case.name())))?);
     }
     if let Some(dir) = &settings.export_lcp {
-        std::fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create the LCP export folder: {e}", dir.display()))?;
+        std::fs::create_dir_all(dir).map_err(|e| Error::io(format!("{}: cannot create the LCP export folder: {e}", dir.display())))?;
     }
     let wanted = |label: &str| settings.methods.is_empty() || settings.methods.iter().any(|m| m == label);
     let mut tracks: BTreeMap<(String, String), Track> = BTreeMap::new();
@@ -206,28 +207,29 @@ pub fn run(settings: &AccuracySettings, progress: &mut dyn FnMut(&Row)) -> Resul
                     rows.push(row);
                 }
             }
-            if settings.march {
-                if let Some(&n) = settings.march_steps.get(level) {
-                    let label = "march cds".to_string();
-                    let mut row = Row::new(case, label.clone(), "marching", n, true);
-                    let track = tracks.entry((case.name().to_string(), label)).or_insert(Track { stopped: None, last: None });
-                    if let Some(why) = &track.stopped {
-                        row.status = format!("skipped: {why}");
-                    } else if start.elapsed().as_secs_f64() > settings.budget_s {
-                        row.status = format!("skipped: total budget of {} s spent", settings.budget_s);
-                    } else {
-                        march_point(&mut row, case, n, reference, settings);
-                        track.record(n, row.t_total.or(row.t_failed), settings.solve_cap_s);
-                    }
-                    progress(&row);
-                    rows.push(row);
+            if settings.march
+                && let Some(&n) = settings.march_steps.get(level)
+            {
+                let label = "march cds".to_string();
+                let mut row = Row::new(case, label.clone(), "marching", n, true);
+                let track = tracks.entry((case.name().to_string(), label)).or_insert(Track { stopped: None, last: None });
+                if let Some(why) = &track.stopped {
+                    row.status = format!("skipped: {why}");
+                } else if start.elapsed().as_secs_f64() > settings.budget_s {
+                    row.status = format!("skipped: total budget of {} s spent", settings.budget_s);
+                } else {
+                    march_point(&mut row, case, n, reference, settings);
+                    track.record(n, row.t_total.or(row.t_failed), settings.solve_cap_s);
                 }
+                progress(&row);
+                rows.push(row);
             }
         }
     }
     Ok(AccuracyStudy { rows, settings: settings.clone(), elapsed_s: start.elapsed().as_secs_f64(), exported, load: (load0, load_average()) })
 }
 
+#[allow(clippy::too_many_arguments)] // one row of the study: its case, method, grid and the shared sinks
 fn periodic_point(
     row: &mut Row,
     case: Case,
@@ -237,7 +239,7 @@ fn periodic_point(
     reference: &Reference,
     settings: &AccuracySettings,
     exported: &mut Vec<PathBuf>,
-) -> Result<(), String> {
+) -> Result<(), Error> {
     let problem = match case.problem(scheme, pairing, k, LcpMethod::Auto) {
         Ok(p) => p,
         Err(e) => {
@@ -246,14 +248,15 @@ fn periodic_point(
         }
     };
     let fft = PeriodFft::new(k);
-    row.lcp_size = if case.has_contact() { k * problem.model.contacts.len() } else { 0 };
-    if let Some(dir) = &settings.export_lcp {
-        if case.has_contact() && row.lcp_size <= settings.export_max {
-            let (a, q) = problem.assemble_lcp(&fft).map_err(|e| e.to_string())?;
-            let p = dir.join(format!("{}-{}-k{k}.dat", case.name(), row.method.replace('/', "-")));
-            write_dat(&p, &a as &dyn LcpMatrix, &q).map_err(|e| format!("{}: {e}", p.display()))?;
-            exported.push(p);
-        }
+    row.lcp_size = if case.has_contact() { k * problem.model().contacts.len() } else { 0 };
+    if let Some(dir) = &settings.export_lcp
+        && case.has_contact()
+        && row.lcp_size <= settings.export_max
+    {
+        let (a, q) = problem.assemble_lcp(&fft).map_err(Error::from)?;
+        let p = dir.join(format!("{}-{}-k{k}.dat", case.name(), row.method.replace('/', "-")));
+        write_dat(&p, &a as &dyn LcpMatrix, &q).map_err(|e| Error::io(format!("{}: {e}", p.display())))?;
+        exported.push(p);
     }
     let mut best = None;
     let mut spent = 0.0;
@@ -433,7 +436,7 @@ impl AccuracyStudy {
             let reached = winners.values().sum::<usize>();
             if reached > 0 {
                 let mut w: Vec<_> = winners.into_iter().collect();
-                w.sort_by(|a, b| b.1.cmp(&a.1));
+                w.sort_by_key(|e| std::cmp::Reverse(e.1));
                 let list: Vec<String> = w.iter().map(|(m, c)| format!("**{m}** at {c} of {reached}")).collect();
                 let _ = writeln!(s, "\nCheapest for the accuracy targets reached: {}.\n", list.join(", "));
             }
@@ -483,7 +486,7 @@ impl AccuracyStudy {
     /// One panel per case: error against CPU time, log axes, one line per method; a last panel
     /// with the impulse error of the rigid stop.
     #[cfg(feature = "plots")]
-    pub fn plot(&self, path: &Path) -> Result<(), String> {
+    pub fn plot(&self, path: &Path) -> Result<(), Error> {
         use crate::plot::{Chart, Legend, Scale, Series, panel_chart};
         let series_of = |case: Case, value: &dyn Fn(&Row) -> Option<f64>| -> Vec<Series> {
             let mut labels: Vec<String> = Vec::new();
@@ -526,16 +529,16 @@ impl AccuracyStudy {
         let panels: Vec<(&Chart, &[Series])> = chart_defs.iter().zip(&all_series).map(|(c, s)| (c, s.as_slice())).collect();
         let cols = panels.len().min(2);
         let rows = panels.len().div_ceil(cols.max(1)) as u32;
-        panel_chart(path, &panels, cols, 1000 * cols as u32, 850 * rows, Legend::LowerLeft)
+        panel_chart(path, &panels, cols, 1000 * cols as u32, 850 * rows, Legend::LowerLeft).map_err(Error::from)
     }
 
     /// Writes accuracy.csv, accuracy.md and (with the `plots` feature) accuracy.png into `dir`.
-    pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>, String> {
-        std::fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create: {e}", dir.display()))?;
+    pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>, Error> {
+        std::fs::create_dir_all(dir).map_err(|e| Error::io(format!("{}: cannot create: {e}", dir.display())))?;
         let mut out = Vec::new();
         for (name, text) in [("accuracy.csv", self.csv()), ("accuracy.md", self.markdown())] {
             let p = dir.join(name);
-            std::fs::write(&p, text).map_err(|e| format!("{}: cannot write: {e}", p.display()))?;
+            std::fs::write(&p, text).map_err(|e| Error::io(format!("{}: cannot write: {e}", p.display())))?;
             out.push(p);
         }
         #[cfg(feature = "plots")]

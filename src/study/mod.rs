@@ -6,6 +6,7 @@
 pub mod accuracy;
 pub mod warmstart;
 
+use crate::Error;
 use crate::exact::{CompliantStopOrbit, LinearOrbit, Oscillator, RigidStopOrbit};
 use crate::model::{Compliance, Model};
 use crate::periodic::{LcpMethod, OutputSelection, PeriodicProblem, SolverSettings};
@@ -51,8 +52,11 @@ impl Case {
         }
     }
 
-    pub fn parse(s: &str) -> Result<Case, String> {
-        Case::ALL.into_iter().find(|c| c.name() == s).ok_or_else(|| format!("unknown case \"{s}\"; expected compliant, rigid, linear or impacting"))
+    pub fn parse(s: &str) -> Result<Case, Error> {
+        Case::ALL
+            .into_iter()
+            .find(|c| c.name() == s)
+            .ok_or_else(|| Error::input(format!("unknown case \"{s}\"; expected compliant, rigid, linear or impacting")))
     }
 
     pub fn title(self) -> &'static str {
@@ -114,21 +118,28 @@ impl Case {
     }
 
     /// The problem at k instants, one thread, `auto` LCP method unless told.
-    pub fn problem(self, scheme: Scheme, pairing: Option<Pairing>, k: usize, method: LcpMethod) -> Result<PeriodicProblem, String> {
+    pub fn problem(self, scheme: Scheme, pairing: Option<Pairing>, k: usize, method: LcpMethod) -> Result<PeriodicProblem, Error> {
         let outputs = OutputSelection { displacement: vec![0], velocity: vec![], acceleration: vec![], contacts: self.has_contact() };
         let solver = SolverSettings { method, tolerance: 1e-9, parallel: false, regularization: None };
-        PeriodicProblem::new(self.model(), Discretization { scheme, steps: k, pairing }, outputs, solver).map_err(|e| e.to_string())
+        PeriodicProblem::new(self.model(), Discretization { scheme, steps: k, pairing }, outputs, solver).map_err(Error::from)
     }
 
     /// The exact reference.
-    pub fn reference(self) -> Result<Reference, String> {
+    pub fn reference(self) -> Result<Reference, Error> {
         Ok(match self {
-            Case::Compliant => Reference::Compliant(CompliantStopOrbit::solve(&COMPLIANT_OSC, COMPLIANT_STIFFNESS, COMPLIANT_GAP, None)?),
-            Case::Rigid => Reference::Rigid(RigidStopOrbit::solve(&RIGID_OSC, RIGID_GAP)?),
-            Case::Impacting => Reference::Rigid(RigidStopOrbit::solve(&IMPACTING_OSC, IMPACTING_GAP)?),
-            Case::Linear => Reference::Linear(LinearOrbit::solve(&COMPLIANT_OSC)?),
+            Case::Compliant => {
+                Reference::Compliant(CompliantStopOrbit::solve(&COMPLIANT_OSC, COMPLIANT_STIFFNESS, COMPLIANT_GAP, None).map_err(reference_error)?)
+            }
+            Case::Rigid => Reference::Rigid(RigidStopOrbit::solve(&RIGID_OSC, RIGID_GAP).map_err(reference_error)?),
+            Case::Impacting => Reference::Rigid(RigidStopOrbit::solve(&IMPACTING_OSC, IMPACTING_GAP).map_err(reference_error)?),
+            Case::Linear => Reference::Linear(LinearOrbit::solve(&COMPLIANT_OSC).map_err(reference_error)?),
         })
     }
+}
+
+/// A failure of a semi-analytic reference (whatever its error type): the study cannot run.
+fn reference_error(e: impl std::fmt::Display) -> Error {
+    Error::solve(format!("the exact reference: {e}"))
 }
 
 /// A method label: "cds/forward", or "cds" without contact.

@@ -7,6 +7,7 @@
 //! only when its principal solve certifies as is (otherwise it runs cold); block pivoting starts
 //! its exchanges from the guess.
 use super::{RIGID_GAP, RIGID_OSC, sci};
+use crate::Error;
 use crate::exact::Oscillator;
 use crate::model::Compliance;
 use crate::periodic::{LcpMethod, OutputSelection, PeriodFft, PeriodicProblem, SolverSettings};
@@ -67,19 +68,19 @@ pub struct WarmStudy {
     pub settings: WarmSettings,
 }
 
-fn problem(omega: f64, k: usize, method: LcpMethod) -> Result<PeriodicProblem, String> {
+fn problem(omega: f64, k: usize, method: LcpMethod) -> Result<PeriodicProblem, Error> {
     let osc = Oscillator { omega, ..RIGID_OSC };
     let model = osc.model(vec![Oscillator::stop(RIGID_GAP, Compliance::Rigid)]);
     let outputs = OutputSelection { displacement: vec![0], velocity: vec![], acceleration: vec![], contacts: true };
     let solver = SolverSettings { method, tolerance: 1e-9, parallel: false, regularization: None };
-    PeriodicProblem::new(model, Discretization { scheme: Scheme::Cds, steps: k, pairing: Some(Pairing::Forward) }, outputs, solver).map_err(|e| e.to_string())
+    PeriodicProblem::new(model, Discretization { scheme: Scheme::Cds, steps: k, pairing: Some(Pairing::Forward) }, outputs, solver).map_err(Error::from)
 }
 
 /// Fastest of `repeats` solves (the pivots are the same every time).
-fn timed(p: &PeriodicProblem, fft: &PeriodFft, warm: Option<&[usize]>, repeats: usize) -> Result<Response, String> {
+fn timed(p: &PeriodicProblem, fft: &PeriodFft, warm: Option<&[usize]>, repeats: usize) -> Result<Response, Error> {
     let mut best: Option<Response> = None;
     for _ in 0..repeats.max(1) {
-        let r = p.solve_with(fft, warm).map_err(|e| e.to_string())?;
+        let r = p.solve_with(fft, warm).map_err(Error::from)?;
         if best.as_ref().is_none_or(|b| r.timing_s.lcp < b.timing_s.lcp) {
             best = Some(r);
         }
@@ -108,7 +109,7 @@ fn compare(kind: &'static str, k: usize, method: LcpMethod, omega: f64, delta: f
     }
 }
 
-pub fn run(settings: &WarmSettings, progress: &mut dyn FnMut(&WarmRow)) -> Result<WarmStudy, String> {
+pub fn run(settings: &WarmSettings, progress: &mut dyn FnMut(&WarmRow)) -> Result<WarmStudy, Error> {
     let mut rows = Vec::new();
     let (lo, hi, n) = settings.sweep;
     let omegas: Vec<f64> = (0..n).map(|i| if n > 1 { lo + (hi - lo) * i as f64 / (n - 1) as f64 } else { lo }).collect();
@@ -254,7 +255,7 @@ impl WarmStudy {
 
     /// Pivots along the sweep, cold and warm, per k and method.
     #[cfg(feature = "plots")]
-    pub fn plot(&self, path: &Path) -> Result<(), String> {
+    pub fn plot(&self, path: &Path) -> Result<(), Error> {
         use crate::plot::{Chart, Scale, Series, line_chart};
         let mut series = Vec::new();
         for &k in &self.settings.steps {
@@ -282,15 +283,15 @@ impl WarmStudy {
             x_scale: Scale::Linear,
             y_scale: Scale::Log,
         };
-        line_chart(path, &chart, &series, 1100, 750)
+        line_chart(path, &chart, &series, 1100, 750).map_err(Error::from)
     }
 
-    pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>, String> {
-        std::fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create: {e}", dir.display()))?;
+    pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>, Error> {
+        std::fs::create_dir_all(dir).map_err(|e| Error::io(format!("{}: cannot create: {e}", dir.display())))?;
         let mut out = Vec::new();
         for (name, text) in [("warmstart.csv", self.csv()), ("warmstart.md", self.markdown())] {
             let p = dir.join(name);
-            std::fs::write(&p, text).map_err(|e| format!("{}: cannot write: {e}", p.display()))?;
+            std::fs::write(&p, text).map_err(|e| Error::io(format!("{}: cannot write: {e}", p.display())))?;
             out.push(p);
         }
         #[cfg(feature = "plots")]

@@ -14,7 +14,7 @@ pub fn peak_rss_mib() -> Option<f64> {
 
 /// One measurement, printed as one tab-separated line for the parent.
 pub fn run_single(steps: usize, repeats: usize, method: &str) -> Result<(), Failure> {
-    let text = periodic_contact::defaults::DEFAULT_SCENE
+    let text = crate::defaults::DEFAULT_SCENE
         .replace("steps = 256", &format!("steps = {steps}"))
         .replace("[output]", &format!("[solver]\nmethod = \"{method}\"\n\n[output]"));
     let problem = Scene::parse(&text, "bench").and_then(|s| s.to_problem("bench")).map_err(|e| Failure::input(e.to_string()))?;

@@ -42,7 +42,7 @@ pub fn run(scene: &Path, output: &Path, frequency: Option<f64>) -> Result<(), Fa
 
 /// `cargo run --release` without arguments: the built-in scene and a short table.
 pub fn run_default() -> Result<(), Failure> {
-    let scene = Scene::parse(periodic_contact::defaults::DEFAULT_SCENE, "built-in rigid-stop scene").map_err(|e| Failure::input(e.to_string()))?;
+    let scene = Scene::parse(crate::defaults::DEFAULT_SCENE, "built-in rigid-stop scene").map_err(|e| Failure::input(e.to_string()))?;
     let problem = scene.to_problem("built-in rigid-stop scene").map_err(|e| Failure::input(e.to_string()))?;
     let r = solve(&problem)?;
     let x = &r.displacement["0"];

@@ -91,8 +91,8 @@ pub fn run(cmd: StudyCommand) -> Result<(), Failure> {
                     r.t_total.map(|v| format!("{v:.2e}")).unwrap_or_default()
                 )
             })
-            .map_err(Failure::solver)?;
-            let files = study.write(&output).map_err(Failure::input)?;
+            .map_err(Failure::from)?;
+            let files = study.write(&output).map_err(Failure::from)?;
             for f in files {
                 eprintln!("wrote {}", f.display());
             }
@@ -122,8 +122,8 @@ pub fn run(cmd: StudyCommand) -> Result<(), Failure> {
                     if r.status == "ok" { "" } else { &r.status }
                 )
             })
-            .map_err(Failure::solver)?;
-            let files = study.write(&output).map_err(Failure::input)?;
+            .map_err(Failure::from)?;
+            let files = study.write(&output).map_err(Failure::from)?;
             for f in files {
                 eprintln!("wrote {}", f.display());
             }

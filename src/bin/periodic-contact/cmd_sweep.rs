@@ -2,7 +2,6 @@
 //! frequency-response PNG, spectra at chosen points and the comparison with time marching.
 use crate::{Failure, write_output};
 use indicatif::{ProgressBar, ProgressStyle};
-use periodic_contact::periodic::PeriodFft;
 use periodic_contact::scene::Scene;
 use periodic_contact::sweep::{self, SweepSettings, marching::MarchOptions};
 use std::path::{Path, PathBuf};
@@ -108,7 +107,7 @@ pub fn run(a: &Args) -> Result<(), Failure> {
         ProgressStyle::with_template("{spinner} sweep [{bar:40}] {pos}/{len} points, {elapsed_precise} elapsed, ETA {eta}").unwrap().progress_chars("=> "),
     );
     let t = Instant::now();
-    let points = sweep::run(problem, &freqs, &settings, &|| bar.inc(1)).map_err(Failure::input)?;
+    let points = sweep::run(problem, &freqs, &settings, &|| bar.inc(1)).map_err(Failure::from)?;
     let wall = t.elapsed().as_secs_f64();
     bar.finish_and_clear();
 
@@ -130,7 +129,7 @@ pub fn run(a: &Args) -> Result<(), Failure> {
         fallback,
         a.output.display()
     );
-    for (i, d) in problem.outputs.displacement.iter().enumerate() {
+    for (i, d) in problem.outputs().displacement.iter().enumerate() {
         let nl = sweep::peak(&points, |p| p.amplitude[i]);
         let li = sweep::peak(&points, |p| p.linear_amplitude[i]);
         if let (Some(nl), Some(li)) = (nl, li) {
@@ -144,16 +143,15 @@ pub fn run(a: &Args) -> Result<(), Failure> {
     #[cfg(feature = "plots")]
     if !a.no_plot {
         let stem = a.scene.file_stem().map_or(String::new(), |s| s.to_string_lossy().to_string());
-        for (i, d) in problem.outputs.displacement.iter().enumerate() {
+        for (i, d) in problem.outputs().displacement.iter().enumerate() {
             // The first output's curve is <csv stem>.png, the others <csv stem>-dof<d>.png.
             let png = if i == 0 { sibling(&a.output, "", "png") } else { sibling(&a.output, &format!("-dof{d}"), "png") };
-            sweep::plot_frc(&png, &a.param, &values, problem, &points, i, &format!("{stem}: frequency response")).map_err(Failure::solver)?;
+            sweep::plot_frc(&png, &a.param, &values, problem, &points, i, &format!("{stem}: frequency response")).map_err(Failure::from)?;
             eprintln!("frequency-response curve of DOF {d} → {}", png.display());
         }
     }
 
     if !a.spectrum_at.is_empty() {
-        let fft = PeriodFft::new(problem.disc.steps);
         let mut spectra = Vec::new();
         for &v in &a.spectrum_at {
             let f = to_frequency(v);
@@ -163,14 +161,14 @@ pub fn run(a: &Args) -> Result<(), Failure> {
             // Warm-start from the nearest solved sweep point, so as to stay on its branch.
             let near = points.iter().filter(|p| p.error.is_none()).min_by(|x, y| (x.frequency - f).abs().total_cmp(&(y.frequency - f).abs()));
             let mut p = problem.clone();
-            p.solver.parallel = false;
-            let (r, _) = sweep::solve_point(&mut p, &fft, f, near.map(|n| n.active_set.as_slice()));
-            let r = r.map_err(|e| Failure::solver(format!("spectrum at {} = {v}: {e}", a.param)))?;
+            p.set_parallel(false);
+            let (r, _) = sweep::solve_point(&p, f, near.map(|n| n.active_set.as_slice()));
+            let r = r.map_err(|e| Failure::from(e.context(format!("spectrum at {} = {v}", a.param))))?;
             let sp = sweep::spectrum::spectrum(&p, &r, a.harmonics);
             #[cfg(feature = "plots")]
             if !a.no_plot {
                 let png = sibling(&a.output, &format!("-spectrum-{v}"), "png");
-                sweep::spectrum::plot(&png, &sp, &format!("spectrum at {} = {v} (ω = {f:.4} rad/s)", a.param)).map_err(Failure::solver)?;
+                sweep::spectrum::plot(&png, &sp, &format!("spectrum at {} = {v} (ω = {f:.4} rad/s)", a.param)).map_err(Failure::from)?;
                 eprintln!("spectrum at {} = {v} → {}", a.param, png.display());
             }
             spectra.push(sp);
@@ -184,10 +182,10 @@ pub fn run(a: &Args) -> Result<(), Failure> {
         let per_point = wall / points.len() as f64;
         let opts =
             MarchOptions { steps_per_period: a.march_steps, tolerances: a.march_tol.clone(), reference_factor: a.reference_factor, ..Default::default() };
-        let k = problem.disc.steps;
+        let k = problem.discretization().steps;
         println!(
             "time marching (explicit central differences with penalty contacts, from rest) against the periodic LCP (k = {k}); errors: max over the {k} instants of |x − x_ref| / amplitude, per displacement output ({}); reference: the LCP with k = {}",
-            problem.outputs.displacement.iter().map(|d| d.to_string()).collect::<Vec<_>>().join("/"),
+            problem.outputs().displacement.iter().map(|d| d.to_string()).collect::<Vec<_>>().join("/"),
             k * a.reference_factor
         );
         println!("sweep: {per_point:.5} s per point (wall, {} points, {})", points.len(), if a.cold { "cold" } else { "warm-started" });

@@ -7,6 +7,7 @@ mod cmd_modes;
 mod cmd_solve;
 mod cmd_study;
 mod cmd_sweep;
+mod defaults;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;

@@ -11,7 +11,7 @@ pub fn harmonic_amplitudes(fft: &PeriodFft, series: &[f64]) -> Vec<f64> {
     spec.iter()
         .enumerate()
         .map(|(p, v)| {
-            let twice = p != 0 && !(k % 2 == 0 && p == k / 2);
+            let twice = p != 0 && !(k.is_multiple_of(2) && p == k / 2);
             v.norm() * if twice { 2.0 } else { 1.0 } / k as f64
         })
         .collect()
@@ -37,7 +37,7 @@ pub fn spectrum(problem: &PeriodicProblem, response: &Response, max_harmonic: us
         v
     };
     let displacement = problem
-        .outputs
+        .outputs()
         .displacement
         .iter()
         .filter_map(|d| response.displacement.get(&d.to_string()).map(|s| (*d, cut(harmonic_amplitudes(&fft, s)))))
@@ -74,7 +74,7 @@ pub fn to_csv(param: &str, values: &[f64], spectra: &[Spectrum]) -> String {
 /// PNG of one spectrum: each series relative to its largest harmonic (log scale), the first
 /// displacement output and every contact force.
 #[cfg(feature = "plots")]
-pub fn plot(path: &std::path::Path, sp: &Spectrum, title: &str) -> Result<(), String> {
+pub fn plot(path: &std::path::Path, sp: &Spectrum, title: &str) -> Result<(), crate::Error> {
     use crate::plot::{Chart, Scale, Series, line_chart};
     let rel = |a: &[f64]| -> (f64, Vec<(f64, f64)>) {
         let max = a.iter().copied().fold(0.0, f64::max);
@@ -91,5 +91,5 @@ pub fn plot(path: &std::path::Path, sp: &Spectrum, title: &str) -> Result<(), St
         series.push(Series { label: format!("force of contact {i} on DOF {d} (largest {max:.3e})"), points, markers: true });
     }
     let chart = Chart { title, x_label: "harmonic p of ω", y_label: "amplitude / largest harmonic", x_scale: Scale::Linear, y_scale: Scale::Log };
-    line_chart(path, &chart, &series, 1000, 650)
+    line_chart(path, &chart, &series, 1000, 650).map_err(crate::Error::from)
 }

@@ -11,10 +11,11 @@
 //! the resonance): a warm-started chunk follows the branch it starts on, and each chunk starts
 //! cold. For a strictly sequential continuation in the direction of the sweep, use one thread
 //! and one chunk (`--threads 1 --chunks-per-thread 1`).
+#[cfg(feature = "reference")]
 pub mod marching;
 pub mod spectrum;
 
-use crate::periodic::{PeriodFft, PeriodicProblem};
+use crate::periodic::{PeriodicProblem, PeriodicSolver, WarmStart};
 use crate::response::Response;
 use rayon::prelude::*;
 use std::time::Instant;
@@ -71,7 +72,7 @@ pub struct SweepPoint {
 impl SweepPoint {
     fn from_response(problem: &PeriodicProblem, frequency: f64, r: &Response) -> SweepPoint {
         let amp = |m: &std::collections::BTreeMap<String, Vec<f64>>| -> Vec<f64> {
-            problem.outputs.displacement.iter().map(|d| m.get(&d.to_string()).map_or(f64::NAN, |s| Response::peak_to_peak(s) / 2.0)).collect()
+            problem.outputs().displacement.iter().map(|d| m.get(&d.to_string()).map_or(f64::NAN, |s| Response::peak_to_peak(s) / 2.0)).collect()
         };
         SweepPoint {
             frequency,
@@ -103,26 +104,27 @@ pub fn linspace(from: f64, to: f64, n: usize) -> Vec<f64> {
 
 /// Solves `problem` at one frequency, warm-started if `warm` is given, cold if that fails.
 /// Returns the response (or the error) and whether a cold fallback was needed.
-pub fn solve_point(problem: &mut PeriodicProblem, fft: &PeriodFft, frequency: f64, warm: Option<&[usize]>) -> (Result<Response, String>, bool) {
-    problem.model.frequency = frequency;
-    match problem.solve_with(fft, warm) {
-        Ok(r) => (Ok(r), false),
-        Err(e) if warm.is_none() => (Err(e.to_string()), false),
-        Err(_) => (problem.solve_with(fft, None).map_err(|e| e.to_string()), true),
+pub fn solve_point(problem: &PeriodicProblem, frequency: f64, warm: Option<&[usize]>) -> (Result<Response, crate::Error>, bool) {
+    let mut solver = PeriodicSolver::new(problem.clone());
+    if let Some(w) = warm {
+        solver.set_warm_start(w);
     }
+    let r = solver.update_frequency(frequency).and_then(|()| solver.solve()).map_err(crate::Error::from);
+    (r, solver.last_start() == WarmStart::ColdFallback)
 }
 
 /// Runs the sweep over `frequencies` (any order; chunks are contiguous in the given order).
 /// `on_point` is called after each point (from worker threads), e.g. to advance a progress bar.
-pub fn run(template: &PeriodicProblem, frequencies: &[f64], settings: &SweepSettings, on_point: &(dyn Fn() + Sync)) -> Result<Vec<SweepPoint>, String> {
+pub fn run(template: &PeriodicProblem, frequencies: &[f64], settings: &SweepSettings, on_point: &(dyn Fn() + Sync)) -> Result<Vec<SweepPoint>, crate::Error> {
     if let Some(f) = frequencies.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
-        return Err(format!("frequency: {f} is not a finite angular frequency > 0 [rad/s]"));
+        return Err(crate::Error::input(format!("frequency: {f} is not a finite angular frequency > 0 [rad/s]")));
     }
     let mut template = template.clone();
     // Parallelism is over points: each solve stays on its thread.
-    template.solver.parallel = false;
-    let fft = PeriodFft::new(template.disc.steps);
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(settings.threads).build().map_err(|e| format!("threads: {e}"))?;
+    template.set_parallel(false);
+    // One plan for every chunk: the chunks clone this session.
+    let session = PeriodicSolver::new(template).with_warm_starts(settings.warm_start);
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(settings.threads).build().map_err(|e| crate::Error::input(format!("threads: {e}")))?;
     let threads = pool.current_num_threads().max(1);
     let n = frequencies.len();
     let chunks = (threads * settings.chunks_per_thread.max(1)).min(n).max(1);
@@ -131,22 +133,22 @@ pub fn run(template: &PeriodicProblem, frequencies: &[f64], settings: &SweepSett
         bounds
             .par_iter()
             .map(|&(lo, hi)| {
-                let mut problem = template.clone();
-                let fft = fft.clone();
-                let mut prev: Option<Vec<usize>> = None;
+                let mut solver = session.clone();
                 let mut out = Vec::with_capacity(hi - lo);
                 for &f in &frequencies[lo..hi] {
                     let t = Instant::now();
-                    let warm = if settings.warm_start { prev.as_deref() } else { None };
-                    let (r, fallback) = solve_point(&mut problem, &fft, f, warm);
+                    let r = solver.update_frequency(f).and_then(|()| solver.solve());
                     let mut point = match &r {
-                        Ok(r) => SweepPoint::from_response(&problem, f, r),
-                        Err(e) => SweepPoint { frequency: f, error: Some(e.clone()), ..Default::default() },
+                        Ok(r) => SweepPoint::from_response(solver.problem(), f, r),
+                        Err(e) => SweepPoint { frequency: f, error: Some(e.to_string()), ..Default::default() },
                     };
-                    point.warm_start_used = warm.is_some() && !fallback && r.is_ok();
-                    point.cold_fallback = fallback;
+                    point.warm_start_used = r.is_ok() && solver.last_start() == WarmStart::Used;
+                    point.cold_fallback = solver.last_start() == WarmStart::ColdFallback;
                     point.time_s = t.elapsed().as_secs_f64();
-                    prev = r.ok().map(|r| r.active_set);
+                    if r.is_err() {
+                        // The next point starts cold, as after any failure.
+                        solver.reset_warm_start();
+                    }
                     out.push(point);
                     on_point();
                 }
@@ -166,8 +168,8 @@ pub fn to_csv(param: &str, values: &[f64], problem: &PeriodicProblem, points: &[
     if param != "frequency" {
         head.push("frequency".into());
     }
-    head.extend(problem.outputs.displacement.iter().map(|d| format!("amplitude_{d}")));
-    head.extend(problem.outputs.displacement.iter().map(|d| format!("linear_amplitude_{d}")));
+    head.extend(problem.outputs().displacement.iter().map(|d| format!("amplitude_{d}")));
+    head.extend(problem.outputs().displacement.iter().map(|d| format!("linear_amplitude_{d}")));
     let contact_dofs = contact_labels(problem);
     head.extend(contact_dofs.iter().enumerate().map(|(i, d)| format!("max_force_c{i}_dof{d}")));
     head.extend(contact_dofs.iter().enumerate().map(|(i, d)| format!("contact_fraction_c{i}_dof{d}")));
@@ -179,7 +181,7 @@ pub fn to_csv(param: &str, values: &[f64], problem: &PeriodicProblem, points: &[
         if param != "frequency" {
             row.push(p.frequency.to_string());
         }
-        let nd = problem.outputs.displacement.len();
+        let nd = problem.outputs().displacement.len();
         let nc = contact_dofs.len();
         let num = |x: Option<&f64>| x.map_or("nan".to_string(), |x| format!("{x:e}"));
         row.extend((0..nd).map(|i| num(p.amplitude.get(i))));
@@ -203,9 +205,9 @@ pub fn to_csv(param: &str, values: &[f64], problem: &PeriodicProblem, points: &[
 
 /// The user's DOF of each contact.
 pub fn contact_labels(problem: &PeriodicProblem) -> Vec<usize> {
-    match &problem.output_map {
+    match problem.output_map() {
         Some(m) if !m.contact_dofs.is_empty() => m.contact_dofs.clone(),
-        _ => problem.model.contacts.iter().map(|c| c.dof).collect(),
+        _ => problem.model().contacts.iter().map(|c| c.dof).collect(),
     }
 }
 
@@ -230,9 +232,9 @@ pub fn plot_frc(
     points: &[SweepPoint],
     i: usize,
     title: &str,
-) -> Result<(), String> {
+) -> Result<(), crate::Error> {
     use crate::plot::{Chart, Scale, Series, line_chart};
-    let d = problem.outputs.displacement[i];
+    let d = problem.outputs().displacement[i];
     let pts = |lin: bool| -> Vec<(f64, f64)> {
         values.iter().zip(points).filter(|(_, p)| p.error.is_none()).map(|(v, p)| (*v, if lin { p.linear_amplitude[i] } else { p.amplitude[i] })).collect()
     };
@@ -246,5 +248,5 @@ pub fn plot_frc(
     };
     let y_label = format!("amplitude of DOF {d} (peak-to-peak / 2)");
     let chart = Chart { title, x_label, y_label: &y_label, x_scale: Scale::Linear, y_scale: Scale::Linear };
-    line_chart(path, &chart, &series, 1000, 650)
+    line_chart(path, &chart, &series, 1000, 650).map_err(crate::Error::from)
 }

@@ -7,10 +7,12 @@
 //! modes of a Craig–Bampton model and the contact stiffness set) and a stopping tolerance on the
 //! periodicity defect. Errors are measured at the k instants of the LCP against the LCP with
 //! `reference_factor`·k instants, and divided by the reference amplitude (peak-to-peak/2).
+use crate::Error;
 use crate::marching::{MarchSettings, march, omega_max_dense};
 use crate::model::Compliance;
-use crate::periodic::{PeriodFft, PeriodicProblem};
+use crate::periodic::{PeriodicProblem, PeriodicSolver};
 use crate::response::Response;
+use crate::time::Discretization;
 use std::time::Instant;
 
 /// Settings of [`compare`].
@@ -71,15 +73,15 @@ pub const STEP_GRAIN: usize = 128;
 
 /// Smallest steps per period, multiple of [`STEP_GRAIN`], at `margin` × the stability limit of
 /// the model (compliant contacts closed) at frequency ω.
-pub fn stable_steps(problem: &PeriodicProblem, frequency: f64, margin: f64) -> Result<usize, String> {
-    let s = &problem.model.structure;
+pub fn stable_steps(problem: &PeriodicProblem, frequency: f64, margin: f64) -> Result<usize, Error> {
+    let s = &problem.model().structure;
     let mut kc = s.stiffness.to_dense();
-    for c in &problem.model.contacts {
+    for c in &problem.model().contacts {
         if let Compliance::Compliant { stiffness } = c.compliance {
             kc[(c.dof, c.dof)] += stiffness;
         }
     }
-    let wmax = omega_max_dense(&s.mass.to_dense(), &kc)?;
+    let wmax = omega_max_dense(&s.mass.to_dense(), &kc).map_err(|e| Error::solve(format!("the stability limit of time marching: {e}")))?;
     let period = 2.0 * std::f64::consts::PI / frequency;
     let n_min = (margin * period * wmax / 2.0).ceil() as usize;
     Ok(n_min.div_ceil(STEP_GRAIN).max(1) * STEP_GRAIN)
@@ -104,28 +106,28 @@ fn errors(x: &[Vec<f64>], stride: usize, reference: &[Vec<f64>], rstride: usize,
 
 /// The displacement outputs of a response, in the problem's order.
 fn outputs(p: &PeriodicProblem, r: &Response) -> Vec<Vec<f64>> {
-    p.outputs.displacement.iter().map(|d| r.displacement[&d.to_string()].clone()).collect()
+    p.outputs().displacement.iter().map(|d| r.displacement[&d.to_string()].clone()).collect()
 }
 
 /// Solves the LCP (cold) at `frequency`, a reference LCP with more instants, and marches from
 /// rest once per tolerance; compares the displacement outputs at the LCP's instants.
-pub fn compare(problem: &PeriodicProblem, frequency: f64, opts: &MarchOptions) -> Result<MarchComparison, String> {
+pub fn compare(problem: &PeriodicProblem, frequency: f64, opts: &MarchOptions) -> Result<MarchComparison, Error> {
     let mut p = problem.clone();
-    p.model.frequency = frequency;
-    p.solver.parallel = false;
-    let k = p.disc.steps;
-    let fft = PeriodFft::new(k);
+    p.set_frequency(frequency).map_err(|e| Error::from(e).context("LCP"))?;
+    p.set_parallel(false);
+    let k = p.discretization().steps;
     let t = Instant::now();
-    let response = p.solve_with(&fft, None).map_err(|e| format!("LCP: {e}"))?;
+    let response = PeriodicSolver::new(p.clone()).solve().map_err(|e| Error::from(e).context("LCP"))?;
     let lcp_time_s = t.elapsed().as_secs_f64();
     let lcp = outputs(&p, &response);
 
     let reference = if opts.reference_factor > 1 {
-        let mut q = p.clone();
-        q.disc.steps = k * opts.reference_factor;
-        let fft = PeriodFft::new(q.disc.steps);
+        let kr = k * opts.reference_factor;
+        let what = format!("reference LCP (k = {kr})");
+        let mut reference = PeriodicSolver::new(p.clone());
+        reference.update_discretization(Discretization { steps: kr, ..p.discretization() }).map_err(|e| Error::from(e).context(&what))?;
         // Warm start: the coarse active set, each instant repeated.
-        let m = p.model.contacts.len();
+        let m = p.model().contacts.len();
         let warm: Vec<usize> = response
             .active_set
             .iter()
@@ -134,8 +136,9 @@ pub fn compare(problem: &PeriodicProblem, frequency: f64, opts: &MarchOptions) -
                 (0..opts.reference_factor).map(move |s| (j * opts.reference_factor + s) * m + a)
             })
             .collect();
-        let r = q.solve_with(&fft, Some(&warm)).or_else(|_| q.solve_with(&fft, None)).map_err(|e| format!("reference LCP (k = {}): {e}", q.disc.steps))?;
-        Some(outputs(&q, &r))
+        reference.set_warm_start(&warm);
+        let r = reference.solve().map_err(|e| Error::from(e).context(&what))?;
+        Some(outputs(reference.problem(), &r))
     } else {
         None
     };
@@ -148,21 +151,24 @@ pub fn compare(problem: &PeriodicProblem, frequency: f64, opts: &MarchOptions) -
     // The instants common to both grids.
     let common = gcd(n, k);
     if common < 16 {
-        return Err(format!("steps_per_period: is {n}, shares only {common} instants with the LCP's {k}; use a multiple of {}", k.min(STEP_GRAIN)));
+        return Err(Error::input(format!(
+            "steps_per_period: is {n}, shares only {common} instants with the LCP's {k}; use a multiple of {}",
+            k.min(STEP_GRAIN)
+        )));
     }
     let (stride, lstride) = (n / common, k / common);
     let mut runs = Vec::new();
     for &tolerance in &opts.tolerances {
         let settings = MarchSettings { steps_per_period: n, max_periods: opts.max_periods, tolerance, ..Default::default() };
         let t = Instant::now();
-        let m = march(&p.model, &settings)?;
+        let m = march(p.model(), &settings).map_err(|e| Error::solve(format!("time marching: {e}")))?;
         let time_s = t.elapsed().as_secs_f64();
         let xm: Vec<Vec<f64>> = p
-            .outputs
+            .outputs()
             .displacement
             .iter()
             .map(|d| {
-                let terms: Vec<(usize, f64)> = match &p.output_map {
+                let terms: Vec<(usize, f64)> = match p.output_map() {
                     Some(map) => map.rows[d].clone(),
                     None => vec![(*d, 1.0)],
                 };

@@ -1,0 +1,8 @@
+//! What is computed from solved periodic responses: sweeps over a parameter, spectra, and the
+//! comparison with time marching.
+//!
+//! This is the room for the analyses that call the solver session ([`crate::periodic::PeriodicSolver`])
+//! many times or post-process its responses: continuation of branches through folds, Floquet
+//! stability and bifurcations, and an event-fitted polish each go here as a module of their
+//! own, beside [`sweep`] (a sweep is the simplest continuation: fixed steps, no predictor).
+pub mod sweep;

@@ -1,0 +1,138 @@
+//! The solver session: one per scene and front end (CLI sweep, C API handle, FMU instance).
+//!
+//! In the spirit of Clarabel's `update_*` and faer's reusable factorisations: the session owns
+//! the checked problem, the FFT plan of its k and the last solution's active set, and a change
+//! of parameter updates them in place instead of rebuilding. A solve is warm-started from the
+//! last active set when there is one; a warm start that fails is retried cold, so the warm
+//! start can only save pivots, never change whether a solution is found.
+use super::{PeriodFft, PeriodicProblem, SolveError};
+use crate::response::Response;
+use crate::time::Discretization;
+
+/// How the last solve started.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum WarmStart {
+    /// No previous active set (first solve, new grid, or warm starts off).
+    #[default]
+    Cold,
+    /// Started from the previous active set and solved from there.
+    Used,
+    /// The warm-started solve failed and the cold retry solved it.
+    ColdFallback,
+}
+
+/// A problem with its caches, updated in place.
+#[derive(Clone, Debug)]
+pub struct PeriodicSolver {
+    problem: PeriodicProblem,
+    fft: PeriodFft,
+    /// Active set of the last certified solution, for the next warm start (empty: none).
+    active_set: Vec<usize>,
+    warm_starts: bool,
+    last_start: WarmStart,
+}
+
+impl PeriodicSolver {
+    /// Plans the FFT of the problem's k; the first solve is cold.
+    pub fn new(problem: PeriodicProblem) -> Self {
+        let fft = PeriodFft::new(problem.discretization().steps);
+        PeriodicSolver { problem, fft, active_set: Vec::new(), warm_starts: true, last_start: WarmStart::Cold }
+    }
+
+    /// Whether solves start from the previous active set (default true).
+    pub fn with_warm_starts(mut self, on: bool) -> Self {
+        self.warm_starts = on;
+        self
+    }
+
+    pub fn problem(&self) -> &PeriodicProblem {
+        &self.problem
+    }
+    /// The FFT plan of the current k (shared by assembly, recovery and spectra).
+    pub fn fft(&self) -> &PeriodFft {
+        &self.fft
+    }
+    /// Active set of the last solution (indices into the LCP's z), empty before the first.
+    pub fn active_set(&self) -> &[usize] {
+        &self.active_set
+    }
+    /// How the last solve started.
+    pub fn last_start(&self) -> WarmStart {
+        self.last_start
+    }
+
+    /// Changes ω; the active set is kept as the next warm start (a neighbouring orbit).
+    pub fn update_frequency(&mut self, frequency: f64) -> Result<(), SolveError> {
+        self.problem.set_frequency(frequency)
+    }
+
+    /// Changes the grid: a new k re-plans the FFT and drops the active set, which indexes
+    /// the old grid.
+    pub fn update_discretization(&mut self, disc: Discretization) -> Result<(), SolveError> {
+        let old_k = self.problem.discretization().steps;
+        self.problem.set_discretization(disc)?;
+        if disc.steps != old_k {
+            self.fft = PeriodFft::new(disc.steps);
+            self.active_set.clear();
+        }
+        Ok(())
+    }
+
+    /// Replaces the problem (a new model or tuning); the plan is kept when k is the same, and the
+    /// active set when the LCP has the same size (same k and number of contacts).
+    pub fn update_problem(&mut self, problem: PeriodicProblem) {
+        let (k0, m0) = (self.problem.discretization().steps, self.problem.model().contacts.len());
+        let (k, m) = (problem.discretization().steps, problem.model().contacts.len());
+        if k != k0 {
+            self.fft = PeriodFft::new(k);
+        }
+        if (k, m) != (k0, m0) {
+            self.active_set.clear();
+        }
+        self.problem = problem;
+    }
+
+    /// Forgets the active set: the next solve is cold.
+    pub fn reset_warm_start(&mut self) {
+        self.active_set.clear();
+    }
+
+    /// Sets the warm start of the next solve (indices into the LCP's z, e.g. a neighbour's).
+    pub fn set_warm_start(&mut self, active_set: &[usize]) {
+        self.active_set.clear();
+        self.active_set.extend_from_slice(active_set);
+    }
+
+    /// Solves, warm-started from the last active set when there is one, cold if that fails.
+    /// The active set of the answer becomes the next warm start.
+    pub fn solve(&mut self) -> Result<Response, SolveError> {
+        let warm = self.warm_starts && !self.active_set.is_empty();
+        let result = if warm {
+            match self.problem.solve_with(&self.fft, Some(&self.active_set)) {
+                Ok(r) => Ok((r, WarmStart::Used)),
+                Err(_) => self.problem.solve_with(&self.fft, None).map(|r| (r, WarmStart::ColdFallback)),
+            }
+        } else {
+            self.problem.solve_with(&self.fft, None).map(|r| (r, WarmStart::Cold))
+        };
+        match result {
+            Ok((r, start)) => {
+                self.last_start = start;
+                self.set_warm_start(&r.active_set);
+                Ok(r)
+            }
+            Err(e) => {
+                self.last_start = if warm { WarmStart::ColdFallback } else { WarmStart::Cold };
+                Err(e)
+            }
+        }
+    }
+
+    /// Solves cold, whatever the active set (the reference of a warm-start comparison).
+    pub fn solve_cold(&mut self) -> Result<Response, SolveError> {
+        let r = self.problem.solve_with(&self.fft, None)?;
+        self.last_start = WarmStart::Cold;
+        self.set_warm_start(&r.active_set);
+        Ok(r)
+    }
+}

@@ -1,0 +1,187 @@
+//! ARCHITECTURE.md stays true: the rooms of `src/` and what each may use are read from its table,
+//! and checked against the `crate::…` paths the code actually names. Also the house rules the
+//! table cannot show: no cycle between rooms, no file over 600 lines, at most 10
+//! `Result<_, String>` in the library.
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+const ROOT: &str = env!("CARGO_MANIFEST_DIR");
+const MAX_LINES: usize = 600;
+const MAX_STRING_RESULTS: usize = 10;
+
+/// The table between `<!-- rooms -->` and `<!-- /rooms -->`: `| room | may use |` rows.
+fn declared_rooms() -> BTreeMap<String, BTreeSet<String>> {
+    let text = std::fs::read_to_string(Path::new(ROOT).join("ARCHITECTURE.md")).expect("ARCHITECTURE.md at the repository root");
+    let start = text.find("<!-- rooms -->").expect("ARCHITECTURE.md has a <!-- rooms --> table");
+    let end = text.find("<!-- /rooms -->").expect("ARCHITECTURE.md closes the table with <!-- /rooms -->");
+    let mut rooms = BTreeMap::new();
+    for line in text[start..end].lines().filter(|l| l.starts_with('|')) {
+        let cells: Vec<&str> = line.split('|').map(str::trim).collect();
+        let (room, uses) = (cells[1].trim_matches('`'), cells[2]);
+        if room == "room" || room.starts_with('-') {
+            continue;
+        }
+        let uses = uses.split(',').map(|u| u.trim().trim_matches('`').to_string()).filter(|u| !u.is_empty() && u != "—").collect();
+        rooms.insert(room.to_string(), uses);
+    }
+    rooms
+}
+
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            rust_files(&p, out);
+        } else if p.extension().is_some_and(|x| x == "rs") {
+            out.push(p);
+        }
+    }
+}
+
+/// The top-level room of a file of `src/` (`periodic` for src/periodic/session.rs).
+fn room_of(file: &Path) -> Option<String> {
+    let rel = file.strip_prefix(Path::new(ROOT).join("src")).ok()?;
+    let first = rel.components().next()?.as_os_str().to_str()?;
+    Some(first.trim_end_matches(".rs").to_string())
+}
+
+/// Rooms named by `crate::x` paths in the code (comments skipped), including `crate::{x, y}`;
+/// `crate::Error` and `crate::ErrorKind` are the `error` room.
+fn rooms_named(code: &str) -> BTreeSet<String> {
+    let mut named = BTreeSet::new();
+    for line in code.lines().map(str::trim_start).filter(|l| !l.starts_with("//")) {
+        let mut rest = line;
+        while let Some(i) = rest.find("crate::") {
+            rest = &rest[i + "crate::".len()..];
+            let items: Vec<&str> = if let Some(inner) = rest.strip_prefix('{') {
+                let close = inner.find('}').unwrap_or(inner.len());
+                inner[..close].split(',').map(|s| s.trim()).collect()
+            } else {
+                vec![rest]
+            };
+            for item in items {
+                let name: String = item.chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
+                let room = match name.as_str() {
+                    "Error" | "ErrorKind" => "error".to_string(),
+                    _ => name,
+                };
+                if !room.is_empty() {
+                    named.insert(room);
+                }
+            }
+        }
+    }
+    named
+}
+
+/// Room → rooms it names, over every file of `src/` except the binary.
+fn actual_dependencies() -> BTreeMap<String, BTreeSet<String>> {
+    let mut files = Vec::new();
+    rust_files(&Path::new(ROOT).join("src"), &mut files);
+    let mut deps: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    for f in files {
+        let Some(room) = room_of(&f) else { continue };
+        if room == "bin" || room == "lib" {
+            continue;
+        }
+        let code = std::fs::read_to_string(&f).unwrap();
+        let entry = deps.entry(room.clone()).or_default();
+        entry.extend(rooms_named(&code).into_iter().filter(|r| *r != room));
+    }
+    deps
+}
+
+#[test]
+fn every_room_uses_only_what_architecture_md_allows() {
+    let declared = declared_rooms();
+    let actual = actual_dependencies();
+    let mut wrong = Vec::new();
+    for (room, uses) in &actual {
+        let Some(allowed) = declared.get(room) else {
+            wrong.push(format!("src/{room} is not in the ARCHITECTURE.md table"));
+            continue;
+        };
+        let extra: Vec<&String> = uses.difference(allowed).collect();
+        if !extra.is_empty() {
+            wrong.push(format!("{room} uses {extra:?}, which ARCHITECTURE.md does not allow it"));
+        }
+    }
+    for room in declared.keys().filter(|r| !actual.contains_key(*r)) {
+        wrong.push(format!("ARCHITECTURE.md lists {room}, which is not a room of src/"));
+    }
+    assert!(wrong.is_empty(), "ARCHITECTURE.md and the code disagree:\n  {}", wrong.join("\n  "));
+}
+
+#[test]
+fn no_cycle_between_rooms() {
+    let deps = actual_dependencies();
+    // Depth-first search with colours; a grey node reached again closes a cycle.
+    fn visit(r: &str, deps: &BTreeMap<String, BTreeSet<String>>, state: &mut BTreeMap<String, u8>, path: &mut Vec<String>) -> Option<Vec<String>> {
+        match state.get(r) {
+            Some(2) => return None,
+            Some(1) => {
+                let i = path.iter().position(|p| p == r).unwrap();
+                let mut cycle = path[i..].to_vec();
+                cycle.push(r.to_string());
+                return Some(cycle);
+            }
+            _ => {}
+        }
+        state.insert(r.to_string(), 1);
+        path.push(r.to_string());
+        for d in deps.get(r).into_iter().flatten() {
+            if let Some(c) = visit(d, deps, state, path) {
+                return Some(c);
+            }
+        }
+        path.pop();
+        state.insert(r.to_string(), 2);
+        None
+    }
+    let mut state = BTreeMap::new();
+    for r in deps.keys() {
+        if let Some(c) = visit(r, &deps, &mut state, &mut Vec::new()) {
+            panic!("import cycle between rooms: {}", c.join(" → "));
+        }
+    }
+}
+
+#[test]
+fn the_numerical_core_knows_nothing_of_mechanics_files_or_fmi() {
+    let deps = actual_dependencies();
+    let mechanics = ["model", "time", "periodic", "scene", "fe", "reduction", "response", "analysis", "exact", "marching"];
+    let edges = ["fmi", "fmi2", "fmu", "fmu_model", "capi", "scene"];
+    for (room, forbidden) in [("lcp", &mechanics[..]), ("linalg", &mechanics[..]), ("fmi", &mechanics[..]), ("periodic", &edges[..]), ("model", &edges[..])] {
+        let uses = deps.get(room).cloned().unwrap_or_default();
+        let bad: Vec<&&str> = forbidden.iter().filter(|f| uses.contains(**f)).collect();
+        assert!(bad.is_empty(), "{room} must not use {bad:?}");
+    }
+}
+
+#[test]
+fn no_file_over_600_lines_and_few_string_errors() {
+    let mut files = Vec::new();
+    rust_files(&Path::new(ROOT).join("src"), &mut files);
+    rust_files(&Path::new(ROOT).join("fmu/src"), &mut files);
+    let mut long = Vec::new();
+    let mut string_results = Vec::new();
+    for f in &files {
+        let code = std::fs::read_to_string(f).unwrap();
+        let n = code.lines().count();
+        if n > MAX_LINES {
+            long.push(format!("{} ({n} lines)", f.display()));
+        }
+        for (i, line) in code.lines().enumerate() {
+            if line.contains("Result<") && line.contains(", String>") {
+                string_results.push(format!("{}:{}", f.display(), i + 1));
+            }
+        }
+    }
+    assert!(long.is_empty(), "files over {MAX_LINES} lines: {long:?}");
+    assert!(
+        string_results.len() <= MAX_STRING_RESULTS,
+        "{} Result<_, String> (at most {MAX_STRING_RESULTS}):\n  {}",
+        string_results.len(),
+        string_results.join("\n  ")
+    );
+}
