@@ -151,13 +151,13 @@ pub(crate) fn extrema(xv: impl Fn(f64) -> State, a: f64, b: f64, samples: usize)
         let s = xv(t);
         lo = lo.min(s[0]);
         hi = hi.max(s[0]);
-        if let Some((tp, sp)) = prev {
-            if (sp[1] > 0.0 && s[1] < 0.0) || (sp[1] < 0.0 && s[1] > 0.0) {
-                let r = bisect(|t| xv(t)[1], tp, t);
-                let x = xv(r)[0];
-                lo = lo.min(x);
-                hi = hi.max(x);
-            }
+        if let Some((tp, sp)) = prev
+            && ((sp[1] > 0.0 && s[1] < 0.0) || (sp[1] < 0.0 && s[1] > 0.0))
+        {
+            let r = bisect(|t| xv(t)[1], tp, t);
+            let x = xv(r)[0];
+            lo = lo.min(x);
+            hi = hi.max(x);
         }
         prev = Some((t, s));
     }

@@ -81,10 +81,10 @@ pub fn linear_response_dense(
     if stiffness.nrows() != n || stiffness.ncols() != n {
         return Err(ExactError::param("stiffness", format!("is {}×{}, expected {n}×{n}", stiffness.nrows(), stiffness.ncols())));
     }
-    if let Some(c) = damping {
-        if c.nrows() != n || c.ncols() != n {
-            return Err(ExactError::param("damping", format!("is {}×{}, expected {n}×{n}", c.nrows(), c.ncols())));
-        }
+    if let Some(c) = damping
+        && (c.nrows() != n || c.ncols() != n)
+    {
+        return Err(ExactError::param("damping", format!("is {}×{}, expected {n}×{n}", c.nrows(), c.ncols())));
     }
     if !(omega.is_finite() && omega > 0.0) {
         return Err(ExactError::param("omega", format!("is {omega}, must be finite and > 0")));

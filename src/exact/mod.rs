@@ -46,7 +46,7 @@ impl From<ExactError> for crate::Error {
     }
 }
 
-/// Until the study room's errors are typed: its `Result<_, String>` functions use `?` on these.
+/// Until the study room's errors are typed: its functions still returning String errors use `?` on these.
 impl From<ExactError> for String {
     fn from(e: ExactError) -> Self {
         e.to_string()

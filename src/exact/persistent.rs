@@ -56,13 +56,14 @@ impl PersistentContact {
                 best = (z, t);
             }
             let dz = p.force_derivative(t, 1);
-            if let Some((tp, dzp)) = prev {
-                if dzp < 0.0 && dz >= 0.0 {
-                    let r = bisect(|t| p.force_derivative(t, 1), tp, t);
-                    let zr = p.force_derivative(r, 0);
-                    if zr < best.0 {
-                        best = (zr, r);
-                    }
+            if let Some((tp, dzp)) = prev
+                && dzp < 0.0
+                && dz >= 0.0
+            {
+                let r = bisect(|t| p.force_derivative(t, 1), tp, t);
+                let zr = p.force_derivative(r, 0);
+                if zr < best.0 {
+                    best = (zr, r);
                 }
             }
             prev = Some((t, dz));

@@ -126,10 +126,10 @@ impl BladeParams {
         if self.mesh.span < 1 {
             return bad("mesh.span", "needs at least 1 element".into());
         }
-        if self.mesh.chord < 2 || self.mesh.chord % 2 != 0 {
+        if self.mesh.chord < 2 || !self.mesh.chord.is_multiple_of(2) {
             return bad("mesh.chord", format!("must be even and ≥ 2 (a mid-chord node is needed), got {}", self.mesh.chord));
         }
-        if self.mesh.thickness < 2 || self.mesh.thickness % 2 != 0 {
+        if self.mesh.thickness < 2 || !self.mesh.thickness.is_multiple_of(2) {
             return bad("mesh.thickness", format!("must be even and ≥ 2 (mid-thickness tip nodes are needed), got {}", self.mesh.thickness));
         }
         Ok(())

@@ -65,7 +65,7 @@ impl From<MarchError> for crate::Error {
     }
 }
 
-/// Until the sweep room's errors are typed: its `Result<_, String>` functions use `?` on these.
+/// Until the sweep room's errors are typed: its functions still returning String errors use `?` on these.
 impl From<MarchError> for String {
     fn from(e: MarchError) -> Self {
         e.to_string()

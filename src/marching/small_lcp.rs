@@ -96,10 +96,11 @@ pub(crate) fn solve_small_lcp(g: &[f64], q: &[f64], m: usize) -> Result<Vec<f64>
     if m <= 16 {
         for mask in 0u32..(1u32 << m) {
             let active: Vec<bool> = (0..m).map(|i| mask & (1 << i) != 0).collect();
-            if let Some((z, w)) = basis_solution(g, q, m, &active) {
-                if z.iter().all(|&v| v >= -ztol) && w.iter().all(|&v| v >= -tol) {
-                    return Ok(z.into_iter().map(|v| v.max(0.0)).collect());
-                }
+            if let Some((z, w)) = basis_solution(g, q, m, &active)
+                && z.iter().all(|&v| v >= -ztol)
+                && w.iter().all(|&v| v >= -tol)
+            {
+                return Ok(z.into_iter().map(|v| v.max(0.0)).collect());
             }
         }
     }

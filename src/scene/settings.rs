@@ -7,9 +7,9 @@ use crate::time::{Discretization, Pairing, Scheme};
 
 /// `[discretization]`: the scheme, the steps per period and the optional pairing.
 pub fn discretization(spec: &DiscretizationSpec) -> Result<Discretization, BuildError> {
-    let scheme: Scheme = spec.scheme.parse().map_err(|m| BuildError::field("discretization.scheme", format!("{m}")))?;
+    let scheme = spec.scheme.parse::<Scheme>().map_err(|m| BuildError::field("discretization.scheme", m.to_string()))?;
     let pairing = match &spec.pairing {
-        Some(p) => Some(p.parse::<Pairing>().map_err(|m| BuildError::field("discretization.pairing", format!("{m}")))?),
+        Some(p) => Some(p.parse::<Pairing>().map_err(|m| BuildError::field("discretization.pairing", m.to_string()))?),
         None => None,
     };
     Ok(Discretization { scheme, steps: spec.steps, pairing })
@@ -21,7 +21,7 @@ pub fn solver_settings(spec: Option<&SolverSpec>) -> Result<SolverSettings, Buil
     let mut s = SolverSettings::default();
     let Some(spec) = spec else { return Ok(s) };
     if let Some(m) = &spec.method {
-        s.method = m.parse::<LcpMethod>().map_err(|e| BuildError::field("solver.method", format!("{e}")))?;
+        s.method = m.parse::<LcpMethod>().map_err(|e| BuildError::field("solver.method", e.to_string()))?;
     }
     // The negated comparisons below refuse NaN as well.
     if let Some(t) = spec.tolerance {

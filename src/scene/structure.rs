@@ -115,10 +115,10 @@ fn generate(table: &toml::Table) -> Result<(Source, Structure), BuildError> {
 /// Damping and stiffness must have the size of the mass matrix.
 fn check_sizes(full: &Structure) -> Result<(), BuildError> {
     let n = full.mass.nrows();
-    if let Some(c) = &full.damping {
-        if c.nrows() != n || c.ncols() != n {
-            return Err(BuildError::field("damping.matrix", format!("is {}×{}, expected {n}×{n} (the size of structure.mass)", c.nrows(), c.ncols())));
-        }
+    if let Some(c) = &full.damping
+        && (c.nrows() != n || c.ncols() != n)
+    {
+        return Err(BuildError::field("damping.matrix", format!("is {}×{}, expected {n}×{n} (the size of structure.mass)", c.nrows(), c.ncols())));
     }
     let k = &full.stiffness;
     if k.nrows() != n || k.ncols() != n {

@@ -88,7 +88,7 @@ impl Scheme {
                 }
                 Scheme::Fourier => {
                     // p ≤ k/2 here, so p is already the signed wavenumber's magnitude.
-                    let nyquist = k % 2 == 0 && p == k / 2;
+                    let nyquist = k.is_multiple_of(2) && p == k / 2;
                     let pw = p as f64 * omega;
                     (C::new(0.0, if nyquist { 0.0 } else { pw }), C::new(-pw * pw, 0.0), 1.0)
                 }
