@@ -292,7 +292,7 @@ fn fmu_state_get_set_and_serialize_restore_the_run() {
     assert_eq!(unsafe { (a.deserialize_fmu_state)(other.c, old.as_ptr(), size, &mut st3) }, ERROR);
     assert!(st3.is_null());
     let lines = other.log.all();
-    assert!(lines.iter().any(|l| l.message.contains("fmi2DeSerializeFMUstate") && l.message.contains("truncated")), "{lines:?}");
+    assert!(lines.iter().any(|l| l.message.starts_with("fmi2DeSerializeFMUstate: input error: serialized FMU state: ")), "{lines:?}");
     assert!(lines.iter().any(|l| l.status == ERROR && l.message.contains("format version 1 is not readable")), "{lines:?}");
     for (c, p) in [(s.c, &mut st), (other.c, &mut st2)] {
         assert_eq!(unsafe { (a.free_fmu_state)(c, p) }, OK);
