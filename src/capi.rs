@@ -210,7 +210,7 @@ pub unsafe extern "C" fn pc_problem_from_matrices(
         let mass = rows(mass, "mass")?;
         let stiffness = rows(stiffness, "stiffness")?;
         let damping = if damping.is_null() { None } else { Some(rows(damping, "damping")?) };
-        let scheme: Scheme = unsafe { c_str(scheme, "scheme") }?.parse().map_err(|m: String| input(m))?;
+        let scheme: Scheme = unsafe { c_str(scheme, "scheme") }?.parse().map_err(input)?;
         let model = Model { structure: Structure { mass, stiffness, damping }, forces: vec![], contacts: vec![], frequency };
         let outputs = OutputSelection { displacement: (0..n).collect(), velocity: (0..n).collect(), acceleration: vec![], contacts: true };
         let disc = Discretization { scheme, steps, pairing: None };

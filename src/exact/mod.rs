@@ -46,13 +46,6 @@ impl From<ExactError> for crate::Error {
     }
 }
 
-/// Until the study room's errors are typed: its functions still returning String errors use `?` on these.
-impl From<ExactError> for String {
-    fn from(e: ExactError) -> Self {
-        e.to_string()
-    }
-}
-
 /// The forced 1-DOF oscillator m x'' + c x' + k x = F cos Ωt.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Oscillator {

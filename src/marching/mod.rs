@@ -65,13 +65,6 @@ impl From<MarchError> for crate::Error {
     }
 }
 
-/// Until the sweep room's errors are typed: its functions still returning String errors use `?` on these.
-impl From<MarchError> for String {
-    fn from(e: MarchError) -> Self {
-        e.to_string()
-    }
-}
-
 /// Settings of [`march`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct MarchSettings {

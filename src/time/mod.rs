@@ -1,7 +1,7 @@
 //! Discretisation of the period: k instants t_j = j·T/k on the circle, time derivatives as
 //! circulant operators described by their DFT symbols (notes §2).
 mod scheme;
-pub use scheme::{Pairing, Scheme, Symbols};
+pub use scheme::{Pairing, Scheme, SchemeParseError, Symbols};
 
 /// k and the scheme: everything that fixes the time grid and its operators.
 #[derive(Clone, Copy, Debug, PartialEq)]

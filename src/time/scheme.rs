@@ -107,10 +107,19 @@ impl fmt::Display for Scheme {
     }
 }
 
+/// A scheme or pairing name that is not one of ours; the message lists the known ones.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum SchemeParseError {
+    #[error("unknown scheme \"{0}\"; expected one of bds1, bds2, cds, galerkin, fourier")]
+    Scheme(String),
+    #[error("unknown pairing \"{0}\"; expected same or forward")]
+    Pairing(String),
+}
+
 impl FromStr for Scheme {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Scheme::ALL.into_iter().find(|x| x.name() == s).ok_or_else(|| format!("unknown scheme \"{s}\"; expected one of bds1, bds2, cds, galerkin, fourier"))
+    type Err = SchemeParseError;
+    fn from_str(s: &str) -> Result<Self, SchemeParseError> {
+        Scheme::ALL.into_iter().find(|x| x.name() == s).ok_or_else(|| SchemeParseError::Scheme(s.to_string()))
     }
 }
 
@@ -146,12 +155,12 @@ impl fmt::Display for Pairing {
 }
 
 impl FromStr for Pairing {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = SchemeParseError;
+    fn from_str(s: &str) -> Result<Self, SchemeParseError> {
         match s {
             "same" => Ok(Pairing::Same),
             "forward" => Ok(Pairing::Forward),
-            _ => Err(format!("unknown pairing \"{s}\"; expected same or forward")),
+            _ => Err(SchemeParseError::Pairing(s.to_string())),
         }
     }
 }
