@@ -72,33 +72,3 @@ impl Error {
 
 /// A result whose error carries its kind.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
-
-impl From<crate::model::ModelError> for Error {
-    fn from(e: crate::model::ModelError) -> Self {
-        Error::input(e.to_string())
-    }
-}
-
-impl From<crate::scene::SceneError> for Error {
-    fn from(e: crate::scene::SceneError) -> Self {
-        Error::input(e.to_string())
-    }
-}
-
-impl From<crate::lcp::DatError> for Error {
-    fn from(e: crate::lcp::DatError) -> Self {
-        Error::input(e.to_string())
-    }
-}
-
-impl From<crate::lcp::LcpMethodError> for Error {
-    fn from(e: crate::lcp::LcpMethodError) -> Self {
-        Error::input(e.to_string())
-    }
-}
-
-impl From<crate::fe::MtxError> for Error {
-    fn from(e: crate::fe::MtxError) -> Self {
-        Error::input(e.to_string())
-    }
-}

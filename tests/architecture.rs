@@ -105,6 +105,11 @@ fn every_room_uses_only_what_architecture_md_allows() {
         if !extra.is_empty() {
             wrong.push(format!("{room} uses {extra:?}, which ARCHITECTURE.md does not allow it"));
         }
+        // The table says what is true, not only what is allowed: a listed room that is not used goes.
+        let unused: Vec<&String> = allowed.difference(uses).collect();
+        if !unused.is_empty() {
+            wrong.push(format!("{room} does not use {unused:?}, which ARCHITECTURE.md lists for it"));
+        }
     }
     for room in declared.keys().filter(|r| !actual.contains_key(*r)) {
         wrong.push(format!("ARCHITECTURE.md lists {room}, which is not a room of src/"));

@@ -299,3 +299,9 @@ pub fn is_symmetric(a: &SparseColMat<usize, f64>, rtol: f64) -> bool {
     }
     true
 }
+
+impl From<MtxError> for crate::Error {
+    fn from(e: MtxError) -> Self {
+        if e.kind == MtxErrorKind::Io { crate::Error::io(e.to_string()) } else { crate::Error::input(e.to_string()) }
+    }
+}

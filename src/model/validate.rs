@@ -125,3 +125,9 @@ impl Model {
         Ok(())
     }
 }
+
+impl From<ModelError> for crate::Error {
+    fn from(e: ModelError) -> Self {
+        crate::Error::input(e.to_string())
+    }
+}

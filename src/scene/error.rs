@@ -42,3 +42,9 @@ impl BuildError {
         BuildError::Field { field: field.into(), message: message.into() }
     }
 }
+
+impl From<SceneError> for crate::Error {
+    fn from(e: SceneError) -> Self {
+        crate::Error::input(e.to_string())
+    }
+}

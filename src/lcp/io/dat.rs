@@ -192,3 +192,12 @@ impl<'t> Parser<'t> {
         Ok(())
     }
 }
+
+impl From<DatError> for crate::Error {
+    fn from(e: DatError) -> Self {
+        match e {
+            DatError::Io { .. } => crate::Error::io(e.to_string()),
+            _ => crate::Error::input(e.to_string()),
+        }
+    }
+}
