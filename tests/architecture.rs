@@ -190,3 +190,25 @@ fn no_file_over_600_lines_and_few_string_errors() {
         string_results.join("\n  ")
     );
 }
+
+/// Features of `periodic-contact` that cargo enables when it builds `package`.
+fn library_features_in(package: &str) -> String {
+    let out = std::process::Command::new(env!("CARGO"))
+        .args(["tree", "-p", package, "-e", "features", "-i", "periodic-contact", "--offline", "--manifest-path"])
+        .arg(Path::new(ROOT).join("Cargo.toml"))
+        .output()
+        .expect("cargo tree runs");
+    assert!(out.status.success(), "cargo tree: {}", String::from_utf8_lossy(&out.stderr));
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+#[test]
+fn the_fmu_binary_builds_without_references_studies_plots_or_the_c_api() {
+    // The method sees features at all: the CLI's build has them.
+    let cli = library_features_in("periodic-contact");
+    assert!(cli.contains("feature \"reference\"") && cli.contains("feature \"studies\""), "{cli}");
+    let fmu = library_features_in("periodic-contact-fmu");
+    for f in ["reference", "studies", "plots", "capi", "default"] {
+        assert!(!fmu.contains(&format!("periodic-contact feature \"{f}\"")), "the FMU build enables {f}:\n{fmu}");
+    }
+}

@@ -26,8 +26,9 @@ pub enum WarmStart {
 pub struct PeriodicSolver {
     problem: PeriodicProblem,
     fft: PeriodFft,
-    /// Active set of the last certified solution, for the next warm start (empty: none).
-    active_set: Vec<usize>,
+    /// Active set of the last certified solution, the next warm start (`None`: start cold; an
+    /// empty set is a guess too: no contact active).
+    warm_start: Option<Vec<usize>>,
     warm_starts: bool,
     last_start: WarmStart,
 }
@@ -36,7 +37,7 @@ impl PeriodicSolver {
     /// Plans the FFT of the problem's k; the first solve is cold.
     pub fn new(problem: PeriodicProblem) -> Self {
         let fft = PeriodFft::new(problem.discretization().steps);
-        PeriodicSolver { problem, fft, active_set: Vec::new(), warm_starts: true, last_start: WarmStart::Cold }
+        PeriodicSolver { problem, fft, warm_start: None, warm_starts: true, last_start: WarmStart::Cold }
     }
 
     /// Whether solves start from the previous active set (default true).
@@ -52,9 +53,10 @@ impl PeriodicSolver {
     pub fn fft(&self) -> &PeriodFft {
         &self.fft
     }
-    /// Active set of the last solution (indices into the LCP's z), empty before the first.
-    pub fn active_set(&self) -> &[usize] {
-        &self.active_set
+    /// The warm start of the next solve (indices into the LCP's z): the last solution's active
+    /// set, or one given by [`PeriodicSolver::set_warm_start`]; `None` before the first solve.
+    pub fn warm_start(&self) -> Option<&[usize]> {
+        self.warm_start.as_deref()
     }
     /// How the last solve started.
     pub fn last_start(&self) -> WarmStart {
@@ -73,7 +75,7 @@ impl PeriodicSolver {
         self.problem.set_discretization(disc)?;
         if disc.steps != old_k {
             self.fft = PeriodFft::new(disc.steps);
-            self.active_set.clear();
+            self.warm_start = None;
         }
         Ok(())
     }
@@ -87,28 +89,30 @@ impl PeriodicSolver {
             self.fft = PeriodFft::new(k);
         }
         if (k, m) != (k0, m0) {
-            self.active_set.clear();
+            self.warm_start = None;
         }
         self.problem = problem;
     }
 
     /// Forgets the active set: the next solve is cold.
     pub fn reset_warm_start(&mut self) {
-        self.active_set.clear();
+        self.warm_start = None;
     }
 
     /// Sets the warm start of the next solve (indices into the LCP's z, e.g. a neighbour's).
     pub fn set_warm_start(&mut self, active_set: &[usize]) {
-        self.active_set.clear();
-        self.active_set.extend_from_slice(active_set);
+        let w = self.warm_start.get_or_insert_with(Vec::new);
+        w.clear();
+        w.extend_from_slice(active_set);
     }
 
     /// Solves, warm-started from the last active set when there is one, cold if that fails.
     /// The active set of the answer becomes the next warm start.
     pub fn solve(&mut self) -> Result<Response, SolveError> {
-        let warm = self.warm_starts && !self.active_set.is_empty();
-        let result = if warm {
-            match self.problem.solve_with(&self.fft, Some(&self.active_set)) {
+        let guess = self.warm_start.as_deref().filter(|_| self.warm_starts);
+        let warm = guess.is_some();
+        let result = if let Some(guess) = guess {
+            match self.problem.solve_with(&self.fft, Some(guess)) {
                 Ok(r) => Ok((r, WarmStart::Used)),
                 Err(_) => self.problem.solve_with(&self.fft, None).map(|r| (r, WarmStart::ColdFallback)),
             }
