@@ -212,3 +212,40 @@ fn the_fmu_binary_builds_without_references_studies_plots_or_the_c_api() {
         assert!(!fmu.contains(&format!("periodic-contact feature \"{f}\"")), "the FMU build enables {f}:\n{fmu}");
     }
 }
+
+#[test]
+fn no_test_or_source_reads_outside_the_repository() {
+    let root = Path::new(ROOT);
+    let mut files = Vec::new();
+    for dir in ["src", "tests", "validation", "fmu", "examples"] {
+        collect_text_files(&root.join(dir), &mut files);
+    }
+    let this = root.join("tests/architecture.rs");
+    let outside = ["../shared", "/work/", "/root/", "/home/"];
+    let mut hits = Vec::new();
+    for f in files.iter().filter(|f| **f != this) {
+        let Ok(text) = std::fs::read_to_string(f) else { continue };
+        for (i, line) in text.lines().enumerate() {
+            if let Some(p) = outside.iter().find(|p| line.contains(**p)) {
+                hits.push(format!("{}:{}: {p}", f.display(), i + 1));
+            }
+        }
+    }
+    assert!(hits.is_empty(), "paths outside the repository:\n  {}", hits.join("\n  "));
+}
+
+/// Source, script and text files below `dir`, without virtual environments and build output.
+fn collect_text_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for e in entries {
+        let p = e.unwrap().path();
+        let name = p.file_name().unwrap().to_string_lossy().into_owned();
+        if p.is_dir() {
+            if !name.starts_with('.') && name != "target" && name != "__pycache__" && name != "figures" && name != "study" {
+                collect_text_files(&p, out);
+            }
+        } else if ["rs", "py", "sh", "toml", "c", "h", "md"].iter().any(|x| name.ends_with(&format!(".{x}"))) {
+            out.push(p);
+        }
+    }
+}

@@ -410,13 +410,10 @@ fn non_finite_data_is_reported_never_propagated() {
 // ---------------------------------------------------------------------------------------------
 
 fn siconos_dir() -> PathBuf {
-    let local = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/siconos-lcp");
-    if local.is_dir() {
-        return local;
-    }
-    let fixed = PathBuf::from("/work/shared/data/siconos-lcp");
-    assert!(fixed.is_dir(), "Siconos LCP data not found at {} nor at {}", local.display(), fixed.display());
-    fixed
+    // Shipped with the repository (tests/data/siconos-lcp/README.md: origin and licence).
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/siconos-lcp");
+    assert!(dir.is_dir(), "the Siconos LCP data is missing at {}", dir.display());
+    dir
 }
 
 /// What the right answer for each file is, and why.
