@@ -2,8 +2,8 @@
 
 The packaged binary (`binaries/linux64/PeriodicContact.so`) is loaded with ctypes and driven
 call by call. Before every call, a model of the FMI 2.0 co-simulation state machine written in
-this file (`Model`: the allowed-call table of the FMI 2.0 standard, §4.2.4 (co-simulation state machine), the setting rules of
-§1.3 "Which variables may be set where", and the error policy documented in src/fmi/fmi2/mod.rs)
+this file (`Model`: the allowed-call table of the FMI 2.0 standard's co-simulation state machine,
+§4.2.4, its rules on which variables may be set in which state, and the error policy documented in src/fmi/fmi2/mod.rs)
 predicts the status; the FMU must return exactly that status. Sequences are seeded (pytest
 parameters), each a few thousand calls over several interleaved instances of two FMUs:
 
