@@ -21,7 +21,7 @@ part-way); parameter/input reads equal the model's values; fmi2GetRealStatus
 logged message is passed with the format "%s" and the instance's name; calls with a NULL or a
 garbage instance (a buffer of random bytes) return fmi2Error and leave the buffer untouched.
 A "probe" call serializes an FMU state and decodes the machine state and time from its header
-(SERIAL_HEADER, GUID, state code, time; src/fmi2/instance.rs) to compare them with the model's.
+(SERIAL_HEADER, format and model versions, GUID, state code, time; src/fmi/state.rs and src/fmi/fmi2/instance.rs) to compare them with the model's.
 
 The process must survive (a crash fails the whole pytest run). Needs the CLI and the FMU binary
 (`cargo build --release && cargo build --release -p periodic-contact-fmu`); skipped without them
@@ -82,7 +82,8 @@ ALLOWED = {
 LOG_CATEGORIES = ["logEvents", "logStatusWarning", "logStatusDiscard", "logStatusError",
                   "logStatusFatal", "logAll"]
 SENTINEL = 1.25e300
-SERIAL_HEADER = b"PCFMI2S1"
+SERIAL_HEADER = b"PCFMUSTA"  # src/fmi/state.rs: magic, then u16 format version and u16 model version
+SERIAL_FORMAT = 2
 
 UNDAMPED = """
 [structure]
@@ -885,9 +886,10 @@ def op_fmu_state(d: Driver, inst):
 def check_header(d: Driver, fmu: Fmu, data: bytes, clock: Clock):
     """The machine state and time in a serialized state equal the model's at capture time."""
     assert data[:8] == SERIAL_HEADER, data[:8]
-    (n,) = struct.unpack_from("<Q", data, 8)
-    guid = data[16:16 + n].decode()
-    state, time = struct.unpack_from("<Qd", data, 16 + n)
+    (version, _model_version, n) = struct.unpack_from("<HHQ", data, 8)
+    assert version == SERIAL_FORMAT, version
+    guid = data[20:20 + n].decode()
+    state, time = struct.unpack_from("<Bd", data, 20 + n)
     if guid != fmu.guid or state != STATE_CODE[clock.state] or time != clock.time:
         raise Mismatch(f"seed {d.seed}: serialized state {state} at t={time} (GUID {guid}); model "
                        f"{clock.state} ({STATE_CODE[clock.state]}) at t={clock.time}")

@@ -179,8 +179,8 @@ fn outputs(b: &mut Variables, problem: &PeriodicProblem) {
             );
         }
     }
-    // Always present, like the result's `lcp` (size 0, 0 pivots, residual 0 without contact).
-    {
+    // Only with contacts: without them no LCP is solved (the scene's effects, nothing more).
+    if !model.contacts.is_empty() {
         b.output(
             Variable::output("lcp.pivots", Discrete, Kind::Integer { start: None, min: None, max: None }, "Pivots of the last LCP solve"),
             Quantity::Pivots,

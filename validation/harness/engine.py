@@ -174,8 +174,10 @@ def fmu_output_names(output_dofs, m: int) -> dict[str, str]:
     for i in range(m):
         names[f"f{i}"] = f"contact[{i}].force"
         names[f"g{i}"] = f"contact[{i}].gap"
-    names["pivots"] = "lcp.pivots"
-    names["residual"] = "lcp.residual"
+    if m:
+        # Without contacts there is no LCP, and no LCP variables.
+        names["pivots"] = "lcp.pivots"
+        names["residual"] = "lcp.residual"
     return names
 
 
@@ -211,7 +213,7 @@ def check_fmu_contract(fmu: str, output_dofs, m: int) -> list[str]:
         # Only the effects a scene calls for: without contacts there is no clearance to offset,
         # and no contact outputs.
         del want["gap_offset"]
-        problems += [f"{n!r} present without contacts" for n in variables if n.startswith(("contact[", "gap_offset"))]
+        problems += [f"{n!r} present without contacts" for n in variables if n.startswith(("contact[", "gap_offset", "lcp."))]
     for name, var in want.items():
         v = variables.get(name)
         if v is None:
