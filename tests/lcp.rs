@@ -713,7 +713,6 @@ fn enumeration_reference_cases() {
 
 /// Entry ((j,a),(l,b)) = blocks[((j − l) mod k)·m² + a·m + b], written out here from the
 /// definition, independently of the implementation.
-#[allow(clippy::needless_range_loop)]
 fn circulant_reference(k: usize, m: usize, blocks: &[f64]) -> Vec<Vec<f64>> {
     let n = k * m;
     let mut out = vec![vec![0.0; n]; n];
@@ -731,7 +730,6 @@ fn circulant_reference(k: usize, m: usize, blocks: &[f64]) -> Vec<Vec<f64>> {
 }
 
 #[test]
-#[allow(clippy::needless_range_loop)]
 fn block_circulant_agrees_with_its_definition() {
     let mut rng = Rng(0x5EED_0005);
     for &(k, m) in &[(1usize, 1usize), (1, 3), (5, 1), (4, 2), (3, 3), (7, 2)] {

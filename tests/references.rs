@@ -538,7 +538,6 @@ fn march_two_rigid_contacts_is_complementary() {
     assert!(r.converged);
     let mut active = [0usize; 3];
     for j in 0..n {
-        #[allow(clippy::needless_range_loop)]
         for c in 0..2 {
             assert!(r.clearance[j][c] > -1e-12 && r.contact_force[j][c] >= 0.0);
             let w_next = r.clearance[(j + 1) % n][c];

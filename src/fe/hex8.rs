@@ -13,8 +13,6 @@
 //!
 //! Local node order: (ξ, η, ζ) = (−,−,−), (+,−,−), (+,+,−), (−,+,−), then the same at ζ = +1.
 //! Element DOF 3·a + c is displacement component c (x, y, z) of local node a.
-// The negated comparisons (`!(a > b)`) are deliberate: they are true for NaN as well.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
 use nalgebra::{Matrix3, SMatrix, Vector3};
 
 /// Corner signs of the 8 local nodes.

@@ -80,7 +80,6 @@ pub fn clamp(a: &SparseColMat<usize, f64>, fixed: &[usize]) -> Result<(SparseCol
 }
 
 /// The sub-matrix with rows `row_map[i] = Some(new_i)` and columns `col_map[j] = Some(new_j)`.
-#[allow(clippy::needless_range_loop)] // j is the sparse column index, used for more than the map
 pub fn submatrix(a: &SparseColMat<usize, f64>, row_map: &[Option<usize>], col_map: &[Option<usize>], nrows: usize, ncols: usize) -> SparseColMat<usize, f64> {
     let mut t = Vec::new();
     for j in 0..a.ncols() {
@@ -95,7 +94,6 @@ pub fn submatrix(a: &SparseColMat<usize, f64>, row_map: &[Option<usize>], col_ma
 }
 
 /// A dense copy of the sub-matrix (rows `row_map`, columns `col_map`).
-#[allow(clippy::needless_range_loop)] // j is the sparse column index, used for more than the map
 pub fn dense_submatrix(a: &SparseColMat<usize, f64>, rows: &[Option<usize>], cols: &[Option<usize>], nrows: usize, ncols: usize) -> Mat<f64> {
     let mut d = Mat::zeros(nrows, ncols);
     for j in 0..a.ncols() {
@@ -140,7 +138,6 @@ pub fn sparse_times_dense(a: &SparseColMat<usize, f64>, x: MatRef<'_, f64>) -> M
 }
 
 /// y = A x for a sparse A.
-#[allow(clippy::needless_range_loop)] // j is the sparse column index, used for more than the map
 pub fn sparse_mul_vec(a: &SparseColMat<usize, f64>, x: &[f64], y: &mut [f64]) {
     y.iter_mut().for_each(|v| *v = 0.0);
     for j in 0..a.ncols() {

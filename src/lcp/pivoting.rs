@@ -127,7 +127,7 @@ impl BlockPivoting {
             a.mul_into(&z, &mut w);
             w.iter_mut().zip(q).for_each(|(wi, qi)| *wi += qi);
             // Infeasible: active with z < 0, or inactive with w < 0 (NaN counts as infeasible).
-            #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(x >= -tol)` is true for NaN on purpose
+            // `!(x >= -tol)` is true for NaN on purpose
             let is_infeasible = |i: usize| if active[i] { !(z[i] >= -tol) } else { !(w[i] >= -tol) };
             infeasible.clear();
             infeasible.extend((0..n).filter(|&i| is_infeasible(i)));

@@ -120,7 +120,7 @@ pub(crate) fn recheck_exactly(mut sol: LcpSolution, a: &dyn LcpMatrix, q: &[f64]
         }
     }
     let (residual, relative_error) = residuals(q, &sol.z, &w);
-    #[allow(clippy::neg_cmp_op_on_partial_ord)] // a NaN residual must fail the check
+    // `!(… <= …)`: a NaN residual must fail the check
     if !(residual <= cert) || !w.iter().all(|v| v.is_finite()) {
         sol.outcome = LcpOutcome::Inaccurate;
     }

@@ -63,6 +63,22 @@ fn check_positive_definite(name: &str, a: &Matrix) -> Result<(), ModelError> {
 }
 
 impl Model {
+    /// ω alone: finite, > 0, and with a finite period (checked again when only ω changes).
+    pub fn validate_frequency(&self) -> Result<(), ModelError> {
+        if !(self.frequency.is_finite() && self.frequency > 0.0) {
+            return Err(ModelError::new("excitation.frequency", format!("is {}, must be a finite angular frequency > 0 [rad/s]", self.frequency)));
+        }
+        // A subnormal ω (e.g. 1e-320) passes the test above but its period 2π/ω overflows, and
+        // the instants t_j = j·T/k would start with 0·∞ = NaN (found by tests/props.rs).
+        if !self.period().is_finite() {
+            return Err(ModelError::new(
+                "excitation.frequency",
+                format!("is {:e}, too small: the period 2π/ω is not finite; rescale the time unit", self.frequency),
+            ));
+        }
+        Ok(())
+    }
+
     /// Checks dimensions, symmetry, definiteness, finiteness and index ranges.
     pub fn validate(&self) -> Result<(), ModelError> {
         let s = &self.structure;
@@ -76,17 +92,7 @@ impl Model {
             check_square("damping", c, n)?;
         }
         check_positive_definite("structure.mass", &s.mass)?;
-        if !(self.frequency.is_finite() && self.frequency > 0.0) {
-            return Err(ModelError::new("excitation.frequency", format!("is {}, must be a finite angular frequency > 0 [rad/s]", self.frequency)));
-        }
-        // A subnormal ω (e.g. 1e-320) passes the test above but its period 2π/ω overflows, and
-        // the instants t_j = j·T/k would start with 0·∞ = NaN (found by tests/props.rs).
-        if !self.period().is_finite() {
-            return Err(ModelError::new(
-                "excitation.frequency",
-                format!("is {:e}, too small: the period 2π/ω is not finite; rescale the time unit", self.frequency),
-            ));
-        }
+        self.validate_frequency()?;
         for (i, f) in self.forces.iter().enumerate() {
             if f.dof >= n {
                 return Err(ModelError::new(format!("force[{i}].dof"), format!("is {}, the model has DOFs 0..{}", f.dof, n - 1)));

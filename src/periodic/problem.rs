@@ -76,7 +76,7 @@ impl PeriodicProblem {
     /// Changes ω [rad/s], checked as [`PeriodicProblem::new`] would; unchanged on error.
     pub fn set_frequency(&mut self, frequency: f64) -> Result<(), SolveError> {
         let old = std::mem::replace(&mut self.model.frequency, frequency);
-        let checked = check_frequency(&self.model).and_then(|()| check_grid(&self.model, &self.disc));
+        let checked = self.model.validate_frequency().map_err(SolveError::from).and_then(|()| check_grid(&self.model, &self.disc));
         if checked.is_err() {
             self.model.frequency = old;
         }
@@ -325,22 +325,6 @@ fn check_sizes(model: &Model, disc: &Discretization) -> Result<(), SolveError> {
             "structure.mass: a dense {n}×{n} model with steps = {k} needs {} complex {n}×{n} factorisations (≈ {flops:.1e} flops, at most {MAX_DENSE_FLOPS:.0e} accepted): give the matrices in sparse form, reduce the model (Craig–Bampton), or reduce steps",
             k / 2 + 1
         )));
-    }
-    Ok(())
-}
-
-/// ω alone, as [`Model::validate`] checks it (for updates that change nothing else).
-fn check_frequency(model: &Model) -> Result<(), SolveError> {
-    let w = model.frequency;
-    if !(w.is_finite() && w > 0.0) {
-        return Err(crate::model::ModelError::new("excitation.frequency", format!("is {w}, must be a finite angular frequency > 0 [rad/s]")).into());
-    }
-    if !model.period().is_finite() {
-        return Err(crate::model::ModelError::new(
-            "excitation.frequency",
-            format!("is {w:e}, too small: the period 2π/ω is not finite; rescale the time unit"),
-        )
-        .into());
     }
     Ok(())
 }

@@ -10,8 +10,6 @@
 //!
 //! Every mode returned is mass-normalised (φᵀ M φ = 1) and signed so that its largest-magnitude
 //! entry is positive.
-// The negated comparisons (`!(a > b)`) are deliberate: they are true for NaN as well.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
 use crate::fe::sparse::sparse_times_dense;
 use faer::linalg::solvers::Solve;
 use faer::sparse::SparseColMat;
