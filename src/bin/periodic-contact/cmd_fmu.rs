@@ -1,5 +1,5 @@
 //! `fmu SCENE.toml -o NAME.fmu`: packages a scene with the FMI 2.0 co-simulation binary.
-use crate::Failure;
+use crate::{Failure, ensure_writable};
 use periodic_contact::fmu_model;
 use std::path::{Path, PathBuf};
 
@@ -30,6 +30,7 @@ fn find_binary(explicit: Option<&Path>) -> Result<PathBuf, Failure> {
 }
 
 pub fn run(scene: &Path, output: &Path, binary: Option<&Path>) -> Result<(), Failure> {
+    ensure_writable(output, "--output")?;
     let so = find_binary(binary)?;
     let guid = fmu_model::package(scene, &so, output)?;
     eprintln!("packaged {} with {} → {} (GUID {guid})", scene.display(), so.display(), output.display());

@@ -1,5 +1,5 @@
 //! `solve` and the default run.
-use crate::{Failure, write_output};
+use crate::{Failure, ensure_writable, write_output};
 use periodic_contact::periodic::PeriodicProblem;
 use periodic_contact::response::Response;
 use periodic_contact::scene::Scene;
@@ -21,6 +21,7 @@ pub fn load(scene: &Path, frequency: Option<f64>) -> Result<PeriodicProblem, Fai
 }
 
 pub fn run(scene: &Path, output: &Path, frequency: Option<f64>) -> Result<(), Failure> {
+    ensure_writable(output, "--output")?;
     let problem = load(scene, frequency)?;
     // Errors found while solving name the scene too (those of loading already do).
     let r = solve(&problem).map_err(|f| Failure { message: format!("{}: {}", scene.display(), f.message), ..f })?;

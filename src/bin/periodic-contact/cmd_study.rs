@@ -55,6 +55,10 @@ pub enum StudyCommand {
 pub fn run(cmd: StudyCommand) -> Result<(), Failure> {
     match cmd {
         StudyCommand::Accuracy { output, quick, steps, march_steps, cases, methods, no_march, budget, export_lcp, export_max } => {
+            crate::ensure_output_folder(&output, "--output")?;
+            if let Some(dir) = &export_lcp {
+                crate::ensure_output_folder(dir, "--export-lcp")?;
+            }
             let mut s = if quick { accuracy::AccuracySettings::quick() } else { accuracy::AccuracySettings::full() };
             if let Some(k) = steps {
                 if let Some(bad) = k.iter().find(|&&k| !(4..=1 << 22).contains(&k)) {
@@ -102,6 +106,7 @@ pub fn run(cmd: StudyCommand) -> Result<(), Failure> {
             Ok(())
         }
         StudyCommand::Warmstart { output, quick, steps } => {
+            crate::ensure_output_folder(&output, "--output")?;
             let mut s = if quick { warmstart::WarmSettings::quick() } else { warmstart::WarmSettings::full() };
             if let Some(k) = steps {
                 s.steps = k;

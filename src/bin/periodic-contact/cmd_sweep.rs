@@ -1,6 +1,6 @@
 //! `sweep`: a frequency sweep of a scene, warm-started and parallel, with its CSV, the
 //! frequency-response PNG, spectra at chosen points and the comparison with time marching.
-use crate::{Failure, write_output};
+use crate::{Failure, ensure_writable, write_output};
 use indicatif::{ProgressBar, ProgressStyle};
 use periodic_contact::scene::Scene;
 use periodic_contact::sweep::{self, SweepSettings, marching::MarchOptions};
@@ -70,6 +70,8 @@ pub fn run(a: &Args) -> Result<(), Failure> {
     if !(a.from.is_finite() && a.to.is_finite() && a.from > 0.0 && a.to > 0.0) {
         return Err(Failure::input(format!("--from/--to: are {} and {}, must be finite and > 0", a.from, a.to)));
     }
+    // The CSV, its PNGs and the spectra all go beside --output: check before the first solve.
+    ensure_writable(&a.output, "--output")?;
     let t_all = Instant::now();
     let (scene, dir) = Scene::load(&a.scene).map_err(|e| Failure::input(e.to_string()))?;
     let file = a.scene.display().to_string();

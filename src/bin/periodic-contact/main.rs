@@ -132,6 +132,49 @@ fn main() -> ExitCode {
     }
 }
 
+/// Fails fast, before any solving, when `path` ("-": stdout) cannot be written: its folder is
+/// missing or read-only, or it names a folder. A probe file is created and removed beside it.
+pub fn ensure_writable(path: &std::path::Path, flag: &str) -> Result<(), Failure> {
+    if path.as_os_str() == "-" {
+        return Ok(());
+    }
+    if path.is_dir() {
+        return Err(Failure::input(format!("{flag} {}: is a folder; name a file inside it, e.g. {}", path.display(), path.join("out").display())));
+    }
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => std::path::Path::new("."),
+    };
+    if !dir.is_dir() {
+        return Err(Failure::input(format!(
+            "{flag} {}: the folder {} does not exist; create it first (mkdir -p {}) or choose another {flag}",
+            path.display(),
+            dir.display(),
+            dir.display()
+        )));
+    }
+    ensure_folder_writable(dir, flag, path)
+}
+
+/// A folder of outputs (created, as the studies write several files into it), checked before
+/// any work starts.
+pub fn ensure_output_folder(dir: &std::path::Path, flag: &str) -> Result<(), Failure> {
+    std::fs::create_dir_all(dir)
+        .map_err(|e| Failure::input(format!("{flag} {}: cannot create the folder ({e}); choose a writable location", dir.display())))?;
+    ensure_folder_writable(dir, flag, dir)
+}
+
+/// A probe file created and removed in `dir` proves that outputs can be written there.
+pub fn ensure_folder_writable(dir: &std::path::Path, flag: &str, shown: &std::path::Path) -> Result<(), Failure> {
+    let probe = dir.join(format!(".periodic-contact-probe-{}~", std::process::id()));
+    std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&probe)
+        .and_then(|_| std::fs::remove_file(&probe))
+        .map_err(|e| Failure::input(format!("{flag} {}: cannot write into the folder {} ({e}); choose a writable location", shown.display(), dir.display())))
+}
+
 /// Writes `text` to `path`, or stdout for "-", without leaving a half-written file behind.
 pub fn write_output(path: &std::path::Path, text: &str) -> Result<(), Failure> {
     if path.as_os_str() == "-" {
