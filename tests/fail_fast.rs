@@ -135,3 +135,21 @@ fn every_flag_is_in_the_readme() {
     assert!(total > 30, "only {total} flags found: the --help parsing broke");
     assert!(missing.is_empty(), "flags missing from README.md: {missing:?}");
 }
+
+/// Flags used only after the sweep (spectra, marches) are checked before its first point.
+#[test]
+fn a_bad_spectrum_or_march_value_is_refused_before_the_sweep() {
+    let dir = scratch("late-flags");
+    let out = dir.join("s.csv");
+    let scene = repo("fmu/scenes/blade-casing-coarse.toml");
+    for extra in [["--spectrum-at", "0"], ["--march-at", "-3"], ["--march-tol", "0"]] {
+        let t = Instant::now();
+        let o = run(&[&["sweep", scene.as_str(), "--from", "2200", "--to", "2400", "--points", "41", "-o", out.to_str().unwrap()][..], &extra[..]].concat());
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {e}");
+        assert!(e.contains(extra[0]) && !e.contains("sweep:"), "{extra:?}: {e}");
+        assert!(!out.exists(), "{extra:?}: a CSV was written");
+        // Refused after the set-up (the reduction, well under a few seconds), not after 41 points.
+        assert!(t.elapsed().as_secs_f64() < 20.0);
+    }
+}

@@ -88,6 +88,15 @@ pub fn run(a: &Args) -> Result<(), Failure> {
         }
         other => return Err(Failure::input(format!("--param: is \"{other}\", expected frequency or speed"))),
     };
+    // Checked before the first solve, so that a typo does not cost the whole sweep.
+    for (flag, list) in [("--spectrum-at", &a.spectrum_at), ("--march-at", &a.march_at)] {
+        if let Some(v) = list.iter().find(|&&v| !(to_frequency(v).is_finite() && to_frequency(v) > 0.0)) {
+            return Err(Failure::input(format!("{flag}: {v} is not a valid {} (must give a finite ω > 0)", a.param)));
+        }
+    }
+    if let Some(t) = a.march_tol.iter().find(|&&t| !(t.is_finite() && t > 0.0)) {
+        return Err(Failure::input(format!("--march-tol: is {t}, must be finite and > 0")));
+    }
     let problem = &built.problem;
     match &built.reduction {
         Some(r) => eprintln!(
@@ -157,9 +166,6 @@ pub fn run(a: &Args) -> Result<(), Failure> {
         let mut spectra = Vec::new();
         for &v in &a.spectrum_at {
             let f = to_frequency(v);
-            if !(f.is_finite() && f > 0.0) {
-                return Err(Failure::input(format!("--spectrum-at: {v} is not a valid {}", a.param)));
-            }
             // Warm-start from the nearest solved sweep point, so as to stay on its branch.
             let near = points.iter().filter(|p| p.error.is_none()).min_by(|x, y| (x.frequency - f).abs().total_cmp(&(y.frequency - f).abs()));
             let mut p = problem.clone();
