@@ -89,3 +89,28 @@ fn bad_input_exits_2_naming_the_field_and_value() {
     let e = bad(&GOOD.replace("amplitude = 1.0", "amplitude = 1.0\nharmonic = 300"));
     assert!(e.contains("force[0].harmonic") && e.contains("300"), "{e}");
 }
+
+/// `bench` over the class: every case and a drawn member certify at a small k, the family's spread
+/// line is printed, and a measurement that overruns `--timeout` is reported as such, not awaited.
+#[test]
+fn bench_covers_the_class_and_stops_at_its_timeout() {
+    let o = cli().args(["bench", "--case", "all", "--steps", "64", "--repeats", "1", "--draws", "1", "--timeout", "60"]).output().unwrap();
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{out}\n{}", String::from_utf8_lossy(&o.stderr));
+    for case in ["rigid-stick", "rigid-impact", "compliant", "chain"] {
+        assert!(out.contains(&format!("\n{case}: ")), "{case} missing:\n{out}");
+    }
+    // Two members (nominal + 1 draw) per case, each certified to the default tolerance.
+    let rows: Vec<&str> = out.lines().filter(|l| l.starts_with("| 64 |") && !l.contains("spread")).collect();
+    assert_eq!(rows.len(), 8, "{out}");
+    for r in &rows {
+        let residual: f64 = r.split('|').nth(8).unwrap().trim().parse().unwrap_or(f64::NAN);
+        assert!(residual <= 1e-9, "not certified: {r}");
+    }
+    assert_eq!(out.matches("spread of 2 members").count(), 4, "{out}");
+    let t = std::time::Instant::now();
+    let o = cli().args(["bench", "--case", "chain", "--steps", "4096", "--repeats", "1", "--method", "lemke", "--timeout", "0.5"]).output().unwrap();
+    assert!(o.status.success());
+    assert!(String::from_utf8_lossy(&o.stdout).contains("timeout"), "{}", String::from_utf8_lossy(&o.stdout));
+    assert!(t.elapsed().as_secs_f64() < 10.0, "the child was not stopped");
+}

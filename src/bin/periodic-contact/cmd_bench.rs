@@ -1,8 +1,15 @@
-//! `bench`: assembly and LCP time of the rigid 1-DOF stop with cds, per k, with peak memory.
-//! Each k runs in a child process of its own so that its peak resident size is its own.
+//! `bench`: time, pivots and peak memory of the periodic LCP over the class of problems, per k.
+//!
+//! Cases (issue 12): the rigid 1-DOF stop with sticking and with pure impacts, the compliant stop,
+//! the 3-DOF chain with two stops. Each has a nominal scene (draw 0, the shipped scene's values)
+//! and a family: `--draws N` adds N scenes with parameters drawn uniformly within the family's
+//! ranges (seeded), and the report gives the spread per size, worst case first.
+//! Each measurement runs in a child process of its own, so that its peak resident size is its
+//! own and a `--timeout` can stop it.
 use crate::Failure;
 use periodic_contact::scene::Scene;
-use std::process::Command;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
 
 /// Peak resident set size of this process [MiB] (Linux VmHWM), if known.
 pub fn peak_rss_mib() -> Option<f64> {
@@ -12,11 +19,124 @@ pub fn peak_rss_mib() -> Option<f64> {
     Some(kib / 1024.0)
 }
 
-/// One measurement, printed as one tab-separated line for the parent.
-pub fn run_single(steps: usize, repeats: usize, method: &str) -> Result<(), Failure> {
-    let text = crate::defaults::DEFAULT_SCENE
-        .replace("steps = 256", &format!("steps = {steps}"))
-        .replace("[output]", &format!("[solver]\nmethod = \"{method}\"\n\n[output]"));
+/// SplitMix64 (Steele, Lea & Flood 2014): a seeded, dependency-free stream for the draws.
+struct SplitMix(u64);
+
+impl SplitMix {
+    fn next_f64(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn uniform(&mut self, (lo, hi): (f64, f64)) -> f64 {
+        lo + (hi - lo) * self.next_f64()
+    }
+}
+
+/// One member of a family: its scene text and a one-line summary of its parameters.
+struct Member {
+    scene: String,
+    summary: String,
+}
+
+/// A family of benchmark scenes.
+struct Case {
+    name: &'static str,
+    about: &'static str,
+    /// The scene with `steps` instants; `rng` is `None` for the nominal member.
+    member: fn(usize, Option<&mut SplitMix>) -> Member,
+}
+
+fn pick(rng: &mut Option<&mut SplitMix>, nominal: f64, range: (f64, f64)) -> f64 {
+    rng.as_deref_mut().map_or(nominal, |r| r.uniform(range))
+}
+
+/// m x'' + c x' + k x = F cos ωt against a stop at g0 (rigid, or compliant with stiffness kc).
+fn oscillator(steps: usize, c: f64, force: f64, gap: f64, omega: f64, stiffness: Option<f64>) -> Member {
+    let contact_stiffness = stiffness.map_or(String::new(), |kc| format!("stiffness = {kc}\n"));
+    let scene = format!(
+        "[structure]\nmass = [[1.0]]\nstiffness = [[1.0]]\n\n[damping]\nmatrix = [[{c}]]\n\n[excitation]\nfrequency = {omega}\n\n\
+         [[force]]\ndof = 0\namplitude = {force}\n\n[[contact]]\ndof = 0\ndirection = 1\ngap = {gap}\n{contact_stiffness}\n\
+         [discretization]\nscheme = \"cds\"\nsteps = {steps}\n\n[output]\ndisplacement = [0]\n"
+    );
+    let kc = stiffness.map_or(String::new(), |kc| format!(" kc={kc:.3}"));
+    Member { scene, summary: format!("c={c:.3} F={force:.3} g0={gap:.3} ω={omega:.3}{kc}") }
+}
+
+const CASES: [Case; 4] = [
+    Case {
+        name: "rigid-stick",
+        about: "rigid 1-DOF stop with sticking (0 < k·g0 < F; notes §6.3): m = k = 1, F = 1, cds, forward pairing",
+        member: |steps, mut rng| {
+            let c = pick(&mut rng, 0.1, (0.05, 0.2));
+            let gap = pick(&mut rng, 0.5, (0.3, 0.7));
+            let omega = pick(&mut rng, 1.0, (0.8, 1.2));
+            oscillator(steps, c, 1.0, gap, omega, None)
+        },
+    },
+    Case {
+        name: "rigid-impact",
+        about: "rigid 1-DOF stop, pure impacts (F < k·g0: the mass cannot stick): m = k = 1, g0 = 1, cds, forward pairing",
+        member: |steps, mut rng| {
+            let c = pick(&mut rng, 0.05, (0.02, 0.1));
+            let force = pick(&mut rng, 0.4, (0.3, 0.6));
+            let omega = pick(&mut rng, 1.0, (0.9, 1.1));
+            oscillator(steps, c, force, 1.0, omega, None)
+        },
+    },
+    Case {
+        name: "compliant",
+        about: "compliant 1-DOF stop (notes §6.2: m = k = 1, g0 = 1), cds",
+        member: |steps, mut rng| {
+            let c = pick(&mut rng, 0.05, (0.02, 0.1));
+            let force = pick(&mut rng, 1.0, (0.7, 1.3));
+            let omega = pick(&mut rng, 1.3, (1.1, 1.5));
+            let kc = pick(&mut rng, 10.0, (5.0, 50.0));
+            oscillator(steps, c, force, 1.0, omega, Some(kc))
+        },
+    },
+    Case {
+        name: "chain",
+        about: "3-DOF chain with two rigid stops (fmu/scenes/chain-3dof-two-stops.toml), cds, forward pairing",
+        member: |steps, mut rng| {
+            let omega = pick(&mut rng, 0.6, (0.5, 0.7));
+            let force = pick(&mut rng, 0.5, (0.4, 0.6));
+            let g1 = pick(&mut rng, 0.4, (0.3, 0.5));
+            let g2 = pick(&mut rng, 0.3, (0.25, 0.4));
+            let scene = format!(
+                "[structure]\nmass = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]\n\
+                 stiffness = [[2.0, -1.0, 0.0], [-1.0, 2.0, -1.0], [0.0, -1.0, 1.0]]\n\n[damping]\nrayleigh = [0.05, 0.02]\n\n\
+                 [excitation]\nfrequency = {omega}\n\n[[force]]\ndof = 2\namplitude = {force}\n\n\
+                 [[contact]]\ndof = 1\ndirection = 1\ngap = {g1}\n\n[[contact]]\ndof = 2\ndirection = -1\ngap = {g2}\n\n\
+                 [discretization]\nscheme = \"cds\"\nsteps = {steps}\n\n[output]\ndisplacement = [0, 1, 2]\n"
+            );
+            Member { scene, summary: format!("ω={omega:.3} F={force:.3} g1={g1:.3} g2={g2:.3}") }
+        },
+    },
+];
+
+fn case(name: &str) -> Result<&'static Case, Failure> {
+    CASES.iter().find(|c| c.name == name).ok_or_else(|| {
+        Failure::input(format!("--case: \"{name}\" is not a case; expected {} or all", CASES.iter().map(|c| c.name).collect::<Vec<_>>().join(", ")))
+    })
+}
+
+/// Member `draw` of a family: 0 is the nominal scene, i ≥ 1 the i-th draw of the seeded stream.
+fn member(c: &Case, steps: usize, draw: usize, seed: u64) -> Member {
+    if draw == 0 {
+        return (c.member)(steps, None);
+    }
+    // One stream per (seed, draw): a member does not depend on how many were drawn before it.
+    let mut rng = SplitMix(seed ^ (draw as u64).wrapping_mul(0xD1B5_4A32_D192_ED03));
+    (c.member)(steps, Some(&mut rng))
+}
+
+/// One measurement in this process, printed as one tab-separated line for the parent.
+pub fn run_single(name: &str, steps: usize, draw: usize, seed: u64, repeats: usize, method: &str) -> Result<(), Failure> {
+    let m = member(case(name)?, steps, draw, seed);
+    let text = m.scene.replace("[output]", &format!("[solver]\nmethod = \"{method}\"\n\n[output]"));
     let problem = Scene::parse(&text, "bench").and_then(|s| s.to_problem("bench")).map_err(|e| Failure::input(e.to_string()))?;
     let mut best: Option<periodic_contact::response::Response> = None;
     for _ in 0..repeats.max(1) {
@@ -27,35 +147,122 @@ pub fn run_single(steps: usize, repeats: usize, method: &str) -> Result<(), Fail
     }
     let r = best.expect("at least one repeat");
     println!(
-        "{}\t{:.6}\t{:.6}\t{:.6}\t{}\t{:.3e}\t{:.1}",
-        steps,
+        "{:.6}\t{:.6}\t{:.6}\t{}\t{:.3e}\t{:.1}\t{}",
         r.timing_s.assembly,
         r.timing_s.lcp,
         r.timing_s.total,
         r.lcp.pivots,
         r.lcp.residual,
-        peak_rss_mib().unwrap_or(f64::NAN)
+        peak_rss_mib().unwrap_or(f64::NAN),
+        r.lcp.size
     );
     Ok(())
 }
 
-pub fn run(steps: &[usize], repeats: usize, method: &str) -> Result<(), Failure> {
+/// What a child reported, or why it did not.
+enum Outcome {
+    Measured { lcp_s: f64, total_s: f64, assembly_s: f64, pivots: usize, residual: f64, rss_mib: f64, size: usize },
+    Failed(String),
+}
+
+fn measure(name: &str, steps: usize, draw: usize, seed: u64, repeats: usize, method: &str, timeout: Duration) -> Result<Outcome, Failure> {
     let exe = std::env::current_exe().map_err(|e| Failure::solver(e.to_string()))?;
-    println!("rigid 1-DOF stop (fmu/scenes/rigid-stop.toml), cds, forward pairing, solver.method = {method}, one core; best of {repeats}");
-    println!("| k = LCP size | assembly [s] | LCP [s] | total [s] | pivots | residual | peak RSS [MiB] |");
-    println!("|---:|---:|---:|---:|---:|---:|---:|");
-    for &k in steps {
-        let out = Command::new(&exe)
-            .args(["bench", "--single", &k.to_string(), "--repeats", &repeats.to_string(), "--method", method])
-            .env("RAYON_NUM_THREADS", "1")
-            .output()
-            .map_err(|e| Failure::solver(format!("cannot run the benchmark child: {e}")))?;
-        if !out.status.success() {
-            return Err(Failure::solver(format!("k = {k}: {}", String::from_utf8_lossy(&out.stderr).trim())));
+    let args = ["bench", "--single", &steps.to_string(), "--case", name, "--draw", &draw.to_string(), "--seed", &seed.to_string()];
+    let mut child = Command::new(&exe)
+        .args(args)
+        .args(["--repeats", &repeats.to_string(), "--method", method])
+        .env("RAYON_NUM_THREADS", "1")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .map_err(|e| Failure::solver(format!("cannot run the benchmark child: {e}")))?;
+    let start = Instant::now();
+    while child.try_wait().map_err(|e| Failure::solver(e.to_string()))?.is_none() {
+        if start.elapsed() > timeout {
+            let _ = child.kill();
+            let _ = child.wait();
+            return Ok(Outcome::Failed(format!("timeout {} s", timeout.as_secs())));
         }
-        let line = String::from_utf8_lossy(&out.stdout);
-        let f: Vec<&str> = line.trim().split('\t').collect();
-        println!("| {} | {} | {} | {} | {} | {} | {} |", f[0], f[1], f[2], f[3], f[4], f[5], f[6]);
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let out = child.wait_with_output().map_err(|e| Failure::solver(e.to_string()))?;
+    if !out.status.success() {
+        let why = String::from_utf8_lossy(&out.stderr).trim().trim_start_matches("error: ").to_string();
+        return Ok(Outcome::Failed(why.chars().take(80).collect()));
+    }
+    let line = String::from_utf8_lossy(&out.stdout);
+    let f: Vec<&str> = line.trim().split('\t').collect();
+    let num = |i: usize| f.get(i).and_then(|v| v.parse::<f64>().ok()).ok_or_else(|| Failure::solver(format!("unreadable child output {line:?}")));
+    Ok(Outcome::Measured {
+        assembly_s: num(0)?,
+        lcp_s: num(1)?,
+        total_s: num(2)?,
+        pivots: num(3)? as usize,
+        residual: num(4)?,
+        rss_mib: num(5)?,
+        size: num(6)? as usize,
+    })
+}
+
+pub struct BenchArgs<'a> {
+    pub cases: &'a [String],
+    pub steps: &'a [usize],
+    pub repeats: usize,
+    pub method: &'a str,
+    pub draws: usize,
+    pub seed: u64,
+    pub timeout_s: f64,
+}
+
+pub fn run(a: &BenchArgs) -> Result<(), Failure> {
+    if !(a.timeout_s.is_finite() && a.timeout_s > 0.0) {
+        return Err(Failure::input(format!("--timeout: is {}, must be finite and > 0 seconds", a.timeout_s)));
+    }
+    let cases: Vec<&Case> =
+        if a.cases.iter().any(|c| c == "all") { CASES.iter().collect() } else { a.cases.iter().map(|c| case(c)).collect::<Result<_, _>>()? };
+    let timeout = Duration::from_secs_f64(a.timeout_s);
+    println!("solver.method = {}, one core per child, best of {} repeats, timeout {} s per child", a.method, a.repeats, a.timeout_s);
+    for c in cases {
+        println!("\n{}: {}", c.name, c.about);
+        if a.draws > 0 {
+            println!("family: the nominal scene and {} draws (seed {}), parameters uniform in the case's ranges", a.draws, a.seed);
+        }
+        println!("| k | N | member | assembly [s] | LCP [s] | total [s] | pivots | residual | peak RSS [MiB] |");
+        println!("|---:|---:|---|---:|---:|---:|---:|---:|---:|");
+        for &k in a.steps {
+            let mut rows = Vec::new();
+            for draw in 0..=a.draws {
+                let summary = member(c, k, draw, a.seed).summary;
+                rows.push((summary, measure(c.name, k, draw, a.seed, a.repeats, a.method, timeout)?));
+            }
+            // Worst first: failures, then by total time.
+            rows.sort_by(|x, y| match (&x.1, &y.1) {
+                (Outcome::Failed(_), Outcome::Measured { .. }) => std::cmp::Ordering::Less,
+                (Outcome::Measured { .. }, Outcome::Failed(_)) => std::cmp::Ordering::Greater,
+                (Outcome::Measured { total_s: tx, .. }, Outcome::Measured { total_s: ty, .. }) => ty.total_cmp(tx),
+                _ => std::cmp::Ordering::Equal,
+            });
+            for (summary, o) in &rows {
+                match o {
+                    Outcome::Measured { assembly_s, lcp_s, total_s, pivots, residual, rss_mib, size } => {
+                        println!("| {k} | {size} | {summary} | {assembly_s:.4} | {lcp_s:.4} | {total_s:.4} | {pivots} | {residual:.1e} | {rss_mib:.1} |")
+                    }
+                    Outcome::Failed(why) => println!("| {k} | — | {summary} | — | — | — | — | {why} | — |"),
+                }
+            }
+            if rows.len() > 1 {
+                let mut t: Vec<f64> = rows.iter().filter_map(|(_, o)| if let Outcome::Measured { total_s, .. } = o { Some(*total_s) } else { None }).collect();
+                t.sort_by(f64::total_cmp);
+                let failed = rows.len() - t.len();
+                if let (Some(lo), Some(hi)) = (t.first(), t.last()) {
+                    println!(
+                        "| {k} | | spread of {} members: worst {hi:.4} s, median {:.4} s, best {lo:.4} s; {failed} failed | | | | | | |",
+                        rows.len(),
+                        t[t.len() / 2]
+                    );
+                }
+            }
+        }
     }
     Ok(())
 }

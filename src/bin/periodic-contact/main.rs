@@ -51,8 +51,12 @@ enum Command {
     },
     /// Frequency sweep: CSV, frequency-response PNG, spectra, comparison with time marching.
     Sweep(cmd_sweep::Args),
-    /// Benchmark: assembly and LCP time of the rigid 1-DOF stop (cds) per k, and peak memory.
+    /// Benchmark over the class: time, pivots and peak memory per case and k, with random
+    /// families (worst case first).
     Bench {
+        /// Cases (comma-separated): rigid-stick, rigid-impact, compliant, chain, or all.
+        #[arg(long, value_delimiter = ',', default_value = "rigid-stick")]
+        case: Vec<String>,
         /// LCP sizes k to measure.
         #[arg(long, value_delimiter = ',', default_value = "256,512,1024,2048,4096")]
         steps: Vec<usize>,
@@ -62,9 +66,21 @@ enum Command {
         /// LCP method: auto, lemke or pivoting.
         #[arg(long, default_value = "auto")]
         method: String,
+        /// Random members of each case's family besides the nominal one.
+        #[arg(long, default_value_t = 0)]
+        draws: usize,
+        /// Seed of the draws.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Seconds after which one measurement is stopped and reported as a timeout.
+        #[arg(long, default_value_t = 600.0)]
+        timeout: f64,
         /// Internal: measure one size in this process.
         #[arg(long, hide = true)]
         single: Option<usize>,
+        /// Internal: the member of the family measured by --single (0: nominal).
+        #[arg(long, hide = true, default_value_t = 0)]
+        draw: usize,
     },
     /// Solve a raw LCP in Siconos' dense .dat format (block-circulant matrices are detected and
     /// solved by the fast path).
@@ -118,9 +134,9 @@ fn main() -> ExitCode {
         Some(Command::Lcp { file, output, method, tolerance }) => cmd_lcp::run(&file, &output, &method, tolerance),
         Some(Command::Study { study }) => cmd_study::run(study),
         Some(Command::Fmu { scene, output, binary }) => cmd_fmu::run(&scene, &output, binary.as_deref()),
-        Some(Command::Bench { steps, repeats, method, single }) => match single {
-            Some(k) => cmd_bench::run_single(k, repeats, &method),
-            None => cmd_bench::run(&steps, repeats, &method),
+        Some(Command::Bench { case, steps, repeats, method, draws, seed, timeout, single, draw }) => match single {
+            Some(k) => cmd_bench::run_single(case.first().map_or("rigid-stick", String::as_str), k, draw, seed, repeats, &method),
+            None => cmd_bench::run(&cmd_bench::BenchArgs { cases: &case, steps: &steps, repeats, method: &method, draws, seed, timeout_s: timeout }),
         },
     };
     match result {
