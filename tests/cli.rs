@@ -114,3 +114,37 @@ fn bench_covers_the_class_and_stops_at_its_timeout() {
     assert!(String::from_utf8_lossy(&o.stdout).contains("timeout"), "{}", String::from_utf8_lossy(&o.stdout));
     assert!(t.elapsed().as_secs_f64() < 10.0, "the child was not stopped");
 }
+
+/// `solve --export-lcp`: the exported LCP, solved independently by dense lexicographic Lemke
+/// (`lcp --method lemke`, no structure used), gives the contact forces of the solve, for a single
+/// rigid contact and for the two-stop chain (m = 2: z interleaves the contacts per instant).
+#[test]
+fn the_exported_lcp_solved_by_dense_lemke_gives_the_solve_forces() {
+    let dir = std::env::temp_dir().join(format!("pc-export-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for scene in ["rigid-stop.toml", "chain-3dof-two-stops.toml"] {
+        let scene_path = Path::new(env!("CARGO_MANIFEST_DIR")).join("fmu/scenes").join(scene);
+        let (dat, json, out) = (dir.join("a.dat"), dir.join("r.json"), dir.join("z.json"));
+        let o = cli().args(["solve", scene_path.to_str().unwrap(), "-o", json.to_str().unwrap(), "--export-lcp", dat.to_str().unwrap()]).output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let o = cli().args(["lcp", dat.to_str().unwrap(), "--method", "lemke", "-o", out.to_str().unwrap()]).output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        let z: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+        assert_eq!(z["structure"], "dense");
+        let z: Vec<f64> = z["z"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+        let contacts = r["contacts"].as_array().unwrap();
+        let m = contacts.len();
+        assert_eq!(z.len(), m * r["steps"].as_u64().unwrap() as usize);
+        let mut worst: f64 = 0.0;
+        let mut scale: f64 = 0.0;
+        for (c, contact) in contacts.iter().enumerate() {
+            for (j, f) in contact["force"].as_array().unwrap().iter().enumerate() {
+                let f = f.as_f64().unwrap();
+                worst = worst.max((f - z[j * m + c]).abs());
+                scale = scale.max(f.abs());
+            }
+        }
+        assert!(scale > 0.0 && worst <= 1e-9 * scale, "{scene}: forces differ by {worst:e} (scale {scale:e})");
+    }
+}

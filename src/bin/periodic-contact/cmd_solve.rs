@@ -1,5 +1,6 @@
 //! `solve` and the default run.
 use crate::{Failure, ensure_writable, write_output};
+use periodic_contact::linalg::PeriodFft;
 use periodic_contact::periodic::PeriodicProblem;
 use periodic_contact::response::Response;
 use periodic_contact::scene::Scene;
@@ -20,9 +21,36 @@ pub fn load(scene: &Path, frequency: Option<f64>) -> Result<PeriodicProblem, Fai
     Ok(s.build_in(&scene.display().to_string(), &dir).map_err(|e| Failure::input(e.to_string()))?.problem)
 }
 
-pub fn run(scene: &Path, output: &Path, frequency: Option<f64>) -> Result<(), Failure> {
+/// The largest LCP `--export-lcp` writes: a dense .dat of N = 4096 is already 0.4 GB of text.
+const EXPORT_MAX: usize = 4096;
+
+/// Writes the scene's LCP (w = A z + q, z the contact forces) in Siconos' dense `.dat` format.
+fn export_lcp(problem: &PeriodicProblem, path: &Path) -> Result<(), Failure> {
+    let (k, m) = (problem.discretization().steps, problem.model().contacts.len());
+    if m == 0 {
+        return Err(Failure::input("--export-lcp: the scene has no contact, so there is no LCP to export"));
+    }
+    if k * m > EXPORT_MAX {
+        return Err(Failure::input(format!(
+            "--export-lcp: the LCP has N = k·m = {k}·{m} = {} unknowns, above the dense export's limit {EXPORT_MAX}; lower discretization.steps",
+            k * m
+        )));
+    }
+    let (a, q) = problem.assemble_lcp(&PeriodFft::new(k)).map_err(|e| Failure::from(periodic_contact::Error::from(e)))?;
+    periodic_contact::lcp::dat::write_dat(path, &a, &q).map_err(|e| Failure::input(format!("--export-lcp {}: cannot write: {e}", path.display())))?;
+    eprintln!("LCP of size {} (k = {k}, m = {m}) → {}", q.len(), path.display());
+    Ok(())
+}
+
+pub fn run(scene: &Path, output: &Path, frequency: Option<f64>, export: Option<&Path>) -> Result<(), Failure> {
     ensure_writable(output, "--output")?;
+    if let Some(p) = export {
+        ensure_writable(p, "--export-lcp")?;
+    }
     let problem = load(scene, frequency)?;
+    if let Some(p) = export {
+        export_lcp(&problem, p)?;
+    }
     // Errors found while solving name the scene too (those of loading already do).
     let r = solve(&problem).map_err(|f| Failure { message: format!("{}: {}", scene.display(), f.message), ..f })?;
     let json = serde_json::to_string_pretty(&r).map_err(|e| Failure::solver(e.to_string()))?;

@@ -31,6 +31,9 @@ enum Command {
         /// Override excitation.frequency ω [rad/s] (with a casing: ω = lobes·Ω).
         #[arg(long)]
         frequency: Option<f64>,
+        /// Also write the scene's LCP (dense, Siconos .dat format) to this file, for peers.
+        #[arg(long)]
+        export_lcp: Option<PathBuf>,
     },
     /// Package a scene as an FMI 2.0 co-simulation FMU (needs `cargo build --release -p periodic-contact-fmu`).
     Fmu {
@@ -128,7 +131,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         None => cmd_solve::run_default(),
-        Some(Command::Solve { scene, output, frequency }) => cmd_solve::run(&scene, &output, frequency),
+        Some(Command::Solve { scene, output, frequency, export_lcp }) => cmd_solve::run(&scene, &output, frequency, export_lcp.as_deref()),
         Some(Command::Modes { scene, count }) => cmd_modes::run(&scene, count),
         Some(Command::Sweep(args)) => cmd_sweep::run(&args),
         Some(Command::Lcp { file, output, method, tolerance }) => cmd_lcp::run(&file, &output, &method, tolerance),
