@@ -26,6 +26,48 @@ pub struct Chart<'a> {
     pub y_scale: Scale,
 }
 
+/// Tableau 10: a qualitative palette whose colours stay apart (also for most colour-blind
+/// readers). Beyond 10 curves the colours repeat with dashed lines and other markers.
+const TABLEAU10: [RGBColor; 10] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
+];
+
+/// The look of curve `i`: its colour, dashed or not, and its marker (0 circle, 1 triangle,
+/// 2 square).
+fn style(i: usize) -> (RGBColor, bool, usize) {
+    (TABLEAU10[i % 10], (i / 10) % 2 == 1, (i / 10) % 3)
+}
+
+/// Marker outlines in pixels around the point: an octagon (a circle), a triangle, a square.
+fn marker_shape(kind: usize) -> Vec<(i32, i32)> {
+    match kind {
+        0 => vec![(4, 0), (3, 3), (0, 4), (-3, 3), (-4, 0), (-3, -3), (0, -4), (3, -3)],
+        1 => vec![(0, -5), (5, 4), (-5, 4)],
+        _ => vec![(-4, -4), (4, -4), (4, 4), (-4, 4)],
+    }
+}
+
+/// A linear axis's tick: "2" rather than "2.0", "0.25", "6e-5" (6 significant digits at most,
+/// powers of ten below 1e-3 and from 1e6 on).
+fn tick(v: &f64) -> String {
+    let v = *v;
+    if v == 0.0 || !v.is_finite() {
+        return if v == 0.0 { "0".into() } else { format!("{v}") };
+    }
+    let scale = 10f64.powi(5 - v.abs().log10().floor() as i32);
+    let r = (v * scale).round() / scale;
+    if r.abs() < 1e-3 || r.abs() >= 1e6 { format!("{r:e}") } else { format!("{r}") }
+}
+
 fn range(values: impl Iterator<Item = f64>, scale: Scale) -> (f64, f64) {
     let (lo, hi) =
         values.filter(|v| v.is_finite() && (scale == Scale::Linear || *v > 0.0)).fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(v), h.max(v)));
@@ -122,23 +164,31 @@ where
                 let log_fmt = |v: &f64| format!("{v:.0e}");
                 let mut mesh = ctx.configure_mesh();
                 mesh.x_desc(chart.x_label).y_desc(chart.y_label);
-                if chart.x_scale == Scale::Log {
-                    mesh.x_label_formatter(&log_fmt);
-                }
-                if chart.y_scale == Scale::Log {
-                    mesh.y_label_formatter(&log_fmt);
-                }
+                mesh.x_label_formatter(if chart.x_scale == Scale::Log { &log_fmt } else { &tick });
+                mesh.y_label_formatter(if chart.y_scale == Scale::Log { &log_fmt } else { &tick });
                 mesh.draw().map_err(|e| err(&e))?;
             }
             for (i, s) in series.iter().enumerate() {
-                let color = Palette99::pick(i).to_rgba();
+                let (color, dashed, marker) = style(i);
                 let pts: Vec<(f64, f64)> = s.points.iter().copied().filter(keep).collect();
-                ctx.draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))
-                    .map_err(|e| err(&e))?
-                    .label(s.label.clone())
-                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+                let line = color.stroke_width(2);
+                let drawn = if dashed {
+                    ctx.draw_series(DashedLineSeries::new(pts.clone(), 8, 5, line)).map_err(|e| err(&e))?
+                } else {
+                    ctx.draw_series(LineSeries::new(pts.clone(), line)).map_err(|e| err(&e))?
+                };
+                // Legend: two segments (a gap between them when dashed) and the marker.
+                let (gap, shape) = (if dashed { 13 } else { 8 }, marker_shape(marker));
+                let mark = if s.markers { color.filled() } else { color.mix(0.0).filled() };
+                drawn.label(s.label.clone()).legend(move |(x, y)| {
+                    EmptyElement::at((x, y))
+                        + PathElement::new(vec![(0, 0), (8, 0)], line)
+                        + PathElement::new(vec![(gap, 0), (21, 0)], line)
+                        + Polygon::new(shape.iter().map(|(a, b)| (a + 10, *b)).collect::<Vec<_>>(), mark)
+                });
                 if s.markers {
-                    ctx.draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled()))).map_err(|e| err(&e))?;
+                    let shape = marker_shape(marker);
+                    ctx.draw_series(pts.iter().map(|&p| EmptyElement::at(p) + Polygon::new(shape.clone(), color.filled()))).map_err(|e| err(&e))?;
                 }
             }
             let mut labels = ctx.configure_series_labels();
@@ -162,4 +212,19 @@ where
         (Scale::Log, Scale::Linear) => draw!(builder.build_cartesian_2d((xs.0..xs.1).log_scale(), ys.0..ys.1).map_err(|e| err(&e))?),
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn ticks_are_short() {
+        let t = |v: f64| super::tick(&v);
+        assert_eq!(
+            [t(2.0), t(2000.0), t(0.25), t(0.00006000000000001), t(6e-5), t(0.0), t(-1.5), t(2.5e6)],
+            ["2", "2000", "0.25", "6e-5", "6e-5", "0", "-1.5", "2.5e6"]
+        );
+        // Eleven curves: eleven different looks.
+        let looks: std::collections::HashSet<String> = (0..11).map(|i| format!("{:?}", super::style(i))).collect();
+        assert_eq!(looks.len(), 11);
+    }
 }

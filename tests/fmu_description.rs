@@ -101,3 +101,63 @@ fn invalid_scenes_are_refused_with_the_field() {
     let e = e.to_string();
     assert!(e.contains("bad.toml") && e.contains("stiffness"), "{e}");
 }
+
+/// Every Real carries its unit in the scene's units, each declared once with its SI factor;
+/// contact descriptions say what the gap of each kind of contact is.
+#[test]
+fn units_of_every_real_and_contact_descriptions() {
+    use periodic_contact::fmi::table::Kind;
+    let text = format!(
+        "{BASE}[units]\nlength = \"mm\"\nforce = \"kN\"\n[[force]]\ndof = 0\namplitude = 1.0\n[[contact]]\ndof = 0\ngap = 0.5\nmotion = [{{ amplitude = 0.1 }}]\n[[contact]]\ndof = 0\ndirection = -1\ngap = 0.5\nstiffness = 100.0\n[output]\ndisplacement = [0]\nvelocity = [0]\nacceleration = [0]\n"
+    );
+    let m = ContactModel::from_scene_text(&text, "t").unwrap();
+    let d = m.model_description();
+    d.check().unwrap();
+    let unit = |name: &str| -> Option<String> {
+        let vr = d.variables.by_name(name).unwrap_or_else(|| panic!("{name}"));
+        match &d.variables.get(vr).unwrap().kind {
+            Kind::Real { unit, .. } => unit.clone(),
+            k => panic!("{name} is {k:?}"),
+        }
+    };
+    let expected = [
+        ("frequency", Some("rad/s")),
+        ("frequency_in", Some("rad/s")),
+        ("force_scale", Some("1")),
+        ("force_scale_in", Some("1")),
+        ("gap_offset", Some("mm")),
+        ("gap_offset_in", Some("mm")),
+        ("motion_scale", Some("1")),
+        ("displacement[0]", Some("mm")),
+        ("velocity[0]", Some("mm/s")),
+        ("acceleration[0]", Some("mm/s2")),
+        ("contact[0].force", Some("kN")),
+        ("contact[1].gap", Some("mm")),
+        ("lcp.residual", None),
+    ];
+    for (name, u) in expected {
+        assert_eq!(unit(name).as_deref(), u, "{name}");
+    }
+    // Every Real but the residual has a unit.
+    for (_, v) in d.variables.iter() {
+        if let Kind::Real { unit, .. } = &v.kind {
+            assert_eq!(unit.is_none(), v.name == "lcp.residual", "{}", v.name);
+        }
+    }
+    let units: Vec<&str> = d.units.iter().map(|u| u.name.as_str()).collect();
+    assert_eq!(units, ["rad/s", "1", "mm", "mm/s", "mm/s2", "kN"]);
+    let (doc, _) = xml::render(d);
+    assert!(doc.contains("<Unit name=\"mm/s2\">\n      <BaseUnit m=\"1\" s=\"-2\" factor=\"0.001\"/>"), "{doc}");
+    assert!(doc.contains("<Unit name=\"kN\">\n      <BaseUnit kg=\"1\" m=\"1\" s=\"-2\" factor=\"1000.0\"/>"), "{doc}");
+    assert!(doc.contains("<Unit name=\"1\">\n      <BaseUnit/>"), "{doc}");
+    assert!(doc.contains("<Real unit=\"mm\"/>"), "{doc}");
+    // What the gap is, per kind of contact.
+    let text_of = |name: &str| d.variables.get(d.variables.by_name(name).unwrap()).unwrap().description.clone();
+    assert!(text_of("contact[0].gap").starts_with("Clearance >= 0 of the rigid contact 0 on DOF 0"), "{}", text_of("contact[0].gap"));
+    let compliant = text_of("contact[1].gap");
+    assert!(compliant.contains("compliant") && compliant.contains("negative = penetration") && !compliant.contains(">= 0"), "{compliant}");
+    assert!(text_of("contact[1].force").contains("stiffness 100 kN/mm"), "{}", text_of("contact[1].force"));
+    assert!(d.description.ends_with("(units: mm, kN, s)"), "{}", d.description);
+    let html = m.documentation_html("t.toml");
+    assert!(html.contains("Units: length mm, force kN, time s (mass kN.s2/mm)") && html.contains("<td>mm/s2</td>"), "{html}");
+}

@@ -127,58 +127,87 @@ fn cli() -> Command {
     Command::new(env!("CARGO_BIN_EXE_periodic-contact"))
 }
 
+/// The header's columns as (key, unit): "amplitude_1903 [mm]" → ("amplitude_1903", "mm").
+fn columns(head: &str) -> Vec<(&str, &str)> {
+    head.split(',').map(|c| c.split_once(" [").map_or((c, ""), |(k, u)| (k, u.trim_end_matches(']')))).collect()
+}
+
 #[test]
 fn cli_sweep_writes_the_csv_the_curves_and_the_spectra() {
     let dir = std::env::temp_dir().join(format!("pc-sweep-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
+    // The coarse blade's numbers, labelled in mm and kN (labels only: the solve is the same).
+    let scene = dir.join("blade-mm.toml");
+    let text = std::fs::read_to_string(coarse()).unwrap() + "\n[units]\nlength = \"mm\"\nforce = \"kN\"\n";
+    std::fs::write(&scene, text).unwrap();
     let csv = dir.join("s.csv");
     let o = cli()
-        .args(["sweep", coarse().to_str().unwrap(), "--from", "2200", "--to", "2400", "--points", "21", "--threads", "2", "--spectrum-at", "2300", "-o"])
+        .args(["sweep", scene.to_str().unwrap(), "--from", "2200", "--to", "2400", "--points", "21", "--threads", "2", "--spectrum-at", "2300", "-o"])
         .arg(&csv)
         .output()
         .unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{err}");
     assert!(err.contains("21 solved, 0 failed"), "{err}");
+    assert!(err.contains("frequency-response curve of MC:y") && err.contains("MC:y: peak with contact") && err.contains(" mm at ω = "), "{err}");
     let text = std::fs::read_to_string(&csv).unwrap();
     let mut lines = text.lines();
-    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
-    assert_eq!(head[0], "frequency");
+    let head = columns(lines.next().unwrap());
+    let keys: Vec<&str> = head.iter().map(|c| c.0).collect();
+    assert_eq!(head[0], ("frequency", "rad/s"));
     for col in [
-        "amplitude_1903",
-        "linear_amplitude_1868",
-        "max_force_c0_dof1868",
-        "contact_fraction_c2_dof1940",
-        "lcp_size",
-        "pivots",
-        "warm_start_used",
-        "time_s",
-        "status",
+        ("amplitude_1903", "mm"),
+        ("linear_amplitude_1868", "mm"),
+        ("max_force_c0_dof1868", "kN"),
+        ("contact_fraction_c2_dof1940", ""),
+        ("lcp_size", ""),
+        ("pivots", ""),
+        ("warm_start_used", ""),
+        ("time_s", ""),
+        ("status", ""),
     ] {
-        assert!(head.contains(&col), "{col} missing from {head:?}");
+        assert!(head.contains(&col), "{col:?} missing from {head:?}");
     }
+    assert!(keys.iter().enumerate().all(|(i, k)| !keys[..i].contains(k)), "a column twice: {keys:?}");
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.len(), 21);
     assert_eq!(rows[10][0].parse::<f64>().unwrap(), 2300.0);
-    assert!(rows.iter().all(|r| r.last() == Some(&"solved") && r[head.iter().position(|c| *c == "lcp_size").unwrap()] == "1536"));
+    assert!(rows.iter().all(|r| r.last() == Some(&"solved") && r[keys.iter().position(|c| *c == "lcp_size").unwrap()] == "1536"));
     if cfg!(feature = "plots") {
         for f in ["s.png", "s-dof1868.png", "s-spectrum-2300.png"] {
             assert!(std::fs::metadata(dir.join(f)).map(|m| m.len() > 1000).unwrap_or(false), "{f}");
         }
     }
     let spec = std::fs::read_to_string(dir.join("s-spectrum.csv")).unwrap();
-    assert!(spec.starts_with("frequency,frequency,harmonic,displacement_1903"), "{spec}");
+    let spec_head = columns(spec.lines().next().unwrap());
+    assert_eq!(spec_head[..4], [("frequency", "rad/s"), ("harmonic", ""), ("displacement_1903", "mm"), ("displacement_1868", "mm")], "{spec}");
+    assert!(spec_head.iter().enumerate().all(|(i, c)| !spec_head[..i].iter().any(|d| d.0 == c.0)), "a column twice: {spec_head:?}");
+    let force_col = spec_head.iter().position(|c| *c == ("force_c0_dof1868", "kN")).unwrap();
+    let spec_rows: Vec<Vec<&str>> = spec.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    assert_eq!(spec_rows.len(), 21, "harmonics 0..=20 at one point");
 
     // `solve --frequency` gives the sweep's point (a cold solve; below the fold it is unique).
     let out = dir.join("r.json");
-    let o = cli().args(["solve", coarse().to_str().unwrap(), "--frequency", "2300", "-o"]).arg(&out).output().unwrap();
+    let o = cli().args(["solve", scene.to_str().unwrap(), "--frequency", "2300", "-o"]).arg(&out).output().unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
-    let x: Vec<f64> = v["displacement"]["1903"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+    let series = |v: &serde_json::Value| -> Vec<f64> { v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect() };
+    let x = series(&v["displacement"]["1903"]);
     let amp = periodic_contact::response::Response::peak_to_peak(&x) / 2.0;
-    let col = head.iter().position(|c| *c == "amplitude_1903").unwrap();
+    let col = keys.iter().position(|c| *c == "amplitude_1903").unwrap();
     let swept: f64 = rows[10][col].parse().unwrap();
     assert!((amp - swept).abs() <= 1e-9 * swept, "{amp} vs {swept}");
+    // Harmonic 0 of the spectrum is the mean contact force of the solve's samples.
+    let force = series(&v["contacts"][0]["force"]);
+    let mean = force.iter().sum::<f64>() / force.len() as f64;
+    let (p0, f0): (&str, f64) = (spec_rows[0][1], spec_rows[0][force_col].parse().unwrap());
+    assert_eq!(p0, "0");
+    assert!(mean > 0.0 && (f0 - mean).abs() <= 1e-9 * mean, "harmonic 0 {f0} vs mean force {mean}");
+
+    // The curve's axes name the DOF and the units.
+    let built = Scene::load(&scene).map(|(s, d)| s.build_in("blade-mm.toml", &d).unwrap()).unwrap();
+    let (xl, yl) = sweep::frc_axes("frequency", 1903, &built.labels);
+    assert_eq!((xl.as_str(), yl.as_str()), ("excitation frequency ω [rad/s]", "amplitude of MC:y [mm] (peak-to-peak / 2)"));
 
     // `modes`: full against reduced.
     let o = cli().args(["modes", coarse().to_str().unwrap(), "--count", "5"]).output().unwrap();

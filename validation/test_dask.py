@@ -17,8 +17,9 @@ import sweep_dask  # noqa: E402
 
 
 def read_csv(path):
+    """Rows keyed by column key: the CLI's header names a unit after the key ("amplitude_1903 [m]")."""
     with open(path) as f:
-        return list(csv.DictReader(f))
+        return [{k.split(" [")[0]: v for k, v in row.items()} for row in csv.DictReader(f)]
 
 
 def test_dask_sweep_on_a_local_cluster_equals_the_cli_sweep(cli, workdir):

@@ -44,3 +44,28 @@ def test_fmpy_simulate_matches_the_cli(cli, workdir, scene):
         scale = max(np.ptp(x), np.finfo(float).tiny)
         worst = float(np.max(np.abs(got - x)))
         assert worst <= SAME_ENGINE * scale, f"{scene}: displacement[{key}] differs from the CLI by {worst:.3e} (peak-to-peak {scale:.3e})"
+
+
+def test_fmpy_reads_the_units_of_a_scene_in_mm(cli, workdir):
+    """The compliant stop with `[units] length = "mm"`, `force = "kN"`: `fmpy validate` passes and fmpy
+    reads the unit of every Real (dimensionless scale factors "1", the LCP residual none) and the
+    SI factor of each unit."""
+    with open(os.path.join(SCENES, "compliant-stop.toml")) as fh:
+        text = fh.read() + '\n[units]\nlength = "mm"\nforce = "kN"\n'
+    fmu = engine.build_fmu(cli, text, workdir, "frontend_units_mm")
+    problems = validate_fmu(fmu)
+    assert not problems, problems
+    md = fmpy.read_model_description(fmu)
+    unit = {v.name: v.unit for v in md.modelVariables if v.type == "Real"}
+    expected = {"frequency": "rad/s", "frequency_in": "rad/s", "force_scale": "1", "gap_offset": "mm",
+                "displacement[0]": "mm", "contact[0].force": "kN", "contact[0].gap": "mm", "lcp.residual": None}
+    for name, u in expected.items():
+        assert unit[name] == u, (name, unit[name])
+    assert all(u is not None for name, u in unit.items() if name != "lcp.residual"), unit
+    defs = {u.name: u.baseUnit for u in md.unitDefinitions}
+    assert set(defs) == {u for u in unit.values() if u is not None}
+    assert (defs["mm"].m, defs["mm"].factor) == (1, 0.001)
+    assert (defs["kN"].kg, defs["kN"].m, defs["kN"].s, defs["kN"].factor) == (1, 1, -2, 1000.0)
+    assert (defs["rad/s"].rad, defs["rad/s"].s) == (1, -1)
+    gap = next(v for v in md.modelVariables if v.name == "contact[0].gap")
+    assert "negative = penetration" in gap.description, gap.description

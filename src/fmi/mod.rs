@@ -75,6 +75,22 @@ pub struct ModelDescription {
     pub max_output_derivative_order: u32,
 }
 
+impl ModelDescription {
+    /// The variable table's checks ([`VariableTable::check`]), and every Real's unit is one of
+    /// `units` (fmpy refuses an undefined unit).
+    pub fn check(&self) -> Result<()> {
+        self.variables.check()?;
+        for (_, v) in self.variables.iter() {
+            if let table::Kind::Real { unit: Some(u), .. } = &v.kind
+                && !self.units.iter().any(|d| d.name == *u)
+            {
+                return Err(Error::input(format!("{}: its unit \"{u}\" is not in the unit definitions", v.name)));
+            }
+        }
+        Ok(())
+    }
+}
+
 /// A co-simulation model behind the shell. Value references are positions in
 /// `description().variables`; the shell has checked the reference, its type and (for setters)
 /// that the variable may be set in the current state before calling a setter or getter.

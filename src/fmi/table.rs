@@ -180,11 +180,15 @@ pub struct EnumerationType {
     pub items: Vec<(String, i32, String)>,
 }
 
-/// A unit of `<UnitDefinitions>` with its SI base-unit exponents, e.g. `("s", -1), ("rad", 1)`.
+/// A unit of `<UnitDefinitions>`: its name, its non-zero SI base-unit exponents (`kg`, `m`, `s`,
+/// `A`, `K`, `mol`, `cd`, `rad`), e.g. `("s", -1), ("rad", 1)`, and the factor to those base units
+/// (1 mm = 0.001 m: factor 0.001; `<BaseUnit>` writes it when it is not 1). No exponents: the
+/// unit "1" of a ratio.
 #[derive(Clone, Debug, PartialEq)]
 pub struct UnitDefinition {
     pub name: String,
     pub base: Vec<(&'static str, i32)>,
+    pub factor: f64,
 }
 
 #[derive(Clone, Debug, Default, PartialEq)]

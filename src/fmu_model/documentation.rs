@@ -7,8 +7,9 @@ use crate::time::Scheme;
 
 const TEMPLATE: &str = include_str!("documentation.html");
 
-/// The page for the model described by `desc`, built from the scene `scene_name`.
-pub fn render(desc: &ModelDescription, scene_name: &str) -> String {
+/// The page for the model described by `desc`, built from the scene `scene_name` whose units
+/// are `units` (e.g. "length mm, force kN, time s").
+pub fn render(desc: &ModelDescription, scene_name: &str, units: &str) -> String {
     let esc = |s: &str| quick_xml::escape::escape(s).into_owned();
     let mut rows = String::new();
     for (vr, v) in desc.variables.iter() {
@@ -38,6 +39,7 @@ pub fn render(desc: &ModelDescription, scene_name: &str) -> String {
         ("{tool}", esc(&desc.generation_tool)),
         ("{schemes}", schemes),
         ("{rows}", rows),
+        ("{units}", esc(units)),
     ];
     // One pass over the template, so that a value containing "{…}" is never substituted again.
     let mut out = String::with_capacity(TEMPLATE.len() + 4096);

@@ -20,8 +20,8 @@
 //!   for `displacement[d]` it is the velocity.
 use crate::error::{Error, Result};
 use crate::fmi::state::{StateReader, StateWriter};
-use crate::fmi::table::UnitDefinition;
 use crate::fmi::{CoSimModel, DefaultExperiment, EventLog, ModelDescription};
+use crate::model::Units;
 pub use crate::periodic::Tuning;
 use crate::periodic::{MAX_STEPS, MIN_STEPS, PeriodFft, PeriodicProblem, PeriodicSolver};
 use crate::response::Response;
@@ -38,7 +38,7 @@ mod variables;
 
 use series::{Series, Solution};
 pub use state::ContactSnapshot;
-use variables::{Quantity, Role, Variables, unique};
+use variables::{Output, Role, Variables, unique};
 
 pub const MODEL_IDENTIFIER: &str = "PeriodicContact";
 /// The scene inside the FMU's `resources/`.
@@ -82,11 +82,13 @@ fn scheme_code(s: Scheme) -> i32 {
 /// The model of one FMU instance.
 pub struct ContactModel {
     desc: ModelDescription,
+    /// The scene's units (labels: the documentation page).
+    units: Units,
     /// The scene's problem, recovering what the outputs need (displacement and velocity at
     /// every DOF that has either output).
     base: PeriodicProblem,
     roles: Vec<Role>,
-    outputs: Vec<Quantity>,
+    outputs: Vec<Output>,
     start: Values,
     values: Values,
     /// The solver session: the FFT plan and the warm start, updated at each re-solve.
@@ -107,10 +109,11 @@ impl ContactModel {
     /// Builds the model of a scene. `file` names the source in messages only.
     pub fn from_scene_text(text: &str, file: &str) -> Result<Self> {
         let scene = Scene::parse(text, file)?;
-        let problem = scene.to_problem(file)?;
+        let built = scene.build(file)?;
+        let problem = built.problem;
         let shown = problem.outputs().clone();
         let model = problem.model();
-        let Variables { table: t, roles, outputs } = Variables::of(&problem);
+        let Variables { table: t, roles, outputs, units } = Variables::of(&problem, &built.labels);
         let k = problem.discretization().steps;
         let mut base = problem.clone();
         // No rayon inside an FMU: its global pool would outlive the instance and keep the
@@ -127,10 +130,10 @@ impl ContactModel {
         let desc = ModelDescription {
             model_name: MODEL_IDENTIFIER.into(),
             model_identifier: MODEL_IDENTIFIER.into(),
-            description: summary(&problem),
+            description: format!("{} (units: {})", summary(&problem), built.labels.units.summary()),
             generation_tool: format!("periodic-contact {}", env!("CARGO_PKG_VERSION")),
             variables: t,
-            units: vec![UnitDefinition { name: "rad/s".into(), base: vec![("s", -1), ("rad", 1)] }],
+            units,
             enumerations: vec![],
             default_experiment: Some(DefaultExperiment { start_time: 0.0, stop_time: 3.0 * period, step_size: period / k as f64 }),
             max_output_derivative_order: 1,
@@ -141,6 +144,7 @@ impl ContactModel {
         let nout = outputs.len();
         Ok(ContactModel {
             desc,
+            units: built.labels.units,
             roles,
             outputs,
             start,
@@ -188,8 +192,8 @@ impl ContactModel {
             .outputs
             .iter()
             .map(|q| match *q {
-                Quantity::Displacement(d) | Quantity::Velocity(d) => {
-                    let level = u8::from(matches!(q, Quantity::Velocity(_)));
+                Output::Displacement(d) | Output::Velocity(d) => {
+                    let level = u8::from(matches!(q, Output::Velocity(_)));
                     let x = &r.displacement[&key(d)];
                     if fourier {
                         Series::trig(x, fft, |p| if level == 0 { C::ONE } else { C::new(0.0, p as f64 * omega) })
@@ -199,14 +203,14 @@ impl ContactModel {
                 }
                 // fourier: the samples are σ2 X̂ with σ2 = −(pω)² at every p, so their trigonometric
                 // interpolant is the second derivative of the displacement's.
-                Quantity::Acceleration(d) => {
+                Output::Acceleration(d) => {
                     let a = &r.acceleration[&key(d)];
                     if fourier { Series::trig(a, fft, |_| C::ONE) } else { Series::Linear(a.clone()) }
                 }
-                Quantity::Force(i) => Series::Linear(r.contacts[i].force.clone()),
-                Quantity::Gap(i) => Series::Linear(r.contacts[i].gap.clone()),
-                Quantity::Residual => Series::Constant(r.lcp.residual),
-                Quantity::Pivots => Series::Constant(r.lcp.pivots as f64),
+                Output::Force(i) => Series::Linear(r.contacts[i].force.clone()),
+                Output::Gap(i) => Series::Linear(r.contacts[i].gap.clone()),
+                Output::Residual => Series::Constant(r.lcp.residual),
+                Output::Pivots => Series::Constant(r.lcp.pivots as f64),
             })
             .collect();
         Solution {
@@ -279,7 +283,9 @@ impl ContactModel {
 
     /// documentation/index.html: variables, units, conventions.
     pub fn documentation_html(&self, scene_name: &str) -> String {
-        documentation::render(&self.desc, scene_name)
+        let u = &self.units;
+        let units = format!("length {}, force {}, time {} (mass {})", u.length(), u.force(), u.time(), u.mass());
+        documentation::render(&self.desc, scene_name, &units)
     }
 }
 
@@ -463,7 +469,7 @@ fn summary(problem: &PeriodicProblem) -> String {
 pub fn package(scene_path: &Path, binary: &Path, out: &Path) -> Result<String> {
     let text = std::fs::read_to_string(scene_path).map_err(|e| Error::io(format!("{}: cannot read the scene: {e}", scene_path.display())))?;
     let model = ContactModel::from_scene_text(&text, &scene_path.display().to_string())?;
-    model.desc.variables.check().map_err(|e| e.context("internal error, the variable table is invalid"))?;
+    model.desc.check().map_err(|e| e.context("internal error, the model description is invalid"))?;
     let (xml, guid) = crate::fmi::fmi2::xml::render(&model.desc);
     let so = std::fs::read(binary).map_err(|e| Error::io(format!("{}: cannot read the FMU binary: {e}", binary.display())))?;
     if !so.starts_with(b"\x7fELF") {

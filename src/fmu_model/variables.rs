@@ -1,7 +1,13 @@
 //! The variables of the FMU, built from the scene: only the effects it calls for get a
 //! parameter, an input or an output. One table gives the accessors and the model description.
+//!
+//! Units: every Real with a dimension carries its unit in the scene's units (`[units]`, SI by
+//! default), ratios (`force_scale`, `motion_scale` and their inputs) the unit "1"; `lcp.residual`
+//! has none (a maximum over forces and clearances, of no single dimension). Every unit used is
+//! declared in `<UnitDefinitions>` with its SI base units and factor.
 use super::scheme_code;
-use crate::fmi::table::{Kind, Variability, Variable, VariableTable};
+use crate::fmi::table::{Kind, UnitDefinition, Variability, Variable, VariableTable};
+use crate::model::{Compliance, Labels, Quantity};
 use crate::periodic::{MIN_STEPS, PeriodicProblem};
 use crate::time::Scheme;
 use Variability::*;
@@ -25,7 +31,7 @@ pub(super) enum Role {
 
 /// What an output slot shows.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) enum Quantity {
+pub(super) enum Output {
     Displacement(usize),
     Velocity(usize),
     Acceleration(usize),
@@ -39,7 +45,9 @@ pub(super) enum Quantity {
 pub(super) struct Variables {
     pub table: VariableTable,
     pub roles: Vec<Role>,
-    pub outputs: Vec<Quantity>,
+    pub outputs: Vec<Output>,
+    /// The unit definitions of the units used, in order of first use.
+    pub units: Vec<UnitDefinition>,
 }
 
 impl Variables {
@@ -47,23 +55,31 @@ impl Variables {
         self.table.push(v);
         self.roles.push(r);
     }
-    fn output(&mut self, v: Variable, q: Quantity) {
+    fn output(&mut self, v: Variable, q: Output) {
         self.add(v, Role::Output(self.outputs.len()));
         self.outputs.push(q);
     }
 
-    /// The variables of `problem` (the scene's, before the FMU changes its outputs).
-    pub fn of(problem: &PeriodicProblem) -> Variables {
-        let mut b = Variables { table: VariableTable::new(), roles: Vec::new(), outputs: Vec::new() };
-        parameters(&mut b, problem);
-        inputs(&mut b, problem);
-        outputs(&mut b, problem);
+    /// The variables of `problem` (the scene's, before the FMU changes its outputs), labelled
+    /// with the scene's units and DOF names.
+    pub fn of(problem: &PeriodicProblem, labels: &Labels) -> Variables {
+        let mut b = Variables { table: VariableTable::new(), roles: Vec::new(), outputs: Vec::new(), units: Vec::new() };
+        parameters(&mut b, problem, labels);
+        inputs(&mut b, problem, labels);
+        outputs(&mut b, problem, labels);
         b
     }
-}
 
-fn real(start: Option<f64>, unit: Option<&str>) -> Kind {
-    Kind::Real { start, unit: unit.map(String::from), min: None, max: None }
+    /// A Real of quantity `q` in the scene's units (declared on first use).
+    fn real(&mut self, start: Option<f64>, q: Quantity, labels: &Labels) -> Kind {
+        let name = labels.units.name(q);
+        if !self.units.iter().any(|u| u.name == name) {
+            let (factor, exps) = labels.units.si(q);
+            let base = ["kg", "m", "s", "rad"].into_iter().zip(exps).filter(|(_, e)| *e != 0).collect();
+            self.units.push(UnitDefinition { name: name.clone(), base, factor });
+        }
+        Kind::Real { start, unit: Some(name), min: None, max: None }
+    }
 }
 
 /// The DOFs of `l` in order, each once.
@@ -88,26 +104,24 @@ fn effects(problem: &PeriodicProblem) -> (bool, usize, bool) {
     (!model.forces.is_empty(), model.contacts.len(), model.contacts.iter().any(|c| !c.motion.is_empty()))
 }
 
-fn parameters(b: &mut Variables, problem: &PeriodicProblem) {
+fn parameters(b: &mut Variables, problem: &PeriodicProblem, labels: &Labels) {
     let model = problem.model();
     let (has_forces, m, has_motion) = effects(problem);
-    b.add(
-        Variable::parameter(
-            "frequency",
-            Tunable,
-            real(Some(model.frequency), Some("rad/s")),
-            "Fundamental angular frequency of the excitation and of the obstacle motion; period T = 2*pi/frequency",
-        ),
-        Role::Frequency,
-    );
+    let kind = b.real(Some(model.frequency), Quantity::Frequency, labels);
+    let time = labels.units.time();
+    let text = format!("Fundamental angular frequency of the excitation and of the obstacle motion; period T = 2*pi/frequency [{time}]");
+    b.add(Variable::parameter("frequency", Tunable, kind, &text), Role::Frequency);
     if has_forces {
-        b.add(Variable::parameter("force_scale", Tunable, real(Some(1.0), None), "Multiplies every force amplitude of the scene"), Role::ForceScale);
+        let kind = b.real(Some(1.0), Quantity::Ratio, labels);
+        b.add(Variable::parameter("force_scale", Tunable, kind, "Multiplies every force amplitude of the scene"), Role::ForceScale);
     }
     if m > 0 {
-        b.add(Variable::parameter("gap_offset", Tunable, real(Some(0.0), None), "Added to every static clearance (length unit of the scene)"), Role::GapOffset);
+        let kind = b.real(Some(0.0), Quantity::Length, labels);
+        b.add(Variable::parameter("gap_offset", Tunable, kind, "Added to every static clearance"), Role::GapOffset);
     }
     if has_motion {
-        b.add(Variable::parameter("motion_scale", Tunable, real(Some(1.0), None), "Multiplies every obstacle-motion amplitude"), Role::MotionScale);
+        let kind = b.real(Some(1.0), Quantity::Ratio, labels);
+        b.add(Variable::parameter("motion_scale", Tunable, kind, "Multiplies every obstacle-motion amplitude"), Role::MotionScale);
     }
     let k = problem.discretization().steps;
     b.add(
@@ -120,71 +134,72 @@ fn parameters(b: &mut Variables, problem: &PeriodicProblem) {
     b.add(Variable::parameter("scheme", Fixed, scheme, &format!("Time scheme on the period: {}", codes.join(", "))), Role::Scheme);
 }
 
-fn inputs(b: &mut Variables, problem: &PeriodicProblem) {
+fn inputs(b: &mut Variables, problem: &PeriodicProblem, labels: &Labels) {
     let (has_forces, m, has_motion) = effects(problem);
-    b.add(
-        Variable::input("frequency_in", 0.0, Some("rad/s"), "Drives the frequency continuously: when > 0 it replaces the parameter frequency; 0 = not driven"),
-        Role::FrequencyIn,
-    );
+    let input = |b: &mut Variables, name: &str, start: f64, q: Quantity, text: &str, role: Role| {
+        let Kind::Real { unit, .. } = b.real(None, q, labels) else { unreachable!("a Real") };
+        b.add(Variable::input(name, start, unit.as_deref(), text), role);
+    };
+    let text = "Drives the frequency continuously: when > 0 it replaces the parameter frequency; 0 = not driven";
+    input(b, "frequency_in", 0.0, Quantity::Frequency, text, Role::FrequencyIn);
     if has_forces {
-        b.add(Variable::input("force_scale_in", 1.0, None, "Multiplies force_scale (1 = not driven)"), Role::ForceScaleIn);
+        input(b, "force_scale_in", 1.0, Quantity::Ratio, "Multiplies force_scale (1 = not driven)", Role::ForceScaleIn);
     }
     if m > 0 {
-        b.add(Variable::input("gap_offset_in", 0.0, None, "Added to gap_offset (0 = not driven)"), Role::GapOffsetIn);
+        input(b, "gap_offset_in", 0.0, Quantity::Length, "Added to gap_offset (0 = not driven)", Role::GapOffsetIn);
     }
     if has_motion {
-        b.add(Variable::input("motion_scale_in", 1.0, None, "Multiplies motion_scale (1 = not driven)"), Role::MotionScaleIn);
+        input(b, "motion_scale_in", 1.0, Quantity::Ratio, "Multiplies motion_scale (1 = not driven)", Role::MotionScaleIn);
     }
 }
 
-fn outputs(b: &mut Variables, problem: &PeriodicProblem) {
+fn outputs(b: &mut Variables, problem: &PeriodicProblem, labels: &Labels) {
     let (model, shown) = (problem.model(), &problem.outputs());
-    for d in unique(&shown.displacement) {
-        b.output(
-            Variable::output(&format!("displacement[{d}]"), Continuous, real(None, None), &format!("Displacement of DOF {d} (length unit of the scene)")),
-            Quantity::Displacement(d),
-        );
-    }
-    for d in unique(&shown.velocity) {
-        b.output(
-            Variable::output(&format!("velocity[{d}]"), Continuous, real(None, None), &format!("Velocity of DOF {d} (length unit per second)")),
-            Quantity::Velocity(d),
-        );
-    }
-    for d in unique(&shown.acceleration) {
-        b.output(
-            Variable::output(&format!("acceleration[{d}]"), Continuous, real(None, None), &format!("Acceleration of DOF {d} (length unit per second squared)")),
-            Quantity::Acceleration(d),
-        );
+    let name = |d: usize| match labels.names.get(&d) {
+        Some(n) => format!("{n} (DOF {d})"),
+        None => format!("DOF {d}"),
+    };
+    let motions = [
+        ("displacement", "Displacement", Quantity::Length, &shown.displacement, Output::Displacement as fn(usize) -> Output),
+        ("velocity", "Velocity", Quantity::Velocity, &shown.velocity, Output::Velocity),
+        ("acceleration", "Acceleration", Quantity::Acceleration, &shown.acceleration, Output::Acceleration),
+    ];
+    for (var, text, q, list, slot) in motions {
+        for d in unique(list) {
+            let kind = b.real(None, q, labels);
+            b.output(Variable::output(&format!("{var}[{d}]"), Continuous, kind, &format!("{text} of {}", name(d))), slot(d));
+        }
     }
     if shown.contacts {
+        let user_dofs = problem.output_map().map(|m| m.contact_dofs.clone()).filter(|d| d.len() == model.contacts.len());
+        let stiffness_unit = format!("{}/{}", labels.units.force(), labels.units.length());
         for (i, c) in model.contacts.iter().enumerate() {
-            b.output(
-                Variable::output(
-                    &format!("contact[{i}].force"),
-                    Continuous,
-                    real(None, None),
-                    &format!("Compressive force >= 0 of contact {i} on DOF {} (force unit)", c.dof),
+            let at = format!("contact {i} on {}", name(user_dofs.as_ref().map_or(c.dof, |d| d[i])));
+            let (force, gap) = match c.compliance {
+                Compliance::Rigid => (
+                    format!("Compressive force >= 0 of the rigid {at}; > 0 only where the clearance is 0"),
+                    format!("Clearance >= 0 of the rigid {at}: obstacle position gap(t) minus the displacement along the contact direction"),
                 ),
-                Quantity::Force(i),
-            );
-            b.output(
-                Variable::output(
-                    &format!("contact[{i}].gap"),
-                    Continuous,
-                    real(None, None),
-                    &format!("Clearance >= 0 of contact {i} on DOF {} (length unit)", c.dof),
+                Compliance::Compliant { stiffness } => (
+                    format!("Compressive force >= 0 of the compliant {at}: stiffness*penetration, stiffness {stiffness} {stiffness_unit}"),
+                    format!(
+                        "Clearance of the compliant {at}: gap(t) minus the displacement along the contact direction; negative = penetration (force = stiffness*penetration)"
+                    ),
                 ),
-                Quantity::Gap(i),
-            );
+            };
+            let kind = b.real(None, Quantity::Force, labels);
+            b.output(Variable::output(&format!("contact[{i}].force"), Continuous, kind, &force), Output::Force(i));
+            let kind = b.real(None, Quantity::Length, labels);
+            b.output(Variable::output(&format!("contact[{i}].gap"), Continuous, kind, &gap), Output::Gap(i));
         }
     }
     // Only with contacts: without them no LCP is solved (the scene's effects, nothing more).
     if !model.contacts.is_empty() {
+        b.output(Variable::output("lcp.pivots", Discrete, Kind::Integer { start: None, min: None, max: None }, "Pivots of the last LCP solve"), Output::Pivots);
+        let kind = Kind::Real { start: None, unit: None, min: None, max: None };
         b.output(
-            Variable::output("lcp.pivots", Discrete, Kind::Integer { start: None, min: None, max: None }, "Pivots of the last LCP solve"),
-            Quantity::Pivots,
+            Variable::output("lcp.residual", Discrete, kind, "Residual max|min(z, Az+q)| of the last LCP solve (forces and clearances: no unit)"),
+            Output::Residual,
         );
-        b.output(Variable::output("lcp.residual", Discrete, real(None, None), "Residual max|min(z, Az+q)| of the last LCP solve"), Quantity::Residual);
     }
 }

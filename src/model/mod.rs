@@ -6,11 +6,14 @@
 //! - its clearance is gap(t) − s·x[d] ≥ 0 and its force z ≥ 0 is compressive: it pushes DOF d
 //!   by −s·z, so row i of B is s·e_dᵀ.
 //!
-//! Units are the user's, as long as they are consistent (e.g. kg, N/m, m, s; or t, N/mm, mm, s).
+//! Units are the user's, as long as they are consistent (e.g. kg, N/m, m, s; or t, N/mm, mm, s);
+//! a scene may name them ([`Units`]), for labels only.
 mod matrix;
+pub mod units;
 mod validate;
 
 pub use matrix::Matrix;
+pub use units::{Labels, Quantity, Units};
 pub use validate::ModelError;
 
 use std::f64::consts::PI;

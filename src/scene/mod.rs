@@ -4,7 +4,7 @@
 //! The room: `spec` (the TOML schema), `structure` (dense rows, Matrix Market files or the blade
 //! generator; damping; clamping), `contacts` (forces, contacts, node names, casing motion, with
 //! `casing` the casing's formula), `reduce` (Craig–Bampton), `outputs` (outputs in the user's
-//! numbering, the [`OutputMap`](crate::periodic::OutputMap)), `settings` (discretization and solver settings) and `error`.
+//! numbering, the [`OutputMap`](crate::periodic::OutputMap)), `units` (`[units]` and DOF names), `settings` (discretization and solver settings) and `error`.
 pub mod casing;
 mod contacts;
 mod error;
@@ -13,6 +13,7 @@ mod reduce;
 mod settings;
 mod spec;
 mod structure;
+mod units;
 
 pub use casing::Casing;
 pub use error::{BuildError, SceneError};
@@ -20,7 +21,7 @@ pub use settings::{discretization, solver_settings};
 pub use spec::*;
 
 use crate::fe::{Blade, DofMap};
-use crate::model::{Model, Structure};
+use crate::model::{Labels, Model, Structure};
 use crate::periodic::PeriodicProblem;
 use crate::reduction::ReducedModel;
 use contacts::Resolver;
@@ -44,6 +45,8 @@ pub struct SceneModel {
     pub casing: Option<Casing>,
     /// The scene's DOF of each contact, in contact order.
     pub contact_dofs: Vec<usize>,
+    /// The scene's units (`[units]`, labels only) and DOF names, for the front ends.
+    pub labels: Labels,
     /// Wall times of the set-up [s].
     pub timings: BuildTimings,
 }
@@ -112,6 +115,7 @@ impl Scene {
         let (source, structure) = self.structure_source(dir)?;
         let t_structure = t0.elapsed().as_secs_f64();
         let n_user = structure.mass.nrows();
+        let labels = self.labels(&source)?;
         let (full, damping) = self.damped(structure, dir)?;
         let (full, dofs) = self.clamp(full)?;
         let resolver = Resolver { source: &source, dofs: &dofs, n_user };
@@ -143,6 +147,6 @@ impl Scene {
         let solver = solver_settings(self.solver.as_ref())?;
         let problem = outputs::problem(model, disc, outputs, map, solver)?;
         let timings = BuildTimings { structure: t_structure, reduction: t_reduction, total: t0.elapsed().as_secs_f64() };
-        Ok(SceneModel { problem, full, dofs, reduction, casing, contact_dofs, timings })
+        Ok(SceneModel { problem, full, dofs, reduction, casing, contact_dofs, labels, timings })
     }
 }

@@ -19,6 +19,18 @@ pub struct Scene {
     pub reduction: Option<ReductionSpec>,
     /// An out-of-round casing: adds obstacle motion to every contact.
     pub casing: Option<CasingSpec>,
+    /// The names of the scene's units (labels only; default m, N, s).
+    pub units: Option<UnitsSpec>,
+}
+
+/// `[units]`: the length, force and time units the scene's numbers are in (see
+/// [`crate::model::units`] for the allowed names). Mass is force·time²/length, angles radians.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct UnitsSpec {
+    pub length: Option<String>,
+    pub force: Option<String>,
+    pub time: Option<String>,
 }
 
 #[derive(Debug, Clone, Deserialize)]

@@ -15,6 +15,7 @@
 pub mod marching;
 pub mod spectrum;
 
+use crate::model::{Labels, Quantity};
 use crate::periodic::{PeriodicProblem, PeriodicSolver, WarmStart};
 use crate::response::Response;
 use rayon::prelude::*;
@@ -161,17 +162,19 @@ pub fn run(template: &PeriodicProblem, frequencies: &[f64], settings: &SweepSett
 
 /// The CSV of a sweep: the parameter, amplitude per displacement output (nonlinear, then
 /// linear), max force and contact fraction per contact, LCP size, pivots, warm start, fallback,
-/// time and status.
-pub fn to_csv(param: &str, values: &[f64], problem: &PeriodicProblem, points: &[SweepPoint]) -> String {
+/// time and status. A column with a unit names it after its key, `amplitude_1903 [mm]`, in the
+/// scene's units (`labels`); the key before " [" is stable.
+pub fn to_csv(param: &str, values: &[f64], problem: &PeriodicProblem, points: &[SweepPoint], labels: &Labels) -> String {
     let mut s = String::new();
-    let mut head = vec![param.to_string()];
+    let (hz, mm, kn) = (labels.unit(Quantity::Frequency), labels.unit(Quantity::Length), labels.unit(Quantity::Force));
+    let mut head = vec![format!("{param} {hz}")];
     if param != "frequency" {
-        head.push("frequency".into());
+        head.push(format!("frequency {hz}"));
     }
-    head.extend(problem.outputs().displacement.iter().map(|d| format!("amplitude_{d}")));
-    head.extend(problem.outputs().displacement.iter().map(|d| format!("linear_amplitude_{d}")));
+    head.extend(problem.outputs().displacement.iter().map(|d| format!("amplitude_{d} {mm}")));
+    head.extend(problem.outputs().displacement.iter().map(|d| format!("linear_amplitude_{d} {mm}")));
     let contact_dofs = contact_labels(problem);
-    head.extend(contact_dofs.iter().enumerate().map(|(i, d)| format!("max_force_c{i}_dof{d}")));
+    head.extend(contact_dofs.iter().enumerate().map(|(i, d)| format!("max_force_c{i}_dof{d} {kn}")));
     head.extend(contact_dofs.iter().enumerate().map(|(i, d)| format!("contact_fraction_c{i}_dof{d}")));
     head.extend(["lcp_size", "pivots", "warm_start_used", "cold_fallback", "time_s", "status"].map(String::from));
     s.push_str(&head.join(","));
@@ -222,18 +225,31 @@ pub fn peak(points: &[SweepPoint], amplitude: impl Fn(&SweepPoint) -> f64) -> Op
     )
 }
 
-/// PNG of the frequency-response curve of displacement output `i`: with contact and linear.
+/// The axis labels of the frequency-response curve of the scene's DOF `d` over `param`:
+/// ("excitation frequency ω [rad/s]", "amplitude of MC:y [mm] (peak-to-peak / 2)").
+pub fn frc_axes(param: &str, d: usize, labels: &Labels) -> (String, String) {
+    let hz = labels.unit(Quantity::Frequency);
+    let x = match param {
+        "speed" => format!("rotation speed Ω {hz}"),
+        _ => format!("excitation frequency ω {hz}"),
+    };
+    (x, format!("amplitude of {} {} (peak-to-peak / 2)", labels.dof(d), labels.unit(Quantity::Length)))
+}
+
+/// PNG of the frequency-response curve of displacement output `i`: with contact and linear,
+/// labelled with the DOF's name and the scene's units. `swept`: the parameter's name, its
+/// values and the points.
 #[cfg(feature = "plots")]
 pub fn plot_frc(
     path: &std::path::Path,
-    param: &str,
-    values: &[f64],
+    swept: (&str, &[f64], &[SweepPoint]),
     problem: &PeriodicProblem,
-    points: &[SweepPoint],
     i: usize,
+    labels: &Labels,
     title: &str,
 ) -> Result<(), crate::Error> {
     use crate::plot::{Chart, Scale, Series, line_chart};
+    let (param, values, points) = swept;
     let d = problem.outputs().displacement[i];
     let pts = |lin: bool| -> Vec<(f64, f64)> {
         values.iter().zip(points).filter(|(_, p)| p.error.is_none()).map(|(v, p)| (*v, if lin { p.linear_amplitude[i] } else { p.amplitude[i] })).collect()
@@ -242,11 +258,8 @@ pub fn plot_frc(
         Series { label: "with contact".into(), points: pts(false), markers: false },
         Series { label: "linear (contact-free)".into(), points: pts(true), markers: false },
     ];
-    let x_label = match param {
-        "speed" => "rotation speed Ω [rad/s]",
-        _ => "excitation frequency ω [rad/s]",
-    };
-    let y_label = format!("amplitude of DOF {d} (peak-to-peak / 2)");
-    let chart = Chart { title, x_label, y_label: &y_label, x_scale: Scale::Linear, y_scale: Scale::Linear };
+    let (x_label, y_label) = frc_axes(param, d, labels);
+    let title = format!("{title} of {}", labels.dof(d));
+    let chart = Chart { title: &title, x_label: &x_label, y_label: &y_label, x_scale: Scale::Linear, y_scale: Scale::Linear };
     line_chart(path, &chart, &series, 1000, 650).map_err(crate::Error::from)
 }

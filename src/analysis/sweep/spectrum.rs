@@ -1,5 +1,6 @@
 //! Harmonic content of a periodic response: amplitudes of the harmonics of ω of a displacement
 //! and of the contact forces, by FFT of the k samples of one period.
+use crate::model::{Labels, Quantity};
 use crate::periodic::{PeriodFft, PeriodicProblem};
 use crate::response::Response;
 
@@ -50,18 +51,29 @@ fn response_frequency(r: &Response) -> f64 {
     2.0 * std::f64::consts::PI / r.period
 }
 
-/// One CSV for several spectra: parameter, frequency, harmonic, then one column per output and
-/// per contact force.
-pub fn to_csv(param: &str, values: &[f64], spectra: &[Spectrum]) -> String {
+/// One CSV for several spectra: the parameter (and the frequency when the parameter is not the
+/// frequency), harmonic, then one column per output and per contact force, with units as in
+/// [`super::to_csv`]. Harmonic 0 is the mean.
+pub fn to_csv(param: &str, values: &[f64], spectra: &[Spectrum], labels: &Labels) -> String {
     let Some(first) = spectra.first() else { return String::new() };
-    let mut head = vec![param.to_string(), "frequency".into(), "harmonic".into()];
-    head.extend(first.displacement.iter().map(|(d, _)| format!("displacement_{d}")));
-    head.extend(first.force.iter().map(|(i, d, _)| format!("force_c{i}_dof{d}")));
+    let hz = labels.unit(Quantity::Frequency);
+    let mut head = vec![format!("{param} {hz}")];
+    if param != "frequency" {
+        head.push(format!("frequency {hz}"));
+    }
+    head.push("harmonic".into());
+    let (mm, kn) = (labels.unit(Quantity::Length), labels.unit(Quantity::Force));
+    head.extend(first.displacement.iter().map(|(d, _)| format!("displacement_{d} {mm}")));
+    head.extend(first.force.iter().map(|(i, d, _)| format!("force_c{i}_dof{d} {kn}")));
     let mut s = head.join(",") + "\n";
     for (v, sp) in values.iter().zip(spectra) {
         let nh = sp.displacement.first().map(|x| x.1.len()).or(sp.force.first().map(|x| x.2.len())).unwrap_or(0);
         for p in 0..nh {
-            let mut row = vec![v.to_string(), sp.frequency.to_string(), p.to_string()];
+            let mut row = vec![v.to_string()];
+            if param != "frequency" {
+                row.push(sp.frequency.to_string());
+            }
+            row.push(p.to_string());
             row.extend(sp.displacement.iter().map(|(_, a)| format!("{:e}", a[p])));
             row.extend(sp.force.iter().map(|(_, _, a)| format!("{:e}", a[p])));
             s.push_str(&row.join(","));
@@ -71,25 +83,29 @@ pub fn to_csv(param: &str, values: &[f64], spectra: &[Spectrum]) -> String {
     s
 }
 
-/// PNG of one spectrum: each series relative to its largest harmonic (log scale), the first
-/// displacement output and every contact force.
+/// PNG of one spectrum, absolute levels in the scene's units on log axes, harmonic 0 (the mean)
+/// included: the displacement outputs in one panel, the contact forces in the other. Levels
+/// below 1e-9 of a panel's largest are round-off and left out.
 #[cfg(feature = "plots")]
-pub fn plot(path: &std::path::Path, sp: &Spectrum, title: &str) -> Result<(), crate::Error> {
-    use crate::plot::{Chart, Scale, Series, line_chart};
-    let rel = |a: &[f64]| -> (f64, Vec<(f64, f64)>) {
-        let max = a.iter().copied().fold(0.0, f64::max);
-        let pts = a.iter().enumerate().skip(1).map(|(p, v)| (p as f64, if max > 0.0 { v / max } else { 0.0 })).collect();
-        (max, pts)
+pub fn plot(path: &std::path::Path, sp: &Spectrum, labels: &Labels, title: &str) -> Result<(), crate::Error> {
+    use crate::plot::{Chart, Legend, Scale, Series, panel_chart};
+    let series = |curves: Vec<(String, &Vec<f64>)>| -> Vec<Series> {
+        let floor = 1e-9 * curves.iter().flat_map(|(_, a)| a.iter().copied()).fold(0.0, f64::max);
+        curves
+            .into_iter()
+            .map(|(label, a)| {
+                let points: Vec<(f64, f64)> = a.iter().enumerate().filter(|(_, v)| **v > floor).map(|(p, v)| (p as f64, *v)).collect();
+                let label = if points.is_empty() { format!("{label} (zero)") } else { label };
+                Series { label, points, markers: true }
+            })
+            .collect()
     };
-    let mut series = Vec::new();
-    if let Some((d, a)) = sp.displacement.first() {
-        let (max, points) = rel(a);
-        series.push(Series { label: format!("displacement of DOF {d} (largest {max:.3e})"), points, markers: true });
-    }
-    for (i, d, a) in &sp.force {
-        let (max, points) = rel(a);
-        series.push(Series { label: format!("force of contact {i} on DOF {d} (largest {max:.3e})"), points, markers: true });
-    }
-    let chart = Chart { title, x_label: "harmonic p of ω", y_label: "amplitude / largest harmonic", x_scale: Scale::Linear, y_scale: Scale::Log };
-    line_chart(path, &chart, &series, 1000, 650).map_err(crate::Error::from)
+    let shown = series(sp.displacement.iter().map(|(d, a)| (labels.dof(*d), a)).collect());
+    let forces = series(sp.force.iter().map(|(i, d, a)| (format!("contact {i} at {}", labels.dof(*d)), a)).collect());
+    let (y1, y2) = (format!("displacement amplitude {}", labels.unit(Quantity::Length)), format!("contact force amplitude {}", labels.unit(Quantity::Force)));
+    let (t1, t2) = (format!("{title}: displacement"), format!("{title}: contact force"));
+    let x_label = "harmonic p of ω (0: mean)";
+    let c1 = Chart { title: &t1, x_label, y_label: &y1, x_scale: Scale::Linear, y_scale: Scale::Log };
+    let c2 = Chart { title: &t2, x_label, y_label: &y2, x_scale: Scale::Linear, y_scale: Scale::Log };
+    panel_chart(path, &[(&c1, &shown), (&c2, &forces)], 1, 1000, 1100, Legend::UpperRight).map_err(crate::Error::from)
 }

@@ -2,6 +2,7 @@
 //! frequency-response PNG, spectra at chosen points and the comparison with time marching.
 use crate::{Failure, ensure_writable, write_output};
 use indicatif::{ProgressBar, ProgressStyle};
+use periodic_contact::model::Quantity;
 use periodic_contact::scene::Scene;
 use periodic_contact::sweep::{self, SweepSettings, marching::MarchOptions};
 use std::path::{Path, PathBuf};
@@ -122,7 +123,8 @@ pub fn run(a: &Args) -> Result<(), Failure> {
     let wall = t.elapsed().as_secs_f64();
     bar.finish_and_clear();
 
-    write_output(&a.output, &sweep::to_csv(&a.param, &values, problem, &points))?;
+    let labels = &built.labels;
+    write_output(&a.output, &sweep::to_csv(&a.param, &values, problem, &points, labels))?;
     let failed: Vec<&sweep::SweepPoint> = points.iter().filter(|p| p.error.is_some()).collect();
     let pivots: usize = points.iter().map(|p| p.pivots).sum();
     let warm = points.iter().filter(|p| p.warm_start_used).count();
@@ -144,7 +146,15 @@ pub fn run(a: &Args) -> Result<(), Failure> {
         let nl = sweep::peak(&points, |p| p.amplitude[i]);
         let li = sweep::peak(&points, |p| p.linear_amplitude[i]);
         if let (Some(nl), Some(li)) = (nl, li) {
-            eprintln!("  DOF {d}: peak with contact {:.6e} at ω = {:.6}, linear peak {:.6e} at ω = {:.6}", nl.1, nl.0, li.1, li.0);
+            let (unit, hz) = (labels.units.length(), labels.units.name(Quantity::Frequency));
+            eprintln!(
+                "  {}: peak with contact {:.6e} {unit} at ω = {:.6} {hz}, linear peak {:.6e} {unit} at ω = {:.6} {hz}",
+                labels.dof(*d),
+                nl.1,
+                nl.0,
+                li.1,
+                li.0
+            );
         }
     }
     for p in &failed {
@@ -157,8 +167,8 @@ pub fn run(a: &Args) -> Result<(), Failure> {
         for (i, d) in problem.outputs().displacement.iter().enumerate() {
             // The first output's curve is <csv stem>.png, the others <csv stem>-dof<d>.png.
             let png = if i == 0 { sibling(&a.output, "", "png") } else { sibling(&a.output, &format!("-dof{d}"), "png") };
-            sweep::plot_frc(&png, &a.param, &values, problem, &points, i, &format!("{stem}: frequency response")).map_err(Failure::from)?;
-            eprintln!("frequency-response curve of DOF {d} → {}", png.display());
+            sweep::plot_frc(&png, (&a.param, &values, &points), problem, i, labels, &format!("{stem}: frequency response")).map_err(Failure::from)?;
+            eprintln!("frequency-response curve of {} → {}", labels.dof(*d), png.display());
         }
     }
 
@@ -176,13 +186,14 @@ pub fn run(a: &Args) -> Result<(), Failure> {
             #[cfg(feature = "plots")]
             if !a.no_plot {
                 let png = sibling(&a.output, &format!("-spectrum-{v}"), "png");
-                sweep::spectrum::plot(&png, &sp, &format!("spectrum at {} = {v} (ω = {f:.4} rad/s)", a.param)).map_err(Failure::from)?;
+                let title = format!("spectrum at {} = {v} (ω = {f:.4} {})", a.param, labels.units.name(Quantity::Frequency));
+                sweep::spectrum::plot(&png, &sp, labels, &title).map_err(Failure::from)?;
                 eprintln!("spectrum at {} = {v} → {}", a.param, png.display());
             }
             spectra.push(sp);
         }
         let csv = sibling(&a.output, "-spectrum", "csv");
-        write_output(&csv, &sweep::spectrum::to_csv(&a.param, &a.spectrum_at, &spectra))?;
+        write_output(&csv, &sweep::spectrum::to_csv(&a.param, &a.spectrum_at, &spectra, labels))?;
         eprintln!("spectra → {}", csv.display());
     }
 

@@ -61,8 +61,8 @@ impl<M: CoSimModel> Instance<M> {
             Ok(m) => m,
             Err(e) => return fail(describe(&e)),
         };
-        if let Err(m) = model.description().variables.check() {
-            return fail(format!("the variable table is invalid: {}", describe(&m)));
+        if let Err(m) = model.description().check() {
+            return fail(format!("the model description is invalid: {}", describe(&m)));
         }
         let (_, expected) = xml::render(model.description());
         match guid {

@@ -67,7 +67,10 @@ fn document(w: &mut Writer<Vec<u8>>, md: &ModelDescription, guid: &str) -> io::R
                 w.create_element("UnitDefinitions").write_inner_content(|w| {
                     for u in &md.units {
                         w.create_element("Unit").with_attribute(("name", u.name.as_str())).write_inner_content(|w| {
-                            let exps: Vec<(&str, String)> = u.base.iter().map(|(k, e)| (*k, e.to_string())).collect();
+                            let mut exps: Vec<(&str, String)> = u.base.iter().map(|(k, e)| (*k, e.to_string())).collect();
+                            if u.factor != 1.0 {
+                                exps.push(("factor", real(u.factor)));
+                            }
                             w.create_element("BaseUnit").with_attributes(exps.iter().map(|(k, v)| (*k, v.as_str()))).write_empty()?;
                             Ok(())
                         })?;
@@ -221,7 +224,10 @@ mod tests {
             description: "d".into(),
             generation_tool: "t".into(),
             variables: t,
-            units: vec![UnitDefinition { name: "rad/s".into(), base: vec![("s", -1), ("rad", 1)] }],
+            units: vec![
+                UnitDefinition { name: "rad/s".into(), base: vec![("s", -1), ("rad", 1)], factor: 1.0 },
+                UnitDefinition { name: "mm".into(), base: vec![("m", 1)], factor: 1e-3 },
+            ],
             enumerations: vec![EnumerationType { name: "Mode".into(), items: vec![("a".into(), 1, "".into()), ("b".into(), 2, "".into())] }],
             default_experiment: Some(DefaultExperiment { start_time: 0.0, stop_time: 1.0, step_size: 0.1 }),
             max_output_derivative_order: 1,
@@ -248,6 +254,7 @@ mod tests {
         assert!(doc.contains("<Enumeration declaredType=\"Mode\" start=\"2\"/>"));
         assert!(doc.contains("<Real unit=\"rad/s\" start=\"0.5\"/>"));
         assert!(doc.contains("<BaseUnit s=\"-1\" rad=\"1\"/>"));
+        assert!(doc.contains("<Unit name=\"mm\">") && doc.contains("<BaseUnit m=\"1\" factor=\"0.001\"/>"), "{doc}");
         // Outputs and InitialUnknowns: the two outputs, 1-based.
         for section in ["Outputs", "InitialUnknowns"] {
             let a = doc.find(&format!("<{section}>")).unwrap();
