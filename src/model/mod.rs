@@ -8,6 +8,7 @@
 //!
 //! Units are the user's, as long as they are consistent (e.g. kg, N/m, m, s; or t, N/mm, mm, s).
 mod matrix;
+mod spectrum;
 mod validate;
 
 pub use matrix::Matrix;
