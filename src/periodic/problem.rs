@@ -349,6 +349,7 @@ impl PeriodicProblem {
         if first.outcome == LcpOutcome::Solved {
             return Ok((first, None));
         }
+        let mut retried = None;
         if let (Some(eps), LcpOutcome::RayTermination | LcpOutcome::PivotLimit | LcpOutcome::Inaccurate) = (self.solver.regularization, first.outcome) {
             let shift = eps * a.max_abs().0;
             let mut regularized = a.clone();
@@ -359,8 +360,9 @@ impl PeriodicProblem {
             if second.outcome == LcpOutcome::Solved {
                 return Ok((second, Some(shift)));
             }
+            retried = Some(shift);
         }
-        Err(lcp_failure(first))
+        Err(lcp_failure(first, retried))
     }
 
     fn solve_lcp_once(&self, a: &BlockCirculant, q: &[f64], warm_start: Option<&[usize]>) -> LcpSolution {
