@@ -172,7 +172,8 @@ fn cli_sweep_writes_the_csv_the_curves_and_the_spectra() {
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.len(), 21);
     assert_eq!(rows[10][0].parse::<f64>().unwrap(), 2300.0);
-    assert!(rows.iter().all(|r| r.last() == Some(&"solved") && r[keys.iter().position(|c| *c == "lcp_size").unwrap()] == "1536"));
+    assert!(rows.iter().all(|r| r.last() == Some(&"solved") && r[keys.iter().position(|c| *c == "lcp_size").unwrap()] == "3072"));
+    // 3 contacts × k = 1024: the scene's k since cds refuses k = 512 (ω_max·h = 3.35 > 2).
     if cfg!(feature = "plots") {
         for f in ["s.png", "s-dof1868.png", "s-spectrum-2300.png"] {
             assert!(std::fs::metadata(dir.join(f)).map(|m| m.len() > 1000).unwrap_or(false), "{f}");

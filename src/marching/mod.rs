@@ -24,8 +24,8 @@ mod small_lcp;
 
 use crate::error::ErrorKind;
 use crate::model::{Compliance, Model, ModelError};
+use faer::Mat;
 use faer::linalg::solvers::{DenseSolveCore, Solve};
-use faer::{Mat, Side};
 pub use small_lcp::StepLcpError;
 use small_lcp::solve_small_lcp;
 use std::time::Instant;
@@ -129,25 +129,6 @@ impl MarchResult {
     }
 }
 
-/// Largest undamped angular frequency of (K, M): M = L Lᵀ, eigenvalues of L⁻¹ K L⁻ᵀ.
-pub fn omega_max_dense(mass: &Mat<f64>, stiffness: &Mat<f64>) -> Result<f64, MarchError> {
-    let llt = mass.llt(Side::Lower).map_err(|_| MarchError::setting("structure.mass", "is not positive definite"))?;
-    let l = llt.L();
-    let mut x = stiffness.clone();
-    l.solve_lower_triangular_in_place(x.as_mut());
-    let mut s = x.transpose().to_owned();
-    l.solve_lower_triangular_in_place(s.as_mut());
-    let n = s.nrows();
-    let sym = Mat::<f64>::from_fn(n, n, |i, j| 0.5 * (s[(i, j)] + s[(j, i)]));
-    let ev =
-        sym.self_adjoint_eigenvalues(Side::Lower).map_err(|e| MarchError::setting("structure.stiffness", format!("eigenvalues of M⁻¹K failed ({e:?})")))?;
-    let lmax = ev.iter().copied().fold(0.0f64, f64::max);
-    if !lmax.is_finite() {
-        return Err(MarchError::setting("structure.stiffness", format!("largest eigenvalue of M⁻¹K is {lmax}")));
-    }
-    Ok(lmax.sqrt())
-}
-
 /// Row-major n×n product y = A x.
 fn matvec_add(a: &[f64], x: &[f64], y: &mut [f64], n: usize) {
     for i in 0..n {
@@ -190,14 +171,8 @@ pub fn march(model: &Model, settings: &MarchSettings) -> Result<MarchResult, Mar
     let kk = model.structure.stiffness.to_dense();
     let cc = model.structure.damping.as_ref().map_or_else(|| Mat::<f64>::zeros(n, n), |c| c.to_dense());
 
-    // Stability limit with the compliant contacts closed.
-    let mut kc = kk.clone();
-    for c in &model.contacts {
-        if let Compliance::Compliant { stiffness } = c.compliance {
-            kc[(c.dof, c.dof)] += stiffness;
-        }
-    }
-    let omega_max = omega_max_dense(&mm, &kc)?;
+    // Stability limit with the compliant contacts closed (the model's one ω_max routine).
+    let omega_max = model.omega_max()?;
     if omega_max * h >= 2.0 {
         let n_min = (period * omega_max / 2.0).floor() as usize + 1;
         return Err(MarchError::setting(

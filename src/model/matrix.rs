@@ -9,6 +9,19 @@ pub enum Matrix {
     Sparse(SparseColMat<usize, f64>),
 }
 
+/// Equal when of the same shape with the same entries (a stored zero equals a missing one).
+impl PartialEq for Matrix {
+    fn eq(&self, other: &Matrix) -> bool {
+        if (self.nrows(), self.ncols()) != (other.nrows(), other.ncols()) {
+            return false;
+        }
+        let mut same = true;
+        self.for_each(|i, j, v| same &= other.get(i, j) == v);
+        other.for_each(|i, j, v| same &= self.get(i, j) == v);
+        same
+    }
+}
+
 impl Matrix {
     pub fn from_rows(rows: &[Vec<f64>]) -> Matrix {
         let n = rows.len();

@@ -9,6 +9,7 @@
 //! Units are the user's, as long as they are consistent (e.g. kg, N/m, m, s; or t, N/mm, mm, s);
 //! a scene may name them ([`Units`]), for labels only.
 mod matrix;
+mod spectrum;
 pub mod units;
 mod validate;
 

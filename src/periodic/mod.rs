@@ -1,6 +1,7 @@
 //! The periodic contact problem: assembly in the frequency domain, one LCP over the period,
 //! recovery of the requested responses (notes §2–3).
 mod assembly;
+pub mod limits;
 use crate::linalg::fft; // the crate's one FFT plan type, shared with lcp
 mod problem;
 mod recovery;
@@ -108,20 +109,28 @@ impl From<SolveError> for Error {
     }
 }
 
-/// The typed failure of an LCP solve, with the remedy to try.
-pub(crate) fn lcp_failure(sol: LcpSolution) -> SolveError {
+/// The typed failure of an LCP solve, with the remedies to try. Scheme limits are refused before
+/// solving, so the remedies left are the ones of notes §3. `regularized`: the ε·max|A| of a
+/// `[solver] regularization` retry that failed too (said, and not advised again).
+pub(crate) fn lcp_failure(sol: LcpSolution, regularized: Option<f64>) -> SolveError {
     let hint = match sol.outcome {
         LcpOutcome::RayTermination => {
-            "no periodic solution was reached (the LCP matrix is not a P-matrix above the first resonance); remedies: make the contact compliant (stiffness = …), use cds or galerkin with pairing = \"forward\" or bds1, add damping, or opt in to [solver] regularization = 1e-4"
+            "no periodic solution was reached (the LCP matrix is not a P-matrix above the first resonance); remedies: for rigid contact use cds or galerkin with pairing = \"forward\" or bds1 with pairing = \"same\" (notes §3), add damping, or make the contact compliant (stiffness = …)"
         }
         LcpOutcome::PivotLimit => {
-            "the pivot budget ran out (a degenerate or ill-posed LCP); remedies: make the contact compliant, use another scheme or pairing, add damping, or opt in to [solver] regularization = 1e-4"
+            "the pivot budget ran out (a degenerate or ill-posed LCP); remedies: for rigid contact use cds or galerkin with pairing = \"forward\" or bds1 with pairing = \"same\", add damping, or make the contact compliant (stiffness = …)"
         }
         LcpOutcome::NonFiniteData => "the assembled LCP holds NaN or infinite values; check the model for a singular operator",
         LcpOutcome::Inaccurate => {
-            "the final basis is too ill-conditioned to certify the residual; remedies: add damping or make the contact compliant, reduce steps, or opt in to [solver] regularization = 1e-4"
+            "the final basis is too ill-conditioned to certify the residual; remedies: add damping, make the contact compliant (stiffness = …), or reduce steps"
         }
         LcpOutcome::Solved => unreachable!(),
     };
-    SolveError::Lcp { outcome: sol.outcome, info: sol.info, hint: hint.into() }
+    let hint = match regularized {
+        Some(shift) => {
+            format!("{hint}; the [solver] regularization retry on A + {shift:.3e}·I (a compliant contact of stiffness {:.3e}) failed too", 1.0 / shift)
+        }
+        None => hint.to_string(),
+    };
+    SolveError::Lcp { outcome: sol.outcome, info: sol.info, hint }
 }

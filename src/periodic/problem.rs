@@ -1,7 +1,7 @@
 //! The checked problem: a model with its discretisation, outputs and solver settings. Fields are
 //! private: every way in (constructor, updaters) runs the checks, so a `PeriodicProblem` is
 //! always ready to solve.
-use super::{Assembly, OutputMap, OutputSelection, PeriodFft, SolveError, SolverSettings, assembly, lcp_failure, recovery, solve_circulant_lcp};
+use super::{Assembly, OutputMap, OutputSelection, PeriodFft, SolveError, SolverSettings, assembly, lcp_failure, limits, recovery, solve_circulant_lcp};
 use crate::lcp::{BlockCirculant, LcpMatrix, LcpOutcome, LcpSolution};
 use crate::model::{Contact, Model};
 use crate::response::Response;
@@ -17,6 +17,10 @@ pub struct PeriodicProblem {
     solver: SolverSettings,
     /// `Some`: `outputs` are user DOFs (labels), computed through the map.
     output_map: Option<OutputMap>,
+    /// ω_max of the model as solved ([`Model::omega_max`]), cached: it depends on neither ω nor k.
+    omega_max: f64,
+    /// `Some(note)`: k was chosen by `steps = "auto"` (the note says how).
+    auto_steps: Option<String>,
 }
 
 /// Fewest instants per period that any scheme needs.
@@ -35,14 +39,69 @@ pub const MAX_LCP_SIZE: usize = 1 << 15;
 pub const MAX_DENSE_FLOPS: f64 = 1e12;
 
 impl PeriodicProblem {
+    /// Checks everything, the scheme's stability limit included ([`crate::time::Scheme::stability_limit`]).
     pub fn new(model: Model, disc: Discretization, outputs: OutputSelection, solver: SolverSettings) -> Result<Self, SolveError> {
+        Self::build(model, disc, outputs, solver, None, None)
+    }
+
+    /// [`PeriodicProblem::new`] with k chosen by `steps = "auto"` ([`limits::auto_steps`]) at the
+    /// model's frequency; `disc.steps` is ignored. The choice is reported in [`Self::warnings`].
+    pub fn new_auto(model: Model, disc: Discretization, outputs: OutputSelection, solver: SolverSettings) -> Result<Self, SolveError> {
+        model.validate()?;
+        let omega_max = model.omega_max()?;
+        let (steps, note) = limits::auto_steps(&model, disc.scheme, omega_max, model.frequency);
+        Self::build(model, Discretization { steps, ..disc }, outputs, solver, Some(omega_max), Some(note))
+    }
+
+    fn build(
+        model: Model,
+        disc: Discretization,
+        outputs: OutputSelection,
+        solver: SolverSettings,
+        omega_max: Option<f64>,
+        auto_steps: Option<String>,
+    ) -> Result<Self, SolveError> {
         // Size limits first: they are O(1), the validation below factorises M.
         check_sizes(&model, &disc)?;
         model.validate()?;
         check_grid(&model, &disc)?;
         check_solver(&solver)?;
         check_outputs(&outputs, model.n())?;
-        Ok(PeriodicProblem { model, disc, outputs, solver, output_map: None })
+        let omega_max = match omega_max {
+            Some(w) => w,
+            None => model.omega_max()?,
+        };
+        limits::check_stability(&model, &disc, omega_max)?;
+        Ok(PeriodicProblem { model, disc, outputs, solver, output_map: None, omega_max, auto_steps })
+    }
+
+    /// ω_max [rad/s] of the model as solved (compliant contacts closed), the bound of the
+    /// schemes' stability limits.
+    pub fn omega_max(&self) -> f64 {
+        self.omega_max
+    }
+
+    /// Whether k was chosen by `steps = "auto"`.
+    pub fn steps_auto(&self) -> bool {
+        self.auto_steps.is_some()
+    }
+
+    /// With `steps = "auto"`, chooses k again for `frequency` and moves the problem there (a
+    /// sweep passes its lowest frequency, the largest h, so that every point shares one k);
+    /// unchanged otherwise or on error.
+    pub fn fit_auto_steps(&mut self, frequency: f64, why: &str) -> Result<(), SolveError> {
+        if self.auto_steps.is_none() {
+            return Ok(());
+        }
+        let old = std::mem::replace(&mut self.model.frequency, frequency);
+        let (steps, note) = limits::auto_steps(&self.model, self.disc.scheme, self.omega_max, frequency);
+        let fitted = self.model.validate_frequency().map_err(SolveError::from).and_then(|()| self.set_discretization(Discretization { steps, ..self.disc }));
+        if fitted.is_err() {
+            self.model.frequency = old;
+        }
+        fitted?;
+        self.auto_steps = Some(format!("{note}, {why}"));
+        Ok(())
     }
 
     pub fn model(&self) -> &Model {
@@ -65,7 +124,10 @@ impl PeriodicProblem {
     /// The same outputs, settings and output map over another model with the same DOFs and
     /// grid `disc` (a tuned copy: other frequency, loads or gaps), checked again.
     pub fn with_model(&self, model: Model, disc: Discretization) -> Result<Self, SolveError> {
-        let mut p = PeriodicProblem::new(model, disc, OutputSelection::default(), self.solver.clone())?;
+        // ω_max depends on M, K and the contact stiffnesses only: reuse it when they are the same.
+        let omega_max = same_spectrum(&self.model, &model).then_some(self.omega_max);
+        let auto = self.auto_steps.clone().filter(|_| disc.steps == self.disc.steps);
+        let mut p = PeriodicProblem::build(model, disc, OutputSelection::default(), self.solver.clone(), omega_max, auto)?;
         match &self.output_map {
             None => p.set_outputs(self.outputs.clone())?,
             Some(map) => p = p.with_output_map(self.outputs.clone(), map.clone())?,
@@ -76,7 +138,12 @@ impl PeriodicProblem {
     /// Changes ω [rad/s], checked as [`PeriodicProblem::new`] would; unchanged on error.
     pub fn set_frequency(&mut self, frequency: f64) -> Result<(), SolveError> {
         let old = std::mem::replace(&mut self.model.frequency, frequency);
-        let checked = self.model.validate_frequency().map_err(SolveError::from).and_then(|()| check_grid(&self.model, &self.disc));
+        let checked = self
+            .model
+            .validate_frequency()
+            .map_err(SolveError::from)
+            .and_then(|()| check_grid(&self.model, &self.disc))
+            .and_then(|()| limits::check_stability(&self.model, &self.disc, self.omega_max));
         if checked.is_err() {
             self.model.frequency = old;
         }
@@ -87,6 +154,10 @@ impl PeriodicProblem {
     pub fn set_discretization(&mut self, disc: Discretization) -> Result<(), SolveError> {
         check_sizes(&self.model, &disc)?;
         check_grid(&self.model, &disc)?;
+        limits::check_stability(&self.model, &disc, self.omega_max)?;
+        if disc.steps != self.disc.steps {
+            self.auto_steps = None;
+        }
         self.disc = disc;
         Ok(())
     }
@@ -163,7 +234,7 @@ impl PeriodicProblem {
 
     /// Warnings about choices that do not converge, said before solving.
     pub fn warnings(&self) -> Vec<String> {
-        let mut w = Vec::new();
+        let mut w: Vec<String> = self.auto_steps.iter().cloned().collect();
         for (i, c) in self.model.contacts.iter().enumerate() {
             let p = self.pairing_of(c);
             if c.is_rigid() {
@@ -278,6 +349,7 @@ impl PeriodicProblem {
         if first.outcome == LcpOutcome::Solved {
             return Ok((first, None));
         }
+        let mut retried = None;
         if let (Some(eps), LcpOutcome::RayTermination | LcpOutcome::PivotLimit | LcpOutcome::Inaccurate) = (self.solver.regularization, first.outcome) {
             let shift = eps * a.max_abs().0;
             let mut regularized = a.clone();
@@ -288,8 +360,9 @@ impl PeriodicProblem {
             if second.outcome == LcpOutcome::Solved {
                 return Ok((second, Some(shift)));
             }
+            retried = Some(shift);
         }
-        Err(lcp_failure(first))
+        Err(lcp_failure(first, retried))
     }
 
     fn solve_lcp_once(&self, a: &BlockCirculant, q: &[f64], warm_start: Option<&[usize]>) -> LcpSolution {
@@ -301,6 +374,12 @@ impl PeriodicProblem {
         let asm = assembly::assemble(&self.model, &self.disc, &[], fft, self.solver.parallel)?;
         Ok(self.lcp(&asm, fft))
     }
+}
+
+/// Whether two models have the same ω_max: the same M, K and contact compliances.
+fn same_spectrum(a: &Model, b: &Model) -> bool {
+    let springs = |m: &Model| -> Vec<(usize, crate::model::Compliance)> { m.contacts.iter().map(|c| (c.dof, c.compliance)).collect() };
+    a.structure.mass == b.structure.mass && a.structure.stiffness == b.structure.stiffness && springs(a) == springs(b)
 }
 
 /// Sizes we refuse before any work: k, the LCP size and the dense assembly's cost.

@@ -77,7 +77,7 @@ impl Resolver<'_> {
 impl Scene {
     /// The `[[force]]` entries in the full (clamped) numbering.
     pub(super) fn forces(&self, resolver: &Resolver) -> Result<Vec<Force>, BuildError> {
-        let k = self.discretization.steps;
+        let k = self.discretization.steps.count().unwrap_or(0);
         let mut forces = Vec::with_capacity(self.force.len());
         for (i, f) in self.force.iter().enumerate() {
             let field = format!("force[{i}]");

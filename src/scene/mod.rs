@@ -143,9 +143,9 @@ impl Scene {
         let t_reduction = if reduction.is_some() { t_red.elapsed().as_secs_f64() } else { 0.0 };
         model.validate()?;
 
-        let disc = discretization(&self.discretization)?;
+        let (disc, auto) = discretization(&self.discretization)?;
         let solver = solver_settings(self.solver.as_ref())?;
-        let problem = outputs::problem(model, disc, outputs, map, solver)?;
+        let problem = outputs::problem(model, (disc, auto), outputs, map, solver)?;
         let timings = BuildTimings { structure: t_structure, reduction: t_reduction, total: t0.elapsed().as_secs_f64() };
         Ok(SceneModel { problem, full, dofs, reduction, casing, contact_dofs, labels, timings })
     }

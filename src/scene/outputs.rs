@@ -49,11 +49,12 @@ pub(super) fn clamped_map(outputs: &OutputSelection, dofs: &DofMap, contact_dofs
 /// The problem with its outputs: directly in the model's numbering, or through `map`.
 pub(super) fn problem(
     model: Model,
-    disc: Discretization,
+    (disc, auto): (Discretization, bool),
     outputs: OutputSelection,
     map: Option<OutputMap>,
     solver: SolverSettings,
 ) -> Result<PeriodicProblem, BuildError> {
+    let new = if auto { PeriodicProblem::new_auto } else { PeriodicProblem::new };
     let Some(map) = map else {
         let n = model.n();
         for (name, list) in [("displacement", &outputs.displacement), ("velocity", &outputs.velocity), ("acceleration", &outputs.acceleration)] {
@@ -61,7 +62,7 @@ pub(super) fn problem(
                 return Err(BuildError::field(format!("output.{name}[{i}]"), format!("DOF {d} does not exist, the model has DOFs 0..{}", n - 1)));
             }
         }
-        return Ok(PeriodicProblem::new(model, disc, outputs, solver)?);
+        return Ok(new(model, disc, outputs, solver)?);
     };
-    Ok(PeriodicProblem::new(model, disc, OutputSelection::default(), solver).and_then(|p| p.with_output_map(outputs, map))?)
+    Ok(new(model, disc, OutputSelection::default(), solver).and_then(|p| p.with_output_map(outputs, map))?)
 }

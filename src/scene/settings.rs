@@ -1,18 +1,28 @@
 //! The `[discretization]` and `[solver]` sections: the scene owns their conversion into the
 //! engine's [`Discretization`] and [`SolverSettings`].
-use super::{BuildError, DiscretizationSpec, SolverSpec};
+use super::{BuildError, DiscretizationSpec, SolverSpec, StepsSpec};
 use crate::lcp::LcpMethod;
 use crate::periodic::SolverSettings;
 use crate::time::{Discretization, Pairing, Scheme};
 
-/// `[discretization]`: the scheme, the steps per period and the optional pairing.
-pub fn discretization(spec: &DiscretizationSpec) -> Result<Discretization, BuildError> {
+/// `[discretization]`: the scheme, the steps per period and the optional pairing; `true` when
+/// `steps = "auto"` (the steps returned are then a placeholder, chosen by
+/// `PeriodicProblem::new_auto`).
+pub fn discretization(spec: &DiscretizationSpec) -> Result<(Discretization, bool), BuildError> {
     let scheme = spec.scheme.parse::<Scheme>().map_err(|m| BuildError::field("discretization.scheme", m.to_string()))?;
     let pairing = match &spec.pairing {
         Some(p) => Some(p.parse::<Pairing>().map_err(|m| BuildError::field("discretization.pairing", m.to_string()))?),
         None => None,
     };
-    Ok(Discretization { scheme, steps: spec.steps, pairing })
+    let (steps, auto) = match &spec.steps {
+        StepsSpec::Count(k) => (*k, false),
+        StepsSpec::Named(a) if a == "auto" => (crate::periodic::MIN_STEPS, true),
+        StepsSpec::Named(a) => {
+            return Err(BuildError::field("discretization.steps", format!("is \"{a}\", must be a number of instants per period or \"auto\"")));
+        }
+        StepsSpec::Invalid(v) => return Err(BuildError::field("discretization.steps", format!("is {v}, must be a number of instants per period or \"auto\""))),
+    };
+    Ok((Discretization { scheme, steps, pairing }, auto))
 }
 
 /// `[solver]`: the defaults of [`SolverSettings`] with the given method, tolerance and

@@ -197,16 +197,37 @@ pub struct ContactSpec {
 pub struct DiscretizationSpec {
     #[serde(default = "default_scheme")]
     pub scheme: String,
+    /// Instants per period k, or `"auto"`: the smallest power of two within the scheme's
+    /// stability limit (see `periodic::limits::auto_steps`).
     #[serde(default = "default_steps")]
-    pub steps: usize,
+    pub steps: StepsSpec,
     pub pairing: Option<String>,
+}
+
+/// `steps = 512` or `steps = "auto"`; anything else is kept to be refused naming the field.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(untagged)]
+pub enum StepsSpec {
+    Count(usize),
+    Named(String),
+    Invalid(toml::Value),
+}
+
+impl StepsSpec {
+    /// The explicit count, `None` for `"auto"` (or an invalid value, refused when building).
+    pub fn count(&self) -> Option<usize> {
+        match self {
+            StepsSpec::Count(k) => Some(*k),
+            _ => None,
+        }
+    }
 }
 
 fn default_scheme() -> String {
     "cds".into()
 }
-fn default_steps() -> usize {
-    256
+fn default_steps() -> StepsSpec {
+    StepsSpec::Count(256)
 }
 
 impl Default for DiscretizationSpec {

@@ -40,6 +40,27 @@ impl Scheme {
         }
     }
 
+    /// The largest ω_max·h (h = T/k, ω_max the model's highest undamped angular frequency) for
+    /// which the scheme's recurrence is stable; `None`: no limit (A-stable, or not a time stepper).
+    ///
+    /// From the symbols of notes §2 applied to one mode m x'' + k x = 0, Ω = ω_r·h, z the one-step
+    /// shift of x_j = zʲ:
+    /// - cds: z − 2 + z⁻¹ + Ω² = 0, so z + z⁻¹ = 2 − Ω²; both roots lie on the unit circle iff
+    ///   |2 − Ω²| < 2, i.e. Ω < 2 (explicit central differences, Ω = 2 a double root −1 that
+    ///   grows linearly).
+    /// - galerkin: M(x_{j+1} − 2x_j + x_{j−1})/h² + K(x_{j+1} + 4x_j + x_{j−1})/6 (the weight
+    ///   (2 + cos θ)/3), i.e. Newmark's linear acceleration (β = 1/6): z + z⁻¹ =
+    ///   (2 − 2Ω²/3)/(1 + Ω²/6), of modulus < 2 iff Ω² < 12, i.e. Ω < 2√3 ≈ 3.464.
+    /// - bds1 (backward Euler) and bds2 (BDF2) are A-stable: no limit.
+    /// - fourier does not step in time: no limit (only its resolution: harmonics below k/2).
+    pub fn stability_limit(self) -> Option<f64> {
+        match self {
+            Scheme::Cds => Some(2.0),
+            Scheme::Galerkin => Some(2.0 * 3f64.sqrt()),
+            Scheme::Bds1 | Scheme::Bds2 | Scheme::Fourier => None,
+        }
+    }
+
     /// The pairing that converges for rigid contact (notes §3, findings).
     pub fn default_pairing(self, rigid: bool) -> Pairing {
         match self {

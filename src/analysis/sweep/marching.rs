@@ -8,8 +8,7 @@
 //! periodicity defect. Errors are measured at the k instants of the LCP against the LCP with
 //! `reference_factor`·k instants, and divided by the reference amplitude (peak-to-peak/2).
 use crate::Error;
-use crate::marching::{MarchSettings, march, omega_max_dense};
-use crate::model::Compliance;
+use crate::marching::{MarchSettings, march};
 use crate::periodic::{PeriodicProblem, PeriodicSolver};
 use crate::response::Response;
 use crate::time::Discretization;
@@ -74,14 +73,7 @@ pub const STEP_GRAIN: usize = 128;
 /// Smallest steps per period, multiple of [`STEP_GRAIN`], at `margin` × the stability limit of
 /// the model (compliant contacts closed) at frequency ω.
 pub fn stable_steps(problem: &PeriodicProblem, frequency: f64, margin: f64) -> Result<usize, Error> {
-    let s = &problem.model().structure;
-    let mut kc = s.stiffness.to_dense();
-    for c in &problem.model().contacts {
-        if let Compliance::Compliant { stiffness } = c.compliance {
-            kc[(c.dof, c.dof)] += stiffness;
-        }
-    }
-    let wmax = omega_max_dense(&s.mass.to_dense(), &kc).map_err(|e| Error::solve(format!("the stability limit of time marching: {e}")))?;
+    let wmax = problem.model().omega_max().map_err(|e| Error::solve(format!("the stability limit of time marching: {e}")))?;
     let period = 2.0 * std::f64::consts::PI / frequency;
     let n_min = (margin * period * wmax / 2.0).ceil() as usize;
     Ok(n_min.div_ceil(STEP_GRAIN).max(1) * STEP_GRAIN)

@@ -9,7 +9,8 @@
 //!
 //! Several periodic solutions can coexist (the hardening branch of a rubbing blade overhangs
 //! the resonance): a warm-started chunk follows the branch it starts on, and each chunk starts
-//! cold. For a strictly sequential continuation in the direction of the sweep, use one thread
+//! cold. With `steps = "auto"` every point shares one k, chosen at the sweep's lowest frequency
+//! (the largest h = 2π/(ω·k), where the scheme's limit bites first). For a strictly sequential continuation in the direction of the sweep, use one thread
 //! and one chunk (`--threads 1 --chunks-per-thread 1`).
 #[cfg(feature = "reference")]
 pub mod marching;
@@ -121,6 +122,12 @@ pub fn run(template: &PeriodicProblem, frequencies: &[f64], settings: &SweepSett
         return Err(crate::Error::input(format!("frequency: {f} is not a finite angular frequency > 0 [rad/s]")));
     }
     let mut template = template.clone();
+    // `steps = "auto"`: one k for every point, chosen at the lowest frequency (the largest h).
+    if let Some(lowest) = frequencies.iter().copied().reduce(f64::min) {
+        template
+            .fit_auto_steps(lowest, &format!("chosen at the lowest frequency of the sweep ({lowest} rad/s), shared by every point"))
+            .map_err(crate::Error::from)?;
+    }
     // Parallelism is over points: each solve stays on its thread.
     template.set_parallel(false);
     // One plan for every chunk: the chunks clone this session.

@@ -98,7 +98,18 @@ pub fn run(a: &Args) -> Result<(), Failure> {
     if let Some(t) = a.march_tol.iter().find(|&&t| !(t.is_finite() && t > 0.0)) {
         return Err(Failure::input(format!("--march-tol: is {t}, must be finite and > 0")));
     }
-    let problem = &built.problem;
+    let values = sweep::linspace(a.from, a.to, a.points);
+    let freqs: Vec<f64> = values.iter().map(|&v| to_frequency(v)).collect();
+    let mut problem = built.problem.clone();
+    // `steps = "auto"`: one k for the sweep, at its lowest frequency (sweep::run does the same).
+    if let Some(lowest) = freqs.iter().copied().reduce(f64::min) {
+        let why = format!("chosen at the lowest frequency of the sweep ({lowest} rad/s), shared by every point");
+        problem.fit_auto_steps(lowest, &why).map_err(|e| Failure::from(periodic_contact::Error::from(e)))?;
+    }
+    for w in problem.warnings() {
+        eprintln!("warning: {w}");
+    }
+    let problem = &problem;
     match &built.reduction {
         Some(r) => eprintln!(
             "{file}: {} DOFs reduced to {} (Craig–Bampton, {} boundary + {} modes) in {:.3} s; set-up {:.3} s",
@@ -111,8 +122,6 @@ pub fn run(a: &Args) -> Result<(), Failure> {
         ),
         None => eprintln!("{file}: {} DOFs, set-up {:.3} s", built.full.n(), built.timings.total),
     }
-    let values = sweep::linspace(a.from, a.to, a.points);
-    let freqs: Vec<f64> = values.iter().map(|&v| to_frequency(v)).collect();
     let settings = SweepSettings { warm_start: !a.cold, threads: a.threads, chunks_per_thread: a.chunks_per_thread };
     let bar = if a.quiet { ProgressBar::hidden() } else { ProgressBar::new(a.points as u64) };
     bar.set_style(
