@@ -56,16 +56,17 @@ fn marker_shape(kind: usize) -> Vec<(i32, i32)> {
     }
 }
 
-/// A linear axis's tick: "2" rather than "2.0", "0.25", "6e-5" (6 significant digits at most,
-/// powers of ten below 1e-3 and from 1e6 on).
-fn tick(v: &f64) -> String {
-    let v = *v;
-    if v == 0.0 || !v.is_finite() {
-        return if v == 0.0 { "0".into() } else { format!("{v}") };
+/// A tick of a linear axis over `lo..hi`: "2" rather than "2.0", "0.25"; 6 significant digits
+/// at most; powers of ten for the whole axis when it only reaches below 1e-2 or from 1e6 on
+/// ("6e-5"); "0" for a tick that is zero up to round-off.
+fn tick(v: f64, lo: f64, hi: f64) -> String {
+    let big = lo.abs().max(hi.abs());
+    if !v.is_finite() || v.abs() <= 1e-9 * big {
+        return if v.is_finite() { "0".into() } else { format!("{v}") };
     }
     let scale = 10f64.powi(5 - v.abs().log10().floor() as i32);
     let r = (v * scale).round() / scale;
-    if r.abs() < 1e-3 || r.abs() >= 1e6 { format!("{r:e}") } else { format!("{r}") }
+    if (1e-2..1e6).contains(&big) { format!("{r}") } else { format!("{r:e}") }
 }
 
 fn range(values: impl Iterator<Item = f64>, scale: Scale) -> (f64, f64) {
@@ -164,8 +165,10 @@ where
                 let log_fmt = |v: &f64| format!("{v:.0e}");
                 let mut mesh = ctx.configure_mesh();
                 mesh.x_desc(chart.x_label).y_desc(chart.y_label);
-                mesh.x_label_formatter(if chart.x_scale == Scale::Log { &log_fmt } else { &tick });
-                mesh.y_label_formatter(if chart.y_scale == Scale::Log { &log_fmt } else { &tick });
+                let x_tick = |v: &f64| tick(*v, xs.0, xs.1);
+                let y_tick = |v: &f64| tick(*v, ys.0, ys.1);
+                mesh.x_label_formatter(if chart.x_scale == Scale::Log { &log_fmt } else { &x_tick });
+                mesh.y_label_formatter(if chart.y_scale == Scale::Log { &log_fmt } else { &y_tick });
                 mesh.draw().map_err(|e| err(&e))?;
             }
             for (i, s) in series.iter().enumerate() {
@@ -218,11 +221,10 @@ where
 mod tests {
     #[test]
     fn ticks_are_short() {
-        let t = |v: f64| super::tick(&v);
-        assert_eq!(
-            [t(2.0), t(2000.0), t(0.25), t(0.00006000000000001), t(6e-5), t(0.0), t(-1.5), t(2.5e6)],
-            ["2", "2000", "0.25", "6e-5", "6e-5", "0", "-1.5", "2.5e6"]
-        );
+        let t = |v: f64, hi: f64| super::tick(v, -0.05 * hi, hi);
+        assert_eq!([t(2.0, 20.0), t(2000.0, 2700.0), t(0.25, 1.0), t(-1.5, 10.0), t(0.0, 1.0)], ["2", "2000", "0.25", "-1.5", "0"]);
+        // Axes in 1e-4 m: every tick a power of ten, zero up to round-off is 0.
+        assert_eq!([t(0.00006000000000001, 1e-3), t(1e-3, 1e-3), t(-2.7e-20, 1e-3), t(2.5e6, 3e6)], ["6e-5", "1e-3", "0", "2.5e6"]);
         // Eleven curves: eleven different looks.
         let looks: std::collections::HashSet<String> = (0..11).map(|i| format!("{:?}", super::style(i))).collect();
         assert_eq!(looks.len(), 11);
