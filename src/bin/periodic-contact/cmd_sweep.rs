@@ -136,6 +136,10 @@ pub fn run(a: &Args) -> Result<(), Failure> {
             eprintln!("  DOF {d}: peak with contact {:.6e} at ω = {:.6}, linear peak {:.6e} at ω = {:.6}", nl.1, nl.0, li.1, li.0);
         }
     }
+    // The solver path only where a fallback was taken (the progress bar stays clean).
+    for p in points.iter().filter(|p| p.lcp_path.contains("fallback")) {
+        eprintln!("  solver at ω = {}: {}", p.frequency, p.lcp_path);
+    }
     for p in &failed {
         eprintln!("  failed at ω = {}: {}", p.frequency, p.error.as_deref().unwrap_or(""));
     }
