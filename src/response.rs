@@ -15,6 +15,11 @@ pub struct ContactResponse {
     pub force: Vec<f64>,
     /// Clearance ≥ 0 at each instant.
     pub gap: Vec<f64>,
+    /// The gap sample each force sample is complementary to: `paired_gap[j]` is `gap[j]` for
+    /// same-instant pairing and `gap[(j + 1) mod k]` for forward pairing, so a rigid contact has
+    /// `force[j]·paired_gap[j] = 0` and `paired_gap ≥ 0` (a compliant one:
+    /// `force[j]·(paired_gap[j] + force[j]/stiffness) = 0`).
+    pub paired_gap: Vec<f64>,
 }
 
 #[derive(Clone, Debug, Default, Serialize)]
@@ -27,9 +32,28 @@ pub struct LcpSummary {
     pub residual: f64,
     /// Siconos' ‖z − max(0, z − w)‖₂/‖q‖₂.
     pub relative_error: f64,
+    /// True when the solve started from a warm start and kept it (`warm_start.outcome` is
+    /// "accepted" or "repaired").
     pub warm_start_used: bool,
+    /// What became of the warm start.
+    pub warm_start: WarmStartSummary,
+    /// The methods that ran and the fallbacks taken, one line (e.g. "auto (N = 2048 > 256: block
+    /// pivoting first): block pivoting, 9 pivots → ray termination; fallback: dense
+    /// lexicographic Lemke, 3100 pivots → solved").
+    pub path: String,
     /// The Tikhonov shift added to A's diagonal, when `[solver] regularization` was needed.
     pub regularization: Option<f64>,
+}
+
+/// What became of the warm start of a solve.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct WarmStartSummary {
+    /// "cold" (none offered), "accepted" (the guess was the answer), "repaired" (the solve
+    /// started from the guess and fixed it in `pivots` pivots) or "rejected" (the guess was
+    /// discarded and the solve ran cold).
+    pub outcome: String,
+    /// Pivots of the solve that gave the answer (for "rejected": the cold solve's).
+    pub pivots: usize,
 }
 
 #[derive(Clone, Debug, Default, Serialize)]

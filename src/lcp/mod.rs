@@ -34,5 +34,5 @@ pub use matrix::{BlockCirculant, DenseMatrix, LcpMatrix};
 pub use pivoting::{BlockPivoting, PivotingSettings};
 pub use policy::{AUTO_LEMKE_MAX, LcpMethod, LcpMethodError, solve_circulant_lcp};
 pub use reference::solve_by_enumeration;
-pub use status::{LcpInfo, LcpOutcome, LcpSolution, residuals};
+pub use status::{LcpInfo, LcpOutcome, LcpSolution, LcpStep, WarmOutcome, residuals};
 pub use structured::CirculantOperator;

@@ -72,7 +72,14 @@ impl BlockPivoting {
                 outcome,
                 z,
                 w,
-                info: LcpInfo { pivots: iterations, residual, relative_error, time_s: start.elapsed().as_secs_f64(), warm_start_used: false },
+                info: LcpInfo {
+                    pivots: iterations,
+                    residual,
+                    relative_error,
+                    time_s: start.elapsed().as_secs_f64(),
+                    warm_start_used: false,
+                    ..LcpInfo::default()
+                },
             }
         };
         let (_, finite) = a.max_abs();
@@ -168,6 +175,7 @@ impl BlockPivoting {
                         relative_error,
                         time_s: start.elapsed().as_secs_f64(),
                         warm_start_used: s.warm_start.is_some() && iteration == 1,
+                        ..LcpInfo::default()
                     },
                 };
             }

@@ -1,6 +1,6 @@
 //! The LCP policy: which method solves a block-circulant LCP, and the fallbacks (`auto`).
 //! Shared by the engine and by `periodic-contact lcp`, so it knows nothing of mechanics.
-use super::{BlockCirculant, BlockPivoting, CirculantOperator, LcpOutcome, LcpSolution, Lemke, LemkeSettings, PivotingSettings};
+use super::{BlockCirculant, BlockPivoting, CirculantOperator, LcpOutcome, LcpSolution, LcpStep, Lemke, LemkeSettings, PivotingSettings, WarmOutcome};
 
 /// Which LCP method to use.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -38,13 +38,30 @@ pub fn solve_circulant_lcp(a: &BlockCirculant, q: &[f64], method: LcpMethod, tol
     if q.is_empty() {
         return LcpSolution { outcome: LcpOutcome::Solved, z: vec![], w: vec![], info: Default::default() };
     }
+    let step = |method, sol: &LcpSolution| LcpStep { method, size: q.len(), pivots: sol.info.pivots, outcome: sol.outcome, time_s: sol.info.time_s };
     let lemke = || {
         let settings = LemkeSettings { certify_tol: tolerance, warm_start: warm_start.map(<[usize]>::to_vec), ..LemkeSettings::default() };
-        Lemke::new(settings).solve(a, q)
+        let mut sol = Lemke::new(settings).solve(a, q);
+        // Lemke accepts a guess that certifies as it is, or discards it and runs cold.
+        sol.info.warm = match (warm_start, sol.info.warm_start_used) {
+            (None, _) => WarmOutcome::NotOffered,
+            (Some(_), true) => WarmOutcome::Accepted,
+            (Some(_), false) => WarmOutcome::Rejected,
+        };
+        sol.info.path = vec![step(LcpMethod::Lemke, &sol)];
+        sol
     };
     let pivoting = || {
         let settings = PivotingSettings { certify_tol: tolerance, warm_start: warm_start.map(<[usize]>::to_vec), ..PivotingSettings::default() };
-        BlockPivoting::new(settings).solve(&CirculantOperator::new(a), q)
+        let mut sol = BlockPivoting::new(settings).solve(&CirculantOperator::new(a), q);
+        // Block pivoting always starts from the guess: one exchange (the check) means it was right.
+        sol.info.warm = match warm_start {
+            None => WarmOutcome::NotOffered,
+            Some(_) if sol.info.pivots <= 1 => WarmOutcome::Accepted,
+            Some(_) => WarmOutcome::Repaired { pivots: sol.info.pivots },
+        };
+        sol.info.path = vec![step(LcpMethod::Pivoting, &sol)];
+        sol
     };
     match method {
         LcpMethod::Lemke => lemke(),
@@ -59,6 +76,7 @@ pub fn solve_circulant_lcp(a: &BlockCirculant, q: &[f64], method: LcpMethod, tol
                 let mut sol = lemke();
                 sol.info.pivots += fast.info.pivots;
                 sol.info.time_s += fast.info.time_s;
+                sol.info.path.splice(0..0, fast.info.path);
                 sol
             }
         }

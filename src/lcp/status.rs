@@ -48,6 +48,51 @@ pub struct LcpInfo {
     pub time_s: f64,
     /// True when the warm-start guess was accepted without pivoting.
     pub warm_start_used: bool,
+    /// What became of a warm start (set by the policy, [`crate::lcp::solve_circulant_lcp`]).
+    #[serde(skip)]
+    pub warm: WarmOutcome,
+    /// The methods the policy ran, in order (empty when no policy ran).
+    #[serde(skip)]
+    pub path: Vec<LcpStep>,
+}
+
+/// What became of a warm-start guess.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum WarmOutcome {
+    /// No guess was offered.
+    #[default]
+    NotOffered,
+    /// The guess was the answer (no pivot beyond checking it).
+    Accepted,
+    /// The solve started from the guess and repaired it in `pivots` pivots.
+    Repaired { pivots: usize },
+    /// The guess was discarded and the solve ran cold.
+    Rejected,
+}
+
+impl WarmOutcome {
+    /// "cold" (none offered), "accepted", "repaired" or "rejected".
+    pub fn name(self) -> &'static str {
+        match self {
+            WarmOutcome::NotOffered => "cold",
+            WarmOutcome::Accepted => "accepted",
+            WarmOutcome::Repaired { .. } => "repaired",
+            WarmOutcome::Rejected => "rejected",
+        }
+    }
+}
+
+/// One method run by the policy, and how it ended.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LcpStep {
+    /// `Lemke` (dense lexicographic) or `Pivoting` (block pivoting with FFT products).
+    pub method: super::LcpMethod,
+    /// LCP size N.
+    pub size: usize,
+    /// Pivots (Lemke) or block exchanges plus finishing pivots (pivoting).
+    pub pivots: usize,
+    pub outcome: LcpOutcome,
+    pub time_s: f64,
 }
 
 /// The outcome with the best iterate. z and w are always finite (zeros when nothing better).

@@ -1,8 +1,8 @@
 //! Recovery (notes §3): X̂_p = X̂lin_p − (Ẑ_p⁻¹Bᵀ) ẑ_p at the output DOFs only, velocities and
 //! accelerations by the symbols σ1, σ2; contact gaps from B X̂_p = B X̂lin_p − Ĝ_p ẑ_p.
 use super::{Assembly, PeriodFft, PeriodicProblem, SolveError};
-use crate::lcp::LcpSolution;
-use crate::response::{ContactResponse, LcpSummary, Response};
+use crate::lcp::{AUTO_LEMKE_MAX, LcpMethod, LcpSolution, LcpStep, WarmOutcome};
+use crate::response::{ContactResponse, LcpSummary, Response, WarmStartSummary};
 use num_complex::Complex64 as C;
 use std::collections::BTreeMap;
 
@@ -90,6 +90,10 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
             let bx = fft.inverse(&tmp);
             let gap: Vec<f64> = time.iter().zip(&bx).map(|(&t, &b)| ca.gap_at(model.frequency, t) - b).collect();
             let force: Vec<f64> = (0..k).map(|j| sol.z[j * m + a]).collect();
+            let gap = finite(gap, "contact gap", a)?;
+            // Row j of the LCP pairs force sample j with the gap at t_{j+s} (`PeriodicProblem::lcp`).
+            let s = problem.pairing_of(ca).offset();
+            let paired_gap = (0..k).map(|j| gap[(j + s) % k]).collect();
             contacts.push(ContactResponse {
                 dof: problem.output_map().as_ref().and_then(|m| m.contact_dofs.get(a).copied()).unwrap_or(ca.dof),
                 direction: ca.direction as i32,
@@ -99,7 +103,8 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
                 },
                 pairing: problem.pairing_of(ca).name().to_string(),
                 force: finite(force, "contact force", a)?,
-                gap: finite(gap, "contact gap", a)?,
+                gap,
+                paired_gap,
             });
         }
     }
@@ -134,7 +139,9 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
             pivots: sol.info.pivots,
             residual: sol.info.residual,
             relative_error: sol.info.relative_error,
-            warm_start_used: sol.info.warm_start_used,
+            warm_start_used: matches!(sol.info.warm, WarmOutcome::Accepted | WarmOutcome::Repaired { .. }),
+            warm_start: WarmStartSummary { outcome: sol.info.warm.name().to_string(), pivots: sol.info.pivots },
+            path: render_path(problem.solver_settings().method, &sol.info.path),
             regularization: None,
         },
         warnings: problem.warnings(),
@@ -146,4 +153,24 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
 
 fn finite(v: Vec<f64>, what: &str, index: usize) -> Result<Vec<f64>, SolveError> {
     if v.iter().all(|x| x.is_finite()) { Ok(v) } else { Err(SolveError::NonFinite(format!("{what} {index}"))) }
+}
+
+/// The policy's path in one line: the method asked for (with `auto`'s size rule), then each
+/// method run with its pivots, time and outcome, fallbacks after a ';'.
+pub fn render_path(method: LcpMethod, path: &[LcpStep]) -> String {
+    let Some(first) = path.first() else { return "no LCP (no contact, or no force needed)".to_string() };
+    let n = first.size;
+    let head = match method {
+        LcpMethod::Auto if n <= AUTO_LEMKE_MAX => format!("auto (N = {n} ≤ {AUTO_LEMKE_MAX}: dense Lemke)"),
+        LcpMethod::Auto => format!("auto (N = {n} > {AUTO_LEMKE_MAX}: block pivoting first)"),
+        m => format!("{} (N = {n})", m.name()),
+    };
+    let steps: Vec<String> = path
+        .iter()
+        .map(|s| {
+            let what = if s.method == LcpMethod::Pivoting { "block pivoting" } else { "dense lexicographic Lemke" };
+            format!("{what}, {} pivots, {:.3} s → {}", s.pivots, s.time_s, s.outcome.name())
+        })
+        .collect();
+    format!("{head}: {}", steps.join("; fallback: "))
 }

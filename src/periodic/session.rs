@@ -6,7 +6,7 @@
 //! last active set when there is one; a warm start that fails is retried cold, so the warm
 //! start can only save pivots, never change whether a solution is found.
 use super::{PeriodFft, PeriodicProblem, SolveError};
-use crate::response::Response;
+use crate::response::{Response, WarmStartSummary};
 use crate::time::Discretization;
 
 /// How the last solve started.
@@ -120,7 +120,12 @@ impl PeriodicSolver {
             self.problem.solve_with(&self.fft, None).map(|r| (r, WarmStart::Cold))
         };
         match result {
-            Ok((r, start)) => {
+            Ok((mut r, start)) => {
+                if start == WarmStart::ColdFallback {
+                    // The warm-started solve failed; the answer is the cold retry's.
+                    r.lcp.warm_start = WarmStartSummary { outcome: "rejected".to_string(), pivots: r.lcp.pivots };
+                    r.lcp.warm_start_used = false;
+                }
                 self.last_start = start;
                 self.set_warm_start(&r.active_set);
                 Ok(r)

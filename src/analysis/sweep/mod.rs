@@ -67,6 +67,8 @@ pub struct SweepPoint {
     pub lcp_s: f64,
     /// The failure, if the point could not be solved.
     pub error: Option<String>,
+    /// The LCP methods that ran and the fallbacks taken (`lcp.path` of the JSON).
+    pub lcp_path: String,
     /// Active set of the solution (warm start of a neighbour).
     pub active_set: Vec<usize>,
 }
@@ -90,6 +92,7 @@ impl SweepPoint {
             assembly_s: r.timing_s.assembly,
             lcp_s: r.timing_s.lcp,
             error: None,
+            lcp_path: r.lcp.path.clone(),
             active_set: r.active_set.clone(),
         }
     }

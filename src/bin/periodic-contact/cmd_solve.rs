@@ -55,6 +55,7 @@ pub fn run(scene: &Path, output: &Path, frequency: Option<f64>, export: Option<&
     let r = solve(&problem).map_err(|f| Failure { message: format!("{}: {}", scene.display(), f.message), ..f })?;
     let json = serde_json::to_string_pretty(&r).map_err(|e| Failure::solver(e.to_string()))?;
     write_output(output, &json)?;
+    eprintln!("solver: {}", r.lcp.path);
     if output.as_os_str() != "-" {
         eprintln!(
             "solved {}: LCP size {}, {} pivots, residual {:.2e}, {:.3} s → {}",

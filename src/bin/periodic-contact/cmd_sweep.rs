@@ -166,6 +166,10 @@ pub fn run(a: &Args) -> Result<(), Failure> {
             );
         }
     }
+    // The solver path only where a fallback was taken (the progress bar stays clean).
+    for p in points.iter().filter(|p| p.lcp_path.contains("fallback")) {
+        eprintln!("  solver at ω = {}: {}", p.frequency, p.lcp_path);
+    }
     for p in &failed {
         eprintln!("  failed at ω = {}: {}", p.frequency, p.error.as_deref().unwrap_or(""));
     }

@@ -91,7 +91,14 @@ impl Lemke {
             outcome,
             z: c.z,
             w: c.w,
-            info: LcpInfo { pivots, residual: c.residual, relative_error: c.relative_error, time_s: start.elapsed().as_secs_f64(), warm_start_used: warm },
+            info: LcpInfo {
+                pivots,
+                residual: c.residual,
+                relative_error: c.relative_error,
+                time_s: start.elapsed().as_secs_f64(),
+                warm_start_used: warm,
+                ..LcpInfo::default()
+            },
         };
 
         let (amax, a_finite) = a.max_abs();

@@ -137,7 +137,12 @@ pub fn solve_from_basis(a: &dyn LcpMatrix, q: &[f64], active: &[bool], lu: Optio
     let n = a.dim();
     let done = |outcome, pivots, z: Vec<f64>, w: Vec<f64>| {
         let (residual, relative_error) = residuals(q, &z, &w);
-        LcpSolution { outcome, z, w, info: LcpInfo { pivots, residual, relative_error, time_s: start.elapsed().as_secs_f64(), warm_start_used: false } }
+        LcpSolution {
+            outcome,
+            z,
+            w,
+            info: LcpInfo { pivots, residual, relative_error, time_s: start.elapsed().as_secs_f64(), warm_start_used: false, ..LcpInfo::default() },
+        }
     };
     let Some(mut basis) = Basis::new(a, active, lu) else {
         return done(LcpOutcome::Inaccurate, 0, vec![0.0; n], q.to_vec());
@@ -274,6 +279,11 @@ fn finish(
     let (residual, relative_error) = residuals(q, &z, &w);
     let qmax = q.iter().fold(1.0f64, |m, v| m.max(v.abs()));
     let outcome = if residual <= certify_tol * qmax { LcpOutcome::Solved } else { LcpOutcome::Inaccurate };
-    let sol = LcpSolution { outcome, z, w, info: LcpInfo { pivots, residual, relative_error, time_s: start.elapsed().as_secs_f64(), warm_start_used: false } };
+    let sol = LcpSolution {
+        outcome,
+        z,
+        w,
+        info: LcpInfo { pivots, residual, relative_error, time_s: start.elapsed().as_secs_f64(), warm_start_used: false, ..LcpInfo::default() },
+    };
     finite_or_zero(sol, q)
 }
