@@ -162,8 +162,8 @@ fn unknown_keys_get_a_suggestion() {
 
 #[test]
 fn wrong_types() {
-    refused(&with("steps = 64", "steps = 2.5"), &["steps", "2.5", "expected usize"]);
-    refused(&with("steps = 64", "steps = \"64\""), &["steps", "\"64\"", "expected usize"]);
+    refused(&with("steps = 64", "steps = 2.5"), &["steps", "2.5", "number of instants per period or \"auto\""]);
+    refused(&with("steps = 64", "steps = \"64\""), &["steps", "64", "number of instants per period or \"auto\""]);
     refused(&with("steps = 64", "steps = -64"), &["steps", "-64"]);
     refused(&with("dof = 0\ndirection", "dof = -1\ndirection"), &["dof", "-1"]);
     refused(&with("direction = 1", "direction = \"up\""), &["direction", "up"]);
