@@ -3,12 +3,15 @@
  *
  *   cc examples/capi_demo.c -Iinclude -Ltarget/release -lperiodic_contact \
  *      -Wl,-rpath,$PWD/target/release -o capi_demo
- *   ./capi_demo fmu/scenes/rigid-stop.toml
+ *   ./capi_demo fmu/scenes/rigid-stop.toml [fmu/scenes/chain-3dof-two-stops.toml forward same]
  *
  * Prints one "key index value" line per number (%.17g), so a test can compare them with the
  * Rust API: the scene's displacement and velocity of DOF 0; the same scene re-solved with
  * frequency*1.05 and force scale 2 (warm-started); a 2-DOF structure given as matrices; and
- * the error message of a scene file that does not exist.
+ * the error message of a scene file that does not exist. With a second scene (with contacts)
+ * and one pairing per contact: the problem's DOF count and each contact's DOF, direction and
+ * pairing as set, each contact's force, gap and paired gap, max |force*paired_gap|, and the
+ * warm-start outcome and solver path of a cold solve and of a warm re-solve.
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -51,6 +54,63 @@ static int print_result(const char *prefix, const pc_result *r) {
     }
     for (size_t i = 0; i < pc_result_warning_count(r); i++)
         fprintf(stderr, "%s warning: %s\n", prefix, pc_result_warning(r, i));
+    return 0;
+}
+
+/* Section 5: per-contact pairing and the inspection accessors. */
+static int contacts_demo(const char *path, int npairing, char **pairing) {
+    pc_problem *p = pc_problem_from_scene_file(path);
+    if (!p) return fail("pc_problem_from_scene_file (contacts)");
+    size_t m = pc_problem_contact_count(p);
+    printf("contacts.dof_count 0 %zu\ncontacts.count 0 %zu\n", pc_problem_dof_count(p), m);
+    for (size_t i = 0; i < m && (int)i < npairing; i++)
+        if (pc_problem_set_contact_pairing(p, i, pairing[i]) != PC_OK) return fail("set_contact_pairing");
+    for (size_t i = 0; i < m; i++) {
+        size_t dof = 0;
+        int direction = 0;
+        if (pc_problem_contact(p, i, &dof, &direction) != PC_OK) return fail("pc_problem_contact");
+        printf("contacts.dof %zu %zu\ncontacts.direction %zu %d\n", i, dof, i, direction);
+        printf("contacts.pairing %zu %s\n", i, pc_problem_contact_pairing(p, i));
+    }
+    printf("contacts.bad_index 0 %d\n", pc_problem_set_contact_pairing(p, m, "same"));
+    printf("contacts.bad_name 0 %d\n", pc_problem_set_contact_pairing(p, 0, "backward"));
+    const char *label[2] = {"cold", "warm"};
+    for (int pass = 0; pass < 2; pass++) {
+        if (pass == 1 && pc_problem_set_frequency(p, 1.001 * pc_problem_frequency(p)) != PC_OK)
+            return fail("set_frequency (contacts)");
+        pc_result *r = pc_problem_solve(p);
+        if (!r) return fail("pc_problem_solve (contacts)");
+        size_t k = pc_result_steps(r), pivots = 0;
+        double *f = malloc(k * sizeof *f), *g = malloc(k * sizeof *g);
+        if (!f || !g) return 1;
+        for (size_t i = 0; pass == 0 && i < pc_result_contact_count(r); i++) {
+            char key[64];
+            printf("contacts.result_pairing %zu %s\n", i, pc_result_contact_pairing(r, i));
+            snprintf(key, sizeof key, "contacts.force%zu", i);
+            if (print_series(key, r, i, pc_result_contact_force)) return 1;
+            snprintf(key, sizeof key, "contacts.gap%zu", i);
+            if (print_series(key, r, i, pc_result_contact_gap)) return 1;
+            snprintf(key, sizeof key, "contacts.paired_gap%zu", i);
+            if (print_series(key, r, i, pc_result_contact_paired_gap)) return 1;
+            if (pc_result_contact_force(r, i, f, k) != PC_OK) return fail("force");
+            if (pc_result_contact_paired_gap(r, i, g, k) != PC_OK) return fail("paired_gap");
+            double worst = 0;
+            for (size_t j = 0; j < k; j++) {
+                double c = f[j] * g[j] < 0 ? -f[j] * g[j] : f[j] * g[j];
+                if (c > worst) worst = c;
+            }
+            printf("contacts.complementarity %zu %.17g\n", i, worst);
+        }
+        free(f);
+        free(g);
+        const char *outcome = NULL;
+        if (pc_result_warm_start(r, &outcome, &pivots) != PC_OK) return fail("warm_start");
+        printf("contacts.%s.warm_start 0 %s\ncontacts.%s.pivots 0 %zu\n", label[pass], outcome,
+               label[pass], pivots);
+        printf("contacts.%s.path 0 %s\n", label[pass], pc_result_lcp_path(r));
+        pc_result_free(r);
+    }
+    pc_problem_free(p);
     return 0;
 }
 
@@ -103,5 +163,8 @@ int main(int argc, char **argv) {
     printf("null.code 0 %d\n", pc_problem_set_frequency(NULL, 1.0));
     pc_problem_free(NULL);
     pc_result_free(NULL);
+
+    /* 5. Contacts: per-contact pairing, the problem's and the result's inspection accessors. */
+    if (argc >= 3 && contacts_demo(argv[2], argc - 3, argv + 3)) return 1;
     return 0;
 }

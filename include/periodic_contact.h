@@ -9,10 +9,27 @@
  * Conventions
  *   - Opaque handles (pc_problem, pc_result), each freed by its own function; NULL is ignored.
  *   - Functions returning int return PC_OK (0) or an error code; functions returning a handle
- *     return NULL on failure. pc_last_error() then gives the reason (per thread, like errno;
- *     valid until the next call on this thread).
- *   - No exception/panic crosses the boundary. A handle is not thread-safe; distinct handles
- *     may be used from distinct threads.
+ *     return NULL on failure. pc_last_error() then gives the reason.
+ *   - No exception/panic crosses the boundary (a caught panic is PC_ERROR_INTERNAL).
+ *
+ * Lifetimes and ownership
+ *   - A pc_problem lives until pc_problem_free; a pc_result until pc_result_free. A result does
+ *     not borrow its problem: either may be freed first. Free each handle exactly once.
+ *   - Strings from pc_result_warning, pc_result_json, pc_result_warm_start and
+ *     pc_result_lcp_path are owned by their result: valid until pc_result_free, never free them.
+ *   - pc_version and the pairing names ("same", "forward") have static storage.
+ *   - pc_last_error's string is thread-local: valid until the next failing call on the same
+ *     thread (a successful call makes it ""; copy it if you need it longer). Never free it.
+ *   - Copy functions write into caller buffers; the library keeps no caller pointer.
+ *
+ * Const-ness and thread safety
+ *   - Functions taking a const handle only read it. Distinct problems (and their results) may
+ *     be used from distinct threads at the same time.
+ *   - Const readers of one result may run concurrently, pc_result_json included (its text is
+ *     made once, on the first call, behind a once-only cell).
+ *   - A problem must not be mutated (pc_problem_set_*, pc_problem_add_*, pc_problem_solve,
+ *     pc_problem_free) while another thread reads or solves it: serialise those calls.
+ *
  *   - Units are the scene's (consistent: e.g. kg, N/m, m, s); frequencies are rad/s.
  *     Contact i with direction s on DOF d keeps s*x[d] <= gap(t); its force >= 0 is
  *     compressive, its gap >= 0 is the clearance.
@@ -39,7 +56,8 @@ typedef struct PcResult pc_result;
 
 /* Library version, static storage. */
 const char *pc_version(void);
-/* Message of the last failed call on this thread ("" after a success). */
+/* Message of the last failed call on this thread ("" after a success): thread-local, valid
+ * until the next failing call on this thread; never free it. */
 const char *pc_last_error(void);
 
 /* ---- problems ------------------------------------------------------------------------ */
@@ -70,6 +88,10 @@ int pc_problem_set_outputs(pc_problem *p, const size_t *displacement, size_t n_d
                            const size_t *acceleration, size_t n_acceleration, int contacts);
 /* "same", "forward", or NULL for the per-contact default. */
 int pc_problem_set_pairing(pc_problem *p, const char *pairing);
+/* The pairing of contact `contact` alone ("same", "forward", or NULL to drop the override);
+ * it wins over pc_problem_set_pairing. PC_ERROR_ARGUMENT for an index out of range,
+ * PC_ERROR_INPUT for another name. The scene key `pairing` of a [[contact]] does the same. */
+int pc_problem_set_contact_pairing(pc_problem *p, size_t contact, const char *pairing);
 /* 1 (default): factorise the harmonics on rayon's global thread pool; 0: on the calling thread. */
 int pc_problem_set_parallel(pc_problem *p, int parallel);
 /* Tunable values, applied at the next solve. */
@@ -78,6 +100,17 @@ int pc_problem_set_force_scale(pc_problem *p, double scale); /* times every forc
 int pc_problem_set_gap_offset(pc_problem *p, double offset); /* plus every clearance   */
 int pc_problem_set_motion_scale(pc_problem *p, double scale);/* times obstacle motion  */
 double pc_problem_frequency(const pc_problem *p);
+/* DOFs in the user's numbering: the scene's full model for a reduced or clamped scene (fixed
+ * DOFs among them cannot be output), n for pc_problem_from_matrices. 0 for NULL. */
+size_t pc_problem_dof_count(const pc_problem *p);
+/* Number of contacts (0 for NULL). */
+size_t pc_problem_contact_count(const pc_problem *p);
+/* Contact i's DOF in the user's numbering and its direction (+1/-1); outputs may be NULL.
+ * PC_ERROR_ARGUMENT for a NULL handle or i out of range. */
+int pc_problem_contact(const pc_problem *p, size_t i, size_t *dof, int *direction);
+/* The pairing contact i will be solved with: "same" or "forward" (static storage);
+ * NULL for a NULL handle or i out of range. */
+const char *pc_problem_contact_pairing(const pc_problem *p, size_t i);
 /* Solves; warm-started from this problem's previous solve. NULL on failure. */
 pc_result *pc_problem_solve(pc_problem *p);
 void pc_problem_free(pc_problem *p);
@@ -93,13 +126,28 @@ int pc_result_acceleration(const pc_result *r, size_t dof, double *out, size_t l
 size_t pc_result_contact_count(const pc_result *r);
 int pc_result_contact_force(const pc_result *r, size_t i, double *out, size_t len);
 int pc_result_contact_gap(const pc_result *r, size_t i, double *out, size_t len);
+/* The gap each force sample is complementary to: paired_gap[j] = gap[j] ("same") or
+ * gap[(j+1) mod k] ("forward"), so a rigid contact has force[j]*paired_gap[j] = 0 (compliant:
+ * force[j]*(paired_gap[j] + force[j]/stiffness) = 0). */
+int pc_result_contact_paired_gap(const pc_result *r, size_t i, double *out, size_t len);
+/* The pairing contact i was solved with ("same"/"forward", static); NULL when out of range. */
+const char *pc_result_contact_pairing(const pc_result *r, size_t i);
 /* Any output pointer may be NULL. */
 int pc_result_lcp(const pc_result *r, size_t *size, size_t *pivots, double *residual,
                   int *warm_start_used);
+/* What became of the warm start: *outcome = "cold", "accepted", "repaired" or "rejected"
+ * (owned by the result), *pivots = pivots of the solve that gave the answer. Outputs may be NULL. */
+int pc_result_warm_start(const pc_result *r, const char **outcome, size_t *pivots);
+/* The LCP methods that ran and the fallbacks taken, one line (the JSON's lcp.path); owned by
+ * the result; NULL for NULL. */
+const char *pc_result_lcp_path(const pc_result *r);
 size_t pc_result_warning_count(const pc_result *r);
+/* Warning i, owned by the result (valid until pc_result_free); NULL when out of range. */
 const char *pc_result_warning(const pc_result *r, size_t i);
-/* The result as the CLI's JSON; valid as long as the result. */
-const char *pc_result_json(pc_result *r);
+/* The result as the CLI's JSON (with each contact's paired_gap, lcp.warm_start and lcp.path).
+   The string is owned by the result: valid until pc_result_free(r), never free it yourself.
+   Made once on the first call; calls on the same const result may run concurrently. */
+const char *pc_result_json(const pc_result *r);
 void pc_result_free(pc_result *r);
 
 #ifdef __cplusplus

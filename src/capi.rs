@@ -7,14 +7,18 @@
 //! - `pc_result`: one solved periodic response; its time series are copied into caller buffers.
 //!
 //! No panic crosses the boundary: every function runs inside `catch_unwind` and reports
-//! `PC_ERROR_INTERNAL`. Handles are not thread-safe; different handles may be used from
-//! different threads.
+//! `PC_ERROR_INTERNAL`. Distinct problems may be used from distinct threads; const readers of
+//! one result may run concurrently (the JSON is cached in a `OnceLock`); a problem must not be
+//! mutated while another thread solves it. Readers of contacts, pairing, warm start and
+//! solver path: `inspect`.
 use crate::model::{Compliance, Contact, Force, Harmonic, Matrix, Model, Structure};
 use crate::periodic::Tuning;
 use crate::periodic::{OutputSelection, PeriodicProblem, PeriodicSolver, SolveError, SolverSettings};
 use crate::response::Response;
 use crate::scene::Scene;
 use crate::time::{Discretization, Pairing, Scheme};
+mod inspect;
+
 use std::cell::RefCell;
 use std::ffi::{CStr, CString, c_char, c_int};
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -113,7 +117,11 @@ pub struct PcProblem {
 pub struct PcResult {
     response: Response,
     warnings: Vec<CString>,
-    json: Option<CString>,
+    /// `lcp.warm_start.outcome` and `lcp.path`, as C strings owned by the result.
+    warm_start: CString,
+    path: CString,
+    /// The JSON, made on first request; a `OnceLock` so that const readers may run concurrently.
+    json: std::sync::OnceLock<CString>,
 }
 
 impl PcProblem {
@@ -367,7 +375,8 @@ pub unsafe extern "C" fn pc_problem_solve(p: *mut PcProblem) -> *mut PcResult {
         }
         let response = p.session.as_mut().expect("just set").solve().map_err(solver_error)?;
         let warnings = response.warnings.iter().map(|w| to_cstring(w)).collect();
-        Ok(Box::new(PcResult { response, warnings, json: None }))
+        let (warm_start, path) = (to_cstring(&response.lcp.warm_start.outcome), to_cstring(&response.lcp.path));
+        Ok(Box::new(PcResult { response, warnings, warm_start, path, json: std::sync::OnceLock::new() }))
     })
 }
 
@@ -459,17 +468,25 @@ pub unsafe extern "C" fn pc_result_contact_count(r: *const PcResult) -> usize {
     unsafe { r.as_ref() }.map_or(0, |r| r.response.contacts.len())
 }
 
+/// Copies the series `pick` of contact `i` of result `r` into `out` (len ≥ k).
+///
+/// # Safety
+/// `r` is NULL or a live result handle; `out` holds `len` writable doubles.
+unsafe fn contact_series(r: *const PcResult, i: usize, out: *mut f64, len: usize, pick: fn(&crate::response::ContactResponse) -> &[f64]) -> c_int {
+    guarded(|| {
+        let r = unsafe { result(r) }?;
+        let c = r.response.contacts.get(i).ok_or_else(|| arg(format!("contact {i} does not exist in this result")))?;
+        copy_out(pick(c), out, len)
+    })
+}
+
 /// Copies the compressive force (≥ 0) of contact `i` at the k instants.
 ///
 /// # Safety
 /// `out` holds `len` writable doubles.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn pc_result_contact_force(r: *const PcResult, i: usize, out: *mut f64, len: usize) -> c_int {
-    guarded(|| {
-        let r = unsafe { result(r) }?;
-        let c = r.response.contacts.get(i).ok_or_else(|| arg(format!("contact {i} does not exist in this result")))?;
-        copy_out(&c.force, out, len)
-    })
+    unsafe { contact_series(r, i, out, len, |c| &c.force) }
 }
 
 /// Copies the clearance (≥ 0) of contact `i` at the k instants.
@@ -478,11 +495,7 @@ pub unsafe extern "C" fn pc_result_contact_force(r: *const PcResult, i: usize, o
 /// `out` holds `len` writable doubles.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn pc_result_contact_gap(r: *const PcResult, i: usize, out: *mut f64, len: usize) -> c_int {
-    guarded(|| {
-        let r = unsafe { result(r) }?;
-        let c = r.response.contacts.get(i).ok_or_else(|| arg(format!("contact {i} does not exist in this result")))?;
-        copy_out(&c.gap, out, len)
-    })
+    unsafe { contact_series(r, i, out, len, |c| &c.gap) }
 }
 
 /// LCP diagnostics: size k·m (0 without contact), pivots, residual ‖min(z, Az+q)‖∞, and whether
@@ -535,16 +548,17 @@ pub unsafe extern "C" fn pc_result_warning(r: *const PcResult, i: usize) -> *con
 /// # Safety
 /// `r` is NULL or a live result handle.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn pc_result_json(r: *mut PcResult) -> *const c_char {
+pub unsafe extern "C" fn pc_result_json(r: *const PcResult) -> *const c_char {
     let mut out = std::ptr::null();
     guarded(|| {
         // SAFETY: NULL or a live handle.
-        let r = unsafe { r.as_mut() }.ok_or_else(|| arg("the result handle is NULL"))?;
-        if r.json.is_none() {
+        let r = unsafe { r.as_ref() }.ok_or_else(|| arg("the result handle is NULL"))?;
+        if r.json.get().is_none() {
             let text = serde_json::to_string_pretty(&r.response).map_err(|e| (PC_ERROR_INTERNAL, e.to_string()))?;
-            r.json = Some(to_cstring(&text));
+            // A concurrent reader may have set it first: both texts are equal, the first stays.
+            let _ = r.json.set(to_cstring(&text));
         }
-        out = r.json.as_ref().expect("set above").as_ptr();
+        out = r.json.get().expect("set above").as_ptr();
         Ok(())
     });
     out

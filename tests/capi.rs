@@ -3,6 +3,7 @@
 //! number it prints is checked against the Rust API for the same problem.
 use periodic_contact::periodic::Tuning;
 use periodic_contact::scene::Scene;
+use periodic_contact::time::Pairing;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -47,6 +48,20 @@ steps = 32
 displacement = [0, 1]
 velocity = [0, 1]
 "#;
+
+/// The two-stop chain (rigid stops on DOF 1, direction +1, and DOF 2, direction −1), with one
+/// pairing per contact set through `pc_problem_set_contact_pairing`. Under bds1 (the scene's cds
+/// with a rigid same-paired stop is ill-posed: pivot limit): contact 0 keeps bds1's default
+/// `same`, contact 1 is set to `forward`.
+const CHAIN: &str = "fmu/scenes/chain-3dof-two-stops.toml";
+const PAIRINGS: [Pairing; 2] = [Pairing::Same, Pairing::Forward];
+
+/// The chain scene under bds1.
+fn chain_bds1() -> String {
+    let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(CHAIN)).unwrap();
+    assert!(text.contains("scheme = \"cds\""));
+    text.replace("scheme = \"cds\"", "scheme = \"bds1\"")
+}
 
 /// target/<profile>/ of this test run, holding libperiodic_contact.so after `cargo build`
 /// (`cargo test` builds the library as an rlib only, so the cdylib comes from `cargo build`).
@@ -109,7 +124,9 @@ fn the_c_example_links_solves_and_prints_what_the_rust_api_computes() {
     assert!(cc.status.success(), "cc: {}", String::from_utf8_lossy(&cc.stderr));
     let scene = work.join("scene.toml");
     std::fs::write(&scene, SCENE).unwrap();
-    let run = Command::new(&exe).arg(&scene).output().unwrap();
+    let chain = work.join("chain-bds1.toml");
+    std::fs::write(&chain, chain_bds1()).unwrap();
+    let run = Command::new(&exe).arg(&scene).arg(&chain).args(PAIRINGS.map(|p| p.name())).output().unwrap();
     assert!(run.status.success(), "capi_demo: {}", String::from_utf8_lossy(&run.stderr));
     let out = parse(&String::from_utf8(run.stdout).unwrap());
     assert_eq!(out["version"][0], env!("CARGO_PKG_VERSION"));
@@ -141,4 +158,63 @@ fn the_c_example_links_solves_and_prints_what_the_rust_api_computes() {
     assert_eq!(out["missing.null"][0], "1");
     assert!(out["missing.message"][0].contains("/nonexistent/scene.toml"), "{:?}", out["missing.message"]);
     assert_eq!(out["null.code"][0], "1", "PC_ERROR_ARGUMENT");
+
+    // 5. Contacts: the problem's accessors give the scene's contacts, each contact is solved
+    //    with the pairing set for it alone, and force ⊥ paired_gap holds per contact.
+    let mut chain_problem = Scene::parse(&chain_bds1(), "chain").unwrap().to_problem("chain").unwrap();
+    for (i, p) in PAIRINGS.iter().enumerate() {
+        chain_problem.set_contact_pairing(i, Some(*p)).unwrap();
+    }
+    let rc = chain_problem.solve().unwrap();
+    assert_eq!(out["contacts.dof_count"][0], "3");
+    assert_eq!(out["contacts.count"][0], "2");
+    assert_eq!(out["contacts.bad_index"][0], "1", "PC_ERROR_ARGUMENT");
+    assert_eq!(out["contacts.bad_name"][0], "2", "PC_ERROR_INPUT");
+    let k = rc.steps;
+    for (i, (c, pairing)) in rc.contacts.iter().zip(PAIRINGS).enumerate() {
+        assert_eq!(out["contacts.dof"][i], c.dof.to_string());
+        assert_eq!(out["contacts.direction"][i], c.direction.to_string());
+        assert_eq!(c.dof, [1, 2][i], "the scene's DOF");
+        assert_eq!(c.direction, [1, -1][i], "the scene's direction");
+        assert_eq!(out["contacts.pairing"][i], pairing.name());
+        assert_eq!(out["contacts.result_pairing"][i], pairing.name());
+        assert_eq!(c.pairing, pairing.name(), "the JSON's pairing of contact {i}");
+        let (f, g, pg) =
+            (numbers(&out, &format!("contacts.force{i}")), numbers(&out, &format!("contacts.gap{i}")), numbers(&out, &format!("contacts.paired_gap{i}")));
+        assert_close(&f, &c.force, "force");
+        assert_close(&g, &c.gap, "gap");
+        assert_close(&pg, &c.paired_gap, "paired_gap");
+        // The paired gap is the gap `offset` instants later: 1 for forward, 0 for same.
+        let s = pairing.offset();
+        for j in 0..k {
+            assert_eq!(pg[j], g[(j + s) % k], "contact {i} ({}) paired_gap[{j}]", pairing.name());
+        }
+        let scale = f.iter().fold(0f64, |m, x| m.max(x.abs())) * g.iter().fold(0f64, |m, x| m.max(x.abs()));
+        assert!(f.iter().any(|&x| x > 0.0), "contact {i} never touches: the test would be vacuous");
+        let worst = f.iter().zip(&pg).fold(0f64, |m, (a, b)| m.max((a * b).abs()));
+        assert_eq!(numbers(&out, "contacts.complementarity")[i], worst);
+        assert!(worst <= 1e-9 * scale, "contact {i}: max |force·paired_gap| = {worst:e} > 1e-9·{scale:e}");
+        assert!(pg.iter().all(|&x| x >= -1e-9 * scale.sqrt().max(1.0)), "contact {i}: rigid paired gap < 0");
+    }
+    assert_eq!(out["contacts.cold.warm_start"][0], "cold");
+    let warm = &out["contacts.warm.warm_start"][0];
+    assert!(["accepted", "repaired", "rejected"].contains(&warm.as_str()), "{warm}");
+    assert!(!out["contacts.cold.path"][0].is_empty() && !out["contacts.warm.path"][0].is_empty());
+}
+
+#[test]
+fn a_contact_takes_its_own_pairing_from_the_scene_and_a_bad_name_is_refused() {
+    let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(CHAIN)).unwrap();
+    let with = |pairing: &str| text.replacen("gap = 0.3", &format!("gap = 0.3\npairing = \"{pairing}\""), 1);
+    let p = Scene::parse(&with("same"), "t").unwrap().to_problem("t").unwrap();
+    assert_eq!(p.contact_pairing(0), None);
+    assert_eq!(p.contact_pairing(1), Some(Pairing::Same));
+    assert_eq!([p.pairing_at(0), p.pairing_at(1)], [Pairing::Forward, Pairing::Same], "cds's default for rigid contact, then the override");
+    // The override survives a tuned copy (Tuning goes through with_model).
+    let tuned = Tuning::of(&p).apply(&p, p.discretization()).unwrap();
+    assert_eq!(tuned.contact_pairing(1), Some(Pairing::Same));
+    let err = Scene::parse(&with("backward"), "t").unwrap().to_problem("t").unwrap_err().to_string();
+    assert!(err.contains("contact[1].pairing") && err.contains("backward"), "{err}");
+    let mut p = p;
+    assert!(p.set_contact_pairing(2, Some(Pairing::Same)).is_err(), "index checked");
 }

@@ -21,6 +21,8 @@ pub struct PeriodicProblem {
     omega_max: f64,
     /// `Some(note)`: k was chosen by `steps = "auto"` (the note says how).
     auto_steps: Option<String>,
+    /// Per-contact pairing overrides (index = contact; empty: none), over `disc.pairing`.
+    contact_pairing: Vec<Option<Pairing>>,
 }
 
 /// Fewest instants per period that any scheme needs.
@@ -72,7 +74,7 @@ impl PeriodicProblem {
             None => model.omega_max()?,
         };
         limits::check_stability(&model, &disc, omega_max)?;
-        Ok(PeriodicProblem { model, disc, outputs, solver, output_map: None, omega_max, auto_steps })
+        Ok(PeriodicProblem { model, disc, outputs, solver, output_map: None, omega_max, auto_steps, contact_pairing: Vec::new() })
     }
 
     /// ω_max [rad/s] of the model as solved (compliant contacts closed), the bound of the
@@ -128,6 +130,8 @@ impl PeriodicProblem {
         let omega_max = same_spectrum(&self.model, &model).then_some(self.omega_max);
         let auto = self.auto_steps.clone().filter(|_| disc.steps == self.disc.steps);
         let mut p = PeriodicProblem::build(model, disc, OutputSelection::default(), self.solver.clone(), omega_max, auto)?;
+        // The overrides follow the contacts by index (a contact added later has none).
+        p.contact_pairing = self.contact_pairing.iter().copied().take(p.model.contacts.len()).collect();
         match &self.output_map {
             None => p.set_outputs(self.outputs.clone())?,
             Some(map) => p = p.with_output_map(self.outputs.clone(), map.clone())?,
@@ -224,11 +228,38 @@ impl PeriodicProblem {
         }
     }
 
-    /// The pairing of one contact: the scene's, or the default that converges for it.
+    /// Overrides the pairing of contact `i` (`None`: back to the global pairing or the
+    /// scheme's default); checked index, unchanged on error.
+    pub fn set_contact_pairing(&mut self, i: usize, pairing: Option<Pairing>) -> Result<(), SolveError> {
+        let m = self.model.contacts.len();
+        if i >= m {
+            return Err(SolveError::Invalid(format!("contact pairing: contact {i} does not exist ({m} contacts)")));
+        }
+        self.contact_pairing.resize(m, None);
+        self.contact_pairing[i] = pairing;
+        Ok(())
+    }
+
+    /// The override of contact `i`, if any (`None` also for an index out of range).
+    pub fn contact_pairing(&self, i: usize) -> Option<Pairing> {
+        self.contact_pairing.get(i).copied().flatten()
+    }
+
+    /// The pairing of contact `i`: its override, else the global pairing, else the scheme's
+    /// default that converges for it.
+    pub fn pairing_at(&self, i: usize) -> Pairing {
+        match (self.contact_pairing(i), self.disc.pairing, self.model.contacts.get(i)) {
+            (Some(p), _, _) | (None, Some(p), _) => p,
+            (None, None, c) => self.disc.scheme.default_pairing(c.is_some_and(Contact::is_rigid)),
+        }
+    }
+
+    /// The pairing of one contact of this problem's model ([`Self::pairing_at`]); a contact
+    /// not borrowed from [`Self::model`] gets the global pairing or the scheme's default.
     pub fn pairing_of(&self, c: &Contact) -> Pairing {
-        match self.disc.pairing {
-            Some(p) => p,
-            None => self.disc.scheme.default_pairing(c.is_rigid()),
+        match self.model.contacts.iter().position(|x| std::ptr::eq(x, c)) {
+            Some(i) => self.pairing_at(i),
+            None => self.disc.pairing.unwrap_or_else(|| self.disc.scheme.default_pairing(c.is_rigid())),
         }
     }
 

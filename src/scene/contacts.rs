@@ -3,6 +3,7 @@
 use super::{BuildError, Casing, DofSpec, Scene, Source};
 use crate::fe::DofMap;
 use crate::model::{Compliance, Contact, Force, Harmonic};
+use crate::time::Pairing;
 
 /// Turns the scene's DOF references into (scene DOF, full clamped DOF).
 pub(super) struct Resolver<'a> {
@@ -114,6 +115,18 @@ impl Scene {
             });
         }
         Ok((contacts, contact_dofs))
+    }
+
+    /// Each `[[contact]]`'s own `pairing`, if any (over `discretization.pairing`).
+    pub(super) fn contact_pairings(&self) -> Result<Vec<Option<Pairing>>, BuildError> {
+        let parse = |(i, c): (usize, &super::spec::ContactSpec)| -> Result<Option<Pairing>, BuildError> {
+            let Some(name) = &c.pairing else { return Ok(None) };
+            let p = name
+                .parse::<Pairing>()
+                .map_err(|_| BuildError::field(format!("contact[{i}].pairing"), format!("is \"{name}\", expected \"same\" or \"forward\"")))?;
+            Ok(Some(p))
+        };
+        self.contact.iter().enumerate().map(parse).collect()
     }
 
     /// The `[casing]` section, if any: checks it and adds one motion term to every contact.

@@ -123,6 +123,7 @@ impl Scene {
         // Forces and contacts in the full numbering (user DOF kept for the labels), the casing.
         let forces = self.forces(&resolver)?;
         let (mut contacts, contact_dofs) = self.contacts(&resolver)?;
+        let pairings = self.contact_pairings()?;
         let casing = self.casing_motion(&mut contacts, &source, &dofs)?;
         let outputs = self.outputs(&resolver, matches!(source, Source::Inline), &contact_dofs, &forces)?;
 
@@ -145,7 +146,10 @@ impl Scene {
 
         let (disc, auto) = discretization(&self.discretization)?;
         let solver = solver_settings(self.solver.as_ref())?;
-        let problem = outputs::problem(model, (disc, auto), outputs, map, solver)?;
+        let mut problem = outputs::problem(model, (disc, auto), outputs, map, solver)?;
+        for (i, p) in pairings.into_iter().enumerate().filter(|(_, p)| p.is_some()) {
+            problem.set_contact_pairing(i, p)?;
+        }
         let timings = BuildTimings { structure: t_structure, reduction: t_reduction, total: t0.elapsed().as_secs_f64() };
         Ok(SceneModel { problem, full, dofs, reduction, casing, contact_dofs, labels, timings })
     }

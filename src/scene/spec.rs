@@ -190,6 +190,8 @@ pub struct ContactSpec {
     pub stiffness: Option<f64>,
     #[serde(default)]
     pub motion: Vec<HarmonicSpec>,
+    /// `"same"` or `"forward"`: this contact's pairing, over `discretization.pairing`.
+    pub pairing: Option<String>,
 }
 
 #[derive(Debug, Clone, Deserialize)]
