@@ -41,8 +41,6 @@ pub struct LcpSummary {
     /// pivoting first): block pivoting, 9 pivots → ray termination; fallback: dense
     /// lexicographic Lemke, 3100 pivots → solved").
     pub path: String,
-    /// The Tikhonov shift added to A's diagonal, when `[solver] regularization` was needed.
-    pub regularization: Option<f64>,
 }
 
 /// What became of the warm start of a solve.

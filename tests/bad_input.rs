@@ -297,6 +297,18 @@ fn out_of_range_values() {
     refused(&with("tolerance = 1e-9", "tolerance = 2.0"), &["solver.tolerance", "2"]);
 }
 
+/// `[solver] regularization` was removed: any value is refused, naming the field, why and the
+/// remedy (a contact declared compliant).
+#[test]
+fn the_removed_regularization_is_refused_with_the_remedy() {
+    for v in ["1e-4", "0.01", "0", "\"yes\""] {
+        refused(
+            &with("tolerance = 1e-9", &format!("tolerance = 1e-9\nregularization = {v}")),
+            &["solver.regularization", "removed", "compliant", "stiffness = …"],
+        );
+    }
+}
+
 /// Values that pass every check but overflow the dynamic operator: refused by the solve with a
 /// clear message (it used to say "singular"), exit status 2, the file named.
 #[test]

@@ -35,11 +35,11 @@ fn check(name: &str, p: &PeriodicProblem) -> Option<Response> {
             let mut worst = 0.0f64;
             for (c, contact) in r.contacts.iter().zip(&p.model().contacts) {
                 let s = p.pairing_of(contact).offset();
-                // Compliance 1/k_c, plus the Tikhonov shift when the result records one.
+                // Compliance 1/k_c.
                 let compliance = match contact.compliance {
                     Compliance::Rigid => 0.0,
                     Compliance::Compliant { stiffness } => 1.0 / stiffness,
-                } + r.lcp.regularization.unwrap_or(0.0);
+                };
                 for j in 0..k {
                     let w = c.gap[(j + s) % k] + c.force[j] * compliance;
                     worst = worst.max(c.force[j].min(w).abs()).max((-c.force[j]).max(0.0)).max((-w).max(0.0));
@@ -198,22 +198,18 @@ fn same_instant_pairing_for_cds_and_fourier_with_rigid_contact() {
     }
 }
 
-/// Regularisation policy: a failed LCP says so and suggests remedies; the opt-in
-/// `[solver] regularization` retries on A + εI, and the result records it — never silently.
+/// `[solver] regularization` is gone: it solved A + ε·max|A|·I, a compliant contact in disguise.
+/// The case it used to rescue (rigid contact, cds, same pairing) fails with remedies that do not
+/// mention it, and the remedy it stood for, a contact declared compliant, solves that case.
 #[test]
-fn regularization_is_opt_in_and_recorded() {
+fn the_case_regularization_rescued_is_solved_by_a_compliant_contact() {
     let osc = oscillator(1.0, 1.0, 0.1);
-    let mut p = build(osc.model(vec![Oscillator::stop(0.5, Compliance::Rigid)]), Scheme::Cds, 256, Some(Pairing::Same));
-    let err = p.solve().expect_err("cds with same pairing ends without a solution");
-    let msg = err.to_string();
-    // The diagnosed remedies (forward pairing for rigid contact under cds), not the retry.
-    assert!(msg.contains("compliant") && msg.contains("pairing = \"forward\"") && !msg.contains("regularization"), "the error suggests remedies: {msg}");
-    p.set_solver_settings(SolverSettings { regularization: Some(1e-4), ..p.solver_settings().clone() }).unwrap();
-    let r = check("cds with same pairing, [solver] regularization = 1e-4", &p).expect("solved after regularisation");
-    let shift = r.lcp.regularization.expect("recorded in the result");
-    assert!(shift > 0.0);
-    assert!(r.warnings.iter().any(|w| w.contains("regularization") && w.contains("not the rigid-contact answer")), "{:?}", r.warnings);
-    // Without the opt-in the same scene still fails: nothing is regularised silently.
-    p.set_solver_settings(SolverSettings { regularization: None, ..p.solver_settings().clone() }).unwrap();
-    assert!(p.solve().is_err());
+    let p = build(osc.model(vec![Oscillator::stop(0.5, Compliance::Rigid)]), Scheme::Cds, 256, Some(Pairing::Same));
+    let msg = p.solve().expect_err("cds with same pairing ends without a solution").to_string();
+    assert!(msg.contains("compliant") && msg.contains("pairing = \"forward\"") && !msg.contains("regulari"), "the error suggests remedies: {msg}");
+    // The structure's own stiffness is 1: a contact ten times stiffer.
+    let p = build(osc.model(vec![Oscillator::stop(0.5, Compliance::Compliant { stiffness: 10.0 })]), Scheme::Cds, 256, Some(Pairing::Same));
+    let r = check("cds with same pairing (compliant, 10 × the structure's stiffness)", &p).expect("the compliant contact is solved");
+    assert_eq!(r.lcp.status, "solved");
+    assert!(r.contacts[0].force.iter().all(|f| f.is_finite()) && r.contacts[0].force.iter().any(|&f| f > 0.0), "contact force finite and active");
 }

@@ -60,13 +60,11 @@ pub struct SolverSettings {
     pub tolerance: f64,
     /// Spread the harmonics over threads (rayon). Off inside an FMU.
     pub parallel: bool,
-    /// Opt-in Tikhonov retry: ε relative to max|A| added to A's diagonal when the LCP fails.
-    pub regularization: Option<f64>,
 }
 
 impl Default for SolverSettings {
     fn default() -> Self {
-        SolverSettings { method: LcpMethod::Auto, tolerance: 1e-9, parallel: true, regularization: None }
+        SolverSettings { method: LcpMethod::Auto, tolerance: 1e-9, parallel: true }
     }
 }
 
@@ -110,9 +108,8 @@ impl From<SolveError> for Error {
 }
 
 /// The typed failure of an LCP solve, with the remedies to try. Scheme limits are refused before
-/// solving, so the remedies left are the ones of notes §3. `regularized`: the ε·max|A| of a
-/// `[solver] regularization` retry that failed too (said, and not advised again).
-pub(crate) fn lcp_failure(sol: LcpSolution, regularized: Option<f64>) -> SolveError {
+/// solving, so the remedies left are the ones of notes §3.
+pub(crate) fn lcp_failure(sol: LcpSolution) -> SolveError {
     let hint = match sol.outcome {
         LcpOutcome::RayTermination => {
             "no periodic solution was reached (the LCP matrix is not a P-matrix above the first resonance); remedies: for rigid contact use cds or galerkin with pairing = \"forward\" or bds1 with pairing = \"same\" (notes §3), add damping, or make the contact compliant (stiffness = …)"
@@ -126,11 +123,5 @@ pub(crate) fn lcp_failure(sol: LcpSolution, regularized: Option<f64>) -> SolveEr
         }
         LcpOutcome::Solved => unreachable!(),
     };
-    let hint = match regularized {
-        Some(shift) => {
-            format!("{hint}; the [solver] regularization retry on A + {shift:.3e}·I (a compliant contact of stiffness {:.3e}) failed too", 1.0 / shift)
-        }
-        None => hint.to_string(),
-    };
-    SolveError::Lcp { outcome: sol.outcome, info: sol.info, hint }
+    SolveError::Lcp { outcome: sol.outcome, info: sol.info, hint: hint.to_string() }
 }

@@ -2,7 +2,7 @@
 //! private: every way in (constructor, updaters) runs the checks, so a `PeriodicProblem` is
 //! always ready to solve.
 use super::{Assembly, OutputMap, OutputSelection, PeriodFft, SolveError, SolverSettings, assembly, lcp_failure, limits, recovery, solve_circulant_lcp};
-use crate::lcp::{BlockCirculant, LcpMatrix, LcpOutcome, LcpSolution};
+use crate::lcp::{BlockCirculant, LcpOutcome, LcpSolution};
 use crate::model::{Contact, Model};
 use crate::response::Response;
 use crate::time::{Discretization, Pairing};
@@ -296,18 +296,11 @@ impl PeriodicProblem {
         let t_assembly = t_start.elapsed().as_secs_f64();
 
         let t_lcp = Instant::now();
-        let (sol, regularization) = self.solve_lcp(&a, &q, warm_start)?;
+        let sol = self.solve_lcp(&a, &q, warm_start)?;
         let t_lcp = t_lcp.elapsed().as_secs_f64();
 
         let t_rec = Instant::now();
         let mut response = recovery::recover(self, &asm, fft, &sol)?;
-        if let Some(shift) = regularization {
-            response.lcp.regularization = Some(shift);
-            response.warnings.push(format!(
-                "the LCP of the scene ended without a solution; [solver] regularization solved A + {shift:.3e}·I instead: every contact then behaves as compliant with stiffness {:.3e}, so this is not the rigid-contact answer",
-                1.0 / shift
-            ));
-        }
         response.timing_s.assembly = t_assembly;
         response.timing_s.lcp = t_lcp;
         response.timing_s.recovery = t_rec.elapsed().as_secs_f64();
@@ -372,32 +365,10 @@ impl PeriodicProblem {
         Ok(())
     }
 
-    /// Solves the LCP by the configured method; on failure, and only when the scene opted in
-    /// with `[solver] regularization = ε`, retries once on A + ε·max|A|·I (Tikhonov). The
-    /// second value is the regularization used, if any: the caller records it in the result.
-    fn solve_lcp(&self, a: &BlockCirculant, q: &[f64], warm_start: Option<&[usize]>) -> Result<(LcpSolution, Option<f64>), SolveError> {
-        let first = self.solve_lcp_once(a, q, warm_start);
-        if first.outcome == LcpOutcome::Solved {
-            return Ok((first, None));
-        }
-        let mut retried = None;
-        if let (Some(eps), LcpOutcome::RayTermination | LcpOutcome::PivotLimit | LcpOutcome::Inaccurate) = (self.solver.regularization, first.outcome) {
-            let shift = eps * a.max_abs().0;
-            let mut regularized = a.clone();
-            regularized.add_block_diagonal(&vec![shift; a.m()]);
-            let mut second = self.solve_lcp_once(&regularized, q, None);
-            second.info.pivots += first.info.pivots;
-            second.info.time_s += first.info.time_s;
-            if second.outcome == LcpOutcome::Solved {
-                return Ok((second, Some(shift)));
-            }
-            retried = Some(shift);
-        }
-        Err(lcp_failure(first, retried))
-    }
-
-    fn solve_lcp_once(&self, a: &BlockCirculant, q: &[f64], warm_start: Option<&[usize]>) -> LcpSolution {
-        solve_circulant_lcp(a, q, self.solver.method, self.solver.tolerance, warm_start)
+    /// Solves the LCP by the configured method; a failure is typed with its remedies.
+    fn solve_lcp(&self, a: &BlockCirculant, q: &[f64], warm_start: Option<&[usize]>) -> Result<LcpSolution, SolveError> {
+        let sol = solve_circulant_lcp(a, q, self.solver.method, self.solver.tolerance, warm_start);
+        if sol.outcome == LcpOutcome::Solved { Ok(sol) } else { Err(lcp_failure(sol)) }
     }
 
     /// The LCP (A, q) of the period without solving it (for exports and studies).
@@ -479,9 +450,6 @@ fn check_solver(s: &SolverSettings) -> Result<(), SolveError> {
     let t = s.tolerance;
     if !(t.is_finite() && t > 0.0 && t < 1.0) {
         return Err(SolveError::Invalid(format!("solver.tolerance: is {t}, must be in (0, 1)")));
-    }
-    if let Some(r) = s.regularization.filter(|r| !(r.is_finite() && *r > 0.0 && *r < 1.0)) {
-        return Err(SolveError::Invalid(format!("solver.regularization: is {r}, must be in (0, 1) (relative to the largest entry of the LCP matrix)")));
     }
     Ok(())
 }

@@ -142,7 +142,6 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
             warm_start_used: matches!(sol.info.warm, WarmOutcome::Accepted | WarmOutcome::Repaired { .. }),
             warm_start: WarmStartSummary { outcome: sol.info.warm.name().to_string(), pivots: sol.info.pivots },
             path: render_path(problem.solver_settings().method, &sol.info.path),
-            regularization: None,
         },
         warnings: problem.warnings(),
         timing_s: Default::default(),

@@ -25,8 +25,8 @@ pub fn discretization(spec: &DiscretizationSpec) -> Result<(Discretization, bool
     Ok((Discretization { scheme, steps, pairing }, auto))
 }
 
-/// `[solver]`: the defaults of [`SolverSettings`] with the given method, tolerance and
-/// regularization, each checked.
+/// `[solver]`: the defaults of [`SolverSettings`] with the given method and tolerance, each
+/// checked; the removed `regularization` is refused with its remedy.
 pub fn solver_settings(spec: Option<&SolverSpec>) -> Result<SolverSettings, BuildError> {
     let mut s = SolverSettings::default();
     let Some(spec) = spec else { return Ok(s) };
@@ -40,11 +40,11 @@ pub fn solver_settings(spec: Option<&SolverSpec>) -> Result<SolverSettings, Buil
         }
         s.tolerance = t;
     }
-    if let Some(r) = spec.regularization {
-        if !(r.is_finite() && r > 0.0 && r < 1.0) {
-            return Err(BuildError::field("solver.regularization", format!("is {r}, must be in (0, 1) (relative to the largest entry of the LCP matrix)")));
-        }
-        s.regularization = Some(r);
+    if spec.regularization.is_some() {
+        return Err(BuildError::field("solver.regularization", REGULARIZATION_REMOVED.to_string()));
     }
     Ok(s)
 }
+
+/// Why `[solver] regularization` is refused, and what to write instead.
+const REGULARIZATION_REMOVED: &str = "was removed: its retry solved A + ε·max|A|·I, which is exactly the LCP of every contact made compliant with stiffness 1/(ε·max|A|), a different physical problem presented as the rigid one; remedy: delete the key and, if a compliant contact is what you mean, declare it on the contact with stiffness = … (a scale: the structure's own stiffness at the contact DOF, the diagonal entry of K there; larger is closer to rigid); for rigid contact use cds or galerkin with pairing = \"forward\" or bds1 with pairing = \"same\" (notes §3), or add damping";

@@ -259,8 +259,9 @@ pub struct SolverSpec {
     pub method: Option<String>,
     /// Certification tolerance of the LCP residual, relative to max(1, ‖q‖∞).
     pub tolerance: Option<f64>,
-    /// Opt-in Tikhonov retry when the LCP fails (relative to max|A|); recorded in the result.
-    pub regularization: Option<f64>,
+    /// Removed (it solved a compliant contact in disguise); kept only to refuse it with the
+    /// remedy, whatever its value.
+    pub regularization: Option<serde::de::IgnoredAny>,
 }
 
 /// toml's message already carries the line, column and the offending text; add the closest

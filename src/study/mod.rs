@@ -120,7 +120,7 @@ impl Case {
     /// The problem at k instants, one thread, `auto` LCP method unless told.
     pub fn problem(self, scheme: Scheme, pairing: Option<Pairing>, k: usize, method: LcpMethod) -> Result<PeriodicProblem, Error> {
         let outputs = OutputSelection { displacement: vec![0], velocity: vec![], acceleration: vec![], contacts: self.has_contact() };
-        let solver = SolverSettings { method, tolerance: 1e-9, parallel: false, regularization: None };
+        let solver = SolverSettings { method, tolerance: 1e-9, parallel: false };
         PeriodicProblem::new(self.model(), Discretization { scheme, steps: k, pairing }, outputs, solver).map_err(Error::from)
     }
 
