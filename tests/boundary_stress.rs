@@ -332,8 +332,17 @@ struct CApi {
     result_free: unsafe extern "C" fn(P),
 }
 
-const C_API_FUNCTIONS: [&str; 32] = [
+const C_API_FUNCTIONS: [&str; 41] = [
     "pc_version",
+    "pc_problem_dof_count",
+    "pc_problem_contact_count",
+    "pc_problem_contact",
+    "pc_problem_set_contact_pairing",
+    "pc_problem_contact_pairing",
+    "pc_result_contact_paired_gap",
+    "pc_result_contact_pairing",
+    "pc_result_warm_start",
+    "pc_result_lcp_path",
     "pc_last_error",
     "pc_problem_from_scene_file",
     "pc_problem_from_scene_text",
