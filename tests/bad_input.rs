@@ -340,7 +340,7 @@ fn unknown_names() {
     refused(&with("scheme = \"cds\"", "scheme = \"CDS\""), &["discretization.scheme", "CDS"]);
     refused(&with("scheme = \"cds\"", "scheme = \"cds\"\npairing = \"backward\""), &["discretization.pairing", "backward", "same or forward"]);
     refused(&with("scheme = \"cds\"", "scheme = \"cds\"\npairing = \"\""), &["discretization.pairing", "\"\""]);
-    refused(&with("method = \"auto\"", "method = \"newton\""), &["solver.method", "newton", "auto, lemke or pivoting"]);
+    refused(&with("method = \"auto\"", "method = \"newton\""), &["solver.method", "newton", "auto, lemke, pivoting or shooting"]);
 }
 
 /// Must be refused at once, not attempted.
@@ -357,11 +357,14 @@ fn huge_sizes_are_refused_at_once() {
     refused_quickly(&with("steps = 64", "steps = 1000000000"), &["discretization.steps", "1000000000", "4194304"]);
     refused_quickly(&with("steps = 64", "steps = 9223372036854775807"), &["discretization.steps", "9223372036854775807"]);
     // Within MAX_STEPS but an LCP of 4 million unknowns: it used to panic inside the allocator
-    // (a 33 TB dense block of the pivoting method).
-    refused_quickly(&with("steps = 64", "steps = 4194304"), &["discretization.steps", "4194304", "32768", "reduce steps"]);
+    // (a 33 TB dense block of the pivoting method). Shooting takes up to 2^20 unknowns.
+    refused_quickly(&with("steps = 64", "steps = 4194304"), &["discretization.steps", "4194304", "1048576", "reduce steps"]);
     let two = with("[discretization]", "[[contact]]\ndof = 0\ndirection = -1\ngap = 0.5\n\n[discretization]");
-    let two = two.replacen("steps = 64", "steps = 16400", 1);
-    refused_quickly(&two, &["discretization.steps", "16400 with 2 contact(s)", "32800 unknowns", "at most 32768"]);
+    let two = two.replacen("steps = 64", "steps = 524300", 1);
+    refused_quickly(&two, &["discretization.steps", "524300 with 2 contact(s)", "1048600 unknowns", "at most 1048576"]);
+    // Fourier collocation has no step map: the dense methods' 32768 is its limit.
+    let fourier = with("steps = 64", "steps = 40000").replacen("scheme = \"cds\"", "scheme = \"fourier\"", 1);
+    refused_quickly(&fourier, &["discretization.steps", "40000", "at most 32768", "under fourier", "reduce steps"]);
     // Without contact a fine grid is only FFTs; on a dense model it is one LU per harmonic.
     let n = 100;
     let identity =

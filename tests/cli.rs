@@ -94,7 +94,10 @@ fn bad_input_exits_2_naming_the_field_and_value() {
 /// line is printed, and a measurement that overruns `--timeout` is reported as such, not awaited.
 #[test]
 fn bench_covers_the_class_and_stops_at_its_timeout() {
-    let o = cli().args(["bench", "--case", "all", "--steps", "64", "--repeats", "1", "--draws", "1", "--timeout", "60"]).output().unwrap();
+    let o = cli()
+        .args(["bench", "--case", "rigid-stick,rigid-impact,compliant,chain", "--steps", "64", "--repeats", "1", "--draws", "1", "--timeout", "60"])
+        .output()
+        .unwrap();
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{out}\n{}", String::from_utf8_lossy(&o.stderr));
     for case in ["rigid-stick", "rigid-impact", "compliant", "chain"] {
@@ -108,6 +111,16 @@ fn bench_covers_the_class_and_stops_at_its_timeout() {
         assert!(residual <= 1e-9, "not certified: {r}");
     }
     assert_eq!(out.matches("spread of 2 members").count(), 4, "{out}");
+    // The rigid reduced blade, within cds's limit (k ≥ 813 for this model).
+    let o = cli().args(["bench", "--case", "blade", "--steps", "1024", "--repeats", "1", "--draws", "1", "--timeout", "120"]).output().unwrap();
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{out}");
+    let rows: Vec<&str> = out.lines().filter(|l| l.starts_with("| 1024 | 3072 |")).collect();
+    assert_eq!(rows.len(), 2, "{out}");
+    for r in &rows {
+        let residual: f64 = r.split('|').nth(8).unwrap().trim().parse().unwrap_or(f64::NAN);
+        assert!(residual <= 1e-9, "not certified: {r}");
+    }
     let t = std::time::Instant::now();
     let o = cli().args(["bench", "--case", "chain", "--steps", "4096", "--repeats", "1", "--method", "lemke", "--timeout", "0.5"]).output().unwrap();
     assert!(o.status.success());

@@ -1,5 +1,6 @@
-//! The fast LCP path (block pivoting with FFT products, finished by Lemke from its best basis;
-//! `solver.method = "pivoting"`, and `auto` above N = 256) against lexicographic Lemke
+//! The fast LCP paths (shooting on the step map, `auto`'s first step for the difference schemes;
+//! block pivoting with FFT products, finished by Lemke from its best basis, `solver.method =
+//! "pivoting"`, and `auto` above N = 256 without a step map) against lexicographic Lemke
 //! (`solver.method = "lemke"`): the same answer to 1e-9 on every shipped scene and on the exact
 //! reference cases, and the fallback of `auto` on a case where the fast path fails. Also the raw
 //! `.dat` entry point: block-circulant detection and the fast path from `periodic-contact lcp`.
@@ -8,6 +9,10 @@ use periodic_contact::lcp::{BlockCirculant, DenseMatrix, LcpMatrix, dat};
 use periodic_contact::model::{Compliance, Contact};
 use periodic_contact::periodic::{AUTO_LEMKE_MAX, LcpMethod, OutputSelection, PeriodFft, PeriodicProblem, SolveError, SolverSettings};
 use periodic_contact::response::Response;
+
+#[path = "common/compare.rs"]
+mod compare;
+use compare::{difference, max_abs};
 use periodic_contact::scene::Scene;
 use periodic_contact::time::{Discretization, Pairing, Scheme};
 use std::path::{Path, PathBuf};
@@ -22,26 +27,6 @@ fn with(p: &PeriodicProblem, method: LcpMethod, steps: Option<usize>) -> Periodi
         q.set_discretization(Discretization { steps: k, ..q.discretization() }).unwrap();
     }
     q
-}
-
-fn max_abs(v: &[f64]) -> f64 {
-    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
-}
-
-/// Largest difference of the contact forces (relative to max(1, max force)) and of the recovered
-/// displacements (relative to max(1, max |x|)) between two responses.
-fn difference(a: &Response, b: &Response) -> f64 {
-    let mut d = 0.0f64;
-    for (ca, cb) in a.contacts.iter().zip(&b.contacts) {
-        let scale = max_abs(&cb.force).max(1.0);
-        d = d.max(ca.force.iter().zip(&cb.force).fold(0.0f64, |m, (x, y)| m.max((x - y).abs())) / scale);
-    }
-    for (key, xb) in &b.displacement {
-        let xa = &a.displacement[key];
-        let scale = max_abs(xb).max(1.0);
-        d = d.max(xa.iter().zip(xb).fold(0.0f64, |m, (x, y)| m.max((x - y).abs())) / scale);
-    }
-    d
 }
 
 /// Solves with lemke and with `method`; both must be certified and agree to 1e-9.
@@ -173,21 +158,22 @@ fn auto_agrees_with_lemke_on_the_compliant_stop_reference() {
     }
 }
 
-/// A case where the fast path fails: the compliant stop of notes §6.2 (cds, same pairing) at
-/// k = 512 and 1024. Block pivoting does not reach a solution and its finishing Lemke run from the
-/// best basis ends on a ray; `pivoting` alone therefore fails, and `auto` falls back to full
-/// lexicographic Lemke and solves it (the same answer as `lemke`, pivots of both runs counted).
+/// A case where block pivoting fails: the compliant stop of notes §6.2 under fourier (no
+/// time-stepping map, so `auto` takes the block-circulant chain) at k = 512 and 1024. Block
+/// pivoting does not reach a solution and its finishing Lemke run from the best basis ends on a
+/// ray; `pivoting` alone therefore fails, and `auto` falls back to full lexicographic Lemke and
+/// solves it (the same answer as `lemke`, pivots of both runs counted).
 #[test]
 fn the_fallback_solves_where_the_fast_path_fails() {
     for k in [512, 1024] {
-        let p = osc_problem(&COMPLIANT, vec![Oscillator::stop(1.0, Compliance::Compliant { stiffness: 10.0 })], Scheme::Cds, k, None);
+        let p = osc_problem(&COMPLIANT, vec![Oscillator::stop(1.0, Compliance::Compliant { stiffness: 10.0 })], Scheme::Fourier, k, None);
         assert!(k > AUTO_LEMKE_MAX, "auto takes the fast path first");
         match with(&p, LcpMethod::Pivoting, None).solve() {
             Err(SolveError::Lcp { outcome, info, .. }) => eprintln!("k = {k}: pivoting alone: {} after {} pivots", outcome.name(), info.pivots),
             Err(e) => panic!("k = {k}: unexpected error {e}"),
             Ok(r) => panic!("k = {k}: the fast path was expected to fail here, it solved with {} pivots", r.lcp.pivots),
         }
-        let (auto, lemke) = check_agreement("compliant stop cds (fallback)", &p, LcpMethod::Auto);
+        let (auto, lemke) = check_agreement("compliant stop fourier (fallback)", &p, LcpMethod::Auto);
         assert!(auto.lcp.residual <= 1e-9);
         assert!(auto.lcp.pivots > lemke.lcp.pivots, "auto's pivots include the failed fast path's");
     }

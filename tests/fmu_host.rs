@@ -669,6 +669,12 @@ fn contact_series(json: &serde_json::Value, i: usize, field: &str) -> Vec<f64> {
 
 /// Steps two periods on the grid and compares every output with the CLI's JSON.
 fn compare_two_periods(fmu: &Fmu, s: &Slave, reference: &serde_json::Value, t0: f64) {
+    compare_periods(fmu, s, reference, t0, false);
+}
+
+/// As [`compare_two_periods`]; `warm`: the FMU re-solved warm-started from its last orbit while
+/// the CLI solved cold, so it may take fewer LCP steps (never more).
+fn compare_periods(fmu: &Fmu, s: &Slave, reference: &serde_json::Value, t0: f64, warm: bool) {
     let k = reference["steps"].as_u64().unwrap() as usize;
     let h = reference["period"].as_f64().unwrap() / k as f64;
     let x = series(reference, "displacement", "0");
@@ -682,10 +688,20 @@ fn compare_two_periods(fmu: &Fmu, s: &Slave, reference: &serde_json::Value, t0: 
             assert!((a - b).abs() <= 1e-9 * scale, "{}: step {i}, {name}: FMU {a} vs CLI {b}", fmu.scene.display());
         }
     }
-    assert_eq!(s.integer("lcp.pivots") as u64, reference["lcp"]["pivots"].as_u64().unwrap());
-    // serde_json's default float parser may be off by one ulp.
+    let (pivots, cold) = (s.integer("lcp.pivots") as u64, reference["lcp"]["pivots"].as_u64().unwrap());
+    if warm {
+        assert!(pivots <= cold, "warm re-solve: {pivots} LCP steps, cold CLI solve {cold}");
+    } else {
+        assert_eq!(pivots, cold);
+    }
+    // serde_json's default float parser may be off by one ulp; a warm re-solve ends on another
+    // iterate of the same orbit, so only both certified.
     let residual = reference["lcp"]["residual"].as_f64().unwrap();
-    assert!((s.real("lcp.residual") - residual).abs() <= 1e-12 * residual.abs(), "{} vs {residual}", s.real("lcp.residual"));
+    if warm {
+        assert!(s.real("lcp.residual") <= 1e-9 && residual <= 1e-9, "{} vs {residual}", s.real("lcp.residual"));
+    } else {
+        assert!((s.real("lcp.residual") - residual).abs() <= 1e-12 * residual.abs(), "{} vs {residual}", s.real("lcp.residual"));
+    }
 }
 
 #[test]
@@ -725,7 +741,7 @@ fn contact_start_values_and_a_warm_started_re_solve_match_the_cli() {
     let scene = fmu.dir.join("gap06-w102.toml");
     std::fs::write(&scene, shipped("rigid-stop.toml").replace("gap = 0.5", "gap = 0.6").replace("frequency = 1.0", "frequency = 1.02")).unwrap();
     let tuned = cli_solve(&scene);
-    compare_two_periods(fmu, &s, &tuned, 2.0 * reference["period"].as_f64().unwrap());
+    compare_periods(fmu, &s, &tuned, 2.0 * reference["period"].as_f64().unwrap(), true);
     let line = s.log.find("re-solved").expect("a logEvents line about the re-solve");
     assert_eq!(line.status, OK);
 }

@@ -90,16 +90,21 @@ fn a_warm_start_reports_what_became_of_it() {
     assert!(dx <= 1e-9 * max_abs(c.displacement["0"].iter().copied()).max(1.0));
 }
 
-/// Small LCPs go to dense Lemke directly; on the compliant stop at k = 512 the fast path fails
-/// (tests/fast_solver.rs) and the path shows both steps.
+/// A scheme with a time-stepping map is solved by shooting first, whatever N; fourier has none,
+/// so `auto` goes to dense Lemke up to N = 256 and to block pivoting above, which fails on the
+/// compliant stop (tests/fast_solver.rs) and falls back to Lemke: the path shows both steps.
 #[test]
 fn the_solver_path_names_the_methods_and_the_fallback() {
     let text = RIGID.replace("steps = 256", "steps = 64");
     let r = problem(&text, "rigid-stop k=64").solve().unwrap();
-    assert!(r.lcp.path.starts_with("auto (N = 64 ≤ 256: dense Lemke): dense lexicographic Lemke"), "{}", r.lcp.path);
+    assert!(r.lcp.path.starts_with("auto (N = 64, a time-stepping map: shooting first): shooting"), "{}", r.lcp.path);
     assert!(!r.lcp.path.contains("fallback"));
 
-    let r = problem(COMPLIANT, "compliant-stop k=512").solve().unwrap();
+    let fourier = |steps: &str| COMPLIANT.replace("scheme = \"cds\"", "scheme = \"fourier\"").replace("steps = 512", steps);
+    let r = problem(&fourier("steps = 64"), "compliant-stop fourier k=64").solve().unwrap();
+    assert!(r.lcp.path.starts_with("auto (N = 64 ≤ 256: dense Lemke): dense lexicographic Lemke"), "{}", r.lcp.path);
+
+    let r = problem(&fourier("steps = 512"), "compliant-stop fourier k=512").solve().unwrap();
     let path = &r.lcp.path;
     eprintln!("{path}");
     assert!(path.starts_with("auto (N = 512 > 256: block pivoting first): block pivoting"), "{path}");

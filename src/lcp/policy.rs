@@ -1,6 +1,9 @@
 //! The LCP policy: which method solves a block-circulant LCP, and the fallbacks (`auto`).
 //! Shared by the engine and by `periodic-contact lcp`, so it knows nothing of mechanics.
+use super::status::{evaluate, recheck_exactly};
+use super::structured::{ShootingOutcome, ShootingSettings, StepMapLcp, solve_shooting};
 use super::{BlockCirculant, BlockPivoting, CirculantOperator, LcpOutcome, LcpSolution, LcpStep, Lemke, LemkeSettings, PivotingSettings, WarmOutcome};
+use std::time::Instant;
 
 /// Which LCP method to use.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -9,19 +12,23 @@ pub enum LcpMethod {
     Auto,
     /// Lexicographic Lemke.
     Lemke,
-    /// Block principal pivoting on the active set, FFT products (the fast path for large k).
+    /// Block principal pivoting on the active set, FFT products.
     Pivoting,
+    /// Shooting on the period map of a time-stepping scheme (needs the step map: `solve` of a
+    /// scene, not a raw LCP), certified on the stacked LCP.
+    Shooting,
 }
 
 impl LcpMethod {
     /// Every method, in the order of the documentation.
-    pub const ALL: [LcpMethod; 3] = [LcpMethod::Auto, LcpMethod::Lemke, LcpMethod::Pivoting];
+    pub const ALL: [LcpMethod; 4] = [LcpMethod::Auto, LcpMethod::Lemke, LcpMethod::Pivoting, LcpMethod::Shooting];
 
     pub fn name(self) -> &'static str {
         match self {
             LcpMethod::Auto => "auto",
             LcpMethod::Lemke => "lemke",
             LcpMethod::Pivoting => "pivoting",
+            LcpMethod::Shooting => "shooting",
         }
     }
 }
@@ -30,13 +37,37 @@ impl LcpMethod {
 /// by Lemke from its best basis, with full lexicographic Lemke as the fallback.
 pub const AUTO_LEMKE_MAX: usize = 256;
 
-/// Solves a block-circulant LCP with `method` (the engine's logic: `auto` uses lexicographic
-/// Lemke up to [`AUTO_LEMKE_MAX`], above it block pivoting with FFT products, falling back to
-/// Lemke when that fails). Used by the engine and by `periodic-contact lcp` for a raw LCP whose
-/// matrix is block-circulant.
+/// Solves a block-circulant LCP with `method` (`auto` uses lexicographic Lemke up to
+/// [`AUTO_LEMKE_MAX`], above it block pivoting with FFT products, falling back to Lemke when that
+/// fails). Used by `periodic-contact lcp` for a raw LCP whose matrix is block-circulant; the
+/// engine calls [`solve_periodic_lcp`], which tries shooting first when it has the step map.
 pub fn solve_circulant_lcp(a: &BlockCirculant, q: &[f64], method: LcpMethod, tolerance: f64, warm_start: Option<&[usize]>) -> LcpSolution {
+    solve_periodic_lcp(a, q, None, method, tolerance, warm_start).0
+}
+
+/// After a failed shooting, dense Lemke is the next step up to this size (block pivoting first
+/// above it).
+pub const LEMKE_AFTER_SHOOTING_MAX: usize = 4096;
+
+/// Above this size no dense method runs (Lemke's B⁻¹ or the pivoting LU of the active block
+/// could need N² numbers, 8 GiB at N = 32768): only shooting, whose memory is O(k·(d² + m)).
+pub const DENSE_MAX: usize = 1 << 15;
+
+/// The engine's policy for the period's LCP (A block-circulant, q), with the step map of the
+/// scheme when it has one. `auto`: shooting first when there is a step map (certified on (A, q)
+/// by FFT products), then, up to [`DENSE_MAX`], the block-circulant chain of
+/// [`solve_circulant_lcp`]. Returns the answer and, after a converged shooting, the orbit's
+/// initial state.
+pub fn solve_periodic_lcp(
+    a: &BlockCirculant,
+    q: &[f64],
+    step_map: Option<&StepMapLcp>,
+    method: LcpMethod,
+    tolerance: f64,
+    warm_start: Option<&[usize]>,
+) -> (LcpSolution, Option<Vec<f64>>) {
     if q.is_empty() {
-        return LcpSolution { outcome: LcpOutcome::Solved, z: vec![], w: vec![], info: Default::default() };
+        return (LcpSolution { outcome: LcpOutcome::Solved, z: vec![], w: vec![], info: Default::default() }, None);
     }
     let step = |method, sol: &LcpSolution| LcpStep { method, size: q.len(), pivots: sol.info.pivots, outcome: sol.outcome, time_s: sol.info.time_s };
     let lemke = || {
@@ -63,31 +94,89 @@ pub fn solve_circulant_lcp(a: &BlockCirculant, q: &[f64], method: LcpMethod, tol
         sol.info.path = vec![step(LcpMethod::Pivoting, &sol)];
         sol
     };
-    match method {
+    // A later method's pivots and time add to the earlier ones'; the path keeps every step.
+    let then = |first: LcpSolution, next: &dyn Fn() -> LcpSolution| {
+        if first.outcome == LcpOutcome::Solved {
+            return first;
+        }
+        let mut sol = next();
+        sol.info.pivots += first.info.pivots;
+        sol.info.time_s += first.info.time_s;
+        sol.info.path.splice(0..0, first.info.path);
+        sol
+    };
+    let dense_ok = q.len() <= DENSE_MAX;
+    let blind = || match method {
         LcpMethod::Lemke => lemke(),
         LcpMethod::Pivoting => pivoting(),
-        LcpMethod::Auto if q.len() <= AUTO_LEMKE_MAX => lemke(),
-        LcpMethod::Auto => {
-            let fast = pivoting();
-            if fast.outcome == LcpOutcome::Solved {
-                fast
-            } else {
-                // The robust fallback: lexicographic Lemke; its pivots add to the fast path's.
-                let mut sol = lemke();
-                sol.info.pivots += fast.info.pivots;
-                sol.info.time_s += fast.info.time_s;
-                sol.info.path.splice(0..0, fast.info.path);
-                sol
+        _ if q.len() <= AUTO_LEMKE_MAX => lemke(),
+        _ => then(pivoting(), &lemke),
+    };
+    match (method, step_map) {
+        (LcpMethod::Shooting | LcpMethod::Auto, Some(sm)) => {
+            let (sol, state) = shooting(a, q, sm, tolerance, warm_start);
+            if sol.outcome == LcpOutcome::Solved || method == LcpMethod::Shooting || !dense_ok {
+                return (sol, state);
             }
+            // Shooting fails where the orbit is hard to reach (coexisting orbits near a
+            // resonance): the certified reference next while it is cheap (N ≤
+            // LEMKE_AFTER_SHOOTING_MAX: 0.1–0.6 s on the rigid blade at N = 3072, where block
+            // pivoting took 8 s to end on a ray), else block pivoting first.
+            let fallback = || if q.len() <= LEMKE_AFTER_SHOOTING_MAX { lemke() } else { blind() };
+            (then(sol, &fallback), None)
         }
+        _ => (blind(), None),
     }
+}
+
+/// Shooting on the step map, certified on (A, q) by FFT products (exactly summed when round-off
+/// could reach the tolerance). Steps' counts: Newton iterations.
+fn shooting(a: &BlockCirculant, q: &[f64], sm: &StepMapLcp, tolerance: f64, warm_start: Option<&[usize]>) -> (LcpSolution, Option<Vec<f64>>) {
+    let start = Instant::now();
+    let m = sm.pairs();
+    let warm: Option<Vec<u32>> = warm_start.map(|set| {
+        let mut masks = vec![0u32; sm.k()];
+        for &i in set.iter().filter(|&&i| i < q.len()) {
+            masks[i / m] |= 1 << (i % m);
+        }
+        masks
+    });
+    let shot = solve_shooting(sm, warm.as_deref(), &ShootingSettings::default());
+    let qmax = q.iter().fold(1.0f64, |acc, v| acc.max(v.abs()));
+    let cert = tolerance * qmax;
+    let op = CirculantOperator::new(a);
+    let cand = evaluate(&op, q, shot.z.clone(), cert);
+    let solved = shot.outcome == ShootingOutcome::Converged && cand.residual <= cert;
+    let outcome = if solved {
+        LcpOutcome::Solved
+    } else if shot.outcome == ShootingOutcome::Converged {
+        LcpOutcome::Inaccurate
+    } else {
+        LcpOutcome::PivotLimit
+    };
+    let mut sol = LcpSolution { outcome, z: cand.z, w: cand.w, info: Default::default() };
+    sol.info.residual = cand.residual;
+    sol.info.relative_error = cand.relative_error;
+    sol.info.pivots = shot.iterations;
+    sol = recheck_exactly(sol, &op, q, tolerance);
+    sol.info.time_s = start.elapsed().as_secs_f64();
+    sol.info.warm = match (warm_start, shot.start) {
+        (None, _) => WarmOutcome::NotOffered,
+        (Some(_), "warm") if shot.iterations == 0 => WarmOutcome::Accepted,
+        (Some(_), "warm") => WarmOutcome::Repaired { pivots: shot.iterations },
+        (Some(_), _) => WarmOutcome::Rejected,
+    };
+    sol.info.warm_start_used = sol.info.warm == WarmOutcome::Accepted;
+    sol.info.path = vec![LcpStep { method: LcpMethod::Shooting, size: q.len(), pivots: shot.iterations, outcome: sol.outcome, time_s: sol.info.time_s }];
+    let state = solved.then_some(shot.state);
+    (sol, state)
 }
 
 /// Why a method name was not accepted.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum LcpMethodError {
     /// Not one of [`LcpMethod::ALL`]'s names.
-    #[error("unknown method \"{0}\"; expected auto, lemke or pivoting")]
+    #[error("unknown method \"{0}\"; expected auto, lemke, pivoting or shooting")]
     Unknown(String),
 }
 

@@ -11,10 +11,27 @@ use num_complex::Complex64 as C;
 use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
 use std::sync::{Arc, Mutex, OnceLock};
 
-/// The process-wide planner (plans are cached by length inside it).
-fn planner() -> &'static Mutex<RealFftPlanner<f64>> {
-    static PLANNER: OnceLock<Mutex<RealFftPlanner<f64>>> = OnceLock::new();
-    PLANNER.get_or_init(|| Mutex::new(RealFftPlanner::new()))
+/// The process-wide planner (plans are cached by length inside it); `None` once unloaded.
+static PLANNER: OnceLock<Mutex<Option<RealFftPlanner<f64>>>> = OnceLock::new();
+
+fn planner() -> &'static Mutex<Option<RealFftPlanner<f64>>> {
+    PLANNER.get_or_init(|| Mutex::new(None))
+}
+
+/// Drops the planner's cache when the library is unloaded. Why: an FMU is `dlclose`d by its
+/// importer, and a cache held by a static of an unmapped library can never be freed (valgrind:
+/// definitely lost, tests/boundary_stress.rs). Run by the dynamic loader from `.fini_array`.
+#[cfg(target_os = "linux")]
+#[used]
+#[unsafe(link_section = ".fini_array")]
+static DROP_PLANNER_AT_UNLOAD: extern "C" fn() = drop_planner;
+
+#[cfg(target_os = "linux")]
+extern "C" fn drop_planner() {
+    if let Some(m) = PLANNER.get() {
+        let mut planner = m.lock().unwrap_or_else(|e| e.into_inner());
+        *planner = None;
+    }
 }
 
 /// Forward (r2c) and inverse (c2r) plans of length k.
@@ -35,7 +52,8 @@ impl PeriodFft {
     pub fn new(k: usize) -> Self {
         // A panic while planning cannot leave the planner's cache half-written in a way that
         // matters (it only ever adds plans), so a poisoned lock is still usable.
-        let mut planner = planner().lock().unwrap_or_else(|e| e.into_inner());
+        let mut guard = planner().lock().unwrap_or_else(|e| e.into_inner());
+        let planner = guard.get_or_insert_with(RealFftPlanner::new);
         PeriodFft { k, forward: planner.plan_fft_forward(k), inverse: planner.plan_fft_inverse(k) }
     }
     pub fn k(&self) -> usize {

@@ -148,8 +148,12 @@ impl Operator {
                 if !(0..n).all(|j| (0..n).all(|i| z[(i, j)].re.is_finite() && z[(i, j)].im.is_finite())) {
                     return Err(overflow());
                 }
+                // The size of the terms that sum to Ẑ_p: a pivot at round-off of them is a zero
+                // (a 1-DOF Ẑ_p has one pivot, so a ratio among pivots alone cannot see it).
+                let big = |m: &Mat<f64>| (0..n).flat_map(|j| (0..n).map(move |i| (i, j))).fold(0.0f64, |a, (i, j)| a.max(m[(i, j)].abs()));
+                let terms = s2.norm() * big(mass) + s1.norm() * damping.as_ref().map_or(0.0, big) + w.abs() * big(stiffness);
                 let lu = z.partial_piv_lu();
-                check_pivots(lu.U()).map_err(|_| singular.clone())?;
+                check_pivots(lu.U(), terms).map_err(|_| singular.clone())?;
                 lu.solve(rhs)
             }
             Operator::Modal { .. } => unreachable!("a modal operator is assembled in one batch (assemble_modal)"),
@@ -340,7 +344,7 @@ const MODAL_MIN_DOFS: usize = 16;
 /// Below this many DOFs one factorisation is too cheap to be worth a thread.
 const PARALLEL_MIN_DOFS: usize = 64;
 
-fn check_pivots(u: faer::MatRef<'_, C>) -> Result<(), ()> {
+fn check_pivots(u: faer::MatRef<'_, C>, terms: f64) -> Result<(), ()> {
     let n = u.nrows();
     let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
     for i in 0..n {
@@ -349,7 +353,7 @@ fn check_pivots(u: faer::MatRef<'_, C>) -> Result<(), ()> {
         hi = hi.max(v);
     }
     // NaN-safe: `!(lo > …)` is true for NaN.
-    if !(lo > SINGULAR_PIVOT_RATIO * hi) {
+    if !(lo > SINGULAR_PIVOT_RATIO * hi.max(terms)) {
         return Err(());
     }
     Ok(())

@@ -6,16 +6,19 @@ use crate::linalg::fft; // the crate's one FFT plan type, shared with lcp
 mod problem;
 mod recovery;
 mod session;
+mod state_space;
 mod tuning;
 
 pub use assembly::Assembly;
 pub use fft::PeriodFft;
 pub use problem::{MAX_DENSE_FLOPS, MAX_LCP_SIZE, MAX_STEPS, MIN_STEPS, PeriodicProblem};
+pub use recovery::render_path as render_lcp_path;
 pub use session::{PeriodicSolver, WarmStart};
+pub use state_space::{MAX_STEP_MAP_DOFS, NoStepMap, step_map};
 pub use tuning::Tuning;
 
 use crate::error::{Error, ErrorKind};
-pub use crate::lcp::{AUTO_LEMKE_MAX, LcpMethod, solve_circulant_lcp};
+pub use crate::lcp::{AUTO_LEMKE_MAX, DENSE_MAX, LcpMethod, solve_circulant_lcp};
 use crate::lcp::{LcpOutcome, LcpSolution};
 use crate::model::ModelError;
 

@@ -1,8 +1,8 @@
 //! The checked problem: a model with its discretisation, outputs and solver settings. Fields are
 //! private: every way in (constructor, updaters) runs the checks, so a `PeriodicProblem` is
 //! always ready to solve.
-use super::{Assembly, OutputMap, OutputSelection, PeriodFft, SolveError, SolverSettings, assembly, lcp_failure, limits, recovery, solve_circulant_lcp};
-use crate::lcp::{BlockCirculant, LcpOutcome, LcpSolution};
+use super::{Assembly, OutputMap, OutputSelection, PeriodFft, SolveError, SolverSettings, assembly, lcp_failure, limits, recovery};
+use crate::lcp::{BlockCirculant, DENSE_MAX, LcpMethod, LcpOutcome, LcpSolution, solve_periodic_lcp};
 use crate::model::{Contact, Model};
 use crate::response::Response;
 use crate::time::{Discretization, Pairing};
@@ -29,11 +29,12 @@ pub struct PeriodicProblem {
 pub const MIN_STEPS: usize = 4;
 /// Most instants per period we accept (memory of the recovery grows like k·outputs).
 pub const MAX_STEPS: usize = 1 << 22;
-/// Largest LCP accepted, k·m unknowns. Why: both LCP methods may store a dense block as large as
-/// the active set squared (Lemke's B⁻¹ columns, the pivoting LU): the rigid stop at k = 16384 peaks
-/// at 1.5 GiB, and 2^22 unknowns would ask for terabytes (a panic inside the allocator, found by
-/// the bad-input tests). 32768 keeps the worst case within a few GiB.
-pub const MAX_LCP_SIZE: usize = 1 << 15;
+/// Largest LCP accepted, k·m unknowns. Why: shooting needs O(k·(d² + m)) memory, but the
+/// recovery stores k samples of every output and the FFT assembly k/2 blocks of m²; 2^20 keeps
+/// that within a few hundred MiB. The dense methods stop at [`DENSE_MAX`] (their B⁻¹ or LU of the
+/// active block can need N² numbers): a problem without a step map (fourier, a large model) is
+/// refused above it when it is solved, with the reason.
+pub const MAX_LCP_SIZE: usize = 1 << 20;
 /// Most floating-point operations the dense assembly may cost, ≈ (k/2+1)·(8/3)·n³ (one complex LU
 /// per distinct harmonic). Why: a 5000×5000 dense model at k = 256 would take hours; it must be
 /// refused at once with a remedy, not attempted. 10¹² is a few minutes on one core
@@ -366,8 +367,28 @@ impl PeriodicProblem {
     }
 
     /// Solves the LCP by the configured method; a failure is typed with its remedies.
+    /// `auto` and `shooting` use the scheme's step map when it has one ([`super::state_space`]).
     fn solve_lcp(&self, a: &BlockCirculant, q: &[f64], warm_start: Option<&[usize]>) -> Result<LcpSolution, SolveError> {
-        let sol = solve_circulant_lcp(a, q, self.solver.method, self.solver.tolerance, warm_start);
+        let method = self.solver.method;
+        let step_map = match method {
+            LcpMethod::Auto | LcpMethod::Shooting if !q.is_empty() => Some(super::state_space::step_map(self)),
+            _ => None,
+        };
+        if let Some(Err(why)) = &step_map {
+            if method == LcpMethod::Shooting {
+                return Err(SolveError::Invalid(format!(
+                    "solver.method: \"shooting\" needs a time-stepping map, and this problem has none: {why}; use \"auto\""
+                )));
+            }
+            if q.len() > DENSE_MAX {
+                return Err(SolveError::Limit(format!(
+                    "discretization.steps: an LCP of {} unknowns is past the {DENSE_MAX} of the dense methods, and shooting does not apply: {why}; reduce steps",
+                    q.len()
+                )));
+            }
+        }
+        let step_map = step_map.and_then(Result::ok);
+        let (sol, _state) = solve_periodic_lcp(a, q, step_map.as_ref(), method, self.solver.tolerance, warm_start);
         if sol.outcome == LcpOutcome::Solved { Ok(sol) } else { Err(lcp_failure(sol)) }
     }
 
@@ -391,10 +412,13 @@ fn check_sizes(model: &Model, disc: &Discretization) -> Result<(), SolveError> {
         return Err(SolveError::Invalid(format!("discretization.steps: is {k}, must be in {MIN_STEPS}..={MAX_STEPS}")));
     }
     let m = model.contacts.len();
-    if k.saturating_mul(m) > MAX_LCP_SIZE {
+    // Fourier collocation has no step map: only the dense methods solve it.
+    let most = if disc.scheme == crate::time::Scheme::Fourier { DENSE_MAX } else { MAX_LCP_SIZE };
+    if k.saturating_mul(m) > most {
         return Err(SolveError::Limit(format!(
-            "discretization.steps: is {k} with {m} contact(s), an LCP of {} unknowns (steps × contacts); at most {MAX_LCP_SIZE} are accepted: reduce steps",
-            k.saturating_mul(m)
+            "discretization.steps: is {k} with {m} contact(s), an LCP of {} unknowns (steps × contacts); at most {most} are accepted{}: reduce steps",
+            k.saturating_mul(m),
+            if most == DENSE_MAX { " under fourier (no time-stepping map, dense methods only)" } else { "" }
         )));
     }
     let s = &model.structure;

@@ -160,6 +160,7 @@ pub fn render_path(method: LcpMethod, path: &[LcpStep]) -> String {
     let Some(first) = path.first() else { return "no LCP (no contact, or no force needed)".to_string() };
     let n = first.size;
     let head = match method {
+        LcpMethod::Auto if first.method == LcpMethod::Shooting => format!("auto (N = {n}, a time-stepping map: shooting first)"),
         LcpMethod::Auto if n <= AUTO_LEMKE_MAX => format!("auto (N = {n} ≤ {AUTO_LEMKE_MAX}: dense Lemke)"),
         LcpMethod::Auto => format!("auto (N = {n} > {AUTO_LEMKE_MAX}: block pivoting first)"),
         m => format!("{} (N = {n})", m.name()),
@@ -167,8 +168,12 @@ pub fn render_path(method: LcpMethod, path: &[LcpStep]) -> String {
     let steps: Vec<String> = path
         .iter()
         .map(|s| {
-            let what = if s.method == LcpMethod::Pivoting { "block pivoting" } else { "dense lexicographic Lemke" };
-            format!("{what}, {} pivots, {:.3} s → {}", s.pivots, s.time_s, s.outcome.name())
+            let (what, count) = match s.method {
+                LcpMethod::Shooting => ("shooting (Newton on the period map, certified on the LCP)", "Newton iterations"),
+                LcpMethod::Pivoting => ("block pivoting", "pivots"),
+                _ => ("dense lexicographic Lemke", "pivots"),
+            };
+            format!("{what}, {} {count}, {:.3} s → {}", s.pivots, s.time_s, s.outcome.name())
         })
         .collect();
     format!("{head}: {}", steps.join("; fallback: "))

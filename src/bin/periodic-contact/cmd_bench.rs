@@ -1,7 +1,7 @@
 //! `bench`: time, pivots and peak memory of the periodic LCP over the class of problems, per k.
 //!
 //! Cases (issue 12): the rigid 1-DOF stop with sticking and with pure impacts, the compliant stop,
-//! the 3-DOF chain with two stops. Each has a nominal scene (draw 0, the shipped scene's values)
+//! the 3-DOF chain with two stops, the rigid reduced blade. Each has a nominal scene (draw 0, the shipped scene's values)
 //! and a family: `--draws N` adds N scenes with parameters drawn uniformly within the family's
 //! ranges (seeded), and the report gives the spread per size, worst case first.
 //! Each measurement runs in a child process of its own, so that its peak resident size is its
@@ -65,7 +65,10 @@ fn oscillator(steps: usize, c: f64, force: f64, gap: f64, omega: f64, stiffness:
     Member { scene, summary: format!("c={c:.3} F={force:.3} g0={gap:.3} ω={omega:.3}{kc}") }
 }
 
-const CASES: [Case; 4] = [
+/// The paper's case: the rigid reduced blade (23 DOFs after Craig–Bampton, 3 tip contacts).
+const BLADE: &str = include_str!("../../../fmu/scenes/blade-casing-rigid.toml");
+
+const CASES: [Case; 5] = [
     Case {
         name: "rigid-stick",
         about: "rigid 1-DOF stop with sticking (0 < k·g0 < F; notes §6.3): m = k = 1, F = 1, cds, forward pairing",
@@ -113,6 +116,15 @@ const CASES: [Case; 4] = [
                  [discretization]\nscheme = \"cds\"\nsteps = {steps}\n\n[output]\ndisplacement = [0, 1, 2]\n"
             );
             Member { scene, summary: format!("ω={omega:.3} F={force:.3} g1={g1:.3} g2={g2:.3}") }
+        },
+    },
+    Case {
+        name: "blade",
+        about: "rigid reduced blade (fmu/scenes/blade-casing-rigid.toml: 23 DOFs, LE/MC/TE tip contacts, out-of-round casing), cds, forward pairing; k ≥ 1024 (cds's limit)",
+        member: |steps, mut rng| {
+            let omega = pick(&mut rng, 2300.0, (2200.0, 2400.0));
+            let scene = BLADE.replace("steps = \"auto\"", &format!("steps = {steps}")).replace("frequency = 2300.0", &format!("frequency = {omega}"));
+            Member { scene, summary: format!("ω={omega:.1} rad/s") }
         },
     },
 ];

@@ -15,6 +15,11 @@ const MAX_BLOCK: usize = 8;
 
 pub fn run(file: &Path, output: &Path, method: &str, tolerance: f64) -> Result<(), Failure> {
     let method: LcpMethod = method.parse().map_err(|e| Failure::input(format!("--method: {e}")))?;
+    if method == LcpMethod::Shooting {
+        return Err(Failure::input(
+            "--method: \"shooting\" needs the time-stepping map of a scene, which a raw LCP does not carry; use `periodic-contact solve SCENE` (its `auto` shoots first), or --method auto here".to_string(),
+        ));
+    }
     if !(tolerance.is_finite() && tolerance > 0.0 && tolerance < 1.0) {
         return Err(Failure::input(format!("--tolerance: is {tolerance}, must be in (0, 1)")));
     }

@@ -26,12 +26,14 @@ pub struct Args {
     /// No warm start (every point solved from scratch).
     #[arg(long)]
     pub cold: bool,
-    /// Worker threads (0: every core).
-    #[arg(long, default_value_t = 0)]
+    /// Worker threads (0: every core). The default, one thread and one chunk, continues strictly
+    /// in the sweep's direction, each point warm-started from the last: where several periodic
+    /// solutions coexist it stays on the branch it is on. More threads split the range into
+    /// contiguous chunks, each starting cold, which may land on other branches.
+    #[arg(long, default_value_t = 1)]
     pub threads: usize,
-    /// Contiguous chunks per thread (each chunk starts cold; where several periodic solutions
-    /// coexist, `--threads 1 --chunks-per-thread 1` continues strictly in the sweep's direction).
-    #[arg(long, default_value_t = 4)]
+    /// Contiguous chunks per thread (each chunk starts cold).
+    #[arg(long, default_value_t = 1)]
     pub chunks_per_thread: usize,
     /// Parameter values at which to draw the spectrum (comma-separated).
     #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]

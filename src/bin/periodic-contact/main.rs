@@ -57,7 +57,7 @@ enum Command {
     /// Benchmark over the class: time, pivots and peak memory per case and k, with random
     /// families (worst case first).
     Bench {
-        /// Cases (comma-separated): rigid-stick, rigid-impact, compliant, chain, or all.
+        /// Cases (comma-separated): rigid-stick, rigid-impact, compliant, chain, blade, or all.
         #[arg(long, value_delimiter = ',', default_value = "rigid-stick")]
         case: Vec<String>,
         /// LCP sizes k to measure.
@@ -66,7 +66,7 @@ enum Command {
         /// Repeats per size (the best time is kept).
         #[arg(long, default_value_t = 3)]
         repeats: usize,
-        /// LCP method: auto, lemke or pivoting.
+        /// LCP method: auto, lemke, pivoting or shooting.
         #[arg(long, default_value = "auto")]
         method: String,
         /// Random members of each case's family besides the nominal one.

@@ -6,8 +6,9 @@
 //!
 //! - operators: types implementing [`LcpMatrix`](super::LcpMatrix) with a fast `mul_into`
 //!   ([`CirculantOperator`]); any solver written against the trait uses them unchanged;
-//! - structured solver families (none yet), e.g. an active-block revised Lemke whose basis solves
-//!   use the circulant spectrum, or a state-space cyclic banded MLCP. A new family lives in its
+//! - structured solver families: shooting on a step map (`step_map.rs`, `shooting.rs`: the LCP
+//!   of a time-stepping scheme as the fixed point of its period map, O(k·(d² + m³)) per march),
+//!   and room for others (an active-block revised Lemke, say). A new family lives in its
 //!   own file here, exposes `Settings` + `solve(&self, a, q) -> LcpSolution` like the general
 //!   solvers, and is offered through a new [`LcpMethod`](super::LcpMethod) variant in
 //!   `policy.rs` (and, if it should be tried automatically, a branch of the `auto` policy).
@@ -15,5 +16,9 @@
 //! Rules of the room: it depends on the rest of `lcp` (matrices, status) and on `crate::linalg`
 //! only; hot paths own or receive their scratch buffers (nothing allocated per product or pivot).
 mod circulant;
+mod shooting;
+mod step_map;
 
 pub use circulant::CirculantOperator;
+pub use shooting::{ShootingOutcome, ShootingSettings, ShootingSolution, solve_shooting};
+pub use step_map::{DenseLu, MAX_PAIRS, StepMapData, StepMapError, StepMapLcp, product as dense_product};
