@@ -219,15 +219,19 @@ def _classify_ns(o: Orbit) -> tuple[bool, str]:
 
 def continuation(o0: Orbit, direction: float, omega_range=(0.5, 0.8), ds0: float = 0.02,
                  ds_max: float = 0.08, ds_min: float = 1e-7, max_points: int = 3000,
-                 max_angle: float = 0.1, p: int = 1, log=None, stop=None) -> Branch:
+                 max_angle: float = 0.1, p: int = 1, log=None, stop=None,
+                 start_tangent: np.ndarray | None = None) -> Branch:
     """Pseudo-arclength continuation from orbit o0 in the direction of increasing (direction=+1)
     or decreasing Ω, until Ω leaves omega_range (the last point is corrected onto the bound), the
-    branch closes on its start, or `stop(orbit)` is true. ds in scaled units of u = (s, W·Ω)."""
+    or `stop(cur, nxt)` returns an end orbit (appended last; the step to nxt is dropped). ds in scaled units of u = (s, W·Ω)."""
     R, res = residual(o0.s, o0.omega, p)
     J = _jac(res, p)
     t_ref = np.zeros(5)
     t_ref[4] = direction
-    if o0.tangent is None or abs(o0.tangent[4]) < 1e-3:
+    if start_tangent is not None:
+        # branch switching: the branch point's Jacobian has a 2-D kernel, the caller picks the way
+        t0 = start_tangent / np.linalg.norm(start_tangent)
+    elif o0.tangent is None or abs(o0.tangent[4]) < 1e-3:
         # start: the tangent with the requested Ω direction
         t0 = _tangent(J, t_ref)
         if t0[4] * direction < 0:
@@ -236,6 +240,8 @@ def continuation(o0: Orbit, direction: float, omega_range=(0.5, 0.8), ds0: float
         t0 = o0.tangent if o0.tangent[4] * direction > 0 else -o0.tangent
     cur = _orbit_at(o0.u(), res, t0, p)
     cur.tangent = t0
+    if log:
+        log(f"continuation ({p}T) from Ω = {cur.omega:.6f}, A0 = {cur.measures['amplitude_0']:.6f}")
     orbits, events = [cur], []
     ds = ds0
     lo, hi = omega_range
@@ -253,6 +259,11 @@ def continuation(o0: Orbit, direction: float, omega_range=(0.5, 0.8), ds0: float
         if ang > max_angle and ds > ds_min * 2:
             ds *= 0.5
             continue
+        if stop is not None:
+            end = stop(cur, nxt)
+            if end is not None:
+                orbits.append(end)
+                break
         # events on (cur, nxt]
         fa, fb = monitor_functions(cur), monitor_functions(nxt)
         for kind in ("fold", "period_doubling", "neimark_sacker", "branch_point"):
@@ -285,7 +296,34 @@ def continuation(o0: Orbit, direction: float, omega_range=(0.5, 0.8), ds0: float
             last.tangent = cur.tangent
             orbits[-1] = last
             break
-        if stop is not None and stop(cur):
-            break
     events = [e for e in events if lo <= e.orbit.omega <= hi]
     return Branch(orbits, events, p)
+
+
+def period_doubling_start(pd: Orbit, eps: float = 1e-3):
+    """The T-orbit at a period doubling seen as a 2T-orbit, and the direction of the 2T branch:
+    (v, 0) with v the eigenvector of the monodromy for μ = -1 (Kuznetsov §10.3.2; the 2T map's
+    Jacobian M² - I has the kernel spanned by v and the T-branch tangent)."""
+    mu, V = np.linalg.eig(pd.monodromy)
+    i = int(np.argmin(np.abs(mu + 1.0)))
+    v = V[:, i].real
+    v /= np.linalg.norm(v)
+    o2 = make_orbit(pd.s, pd.omega, 2)
+    return o2, np.append(v, 0.0)
+
+
+def rejoin_stop(pd_orbits: list[Orbit]):
+    """A `stop` for a 2T branch: it has reached a T-orbit when w = Φ_T(s) - s (zero exactly on the
+    T-branch) flips direction between two points; the end is the nearest period doubling of the
+    T-branch (seen as a 2T-orbit)."""
+    def w(o: Orbit):
+        R, _ = residual(o.s, o.omega, 1, False)
+        return R
+
+    def stop(cur: Orbit, nxt: Orbit):
+        wc = w(cur)
+        if np.max(np.abs(wc)) > 1e-7 and wc @ w(nxt) < 0:    # not at the start (a T-orbit)
+            pd = min(pd_orbits, key=lambda o: abs(o.omega - nxt.omega) + np.max(np.abs(o.s - nxt.s)))
+            return make_orbit(pd.s, pd.omega, 2)
+        return None
+    return stop

@@ -47,7 +47,9 @@ def march(omega: float, y0, max_periods: int = 4000, tol: float = 1e-10, p_max: 
                 d = float(np.max(np.abs(hist[-1] - hist[-1 - p])))
                 if p == 1:
                     defect = d
-                if d < tol:
+                # pT only when the p shifts are distinct points (d_1 > 1e-6): a T-orbit whose
+                # multipliers turn by ~2π/p per period closes its pT-defect first
+                if d < tol and (p == 1 or defect > 1e-6):
                     kind, defect = ("T" if p == 1 else f"{p}T"), d
                     break
         if kind != "nonperiodic":
