@@ -212,7 +212,7 @@ def plot(brs, events, runs, others, path: str):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(2, 1, figsize=(9, 9), sharex=True)
+    fig, axes = plt.subplots(2, 1, figsize=(9, 10), sharex=True)
     colors = {"T": "tab:blue"}
     for k, ax in enumerate(axes):
         for lab, br in brs:
@@ -251,11 +251,12 @@ def plot(brs, events, runs, others, path: str):
         ax.grid(alpha=0.3)
     axes[0].axhline(1.0, color="grey", lw=0.8, ls=":")
     axes[0].text(0.505, 1.02, "gap = 1 m", color="grey")
-    axes[1].legend(fontsize=8, loc="upper left")
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, fontsize=8, loc="lower center", ncol=3)
     axes[1].set_xlabel("excitation frequency Ω [rad/s]")
     axes[0].set_title("NLvib Example 03 (unilateral spring k = 100, gap 1): exact shooting + continuation\n"
                       "solid stable, dashed unstable; markers: events and long time integration")
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0.08, 1, 1))
     fig.savefig(path, dpi=120)
     plt.close(fig)
 
@@ -277,6 +278,8 @@ def main():
     # the physical resonance peak: the largest x0 amplitude over the stable orbits of all branches
     stable = [(lab, o) for lab, br in brs for o in br.orbits if o.stable]
     lab_pk, pk = max(stable, key=lambda x: x[1].measures["amplitude_0"])
+    _, spk = max(((lab, o) for lab, br in brs if br.period_multiple == 1 for o in br.orbits if o.stable),
+                 key=lambda x: x[1].measures["amplitude_0"])
     lab_tpk, tpk = max(((lab, o) for lab, br in brs if br.period_multiple == 1 for o in br.orbits),
                        key=lambda x: x[1].measures["amplitude_0"])
     ns = sorted(e["omega"] for e in events if e["type"] == "neimark_sacker")
@@ -299,6 +302,8 @@ def main():
         "resonance_peak": {
             "stable": {"branch": lab_pk, "omega": pk.omega, "amplitude_0": float(pk.measures["amplitude_0"]),
                        "amplitude_1": float(pk.measures["amplitude_1"])},
+            "stable_T": {"omega": spk.omega, "amplitude_0": float(spk.measures["amplitude_0"]),
+                         "amplitude_1": float(spk.measures["amplitude_1"])},
             "T_branch": {"omega": tpk.omega, "amplitude_0": float(tpk.measures["amplitude_0"]),
                          "amplitude_1": float(tpk.measures["amplitude_1"]), "stable": bool(tpk.stable)},
         },
