@@ -90,3 +90,76 @@ fn compliant_stop_is_polished_to_1e_8() {
         assert!((on - t0).abs() < 1e-8 * exact.period(), "entry {on} vs exact {t0}");
     }
 }
+
+/// A 2-DOF chain with a compliant stop on the second mass: the polished orbit agrees with long
+/// explicit time integration from rest (the marcher's own error is O(h²): the gap must shrink
+/// about 4× when its step halves, and be small at the finer step).
+#[test]
+fn two_dof_compliant_chain_agrees_with_long_time_integration() {
+    use periodic_contact::marching::{MarchSettings, march};
+    let scene = r#"
+[structure]
+mass = [[1.0, 0.0], [0.0, 1.0]]
+stiffness = [[2.0, -1.0], [-1.0, 2.0]]
+[damping]
+matrix = [[0.1, 0.0], [0.0, 0.1]]
+[excitation]
+frequency = 1.2
+[[force]]
+dof = 0
+amplitude = 1.0
+[[contact]]
+dof = 1
+gap = 0.3
+stiffness = 20.0
+[discretization]
+scheme = "cds"
+steps = 256
+"#;
+    let p = periodic_contact::scene::Scene::parse(scene, "chain").unwrap().to_problem("chain").unwrap();
+    let t0 = Instant::now();
+    let mut r = p.solve().unwrap();
+    polish::apply(&p, &mut r);
+    let wall = t0.elapsed().as_secs_f64();
+    let s = r.polish.clone().unwrap();
+    assert_eq!(s.status, "polished", "{}", s.reason);
+    assert!(s.events.len() >= 2, "the stop is touched: {:?}", s.events);
+    let ptp = r.displacement.values().map(|x| Response::peak_to_peak(x)).fold(0.0, f64::max);
+    let mut diffs = vec![];
+    for n in [8192, 16384] {
+        let settings = MarchSettings { steps_per_period: n, max_periods: 3000, tolerance: 1e-10, ..MarchSettings::default() };
+        let m = march(p.model(), &settings).unwrap();
+        assert!(m.converged, "marching converged (defect {:.2e})", m.defect);
+        let stride = n / r.steps;
+        let mut d = 0.0f64;
+        for (j, _) in r.time.iter().enumerate() {
+            for dof in 0..2 {
+                d = d.max((r.displacement[&dof.to_string()][j] - m.displacement[j * stride][dof]).abs());
+            }
+        }
+        diffs.push(d / ptp);
+    }
+    eprintln!("2-DOF chain: polish {wall:.3} s, events {:?}; |polish − march| / ptp at N = 8192, 16384: {:.2e}, {:.2e}", s.events, diffs[0], diffs[1]);
+    assert!(diffs[1] < 1e-6, "{diffs:?}");
+    assert!((2.5..6.0).contains(&(diffs[0] / diffs[1])), "the difference is the marcher's O(h²) error: {diffs:?}");
+}
+
+/// The polish's monodromy gives the Floquet multipliers of the exact compliant orbit
+/// (`exact::CompliantStopOrbit::floquet_multipliers`, its own closed-form flows).
+#[test]
+fn monodromy_gives_the_exact_floquet_multipliers() {
+    let osc = Oscillator::new(1.0, 0.05, 1.0, 1.0, 1.3);
+    let exact = CompliantStopOrbit::solve(&osc, 10.0, 1.0, None).unwrap();
+    let p = problem(&osc, Oscillator::stop(1.0, Compliance::Compliant { stiffness: 10.0 }), Scheme::Cds, 256);
+    let r = p.solve().unwrap();
+    let orbit = polish::polish(&p, &r).unwrap();
+    let mut got: Vec<num_complex::Complex64> = orbit.monodromy().complex_eigenvalues().iter().copied().collect();
+    let mut want = exact.floquet_multipliers().to_vec();
+    let key = |c: &num_complex::Complex64| (c.norm(), c.im);
+    got.sort_by(|a, b| key(a).partial_cmp(&key(b)).unwrap());
+    want.sort_by(|a, b| key(a).partial_cmp(&key(b)).unwrap());
+    eprintln!("multipliers: polish {got:?}, exact {want:?}");
+    for (g, w) in got.iter().zip(&want) {
+        assert!((g - w).norm() < 1e-6 * w.norm().max(1e-3), "{g} vs {w}");
+    }
+}

@@ -123,6 +123,11 @@ impl PolishedOrbit {
     /// One period from `y0` with event times `tau`: the state after the last event (back at
     /// event 0), the event conditions, the states after each event and the impulses.
     fn shoot(&self, y0: &DVector<f64>, tau: &[f64]) -> Option<Shot> {
+        self.shoot_to(y0, tau, tau[0] + self.period)
+    }
+
+    /// [`Self::shoot`] with event 0 coming back at `ret` instead of tau[0] + T.
+    fn shoot_to(&self, y0: &DVector<f64>, tau: &[f64], ret: f64) -> Option<Shot> {
         let ne = self.events.len();
         if ne == 0 {
             let end = self.phases[0].flow(0.0, y0, self.period);
@@ -131,7 +136,7 @@ impl PolishedOrbit {
         let (mut g, mut after, mut imp) = (vec![0.0; ne], vec![y0.clone(); ne], vec![0.0; ne]);
         let mut y = y0.clone();
         for e in 0..ne {
-            let (t0, t1) = (tau[e], if e + 1 < ne { tau[e + 1] } else { tau[0] + self.period });
+            let (t0, t1) = (tau[e], if e + 1 < ne { tau[e + 1] } else { ret });
             let ph = &self.phases[e];
             let ym = ph.flow(t0, &y, t1);
             let next = (e + 1) % ne;
@@ -210,11 +215,10 @@ impl PolishedOrbit {
         let ys = y0.amax().max(1e-300);
         let scale = DVector::from_fn(n2 + ne, |i, _| if i < n2 { ys } else { self.period });
         let mut r = self.residual_of(&u).ok_or_else(|| fail("the seeded event sequence cannot be flowed"))?;
-        let mut jac = DMatrix::zeros(n2 + ne, n2 + ne);
         let mut converged = false;
         for it in 0..MAX_ITERATIONS {
-            jac = self.jacobian(&u, &scale).ok_or_else(|| fail("the Jacobian could not be formed"))?;
-            let du = jac.clone().lu().solve(&(-&r)).ok_or_else(|| fail("the shooting Jacobian is singular (a grazing or degenerate event sequence)"))?;
+            let jac = self.jacobian(&u, &scale).ok_or_else(|| fail("the Jacobian could not be formed"))?;
+            let du = jac.lu().solve(&(-&r)).ok_or_else(|| fail("the shooting Jacobian is singular (a grazing or degenerate event sequence)"))?;
             let mut lambda = 1.0;
             let (next, rn) = loop {
                 let cand = &u + &du * lambda;
@@ -243,16 +247,6 @@ impl PolishedOrbit {
             return Err(fail(&format!("Newton did not converge in {MAX_ITERATIONS} iterations (residual {:.2e})", r.amax())));
         }
         self.residual = r.amax();
-        // The monodromy of the section just after event 0: F_y − F_τ G_τ⁻¹ G_y (the event
-        // times follow the state through the conditions).
-        let fy = jac.view((0, 0), (n2, n2)).into_owned() + DMatrix::identity(n2, n2);
-        self.monodromy = if ne == 0 {
-            fy
-        } else {
-            let (ft, gy, gt) = (jac.view((0, n2), (n2, ne)).into_owned(), jac.view((n2, 0), (ne, n2)).into_owned(), jac.view((n2, n2), (ne, ne)).into_owned());
-            let x = gt.lu().solve(&gy).ok_or_else(|| fail("the event conditions are singular in the times (grazing)"))?;
-            fy - ft * x
-        };
         // Times into [0, T): a shift by whole periods changes nothing.
         let shift = (u[n2.min(u.len() - 1)] / self.period).floor() * self.period;
         self.y0 = u.rows(0, n2).into_owned();
@@ -262,7 +256,56 @@ impl PolishedOrbit {
         let shot = self.shoot(&self.y0, &self.times).ok_or_else(|| fail("the converged orbit cannot be flowed"))?;
         self.after = shot.after;
         self.impulses = shot.impulses;
+        self.monodromy = self.stroboscopic().ok_or_else(|| fail("the monodromy could not be formed (an event condition is singular in its time: grazing)"))?;
         Ok(())
+    }
+
+    /// The one-period map at the fixed time s = times[0] (just after event 0), z ↦ y(s + T),
+    /// its events relocated for every z: with w the other event times and event 0's return,
+    /// G(z, w) = 0, and dy/dz = ∂y/∂z − ∂y/∂w·G_w⁻¹·G_z (finite differences, central, 1e-7
+    /// relative).
+    fn stroboscopic(&self) -> Option<DMatrix<f64>> {
+        let n2 = 2 * self.model.n();
+        let ne = self.events.len();
+        let (s, t) = (self.times[0], self.period);
+        let parts = |z: &DVector<f64>, w: &[f64]| -> Option<(DVector<f64>, Vec<f64>)> {
+            if ne == 0 {
+                return Some((self.phases[0].flow(s, z, s + t), vec![]));
+            }
+            let tau: Vec<f64> = std::iter::once(s).chain(w[..ne - 1].iter().copied()).collect();
+            let shot = self.shoot_to(z, &tau, w[ne - 1])?;
+            Some((self.phases[0].flow(w[ne - 1], &shot.end, s + t), shot.conditions))
+        };
+        let w0: Vec<f64> = self.times.iter().skip(1).copied().chain(std::iter::once(s + t)).take(ne).collect();
+        let ys = self.y0.amax().max(1e-300);
+        let (mut yz, mut gz) = (DMatrix::zeros(n2, n2), DMatrix::zeros(ne, n2));
+        for c in 0..n2 {
+            let h = 1e-7 * ys;
+            let (mut up, mut dn) = (self.y0.clone(), self.y0.clone());
+            up[c] += h;
+            dn[c] -= h;
+            let ((a, ga), (b, gb)) = (parts(&up, &w0)?, parts(&dn, &w0)?);
+            yz.set_column(c, &((a - b) / (2.0 * h)));
+            for r in 0..ne {
+                gz[(r, c)] = (ga[r] - gb[r]) / (2.0 * h);
+            }
+        }
+        if ne == 0 {
+            return Some(yz);
+        }
+        let (mut yw, mut gw) = (DMatrix::zeros(n2, ne), DMatrix::zeros(ne, ne));
+        for c in 0..ne {
+            let h = 1e-7 * t;
+            let (mut up, mut dn) = (w0.clone(), w0.clone());
+            up[c] += h;
+            dn[c] -= h;
+            let ((a, ga), (b, gb)) = (parts(&self.y0, &up)?, parts(&self.y0, &dn)?);
+            yw.set_column(c, &((a - b) / (2.0 * h)));
+            for r in 0..ne {
+                gw[(r, c)] = (ga[r] - gb[r]) / (2.0 * h);
+            }
+        }
+        Some(yz - yw * gw.lu().solve(&gz)?)
     }
 
     /// Newton iterations, final residual (max norm of periodicity and event conditions) and the
@@ -277,9 +320,10 @@ impl PolishedOrbit {
         self.correction
     }
 
-    /// The monodromy matrix (2n×2n, state [x; v]) of the Poincaré map at the section just after
-    /// the first event, from the shooting Jacobian (finite differences, step 1e-7 relative): its
-    /// eigenvalues are the orbit's Floquet multipliers (a plastic impact adds zeros).
+    /// The monodromy matrix (2n×2n, state [x; v]): the derivative of the one-period map at the
+    /// fixed time [`Self::section_time`] (just after the first event), the events relocated
+    /// (finite differences, step 1e-7 relative). Its eigenvalues are the orbit's Floquet
+    /// multipliers (a plastic impact adds zeros).
     pub fn monodromy(&self) -> &DMatrix<f64> {
         &self.monodromy
     }
