@@ -44,6 +44,12 @@ static int print_result(const char *prefix, const pc_result *r) {
     printf("%s.period 0 %.17g\n", prefix, pc_result_period(r));
     if (pc_result_lcp(r, &size, &pivots, &residual, NULL) != PC_OK) return fail("lcp");
     printf("%s.lcp_size 0 %zu\n%s.pivots 0 %zu\n", prefix, size, prefix, pivots);
+    int estimated = 0;
+    double estimate = 0, relative = 0;
+    const char *method = NULL;
+    if (pc_result_accuracy(r, &estimated, &estimate, &relative, &method) != PC_OK) return fail("accuracy");
+    printf("%s.accuracy 0 %d\n%s.accuracy 1 %.17g\n%s.accuracy 2 %.17g\n", prefix, estimated, prefix, estimate, prefix, relative);
+    printf("%s.accuracy_method 0 %s\n", prefix, method);
     snprintf(key, sizeof key, "%s.x", prefix);
     if (print_series(key, r, 0, pc_result_displacement)) return 1;
     snprintf(key, sizeof key, "%s.v", prefix);

@@ -111,6 +111,9 @@ int pc_problem_contact(const pc_problem *p, size_t i, size_t *dof, int *directio
 /* The pairing contact i will be solved with: "same" or "forward" (static storage);
  * NULL for a NULL handle or i out of range. */
 const char *pc_problem_contact_pairing(const pc_problem *p, size_t i);
+/* on = 1 (default, or the scene's [discretization] error_estimate): every solve also
+ * estimates its error by a second solve at k/2 (Richardson); 0: skip it, for speed. */
+int pc_problem_set_error_estimate(pc_problem *p, int on);
 /* Solves; warm-started from this problem's previous solve. NULL on failure. */
 pc_result *pc_problem_solve(pc_problem *p);
 void pc_problem_free(pc_problem *p);
@@ -141,6 +144,12 @@ int pc_result_warm_start(const pc_result *r, const char **outcome, size_t *pivot
 /* The LCP methods that ran and the fallbacks taken, one line (the JSON's lcp.path); owned by
  * the result; NULL for NULL. */
 const char *pc_result_lcp_path(const pc_result *r);
+/* The error estimate (the JSON's accuracy): *estimated = 1 with *estimate (length unit, max
+ * over the instants and displacement outputs) and *relative (of the peak-to-peak amplitude),
+ * or *estimated = 0 and both 0; *method says how, or why there is none (owned by the result).
+ * Any output may be NULL. */
+int pc_result_accuracy(const pc_result *r, int *estimated, double *estimate, double *relative,
+                       const char **method);
 size_t pc_result_warning_count(const pc_result *r);
 /* Warning i, owned by the result (valid until pc_result_free); NULL when out of range. */
 const char *pc_result_warning(const pc_result *r, size_t i);

@@ -11,12 +11,14 @@
 //! one result may run concurrently (the JSON is cached in a `OnceLock`); a problem must not be
 //! mutated while another thread solves it. Readers of contacts, pairing, warm start and
 //! solver path: `inspect`.
+use crate::analysis::accuracy;
 use crate::model::{Compliance, Contact, Force, Harmonic, Matrix, Model, Structure};
 use crate::periodic::Tuning;
 use crate::periodic::{OutputSelection, PeriodicProblem, PeriodicSolver, SolveError, SolverSettings};
-use crate::response::Response;
+use crate::response::{Accuracy, Response};
 use crate::scene::Scene;
 use crate::time::{Discretization, Pairing, Scheme};
+mod estimate;
 mod inspect;
 
 use std::cell::RefCell;
@@ -109,6 +111,8 @@ unsafe fn slice<'a, T>(p: *const T, n: usize, what: &str) -> Result<&'a [T], (c_
 pub struct PcProblem {
     base: PeriodicProblem,
     tuning: Tuning,
+    /// Estimate the error of every result (`[discretization] error_estimate`, default true).
+    estimate: bool,
     /// Built at the first solve.
     session: Option<PeriodicSolver>,
 }
@@ -120,13 +124,15 @@ pub struct PcResult {
     /// `lcp.warm_start.outcome` and `lcp.path`, as C strings owned by the result.
     warm_start: CString,
     path: CString,
+    /// `accuracy.method`, owned by the result.
+    accuracy_method: CString,
     /// The JSON, made on first request; a `OnceLock` so that const readers may run concurrently.
     json: std::sync::OnceLock<CString>,
 }
 
 impl PcProblem {
     fn new(base: PeriodicProblem) -> Box<Self> {
-        Box::new(PcProblem { tuning: Tuning::of(&base), base, session: None })
+        Box::new(PcProblem { tuning: Tuning::of(&base), base, estimate: true, session: None })
     }
     /// Rebuilds the base problem after an edit, keeping the old one if the edit is invalid.
     fn edit(&mut self, f: impl FnOnce(&mut Model, &mut OutputSelection)) -> Result<(), (c_int, String)> {
@@ -163,9 +169,11 @@ pub extern "C" fn pc_last_error() -> *const c_char {
     catch_unwind(|| LAST_ERROR.with(|e| e.borrow().as_ptr())).unwrap_or(c"internal error".as_ptr())
 }
 
-fn from_scene(text: &str, file: &str) -> Result<Box<PcProblem>, (c_int, String)> {
-    let scene = Scene::parse(text, file).map_err(input)?;
-    Ok(PcProblem::new(scene.to_problem(file).map_err(input)?))
+fn from_scene(scene: &Scene, file: &str) -> Result<Box<PcProblem>, (c_int, String)> {
+    let built = scene.build(file).map_err(input)?;
+    let mut p = PcProblem::new(built.problem);
+    p.estimate = built.error_estimate;
+    Ok(p)
 }
 
 /// Loads a scene file (TOML). NULL on failure (see `pc_last_error`).
@@ -177,7 +185,7 @@ pub unsafe extern "C" fn pc_problem_from_scene_file(path: *const c_char) -> *mut
     guarded_ptr(|| {
         let path = unsafe { c_str(path, "path") }?;
         let (scene, _) = Scene::load(Path::new(path)).map_err(input)?;
-        Ok(PcProblem::new(scene.to_problem(path).map_err(input)?))
+        from_scene(&scene, path)
     })
 }
 
@@ -187,7 +195,7 @@ pub unsafe extern "C" fn pc_problem_from_scene_file(path: *const c_char) -> *mut
 /// `toml` is a NUL-terminated string.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn pc_problem_from_scene_text(toml: *const c_char) -> *mut PcProblem {
-    guarded_ptr(|| from_scene(unsafe { c_str(toml, "toml") }?, "scene text"))
+    guarded_ptr(|| from_scene(&Scene::parse(unsafe { c_str(toml, "toml") }?, "scene text").map_err(input)?, "scene text"))
 }
 
 /// A structure from n×n row-major matrices (damping may be NULL), without forces or contacts;
@@ -373,10 +381,17 @@ pub unsafe extern "C" fn pc_problem_solve(p: *mut PcProblem) -> *mut PcResult {
             Some(s) => s.update_problem(problem),
             None => p.session = Some(PeriodicSolver::new(problem)),
         }
-        let response = p.session.as_mut().expect("just set").solve().map_err(solver_error)?;
+        let session = p.session.as_mut().expect("just set");
+        let mut response = session.solve().map_err(solver_error)?;
+        response.accuracy = if p.estimate {
+            accuracy::estimate(session.problem(), &response)
+        } else {
+            Accuracy { method: "none: not requested (pc_problem_set_error_estimate)".into(), ..Accuracy::default() }
+        };
+        let accuracy_method = to_cstring(&response.accuracy.method);
         let warnings = response.warnings.iter().map(|w| to_cstring(w)).collect();
         let (warm_start, path) = (to_cstring(&response.lcp.warm_start.outcome), to_cstring(&response.lcp.path));
-        Ok(Box::new(PcResult { response, warnings, warm_start, path, json: std::sync::OnceLock::new() }))
+        Ok(Box::new(PcResult { response, warnings, warm_start, path, accuracy_method, json: std::sync::OnceLock::new() }))
     })
 }
 

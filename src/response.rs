@@ -79,6 +79,11 @@ pub struct Response {
     pub lcp: LcpSummary,
     pub warnings: Vec<String>,
     pub timing_s: Timing,
+    /// What the result says of its own error (`analysis::accuracy`, or the polish).
+    pub accuracy: Accuracy,
+    /// The event-fitted polish (`--polish`, `[discretization] polish = true`), when it ran.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub polish: Option<PolishSummary>,
     /// The contact-free (linear) response at the displacement outputs, same keys: a by-product
     /// of the assembly, for frequency-response curves.
     #[serde(skip)]
@@ -86,6 +91,46 @@ pub struct Response {
     /// Indices of the LCP unknowns with z > 0 (time-major j·m + i): a warm start for the next solve.
     #[serde(skip)]
     pub active_set: Vec<usize>,
+}
+
+/// An estimate of the result's own error.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Accuracy {
+    /// Estimated max over the instants of |x_j − x(t_j)| over the displacement outputs, in the
+    /// length unit; `None` when not estimated (`method` says why).
+    pub estimate: Option<f64>,
+    /// `estimate` divided by the largest peak-to-peak amplitude of the displacement outputs.
+    pub relative: Option<f64>,
+    /// How it was obtained, e.g. "richardson: k/2 = 256, order 2 (cds, forward, rigid contact with sticking)".
+    pub method: String,
+}
+
+/// One event of a polished orbit.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct EventRecord {
+    /// Time in [0, T) [s].
+    pub time: f64,
+    /// Contact index.
+    pub contact: usize,
+    /// "impact", "release", "contact_on" (compliant), "contact_off" (compliant).
+    pub kind: String,
+    /// Impulse of an impact ≥ 0 [force·time]; 0 for the other kinds.
+    pub impulse: f64,
+}
+
+/// What the event-fitted polish did.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PolishSummary {
+    /// "polished" (the orbit above is the polished one) or "fallback" (the LCP's orbit is kept,
+    /// `reason` says why).
+    pub status: String,
+    pub reason: String,
+    pub events: Vec<EventRecord>,
+    /// Newton iterations and the final residual (max norm of the shooting equations).
+    pub iterations: usize,
+    pub residual: f64,
+    /// Wall time of the polish [s].
+    pub time_s: f64,
 }
 
 impl Response {

@@ -332,8 +332,10 @@ struct CApi {
     result_free: unsafe extern "C" fn(P),
 }
 
-const C_API_FUNCTIONS: [&str; 41] = [
+const C_API_FUNCTIONS: [&str; 43] = [
     "pc_version",
+    "pc_problem_set_error_estimate",
+    "pc_result_accuracy",
     "pc_problem_dof_count",
     "pc_problem_contact_count",
     "pc_problem_contact",
@@ -855,7 +857,9 @@ fn the_c_host_reads_what_the_rust_host_reads() {
     let k: usize = host_lines(&out, "steps")[0][0].parse().unwrap();
     let period: f64 = host_lines(&out, "period")[0][0].parse().unwrap();
     let values: Vec<(String, f64)> = host_lines(&out, "output").into_iter().map(|v| (v[0].clone(), v[1].parse().unwrap())).collect();
-    assert_eq!(values.len(), 2 * 5, "two periods × 5 Real outputs");
+    // displacement, velocity, contact force and gap, lcp.residual, accuracy.estimate.
+    const REALS: usize = 6;
+    assert_eq!(values.len(), 2 * REALS, "two periods × {REALS} Real outputs");
     // The same calls through libloading give the same numbers (printed with %.17g: exact).
     let s = fmu.instantiate("c-host-twin").unwrap();
     s.init(0.0);
@@ -863,7 +867,7 @@ fn the_c_host_reads_what_the_rust_host_reads() {
     for i in 0..2 * k {
         assert_eq!(s.step(i as f64 * h, h), OK);
         if (i + 1) % k == 0 {
-            let period_values = &values[((i + 1) / k - 1) * 5..(i + 1) / k * 5];
+            let period_values = &values[((i + 1) / k - 1) * REALS..(i + 1) / k * REALS];
             for (name, v) in period_values {
                 assert_eq!(s.real(name), *v, "{name} after period {}", (i + 1) / k);
             }

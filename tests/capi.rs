@@ -139,6 +139,11 @@ fn the_c_example_links_solves_and_prints_what_the_rust_api_computes() {
     assert_eq!(out["scene.lcp_size"][0], "0");
     assert_close(&numbers(&out, "scene.x"), &r.displacement["0"], "scene.x");
     assert_close(&numbers(&out, "scene.v"), &r.velocity["0"], "scene.v");
+    // The error estimate of the C API is the Rust API's (a second solve at k/2).
+    let a = periodic_contact::analysis::accuracy::estimate(&p, &r);
+    assert_eq!(out["scene.accuracy"][0], "1", "estimated by default: {:?}", out["scene.accuracy_method"]);
+    assert_close(&numbers(&out, "scene.accuracy")[1..2], &[a.estimate.unwrap()], "scene.accuracy");
+    assert!(out["scene.accuracy_method"][0].starts_with("richardson"), "{:?}", out["scene.accuracy_method"]);
 
     // 2. frequency × 1.05 and force scale 2.
     let tuning = Tuning { frequency: 1.05 * 1.7, force_scale: 2.0, gap_offset: 0.0, motion_scale: 1.0 };

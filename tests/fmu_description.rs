@@ -27,7 +27,8 @@ fn set(v: &[&str]) -> BTreeSet<String> {
 
 #[test]
 fn variables_follow_the_effects() {
-    let common = ["frequency", "steps", "scheme", "frequency_in", "displacement[0]"];
+    // The error estimate of each solve is an output by default ([discretization] error_estimate).
+    let common = ["frequency", "steps", "scheme", "frequency_in", "displacement[0]", "accuracy.estimate", "accuracy.estimated"];
     // No force, no contact: only the frequency and the grid (no LCP, so no LCP diagnostics).
     assert_eq!(names(BASE), set(&common));
     // A force: its scale and input.
@@ -45,6 +46,10 @@ fn variables_follow_the_effects() {
     let n = names(&out);
     assert!(n.contains("velocity[0]") && n.contains("acceleration[0]") && !n.contains("displacement[0]") && !n.contains("contact[0].force"));
     assert!(n.contains("lcp.pivots"), "with a contact the LCP diagnostics are there, even without contact outputs");
+    assert!(!n.contains("accuracy.estimate"), "no displacement output, nothing to estimate");
+    // error_estimate = "none": no second solve, no accuracy outputs.
+    let fast = format!("{BASE}[discretization]\nerror_estimate = \"none\"\n");
+    assert_eq!(names(&fast), set(&common[..5]));
 }
 
 #[test]

@@ -160,12 +160,45 @@ fn fourier_interpolates_trigonometrically_the_continuous_response() {
     }
 }
 
+/// The FMU's error estimate lies within a factor of 10 of the true error of its samples against
+/// the exact continuous linear response (notes §6.1, `exact::LinearResponse`).
+#[test]
+fn the_error_estimate_output_is_within_a_factor_of_ten_of_the_true_error() {
+    let fmu = cds();
+    let s = fmu.instantiate("accuracy").unwrap();
+    s.init(0.0);
+    assert_eq!(s.integer("accuracy.estimated"), 1);
+    let estimate = s.real("accuracy.estimate");
+    let problem = periodic_contact::scene::Scene::parse(&linear("cds", 64), "t").unwrap().to_problem("t").unwrap();
+    let exact = periodic_contact::exact::LinearResponse::from_model(problem.model()).unwrap();
+    let r = problem.solve().unwrap();
+    let mut truth = 0.0f64;
+    for (j, &t) in r.time.iter().enumerate() {
+        let x = exact.displacement(t);
+        truth = truth.max((r.displacement["0"][j] - x[0]).abs()).max((r.displacement["1"][j] - x[1]).abs());
+    }
+    eprintln!("FMU accuracy.estimate {estimate:.3e}, true error {truth:.3e}");
+    assert!((0.1..=10.0).contains(&(estimate / truth)), "estimate {estimate:.3e} vs true error {truth:.3e}");
+}
+
 #[test]
 fn only_the_effects_the_scene_calls_for_have_variables() {
     let fmu = cds();
     let names: BTreeSet<&str> = fmu.vars.keys().map(String::as_str).collect();
-    let expected: BTreeSet<&str> =
-        ["frequency", "force_scale", "steps", "scheme", "frequency_in", "force_scale_in", "displacement[0]", "displacement[1]", "velocity[0]"].into();
+    let expected: BTreeSet<&str> = [
+        "frequency",
+        "force_scale",
+        "steps",
+        "scheme",
+        "frequency_in",
+        "force_scale_in",
+        "displacement[0]",
+        "displacement[1]",
+        "velocity[0]",
+        "accuracy.estimate",
+        "accuracy.estimated",
+    ]
+    .into();
     assert_eq!(names, expected);
     assert!(fmu.xml.contains("variableNamingConvention=\"structured\""));
     let s = fmu.instantiate("effects").unwrap();

@@ -5,4 +5,7 @@
 //! many times or post-process its responses: continuation of branches through folds, Floquet
 //! stability and bifurcations, and an event-fitted polish each go here as a module of their
 //! own, beside [`sweep`] (a sweep is the simplest continuation: fixed steps, no predictor).
+//! [`accuracy`] gives every result an error estimate.
+pub mod accuracy;
+pub mod polish;
 pub mod sweep;

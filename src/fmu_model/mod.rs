@@ -18,6 +18,7 @@
 //!
 //!   `fmi2GetRealOutputDerivatives` (order 1) is the exact time derivative of the interpolant:
 //!   for `displacement[d]` it is the velocity.
+use crate::analysis::accuracy;
 use crate::error::{Error, Result};
 use crate::fmi::state::{StateReader, StateWriter};
 use crate::fmi::{CoSimModel, DefaultExperiment, EventLog, ModelDescription};
@@ -93,6 +94,9 @@ pub struct ContactModel {
     values: Values,
     /// The solver session: the FFT plan and the warm start, updated at each re-solve.
     session: PeriodicSolver,
+    /// Each solve also estimates its error (a second solve at k/2): the scene's
+    /// `[discretization] error_estimate`, exposed as `accuracy.estimate`.
+    estimate: bool,
     solution: Option<Arc<Solution>>,
     /// τ(t) = t + phase_offset (mod T): keeps the phase continuous across frequency changes.
     phase_offset: f64,
@@ -113,7 +117,8 @@ impl ContactModel {
         let problem = built.problem;
         let shown = problem.outputs().clone();
         let model = problem.model();
-        let Variables { table: t, roles, outputs, units } = Variables::of(&problem, &built.labels);
+        let Variables { table: t, roles, outputs, units } = Variables::of(&problem, &built.labels, built.error_estimate);
+        let estimate = outputs.iter().any(|o| matches!(o, Output::Accuracy));
         let k = problem.discretization().steps;
         let mut base = problem.clone();
         // No rayon inside an FMU: its global pool would outlive the instance and keep the
@@ -150,6 +155,7 @@ impl ContactModel {
             start,
             values: start,
             session: PeriodicSolver::new(base.clone()),
+            estimate,
             base,
             solution: None,
             phase_offset: 0.0,
@@ -180,7 +186,10 @@ impl ContactModel {
             Some(s) => self.session.set_warm_start(&s.active_set),
             None => self.session.reset_warm_start(),
         }
-        let r = self.session.solve()?;
+        let mut r = self.session.solve()?;
+        if self.estimate {
+            r.accuracy = accuracy::estimate(self.session.problem(), &r);
+        }
         Ok(self.solution_of(cfg, self.session.problem(), &r, self.session.fft()))
     }
 
@@ -211,6 +220,8 @@ impl ContactModel {
                 Output::Gap(i) => Series::Linear(r.contacts[i].gap.clone()),
                 Output::Residual => Series::Constant(r.lcp.residual),
                 Output::Pivots => Series::Constant(r.lcp.pivots as f64),
+                Output::Accuracy => Series::Constant(r.accuracy.estimate.unwrap_or(0.0)),
+                Output::AccuracyAvailable => Series::Constant(f64::from(u8::from(r.accuracy.estimate.is_some()))),
             })
             .collect();
         Solution {

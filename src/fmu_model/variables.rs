@@ -39,6 +39,9 @@ pub(super) enum Output {
     Gap(usize),
     Residual,
     Pivots,
+    /// The error estimate of the last solve (`analysis::accuracy`) and whether there is one.
+    Accuracy,
+    AccuracyAvailable,
 }
 
 /// The table with the role of each value reference and the quantity of each output slot.
@@ -62,11 +65,20 @@ impl Variables {
 
     /// The variables of `problem` (the scene's, before the FMU changes its outputs), labelled
     /// with the scene's units and DOF names.
-    pub fn of(problem: &PeriodicProblem, labels: &Labels) -> Variables {
+    /// With `estimate`, the error estimate of each solve is an output too.
+    pub fn of(problem: &PeriodicProblem, labels: &Labels, estimate: bool) -> Variables {
         let mut b = Variables { table: VariableTable::new(), roles: Vec::new(), outputs: Vec::new(), units: Vec::new() };
         parameters(&mut b, problem, labels);
         inputs(&mut b, problem, labels);
         outputs(&mut b, problem, labels);
+        if estimate && !problem.outputs().displacement.is_empty() {
+            let kind = b.real(None, Quantity::Length, labels);
+            let what = "Error estimate of the last solve: max over the instants and displacement outputs, from a second solve at k/2 (Richardson); 0 when accuracy.estimated = 0";
+            b.output(Variable::output("accuracy.estimate", Discrete, kind, what), Output::Accuracy);
+            let kind = Kind::Integer { start: None, min: None, max: None };
+            let what = "1 when accuracy.estimate holds an estimate; 0 when none can be given (a scheme that does not converge for this contact, k/2 beyond the stability limit)";
+            b.output(Variable::output("accuracy.estimated", Discrete, kind, what), Output::AccuracyAvailable);
+        }
         b
     }
 

@@ -145,6 +145,8 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
         },
         warnings: problem.warnings(),
         timing_s: Default::default(),
+        accuracy: Default::default(),
+        polish: None,
         linear_displacement,
         active_set,
     })

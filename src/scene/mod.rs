@@ -17,7 +17,7 @@ mod units;
 
 pub use casing::Casing;
 pub use error::{BuildError, SceneError};
-pub use settings::{discretization, solver_settings};
+pub use settings::{discretization, error_estimate, solver_settings};
 pub use spec::*;
 
 use crate::fe::{Blade, DofMap};
@@ -49,6 +49,10 @@ pub struct SceneModel {
     pub labels: Labels,
     /// Wall times of the set-up [s].
     pub timings: BuildTimings,
+    /// `[discretization] error_estimate`: estimate the error of every result (default true).
+    pub error_estimate: bool,
+    /// `[discretization] polish`: refine by the event-fitted polish (default false).
+    pub polish: bool,
 }
 
 /// Wall times of [`Scene::build`] [s].
@@ -146,11 +150,12 @@ impl Scene {
 
         let (disc, auto) = discretization(&self.discretization)?;
         let solver = solver_settings(self.solver.as_ref())?;
+        let estimate = error_estimate(&self.discretization)?;
         let mut problem = outputs::problem(model, (disc, auto), outputs, map, solver)?;
         for (i, p) in pairings.into_iter().enumerate().filter(|(_, p)| p.is_some()) {
             problem.set_contact_pairing(i, p)?;
         }
         let timings = BuildTimings { structure: t_structure, reduction: t_reduction, total: t0.elapsed().as_secs_f64() };
-        Ok(SceneModel { problem, full, dofs, reduction, casing, contact_dofs, labels, timings })
+        Ok(SceneModel { problem, full, dofs, reduction, casing, contact_dofs, labels, timings, error_estimate: estimate, polish: self.discretization.polish })
     }
 }

@@ -204,6 +204,12 @@ pub struct DiscretizationSpec {
     #[serde(default = "default_steps")]
     pub steps: StepsSpec,
     pub pairing: Option<String>,
+    /// `"richardson"` (default: a second solve at k/2 estimates the error of every result) or
+    /// `"none"` (skip it, for speed).
+    pub error_estimate: Option<String>,
+    /// Refine the LCP's orbit by the event-fitted polish (default false).
+    #[serde(default)]
+    pub polish: bool,
 }
 
 /// `steps = 512` or `steps = "auto"`; anything else is kept to be refused naming the field.
@@ -234,7 +240,7 @@ fn default_steps() -> StepsSpec {
 
 impl Default for DiscretizationSpec {
     fn default() -> Self {
-        DiscretizationSpec { scheme: default_scheme(), steps: default_steps(), pairing: None }
+        DiscretizationSpec { scheme: default_scheme(), steps: default_steps(), pairing: None, error_estimate: None, polish: false }
     }
 }
 

@@ -1,5 +1,6 @@
 //! `solve` and the default run.
 use crate::{Failure, ensure_writable, write_output};
+use periodic_contact::analysis::{accuracy, polish};
 use periodic_contact::linalg::PeriodFft;
 use periodic_contact::periodic::PeriodicProblem;
 use periodic_contact::response::Response;
@@ -13,12 +14,38 @@ fn solve(problem: &PeriodicProblem) -> Result<Response, Failure> {
     problem.solve().map_err(|e| Failure::from(periodic_contact::Error::from(e)))
 }
 
-pub fn load(scene: &Path, frequency: Option<f64>) -> Result<PeriodicProblem, Failure> {
+/// What the CLI asks of a result beyond the solve: flags can only switch on (`--polish`) or
+/// off (`--no-estimate`) what the scene says.
+#[derive(Clone, Copy, Debug)]
+pub struct Refine {
+    pub estimate: bool,
+    pub polish: bool,
+}
+
+pub fn load(scene: &Path, frequency: Option<f64>, flags: Refine) -> Result<(PeriodicProblem, Refine), Failure> {
     let (mut s, dir) = Scene::load(scene).map_err(|e| Failure::input(e.to_string()))?;
     if let Some(f) = frequency {
         s.set_frequency(f);
     }
-    Ok(s.build_in(&scene.display().to_string(), &dir).map_err(|e| Failure::input(e.to_string()))?.problem)
+    let built = s.build_in(&scene.display().to_string(), &dir).map_err(|e| Failure::input(e.to_string()))?;
+    let refine = Refine { estimate: flags.estimate && built.error_estimate, polish: flags.polish || built.polish };
+    Ok((built.problem, refine))
+}
+
+/// The error estimate, then the polish (whose estimate replaces it), as `refine` asks.
+fn refine(problem: &PeriodicProblem, r: &mut Response, refine: Refine) {
+    if refine.estimate {
+        r.accuracy = accuracy::estimate(problem, r);
+    } else {
+        r.accuracy.method = "none: not requested (--no-estimate or error_estimate = \"none\")".to_string();
+    }
+    if refine.polish {
+        let n = r.warnings.len();
+        polish::apply(problem, r);
+        for w in &r.warnings[n..] {
+            eprintln!("warning: {w}");
+        }
+    }
 }
 
 /// The largest LCP `--export-lcp` writes: a dense .dat of N = 4096 is already 0.4 GB of text.
@@ -42,20 +69,26 @@ fn export_lcp(problem: &PeriodicProblem, path: &Path) -> Result<(), Failure> {
     Ok(())
 }
 
-pub fn run(scene: &Path, output: &Path, frequency: Option<f64>, export: Option<&Path>) -> Result<(), Failure> {
+pub fn run(scene: &Path, output: &Path, frequency: Option<f64>, export: Option<&Path>, flags: Refine) -> Result<(), Failure> {
     ensure_writable(output, "--output")?;
     if let Some(p) = export {
         ensure_writable(p, "--export-lcp")?;
     }
-    let problem = load(scene, frequency)?;
+    let (problem, flags) = load(scene, frequency, flags)?;
     if let Some(p) = export {
         export_lcp(&problem, p)?;
     }
     // Errors found while solving name the scene too (those of loading already do).
-    let r = solve(&problem).map_err(|f| Failure { message: format!("{}: {}", scene.display(), f.message), ..f })?;
+    let mut r = solve(&problem).map_err(|f| Failure { message: format!("{}: {}", scene.display(), f.message), ..f })?;
+    refine(&problem, &mut r, flags);
     let json = serde_json::to_string_pretty(&r).map_err(|e| Failure::solver(e.to_string()))?;
     write_output(output, &json)?;
     eprintln!("solver: {}", r.lcp.path);
+    match (r.accuracy.estimate, r.accuracy.relative) {
+        (Some(e), Some(rel)) => eprintln!("error estimate: {e:.3e} ({rel:.2e} of the peak-to-peak amplitude), {}", r.accuracy.method),
+        (Some(e), None) => eprintln!("error estimate: {e:.3e}, {}", r.accuracy.method),
+        _ => eprintln!("error estimate: {}", r.accuracy.method),
+    }
     if output.as_os_str() != "-" {
         eprintln!(
             "solved {}: LCP size {}, {} pivots, residual {:.2e}, {:.3} s → {}",

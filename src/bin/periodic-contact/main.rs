@@ -34,6 +34,13 @@ enum Command {
         /// Also write the scene's LCP (dense, Siconos .dat format) to this file, for peers.
         #[arg(long)]
         export_lcp: Option<PathBuf>,
+        /// Skip the error estimate (a second solve at k/2; on by default, or as
+        /// `[discretization] error_estimate` says).
+        #[arg(long)]
+        no_estimate: bool,
+        /// Refine the orbit by the event-fitted polish (also `[discretization] polish = true`).
+        #[arg(long)]
+        polish: bool,
     },
     /// Package a scene as an FMI 2.0 co-simulation FMU (needs `cargo build --release -p periodic-contact-fmu`).
     Fmu {
@@ -131,7 +138,9 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         None => cmd_solve::run_default(),
-        Some(Command::Solve { scene, output, frequency, export_lcp }) => cmd_solve::run(&scene, &output, frequency, export_lcp.as_deref()),
+        Some(Command::Solve { scene, output, frequency, export_lcp, no_estimate, polish }) => {
+            cmd_solve::run(&scene, &output, frequency, export_lcp.as_deref(), cmd_solve::Refine { estimate: !no_estimate, polish })
+        }
         Some(Command::Modes { scene, count }) => cmd_modes::run(&scene, count),
         Some(Command::Sweep(args)) => cmd_sweep::run(&args),
         Some(Command::Lcp { file, output, method, tolerance }) => cmd_lcp::run(&file, &output, &method, tolerance),

@@ -1,0 +1,101 @@
+//! An error estimate on every result: a second solve at k/2 and Richardson's extrapolation with
+//! the order the scheme has on this kind of contact (notes §3, README "Which scheme and pairing
+//! converge"). If the error is e_k ≈ C·h^p, then x_{k/2} − x_k ≈ C·h^p·(2^p − 1), so
+//! e_k ≈ max_j |x_{2j}^{(k)} − x_j^{(k/2)}| / (2^p − 1).
+//!
+//! Cost: the k/2 problem has half the LCP unknowns, so the estimate adds roughly a third to half
+//! of a solve; `[discretization] error_estimate = "none"` (CLI `--no-estimate`) skips it.
+use crate::model::Compliance;
+use crate::periodic::{PeriodicProblem, SolveError};
+use crate::response::{Accuracy, Response};
+use crate::time::{Discretization, Pairing, Scheme};
+
+/// Fewest forced instants in a row that count as a sticking arc (a pure impact loads one or two
+/// instants of a forward-paired scheme, its impulse spread over at most two steps).
+const STICK_RUN: usize = 4;
+
+/// The order of convergence of `problem`'s scheme on `r`'s contact regime and why (notes §3);
+/// `None` when the combination is known not to converge.
+pub fn expected_order(problem: &PeriodicProblem, r: &Response) -> (Option<f64>, String) {
+    let scheme = problem.discretization().scheme;
+    let smooth = scheme.order().map_or(2.0, f64::from); // fourier: ≈ 2 at the kink of a compliant force
+    let mut order = if scheme == Scheme::Fourier && r.contacts.is_empty() { 4.0 } else { smooth };
+    let mut why = vec![];
+    for (i, c) in problem.model().contacts.iter().enumerate() {
+        let pairing = problem.pairing_at(i);
+        let (p, what) = match c.compliance {
+            Compliance::Compliant { .. } if pairing == Pairing::Forward => (Some(1.0), "compliant, forward: lags one step"),
+            Compliance::Compliant { .. } => (Some(smooth), "compliant"),
+            Compliance::Rigid => match (scheme, pairing) {
+                (Scheme::Bds1, Pairing::Same) => (Some(1.0), "rigid"),
+                (Scheme::Cds | Scheme::Galerkin, Pairing::Forward) => {
+                    if r.contacts.get(i).is_some_and(|rc| longest_run(&rc.force) >= STICK_RUN) {
+                        (Some(2.0), "rigid with sticking")
+                    } else {
+                        (Some(1.0), "rigid, pure impacts: first order at best")
+                    }
+                }
+                _ => (None, "rigid: this scheme and pairing do not converge"),
+            },
+        };
+        match p {
+            Some(p) => order = order.min(p),
+            None => return (None, format!("contact[{i}] {what} ({scheme}, {pairing})")),
+        }
+        why.push(format!("contact[{i}] {what}"));
+    }
+    let why = if why.is_empty() { "no contact".to_string() } else { why.join(", ") };
+    (Some(order), why)
+}
+
+/// The longest run of instants with a positive force, cyclically.
+fn longest_run(force: &[f64]) -> usize {
+    let k = force.len();
+    if force.iter().all(|&f| f > 0.0) {
+        return k;
+    }
+    let (mut best, mut run) = (0, 0);
+    for j in 0..2 * k {
+        run = if force[j % k] > 0.0 { run + 1 } else { 0 };
+        best = best.max(run);
+    }
+    best
+}
+
+/// Estimates the error of `r` (solved from `problem`) by a second solve at k/2. The estimate is
+/// `None`, with the reason in `method`, when k is odd or too small, k/2 breaks the scheme's
+/// stability limit, the scheme does not converge for this contact, or the k/2 solve fails.
+pub fn estimate(problem: &PeriodicProblem, r: &Response) -> Accuracy {
+    let none = |why: String| Accuracy { estimate: None, relative: None, method: format!("none: {why}") };
+    let disc = problem.discretization();
+    let k = disc.steps;
+    if r.displacement.is_empty() {
+        return none("no displacement output to estimate".into());
+    }
+    let (order, why) = expected_order(problem, r);
+    let Some(p) = order else { return none(format!("{why}, so no error estimate is given")) };
+    if !k.is_multiple_of(2) || k / 2 < crate::periodic::MIN_STEPS {
+        return none(format!("richardson needs an even k ≥ {}, k = {k}", 2 * crate::periodic::MIN_STEPS));
+    }
+    let mut coarse = problem.clone();
+    if let Err(e) = coarse.set_discretization(Discretization { steps: k / 2, ..disc }) {
+        return none(format!("the k/2 = {} solve is refused: {e}", k / 2));
+    }
+    let rc = match coarse.solve() {
+        Ok(rc) => rc,
+        Err(e) => return none(format!("the k/2 = {} solve failed: {}", k / 2, short(&e))),
+    };
+    let (mut diff, mut ptp) = (0.0f64, 0.0f64);
+    for (key, x) in &r.displacement {
+        let Some(xc) = rc.displacement.get(key) else { continue };
+        diff = diff.max(xc.iter().enumerate().map(|(j, v)| (x[2 * j] - v).abs()).fold(0.0, f64::max));
+        ptp = ptp.max(Response::peak_to_peak(x));
+    }
+    let e = diff / (2f64.powf(p) - 1.0);
+    Accuracy { estimate: Some(e), relative: (ptp > 0.0).then(|| e / ptp), method: format!("richardson: k/2 = {}, order {p} ({}, {why})", k / 2, disc.scheme) }
+}
+
+fn short(e: &SolveError) -> String {
+    let s = e.to_string();
+    s.split(':').next().unwrap_or(&s).to_string()
+}

@@ -1,0 +1,143 @@
+//! The event sequence of an orbit, read from the LCP's solution: a rigid contact's run of forced
+//! instants is an impact followed by a sticking arc and a release (or a pure impact when the run
+//! is short); a compliant contact's run of penetrating instants is contact on, then off.
+use crate::model::Model;
+use crate::response::Response;
+
+/// What happens at an event.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EventKind {
+    /// Plastic impact (e = 0); `stick`: the contact stays closed after it.
+    Impact {
+        stick: bool,
+    },
+    /// A stuck rigid contact leaves its obstacle (its force reaches 0).
+    Release,
+    /// A compliant contact closes / opens (its clearance crosses 0).
+    On,
+    Off,
+}
+
+impl EventKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            EventKind::Impact { .. } => "impact",
+            EventKind::Release => "release",
+            EventKind::On => "contact_on",
+            EventKind::Off => "contact_off",
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Event {
+    pub contact: usize,
+    pub kind: EventKind,
+    /// Seed time in [0, T).
+    pub seed: f64,
+}
+
+/// Fewest forced instants in a row read as a sticking arc rather than a pure impact (a pure impact
+/// loads one or two instants of a forward-paired scheme).
+const STICK_RUN: usize = 4;
+
+/// Cyclic runs [start, end] (inclusive) of `on` over k instants; `None` when every instant is on.
+fn runs(on: &[bool]) -> Option<Vec<(usize, usize)>> {
+    let k = on.len();
+    if on.iter().all(|&b| b) {
+        return None;
+    }
+    let first_off = on.iter().position(|&b| !b).expect("some off");
+    let mut out = Vec::new();
+    let mut j = 0;
+    while j < k {
+        let idx = (first_off + j) % k;
+        if on[idx] {
+            let start = idx;
+            let mut len = 0;
+            while on[(start + len) % k] {
+                len += 1;
+            }
+            out.push((start, (start + len - 1) % k));
+            j += len;
+        } else {
+            j += 1;
+        }
+    }
+    Some(out)
+}
+
+/// The events of `r`, sorted by seed time, and the contacts closed all period long (stuck rigid
+/// or closed compliant: they have no event).
+pub fn from_response(model: &Model, r: &Response, offsets: &[usize]) -> (Vec<Event>, Vec<usize>) {
+    let (k, period) = (r.steps, r.period);
+    let h = period / k as f64;
+    let mut events = Vec::new();
+    let mut always = Vec::new();
+    for (i, (c, rc)) in model.contacts.iter().zip(&r.contacts).enumerate() {
+        let t = |j: f64| (j * h).rem_euclid(period);
+        if c.is_rigid() {
+            let big = rc.force.iter().fold(0.0f64, |m, &f| m.max(f));
+            let on: Vec<bool> = rc.force.iter().map(|&f| f > 1e-12 * big.max(1e-300)).collect();
+            let Some(runs) = runs(&on) else {
+                always.push(i);
+                continue;
+            };
+            let s = offsets[i] as f64;
+            for (a, b) in runs {
+                let len = (b + k - a) % k + 1;
+                let stick = len >= STICK_RUN;
+                // The impulse of step a acts at about t_{a+s} (its paired instant), half a step earlier.
+                events.push(Event { contact: i, kind: EventKind::Impact { stick }, seed: t(a as f64 + s - 0.5) });
+                if stick {
+                    events.push(Event { contact: i, kind: EventKind::Release, seed: t(b as f64 + s) });
+                }
+            }
+        } else {
+            let on: Vec<bool> = rc.gap.iter().map(|&g| g < 0.0).collect();
+            let Some(runs) = runs(&on) else {
+                always.push(i);
+                continue;
+            };
+            // The clearance crosses 0 between the last open and the first closed instant.
+            let cross = |j0: usize, j1: usize| {
+                let (g0, g1) = (rc.gap[j0], rc.gap[j1]);
+                j0 as f64 + (g0 / (g0 - g1)).clamp(0.0, 1.0)
+            };
+            for (a, b) in runs {
+                events.push(Event { contact: i, kind: EventKind::On, seed: t(cross((a + k - 1) % k, a)) });
+                events.push(Event { contact: i, kind: EventKind::Off, seed: t(cross(b, (b + 1) % k)) });
+            }
+        }
+    }
+    events.sort_by(|a, b| a.seed.total_cmp(&b.seed));
+    (events, always)
+}
+
+/// The contacts closed (stuck rigid, closed compliant) in the phase after each event: each
+/// contact is closed after its own last event of the sequence before wrapping around.
+pub fn phase_sets(model: &Model, events: &[Event], always: &[usize]) -> Vec<Vec<usize>> {
+    let m = model.contacts.len();
+    let mut closed = vec![false; m];
+    for &i in always {
+        closed[i] = true;
+    }
+    // The state before event 0 is the state after each contact's last event.
+    for e in events {
+        closed[e.contact] = after(e.kind);
+    }
+    let mut out = Vec::with_capacity(events.len());
+    for e in events {
+        closed[e.contact] = after(e.kind);
+        out.push((0..m).filter(|&i| closed[i]).collect());
+    }
+    out
+}
+
+fn after(kind: EventKind) -> bool {
+    match kind {
+        EventKind::Impact { stick } => stick,
+        EventKind::Release | EventKind::Off => false,
+        EventKind::On => true,
+    }
+}

@@ -1,0 +1,438 @@
+//! The shooting equations of an event sequence, their Newton solve, the monodromy, and the
+//! polished orbit's values at any time.
+use super::PolishFailure;
+use super::events::{self, Event, EventKind};
+use super::phase::{self, Phase};
+use crate::model::Model;
+use crate::periodic::PeriodicProblem;
+use crate::response::{EventRecord, Response};
+use nalgebra::{DMatrix, DVector};
+
+const MAX_ITERATIONS: usize = 40;
+
+/// One period flowed: the state back at event 0, the event conditions, the state after each
+/// event and each event's impulse.
+struct Shot {
+    end: DVector<f64>,
+    conditions: Vec<f64>,
+    after: Vec<DVector<f64>>,
+    impulses: Vec<f64>,
+}
+
+/// A periodic orbit made of exact linear phases between events.
+#[derive(Clone, Debug)]
+pub struct PolishedOrbit {
+    pub(super) model: Model,
+    pub(super) period: f64,
+    pub(super) events: Vec<Event>,
+    /// Event times, increasing, times[0] ∈ [0, T) (a single 0 when there is no event).
+    pub(super) times: Vec<f64>,
+    /// The phase after each event (phases[e] runs from times[e] to times[e+1]).
+    pub(super) phases: Vec<Phase>,
+    /// Full state [x; v] just after event 0.
+    pub(super) y0: DVector<f64>,
+    /// State just after each event, and the impulse of each (0 but at impacts).
+    pub(super) after: Vec<DVector<f64>>,
+    pub(super) impulses: Vec<f64>,
+    gaps: Vec<phase::Harmonics>,
+    iterations: usize,
+    residual: f64,
+    correction: f64,
+    monodromy: DMatrix<f64>,
+}
+
+impl PolishedOrbit {
+    pub(super) fn solve(model: &Model, evs: Vec<Event>, always: &[usize]) -> Result<Self, PolishFailure> {
+        let sets = events::phase_sets(model, &evs, always);
+        let mut phases = Vec::new();
+        let empty = vec![always.to_vec()];
+        for set in if evs.is_empty() { &empty } else { &sets } {
+            let stuck: Vec<usize> = set.iter().copied().filter(|&i| model.contacts[i].is_rigid()).collect();
+            let closed: Vec<usize> = set.iter().copied().filter(|&i| !model.contacts[i].is_rigid()).collect();
+            phases.push(
+                Phase::new(model, &stuck, &closed)
+                    .ok_or_else(|| PolishFailure("a phase's operator is singular at a forcing harmonic (undamped resonance)".into()))?,
+            );
+        }
+        let mut dofs: Vec<usize> = model.contacts.iter().map(|c| c.dof).collect();
+        dofs.sort_unstable();
+        if dofs.windows(2).any(|w| w[0] == w[1]) {
+            return Err(PolishFailure("two contacts act on the same DOF".into()));
+        }
+        let gaps = (0..model.contacts.len()).map(|i| phase::gap_harmonics(model, i)).collect();
+        let times = if evs.is_empty() { vec![0.0] } else { evs.iter().map(|e| e.seed).collect() };
+        let n = model.n();
+        let mut o = PolishedOrbit {
+            model: model.clone(),
+            period: model.period(),
+            events: evs,
+            times,
+            phases,
+            y0: DVector::zeros(2 * n),
+            after: vec![],
+            impulses: vec![],
+            gaps,
+            iterations: 0,
+            residual: f64::INFINITY,
+            correction: f64::INFINITY,
+            monodromy: DMatrix::zeros(2 * n, 2 * n),
+        };
+        o.newton()?;
+        Ok(o)
+    }
+
+    fn gap(&self, i: usize, t: f64, order: u32) -> f64 {
+        let w = self.model.frequency;
+        self.gaps[i]
+            .iter()
+            .map(|(p, a)| (a[0] * num_complex::Complex64::from_polar(1.0, *p as f64 * w * t) * num_complex::Complex64::new(0.0, *p as f64 * w).powu(order)).re)
+            .sum()
+    }
+
+    /// Clearance of contact `i` in state `y` at `t`: gap(t) − s·x_d.
+    pub(super) fn clearance(&self, i: usize, y: &DVector<f64>, t: f64) -> f64 {
+        let c = &self.model.contacts[i];
+        self.gap(i, t, 0) - c.direction * y[c.dof]
+    }
+
+    /// Plastic impact of contact `i` at `t`, the contacts `stuck` staying on their obstacles:
+    /// v⁺ = v⁻ − M⁻¹Bᵀ P with B v⁺ = ġ (notes §5's forward increment, in one instant).
+    fn impact(&self, i: usize, stuck: &[usize], y: &DVector<f64>, t: f64) -> Option<(DVector<f64>, f64)> {
+        let n = self.model.n();
+        let mut set: Vec<usize> = stuck.to_vec();
+        if !set.contains(&i) {
+            set.push(i);
+        }
+        let m_inv = phase::dense(&self.model.structure.mass, n).try_inverse()?;
+        let b = DMatrix::from_fn(set.len(), n, |r, d| {
+            let c = &self.model.contacts[set[r]];
+            if c.dof == d { c.direction } else { 0.0 }
+        });
+        let v = y.rows(n, n).into_owned();
+        let rhs = &b * &v - DVector::from_fn(set.len(), |r, _| self.gap(set[r], t, 1));
+        let p = (&b * &m_inv * b.transpose()).lu().solve(&rhs)?;
+        let mut out = y.clone();
+        let dv = &m_inv * b.transpose() * &p;
+        for d in 0..n {
+            out[n + d] -= dv[d];
+        }
+        let k = set.iter().position(|&c| c == i).expect("pushed");
+        Some((out, p[k]))
+    }
+
+    /// One period from `y0` with event times `tau`: the state after the last event (back at
+    /// event 0), the event conditions, the states after each event and the impulses.
+    fn shoot(&self, y0: &DVector<f64>, tau: &[f64]) -> Option<Shot> {
+        self.shoot_to(y0, tau, tau[0] + self.period)
+    }
+
+    /// [`Self::shoot`] with event 0 coming back at `ret` instead of tau[0] + T.
+    fn shoot_to(&self, y0: &DVector<f64>, tau: &[f64], ret: f64) -> Option<Shot> {
+        let ne = self.events.len();
+        if ne == 0 {
+            let end = self.phases[0].flow(0.0, y0, self.period);
+            return Some(Shot { end, conditions: vec![], after: vec![y0.clone()], impulses: vec![0.0] });
+        }
+        let (mut g, mut after, mut imp) = (vec![0.0; ne], vec![y0.clone(); ne], vec![0.0; ne]);
+        let mut y = y0.clone();
+        for e in 0..ne {
+            let (t0, t1) = (tau[e], if e + 1 < ne { tau[e + 1] } else { ret });
+            let ph = &self.phases[e];
+            let ym = ph.flow(t0, &y, t1);
+            let next = (e + 1) % ne;
+            let ev = self.events[next];
+            g[next] = match ev.kind {
+                EventKind::Release => ph.stuck_forces(&ym, t1).into_iter().find(|(c, _)| *c == ev.contact)?.1,
+                _ => self.clearance(ev.contact, &ym, t1),
+            };
+            y = match ev.kind {
+                EventKind::Impact { .. } => {
+                    let stuck: Vec<usize> = ph.stuck_contacts().collect();
+                    let (yp, p) = self.impact(ev.contact, &stuck, &ym, t1)?;
+                    imp[next] = p;
+                    yp
+                }
+                _ => ym,
+            };
+            after[next] = y.clone();
+        }
+        Some(Shot { end: y, conditions: g, after, impulses: imp })
+    }
+
+    fn residual_of(&self, u: &DVector<f64>) -> Option<DVector<f64>> {
+        let n2 = 2 * self.model.n();
+        let y0 = u.rows(0, n2).into_owned();
+        let tau: Vec<f64> = u.iter().skip(n2).copied().collect();
+        let tau = if tau.is_empty() { vec![0.0] } else { tau };
+        let Shot { end: y, conditions: g, .. } = self.shoot(&y0, &tau)?;
+        let mut r = DVector::zeros(u.len());
+        r.rows_mut(0, n2).copy_from(&(y - y0));
+        for (i, v) in g.iter().enumerate() {
+            r[n2 + i] = *v;
+        }
+        Some(r)
+    }
+
+    fn jacobian(&self, u: &DVector<f64>, scale: &DVector<f64>) -> Option<DMatrix<f64>> {
+        let len = u.len();
+        let mut j = DMatrix::zeros(len, len);
+        for c in 0..len {
+            let h = 1e-7 * scale[c];
+            let (mut up, mut dn) = (u.clone(), u.clone());
+            up[c] += h;
+            dn[c] -= h;
+            let col = (self.residual_of(&up)? - self.residual_of(&dn)?) / (2.0 * h);
+            j.set_column(c, &col);
+        }
+        Some(j)
+    }
+
+    fn ordered(&self, u: &DVector<f64>) -> bool {
+        let n2 = 2 * self.model.n();
+        let tau: Vec<f64> = u.iter().skip(n2).copied().collect();
+        tau.windows(2).all(|w| w[0] < w[1]) && tau.last().is_none_or(|&l| l < tau[0] + self.period)
+    }
+
+    fn newton(&mut self) -> Result<(), PolishFailure> {
+        let n2 = 2 * self.model.n();
+        let ne = self.events.len();
+        let fail = |w: &str| PolishFailure(w.to_string());
+        // Seed: the fixed point of the affine one-period map at the seeded times.
+        let zero = DVector::zeros(n2);
+        let c = self.shoot(&zero, &self.times).ok_or_else(|| fail("the seeded event sequence cannot be flowed"))?.end;
+        let mut phi = DMatrix::zeros(n2, n2);
+        for k in 0..n2 {
+            let mut e = zero.clone();
+            e[k] = 1.0;
+            phi.set_column(k, &(self.shoot(&e, &self.times).ok_or_else(|| fail("the seeded flow failed"))?.end - &c));
+        }
+        let y0 = (DMatrix::identity(n2, n2) - &phi).lu().solve(&c).ok_or_else(|| fail("the seeded one-period map has a multiplier 1"))?;
+        let mut u = DVector::zeros(n2 + ne);
+        u.rows_mut(0, n2).copy_from(&y0);
+        for (i, &t) in self.times.iter().take(ne).enumerate() {
+            u[n2 + i] = t;
+        }
+        let ys = y0.amax().max(1e-300);
+        let scale = DVector::from_fn(n2 + ne, |i, _| if i < n2 { ys } else { self.period });
+        let mut r = self.residual_of(&u).ok_or_else(|| fail("the seeded event sequence cannot be flowed"))?;
+        let mut converged = false;
+        for it in 0..MAX_ITERATIONS {
+            let jac = self.jacobian(&u, &scale).ok_or_else(|| fail("the Jacobian could not be formed"))?;
+            let du = jac.lu().solve(&(-&r)).ok_or_else(|| fail("the shooting Jacobian is singular (a grazing or degenerate event sequence)"))?;
+            let mut lambda = 1.0;
+            let (next, rn) = loop {
+                let cand = &u + &du * lambda;
+                if self.ordered(&cand)
+                    && let Some(rc) = self.residual_of(&cand)
+                    && (rc.amax() < r.amax() || rc.amax() < 1e-13 * ys.max(1.0))
+                {
+                    break (cand, rc);
+                }
+                lambda *= 0.5;
+                if lambda < 1e-4 {
+                    return Err(fail("Newton stalled: the LCP's event sequence does not lead to an exact orbit (events merge or reorder)"));
+                }
+            };
+            let step = du.iter().enumerate().map(|(i, v)| (v * lambda).abs() / scale[i]).fold(0.0, f64::max);
+            self.correction = du.rows(0, self.model.n()).amax() * lambda;
+            u = next;
+            r = rn;
+            self.iterations = it + 1;
+            if step < 1e-14 || (step < 1e-11 && r.amax() < 1e-12 * ys.max(1.0)) {
+                converged = true;
+                break;
+            }
+        }
+        if !converged {
+            return Err(fail(&format!("Newton did not converge in {MAX_ITERATIONS} iterations (residual {:.2e})", r.amax())));
+        }
+        self.residual = r.amax();
+        // Times into [0, T): a shift by whole periods changes nothing.
+        let shift = (u[n2.min(u.len() - 1)] / self.period).floor() * self.period;
+        self.y0 = u.rows(0, n2).into_owned();
+        if ne > 0 {
+            self.times = u.iter().skip(n2).map(|t| t - shift).collect();
+        }
+        let shot = self.shoot(&self.y0, &self.times).ok_or_else(|| fail("the converged orbit cannot be flowed"))?;
+        self.after = shot.after;
+        self.impulses = shot.impulses;
+        self.monodromy = self.stroboscopic().ok_or_else(|| fail("the monodromy could not be formed (an event condition is singular in its time: grazing)"))?;
+        Ok(())
+    }
+
+    /// The one-period map at the fixed time s = times[0] (just after event 0), z ↦ y(s + T),
+    /// its events relocated for every z: with w the other event times and event 0's return,
+    /// G(z, w) = 0, and dy/dz = ∂y/∂z − ∂y/∂w·G_w⁻¹·G_z (finite differences, central, 1e-7
+    /// relative).
+    fn stroboscopic(&self) -> Option<DMatrix<f64>> {
+        let n2 = 2 * self.model.n();
+        let ne = self.events.len();
+        let (s, t) = (self.times[0], self.period);
+        let parts = |z: &DVector<f64>, w: &[f64]| -> Option<(DVector<f64>, Vec<f64>)> {
+            if ne == 0 {
+                return Some((self.phases[0].flow(s, z, s + t), vec![]));
+            }
+            let tau: Vec<f64> = std::iter::once(s).chain(w[..ne - 1].iter().copied()).collect();
+            let shot = self.shoot_to(z, &tau, w[ne - 1])?;
+            Some((self.phases[0].flow(w[ne - 1], &shot.end, s + t), shot.conditions))
+        };
+        let w0: Vec<f64> = self.times.iter().skip(1).copied().chain(std::iter::once(s + t)).take(ne).collect();
+        let ys = self.y0.amax().max(1e-300);
+        let (mut yz, mut gz) = (DMatrix::zeros(n2, n2), DMatrix::zeros(ne, n2));
+        for c in 0..n2 {
+            let h = 1e-7 * ys;
+            let (mut up, mut dn) = (self.y0.clone(), self.y0.clone());
+            up[c] += h;
+            dn[c] -= h;
+            let ((a, ga), (b, gb)) = (parts(&up, &w0)?, parts(&dn, &w0)?);
+            yz.set_column(c, &((a - b) / (2.0 * h)));
+            for r in 0..ne {
+                gz[(r, c)] = (ga[r] - gb[r]) / (2.0 * h);
+            }
+        }
+        if ne == 0 {
+            return Some(yz);
+        }
+        let (mut yw, mut gw) = (DMatrix::zeros(n2, ne), DMatrix::zeros(ne, ne));
+        for c in 0..ne {
+            let h = 1e-7 * t;
+            let (mut up, mut dn) = (w0.clone(), w0.clone());
+            up[c] += h;
+            dn[c] -= h;
+            let ((a, ga), (b, gb)) = (parts(&self.y0, &up)?, parts(&self.y0, &dn)?);
+            yw.set_column(c, &((a - b) / (2.0 * h)));
+            for r in 0..ne {
+                gw[(r, c)] = (ga[r] - gb[r]) / (2.0 * h);
+            }
+        }
+        Some(yz - yw * gw.lu().solve(&gz)?)
+    }
+
+    /// Newton iterations, final residual (max norm of periodicity and event conditions) and the
+    /// last displacement correction.
+    pub fn iterations(&self) -> usize {
+        self.iterations
+    }
+    pub fn residual(&self) -> f64 {
+        self.residual
+    }
+    pub fn correction(&self) -> f64 {
+        self.correction
+    }
+
+    /// The monodromy matrix (2n×2n, state [x; v]): the derivative of the one-period map at the
+    /// fixed time [`Self::section_time`] (just after the first event), the events relocated
+    /// (finite differences, step 1e-7 relative). Its eigenvalues are the orbit's Floquet
+    /// multipliers (a plastic impact adds zeros).
+    pub fn monodromy(&self) -> &DMatrix<f64> {
+        &self.monodromy
+    }
+
+    /// The section's time: the first event's (0 without events).
+    pub fn section_time(&self) -> f64 {
+        self.times[0]
+    }
+
+    /// Events with their times in [0, T) and impulses.
+    pub fn event_records(&self) -> Vec<EventRecord> {
+        self.events
+            .iter()
+            .zip(&self.times)
+            .zip(&self.impulses)
+            .map(|((e, &t), &p)| EventRecord { time: t.rem_euclid(self.period), contact: e.contact, kind: e.kind.name().into(), impulse: p })
+            .collect()
+    }
+
+    /// The phase index and its start time for time `t` (any real).
+    pub(super) fn locate(&self, t: f64) -> (usize, f64) {
+        let t0 = self.times[0];
+        let tt = t0 + (t - t0).rem_euclid(self.period);
+        let e = self.times.iter().rposition(|&s| s <= tt).unwrap_or(0);
+        (e, tt)
+    }
+
+    /// Full state [x; v] at `t`.
+    pub fn state(&self, t: f64) -> DVector<f64> {
+        let (e, tt) = self.locate(t);
+        self.phases[e].flow(self.times[e], &self.after[e], tt)
+    }
+
+    /// Acceleration of every DOF at `t` (between events).
+    pub fn acceleration(&self, t: f64) -> DVector<f64> {
+        let (e, tt) = self.locate(t);
+        self.phases[e].acceleration(&self.state(tt), tt)
+    }
+
+    /// Compressive force of contact `i` at `t`: a stuck rigid contact's force, a closed compliant
+    /// contact's stiffness times penetration, else 0 (impulses are in [`Self::event_records`]).
+    pub fn contact_force(&self, i: usize, t: f64) -> f64 {
+        let (e, tt) = self.locate(t);
+        let y = self.state(tt);
+        match self.model.contacts[i].compliance {
+            crate::model::Compliance::Compliant { stiffness } => stiffness * (-self.clearance(i, &y, tt)).max(0.0),
+            crate::model::Compliance::Rigid => self.phases[e].stuck_forces(&y, tt).into_iter().find(|(c, _)| *c == i).map_or(0.0, |(_, z)| z),
+        }
+    }
+
+    /// ∫ of contact `i`'s force over [a, b] plus the impulses in [a, b), by 5-point Gauss–Legendre
+    /// on each piece between events.
+    fn force_integral(&self, i: usize, a: f64, b: f64) -> f64 {
+        const X: [f64; 5] = [0.0, -0.538_469_310_105_683, 0.538_469_310_105_683, -0.906_179_845_938_664, 0.906_179_845_938_664];
+        const W: [f64; 5] = [0.568_888_888_888_889, 0.478_628_670_499_366, 0.478_628_670_499_366, 0.236_926_885_056_189, 0.236_926_885_056_189];
+        let mut cuts = vec![a, b];
+        let mut total = 0.0;
+        for (e, (&t, &p)) in self.times.iter().zip(&self.impulses).enumerate() {
+            for tk in [t - self.period, t, t + self.period] {
+                if tk >= a && tk < b {
+                    cuts.push(tk);
+                    if self.events.get(e).is_some_and(|ev| ev.contact == i) {
+                        total += p;
+                    }
+                }
+            }
+        }
+        cuts.sort_by(f64::total_cmp);
+        for w in cuts.windows(2) {
+            let (c, h) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
+            if h > 0.0 {
+                total += h * X.iter().zip(W).map(|(x, wt)| wt * self.contact_force(i, c + h * x)).sum::<f64>();
+            }
+        }
+        total
+    }
+
+    /// Replaces `r`'s series by this orbit's at the same instants t_j: displacement, velocity and
+    /// acceleration outputs, clearances, and forces (rigid: impulse per step divided by h,
+    /// as the LCP reports them; compliant: the force at t_j).
+    pub fn write(&self, problem: &PeriodicProblem, r: &mut Response) {
+        let n = self.model.n();
+        let h = r.period / r.steps as f64;
+        let states: Vec<DVector<f64>> = r.time.iter().map(|&t| self.state(t)).collect();
+        let accs: Vec<DVector<f64>> = if r.acceleration.is_empty() { vec![] } else { r.time.iter().map(|&t| self.acceleration(t)).collect() };
+        let label = |key: &str, v: &DVector<f64>, off: usize| -> f64 {
+            let l: usize = key.parse().unwrap_or(usize::MAX);
+            match problem.output_map() {
+                Some(map) => map.rows.get(&l).map_or(f64::NAN, |row| row.iter().map(|&(d, c)| c * v[off + d]).sum()),
+                None => v.get(off + l).copied().unwrap_or(f64::NAN),
+            }
+        };
+        for (key, series) in r.displacement.iter_mut() {
+            series.iter_mut().zip(&states).for_each(|(x, y)| *x = label(key, y, 0));
+        }
+        for (key, series) in r.velocity.iter_mut() {
+            series.iter_mut().zip(&states).for_each(|(x, y)| *x = label(key, y, n));
+        }
+        for (key, series) in r.acceleration.iter_mut() {
+            series.iter_mut().zip(&accs).for_each(|(x, a)| *x = label(key, a, 0));
+        }
+        for (i, rc) in r.contacts.iter_mut().enumerate() {
+            for (j, &t) in r.time.iter().enumerate() {
+                rc.gap[j] = self.clearance(i, &states[j], t);
+                rc.force[j] = if self.model.contacts[i].is_rigid() { self.force_integral(i, t, t + h) / h } else { self.contact_force(i, t) };
+            }
+            let s = problem.pairing_at(i).offset();
+            let k = rc.gap.len();
+            rc.paired_gap = (0..k).map(|j| rc.gap[(j + s) % k]).collect();
+        }
+    }
+}

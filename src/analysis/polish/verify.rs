@@ -1,0 +1,104 @@
+//! Is the polished orbit admissible? Between events: the clearance of every free rigid contact
+//! ≥ 0, the force of every stuck one ≥ 0, a closed compliant contact penetrating and an open one
+//! not. Each function is sampled densely on every phase and minimised around each sampled local
+//! minimum (golden section), so that a dip between samples is found too. At the events:
+//! impulses ≥ 0, and a pure impact may not call for sticking (the force that would hold the
+//! contact just after it must not be compressive).
+use super::PolishFailure;
+use super::events::EventKind;
+use super::orbit::PolishedOrbit;
+use super::phase::Phase;
+use nalgebra::DVector;
+
+/// Samples per phase before the local refinement.
+const SAMPLES: usize = 200;
+/// Relative tolerance of the sign checks (of the clearance scale, of the force scale).
+const TOL: f64 = 1e-9;
+
+/// The smallest value of `f` over [a, b]: dense samples, then golden section around each
+/// sampled local minimum.
+fn minimum(a: f64, b: f64, f: &dyn Fn(f64) -> f64) -> (f64, f64) {
+    let ts: Vec<f64> = (0..=SAMPLES).map(|i| a + (b - a) * i as f64 / SAMPLES as f64).collect();
+    let vs: Vec<f64> = ts.iter().map(|&t| f(t)).collect();
+    let mut best = (vs[0], ts[0]);
+    for i in 0..ts.len() {
+        if vs[i] < best.0 {
+            best = (vs[i], ts[i]);
+        }
+        if i > 0 && i + 1 < ts.len() && vs[i] <= vs[i - 1] && vs[i] <= vs[i + 1] {
+            let (mut lo, mut hi) = (ts[i - 1], ts[i + 1]);
+            let g = 0.5 * (5f64.sqrt() - 1.0);
+            for _ in 0..60 {
+                let (c, d) = (hi - g * (hi - lo), lo + g * (hi - lo));
+                if f(c) < f(d) { hi = d } else { lo = c }
+            }
+            let t = 0.5 * (lo + hi);
+            let v = f(t);
+            if v < best.0 {
+                best = (v, t);
+            }
+        }
+    }
+    best
+}
+
+pub(super) fn check(o: &PolishedOrbit) -> Result<(), PolishFailure> {
+    let model = &o.model;
+    let ne = o.events.len().max(1);
+    // Scales: the largest displacement of a contact DOF and the largest force met.
+    let xs = o.after.iter().flat_map(|y| model.contacts.iter().map(move |c| y[c.dof].abs())).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
+    let loads: f64 = model.forces.iter().map(|f| f.term.amplitude.abs()).sum();
+    let fs = o.impulses.iter().fold(loads, |m, p| m.max(p.abs() * model.frequency)).max(f64::MIN_POSITIVE);
+    for (e, &p) in o.impulses.iter().enumerate() {
+        if p < -TOL * fs / model.frequency {
+            return Err(PolishFailure(format!("the impact of contact[{}] at t = {:.6} would pull (impulse {p:.3e})", o.events[e].contact, o.times[e])));
+        }
+    }
+    for e in 0..ne {
+        let (a, b) = (o.times[e], if e + 1 < o.events.len() { o.times[e + 1] } else { o.times[0] + o.period });
+        let ph: &Phase = &o.phases[e];
+        let y0 = &o.after[e];
+        let state = |t: f64| ph.flow(a, y0, t);
+        let stuck: Vec<usize> = ph.stuck_contacts().collect();
+        for (i, c) in model.contacts.iter().enumerate() {
+            let (v, t, what) = if stuck.contains(&i) {
+                let (v, t) = minimum(a, b, &|t| ph.stuck_forces(&state(t), t).into_iter().find(|(k, _)| *k == i).map_or(0.0, |(_, z)| z));
+                (v / fs, t, "force")
+            } else if c.is_rigid() {
+                let (v, t) = minimum(a, b, &|t| o.clearance(i, &state(t), t));
+                (v / xs, t, "clearance")
+            } else {
+                let closed = o.phases[e].closed(i);
+                let sign = if closed { -1.0 } else { 1.0 };
+                let (v, t) = minimum(a, b, &|t| sign * o.clearance(i, &state(t), t));
+                (v / xs, t, if closed { "penetration of the closed compliant contact" } else { "clearance of the open compliant contact" })
+            };
+            if v < -TOL {
+                return Err(PolishFailure(format!(
+                    "contact[{i}]: the {what} is negative ({:.3e} relative) at t = {:.6} between the events at {a:.6} and {b:.6}: the LCP's event sequence is not admissible for the exact orbit",
+                    v,
+                    t.rem_euclid(o.period)
+                )));
+            }
+        }
+    }
+    // A pure impact must not call for sticking: the force that would hold the contact is ≤ 0.
+    for (e, ev) in o.events.iter().enumerate() {
+        if ev.kind == (EventKind::Impact { stick: false }) {
+            let mut stuck: Vec<usize> = o.phases[e].stuck_contacts().collect();
+            stuck.push(ev.contact);
+            let closed: Vec<usize> = (0..model.contacts.len()).filter(|&i| o.phases[e].closed(i)).collect();
+            let Some(hold) = Phase::new(model, &stuck, &closed) else { continue };
+            let y: &DVector<f64> = &o.after[e];
+            let z = hold.stuck_forces(y, o.times[e]).into_iter().find(|(k, _)| *k == ev.contact).map_or(0.0, |(_, z)| z);
+            if z > TOL * fs {
+                return Err(PolishFailure(format!(
+                    "contact[{}]: after the impact at t = {:.6} the contact would stick (holding force {z:.3e} > 0), but the LCP showed no sticking arc; refine steps",
+                    ev.contact,
+                    o.times[e].rem_euclid(o.period)
+                )));
+            }
+        }
+    }
+    Ok(())
+}

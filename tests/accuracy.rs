@@ -1,0 +1,73 @@
+//! Error estimates (`analysis::accuracy`) against the true error, measured on the exact
+//! references of notes §6 (`periodic_contact::exact`, independent of the solver): the estimate
+//! must lie within a factor of 10 of max_j |x_j − x(t_j)| at k = 512.
+use periodic_contact::analysis::accuracy;
+use periodic_contact::exact::{CompliantStopOrbit, Oscillator, RigidRegime, RigidStopOrbit};
+use periodic_contact::model::{Compliance, Contact};
+use periodic_contact::periodic::{OutputSelection, PeriodicProblem, SolverSettings};
+use periodic_contact::time::{Discretization, Scheme};
+
+fn problem(osc: &Oscillator, contact: Contact, scheme: Scheme, k: usize) -> PeriodicProblem {
+    let outputs = OutputSelection { displacement: vec![0], velocity: vec![0], acceleration: vec![], contacts: true };
+    PeriodicProblem::new(osc.model(vec![contact]), Discretization { scheme, steps: k, pairing: None }, outputs, SolverSettings::default()).unwrap()
+}
+
+/// (estimate, true error) at k for one case and scheme.
+fn estimate_and_truth(osc: &Oscillator, contact: Contact, scheme: Scheme, k: usize, exact_x: impl Fn(f64) -> f64) -> (f64, f64, String) {
+    let p = problem(osc, contact, scheme, k);
+    let r = p.solve().unwrap();
+    let a = accuracy::estimate(&p, &r);
+    let truth = r.time.iter().zip(&r.displacement["0"]).map(|(&t, &x)| (x - exact_x(t)).abs()).fold(0.0, f64::max);
+    (a.estimate.unwrap_or_else(|| panic!("{scheme}: no estimate: {}", a.method)), truth, a.method)
+}
+
+fn check(case: &str, est: f64, truth: f64, method: &str) {
+    let ratio = est / truth;
+    eprintln!("{case}: estimate {est:.3e}, true error {truth:.3e}, ratio {ratio:.2} ({method})");
+    assert!((0.1..=10.0).contains(&ratio), "{case}: estimate {est:.3e} vs true error {truth:.3e} (ratio {ratio:.2}), {method}");
+}
+
+const K: usize = 512;
+
+#[test]
+fn estimates_are_within_a_factor_of_ten_on_the_rigid_stop_with_sticking() {
+    let osc = Oscillator::new(1.0, 0.1, 1.0, 1.0, 1.0);
+    let exact = RigidStopOrbit::solve(&osc, 0.5).unwrap();
+    assert_eq!(exact.regime(), RigidRegime::Sticking);
+    for scheme in [Scheme::Bds1, Scheme::Cds, Scheme::Galerkin] {
+        let (e, t, m) = estimate_and_truth(&osc, Oscillator::stop(0.5, Compliance::Rigid), scheme, K, |t| exact.eval(t).0);
+        check(&format!("rigid+sticking {scheme}"), e, t, &m);
+    }
+}
+
+#[test]
+fn estimates_are_within_a_factor_of_ten_on_pure_impacts() {
+    let osc = Oscillator::new(1.0, 0.1, 1.0, 0.5, 0.8);
+    let exact = RigidStopOrbit::solve(&osc, 0.6).unwrap();
+    assert_eq!(exact.regime(), RigidRegime::Impacting);
+    for scheme in [Scheme::Bds1, Scheme::Cds, Scheme::Galerkin] {
+        let (e, t, m) = estimate_and_truth(&osc, Oscillator::stop(0.6, Compliance::Rigid), scheme, K, |t| exact.eval(t).0);
+        check(&format!("pure impacts {scheme}"), e, t, &m);
+    }
+}
+
+#[test]
+fn estimates_are_within_a_factor_of_ten_on_the_compliant_stop() {
+    let osc = Oscillator::new(1.0, 0.05, 1.0, 1.0, 1.3);
+    let exact = CompliantStopOrbit::solve(&osc, 10.0, 1.0, None).unwrap();
+    for scheme in Scheme::ALL {
+        let (e, t, m) = estimate_and_truth(&osc, Oscillator::stop(1.0, Compliance::Compliant { stiffness: 10.0 }), scheme, K, |t| exact.eval(t).0);
+        check(&format!("compliant {scheme}"), e, t, &m);
+    }
+}
+
+/// Where no estimate can be honest (a scheme that does not converge for rigid contact), none is
+/// given, and the reason says so.
+#[test]
+fn no_estimate_where_the_scheme_does_not_converge() {
+    let osc = Oscillator::new(1.0, 0.1, 1.0, 1.0, 1.0);
+    let p = problem(&osc, Oscillator::stop(0.5, Compliance::Rigid), Scheme::Bds2, 256);
+    let r = p.solve().unwrap();
+    let a = accuracy::estimate(&p, &r);
+    assert!(a.estimate.is_none() && a.method.contains("do not converge"), "{a:?}");
+}
