@@ -1,6 +1,7 @@
 //! The periodic contact problem: assembly in the frequency domain, one LCP over the period,
 //! recovery of the requested responses (notes §2–3).
 mod assembly;
+mod cache;
 pub mod limits;
 use crate::linalg::fft; // the crate's one FFT plan type, shared with lcp
 mod problem;

@@ -290,9 +290,19 @@ impl PeriodicProblem {
     /// Solves reusing `fft` (planned for k = steps), warm-started from a previous active set.
     pub fn solve_with(&self, fft: &PeriodFft, warm_start: Option<&[usize]>) -> Result<Response, SolveError> {
         let t_start = Instant::now();
-        let dofs = self.recovery_dofs();
-        let asm = assembly::assemble(&self.model, &self.disc, &dofs, fft, self.solver.parallel)?;
-        let (a, q) = self.lcp(&asm, fft);
+        let asm = self.assemble(fft)?;
+        self.solve_assembled(&asm, fft, warm_start, t_start)
+    }
+
+    /// The harmonic solves of this problem (Ĝ, X̂lin and Ẑ⁻¹Bᵀ at the recovered DOFs).
+    pub(super) fn assemble(&self, fft: &PeriodFft) -> Result<Assembly, SolveError> {
+        assembly::assemble(&self.model, &self.disc, &self.recovery_dofs(), fft, self.solver.parallel)
+    }
+
+    /// Solves with an assembly of this problem (a session's cached one); `t_start`: when the
+    /// solve began, for the timings.
+    pub(super) fn solve_assembled(&self, asm: &Assembly, fft: &PeriodFft, warm_start: Option<&[usize]>, t_start: Instant) -> Result<Response, SolveError> {
+        let (a, q) = self.lcp(asm, fft);
         self.check_lcp_finite(&a, &q)?;
         let t_assembly = t_start.elapsed().as_secs_f64();
 
@@ -301,7 +311,7 @@ impl PeriodicProblem {
         let t_lcp = t_lcp.elapsed().as_secs_f64();
 
         let t_rec = Instant::now();
-        let mut response = recovery::recover(self, &asm, fft, &sol)?;
+        let mut response = recovery::recover(self, asm, fft, &sol)?;
         response.timing_s.assembly = t_assembly;
         response.timing_s.lcp = t_lcp;
         response.timing_s.recovery = t_rec.elapsed().as_secs_f64();

@@ -5,6 +5,7 @@
 //! of parameter updates them in place instead of rebuilding. A solve is warm-started from the
 //! last active set when there is one; a warm start that fails is retried cold, so the warm
 //! start can only save pivots, never change whether a solution is found.
+use super::cache::{AssemblyCache, assembled};
 use super::{PeriodFft, PeriodicProblem, SolveError};
 use crate::response::{Response, WarmStartSummary};
 use crate::time::Discretization;
@@ -31,13 +32,17 @@ pub struct PeriodicSolver {
     warm_start: Option<Vec<usize>>,
     warm_starts: bool,
     last_start: WarmStart,
+    /// The last assembly, reused while only gaps, motions or a common force scale change.
+    cache: Option<AssemblyCache>,
+    /// Assemblies built by this session (the others were reused).
+    assemblies: usize,
 }
 
 impl PeriodicSolver {
     /// Plans the FFT of the problem's k; the first solve is cold.
     pub fn new(problem: PeriodicProblem) -> Self {
         let fft = PeriodFft::new(problem.discretization().steps);
-        PeriodicSolver { problem, fft, warm_start: None, warm_starts: true, last_start: WarmStart::Cold }
+        PeriodicSolver { problem, fft, warm_start: None, warm_starts: true, last_start: WarmStart::Cold, cache: None, assemblies: 0 }
     }
 
     /// Whether solves start from the previous active set (default true).
@@ -61,6 +66,37 @@ impl PeriodicSolver {
     /// How the last solve started.
     pub fn last_start(&self) -> WarmStart {
         self.last_start
+    }
+
+    /// Assemblies this session has built; a solve after [`Self::update_gaps`] or a common scale
+    /// of [`Self::update_forces`] reuses the last one.
+    pub fn assemblies(&self) -> usize {
+        self.assemblies
+    }
+
+    /// Sets each contact's static clearance (model order). Gaps enter only the LCP's q: the next
+    /// solve re-uses the assembly and starts from the last active set.
+    pub fn update_gaps(&mut self, gaps: &[f64]) -> Result<(), SolveError> {
+        let mut model = self.problem.model().clone();
+        if gaps.len() != model.contacts.len() {
+            return Err(SolveError::Invalid(format!("update_gaps: {} gaps for {} contacts", gaps.len(), model.contacts.len())));
+        }
+        model.contacts.iter_mut().zip(gaps).for_each(|(c, &g)| c.gap = g);
+        self.problem = self.problem.with_model(model, self.problem.discretization())?;
+        Ok(())
+    }
+
+    /// Sets each force term's amplitude (model order). Multiplying every amplitude by one factor
+    /// re-uses the assembly (the contact-free response is linear in the forces); any other
+    /// change re-assembles at the next solve.
+    pub fn update_forces(&mut self, amplitudes: &[f64]) -> Result<(), SolveError> {
+        let mut model = self.problem.model().clone();
+        if amplitudes.len() != model.forces.len() {
+            return Err(SolveError::Invalid(format!("update_forces: {} amplitudes for {} forces", amplitudes.len(), model.forces.len())));
+        }
+        model.forces.iter_mut().zip(amplitudes).for_each(|(f, &a)| f.term.amplitude = a);
+        self.problem = self.problem.with_model(model, self.problem.discretization())?;
+        Ok(())
     }
 
     /// Changes ω; the active set is kept as the next warm start (a neighbouring orbit).
@@ -112,12 +148,13 @@ impl PeriodicSolver {
         let guess = self.warm_start.as_deref().filter(|_| self.warm_starts);
         let warm = guess.is_some();
         let result = if let Some(guess) = guess {
-            match self.problem.solve_with(&self.fft, Some(guess)) {
+            let guess = guess.to_vec();
+            match self.solve_cached(Some(&guess)) {
                 Ok(r) => Ok((r, WarmStart::Used)),
-                Err(_) => self.problem.solve_with(&self.fft, None).map(|r| (r, WarmStart::ColdFallback)),
+                Err(_) => self.solve_cached(None).map(|r| (r, WarmStart::ColdFallback)),
             }
         } else {
-            self.problem.solve_with(&self.fft, None).map(|r| (r, WarmStart::Cold))
+            self.solve_cached(None).map(|r| (r, WarmStart::Cold))
         };
         match result {
             Ok((mut r, start)) => {
@@ -137,9 +174,17 @@ impl PeriodicSolver {
         }
     }
 
+    /// One solve on the session's assembly (built or re-used).
+    fn solve_cached(&mut self, warm_start: Option<&[usize]>) -> Result<Response, SolveError> {
+        let t_start = std::time::Instant::now();
+        let (asm, built) = assembled(&mut self.cache, &self.problem, &self.fft)?;
+        self.assemblies += usize::from(built);
+        self.problem.solve_assembled(asm, &self.fft, warm_start, t_start)
+    }
+
     /// Solves cold, whatever the active set (the reference of a warm-start comparison).
     pub fn solve_cold(&mut self) -> Result<Response, SolveError> {
-        let r = self.problem.solve_with(&self.fft, None)?;
+        let r = self.solve_cached(None)?;
         self.last_start = WarmStart::Cold;
         self.set_warm_start(&r.active_set);
         Ok(r)
