@@ -8,10 +8,11 @@ CLI sweep of the same scene. See demo/README.md and demo/runup.py.
     the driver's output at sample n-1 (libcosim's fixed-step transfer: the value set before a
     step is the one the step's re-solve uses);
   - test_envelope_matches_cli_sweep: every extremum of the FMU output lies within the sampling +
-    ramp-drift tolerance of the CLI's peak of the same side at the frequency the FMU used; the
-    only discontinuity of the output is where the CLI's orbit switches too;
-  - test_nonlinear_differs_from_linear: the stop caps the resonance (the linear peak is > 2.5x the
-    contact peak), and the figure figures/demo_runup.png is written.
+    ramp-drift tolerance of the CLI's peak of the same side at the frequency the FMU used, or,
+    where two orbits coexist, on the contact branch the FMU stays on, checked against time
+    integration; the only discontinuity of the output is where the FMU leaves its contact orbit;
+  - test_nonlinear_differs_from_linear: the stop caps the resonance (the linear peak is > 1.2x the
+    peak of the contact branch the FMU follows), and the figure figures/demo_runup.png is written.
 Skipped while the CLI is absent (PC_REQUIRE_BINARIES=1: failed instead).
 """
 import os
@@ -56,38 +57,63 @@ def test_connection(demo):
 
 
 def test_envelope_matches_cli_sweep(demo, cli, workdir):
+    """Every extremum of the FMU output is the peak of a periodic orbit of the engine at the
+    frequency it used: the cold CLI solve's, or, above BRANCH_START where two orbits coexist, the
+    contact orbit the FMU stays on (its re-solves start from its current orbit, issue 13). That
+    branch is checked against the independent time integration of demo/runup.py."""
     a, p = demo.agr, demo.peaks
     c = a["compared"]
     assert c.sum() >= 250, f"only {c.sum()} extrema compared"
-    bad = np.nonzero(c & ~a["ok"])[0]
+    # Where the cold CLI returns the contact-free orbit and the FMU is still in contact, the FMU
+    # is on the coexisting contact branch: compared with the marched branch below.
+    on_branch = c & (p.omega >= runup.BRANCH_START) & (demo.nonlin.side(p.upper)[np.searchsorted(demo.nonlin.omega, p.omega).clip(0, len(demo.nonlin.omega) - 1)] <= runup.GAP + 1e-9)
+    on_branch &= ~a["ok"]
+    bad = np.nonzero(c & ~a["ok"] & ~on_branch)[0]
     assert bad.size == 0, "FMU extrema outside the tolerance of the CLI sweep:\n" + "\n".join(
         f"  ω = {p.omega[i]:.5f} {'max' if p.upper[i] else 'min'}: FMU {p.value[i]:.6f}, "
         f"d = {a['d'][i]:+.2e}, tol {a['tol_rel'][i]:.2e}" for i in bad[:20])
-    # the drift allowance is large only at a few extrema near the switch; elsewhere the plain
-    # sampling bound holds
     d = np.abs(a["d"])
-    plain = c & (a["drift_rel"] <= a["sampling_rel"])
-    assert plain.sum() >= c.sum() - 6
+    plain = c & ~on_branch & (a["drift_rel"] <= a["sampling_rel"])
+    assert plain.sum() >= (c & ~on_branch).sum() - 6
     assert np.all(d[plain] <= 2 * a["sampling_rel"][plain] + 1e-9)
 
-    # At most one discontinuity, where the engine's own orbit switches: contact just before it,
-    # contact-free just after it (CLI, cold solves).
+    # The branch the FMU stays on is the physical one: at each marched frequency it passes, its
+    # extrema (within one ramp step of it) agree with the time integration's. Tolerance: the
+    # marcher's own accuracy (256 samples a period, periodicity 1e-5) and the ramp's drift over
+    # ±0.002 rad/s, 1 % together (measured agreement is printed).
+    br = demo.branch
+    checked = 0
+    if on_branch.any() and br is not None:
+        top = p.omega[on_branch].max()
+        for w, xmax, xmin in zip(br["omega"], br["xmax"], br["xmin"]):
+            near = on_branch & (np.abs(p.omega - w) <= 0.002)
+            if w > top or not near.any():
+                continue
+            for i in np.nonzero(near)[0]:
+                ref = xmax if p.upper[i] else xmin
+                rel = abs(p.value[i] - ref) / ref
+                print(f"branch ω = {w}: FMU {p.value[i]:.6f} vs marched {ref:.6f} ({rel:.1e})")
+                assert rel <= 1e-2, f"ω = {p.omega[i]:.5f}: FMU {p.value[i]:.6f} off the marched branch {ref:.6f}"
+                checked += 1
+        assert checked >= 1, "the FMU's contact branch passed no marched frequency"
+
+    # At most one discontinuity: the FMU leaves its contact orbit (the fold of the branch, or where
+    # the CLI's orbit switches when no other orbit exists): contact just before, none just after.
     jumps = runup.jumps(demo.run)
     assert jumps.size <= 1, f"output discontinuous at {jumps.size} steps"
     assert p.at_jump.sum() <= 2 * jumps.size
     for n in jumps:
-        w_before, w_after = demo.run.w_in[n], demo.run.w_in[n + 1]
-        d = os.path.join(workdir, "demo", "jump")
-        before = engine.solve(cli, runup.scene_text(w_before), d, "before")
-        after = engine.solve(cli, runup.scene_text(w_after), d, "after")
-        assert np.max(before.x[0]) > runup.GAP, f"CLI at ω = {w_before} has no contact"
-        assert np.max(after.x[0]) <= runup.GAP + 1e-12, f"CLI at ω = {w_after} has contact"
+        w_after = demo.run.w_in[n + 1]
+        after = engine.solve(cli, runup.scene_text(w_after), os.path.join(workdir, "demo", "jump"), "after")
+        assert np.max(after.x[0]) <= runup.GAP + 1e-12, f"CLI at ω = {w_after} has contact after the jump"
 
 
 def test_nonlinear_differs_from_linear(demo):
     peak_fmu = demo.peaks.value[demo.agr["compared"]].max()
     peak_lin = demo.linear.amp.max()
-    assert peak_lin > 2.5 * peak_fmu, (peak_lin, peak_fmu)
+    # Measured: linear 4.00, FMU 2.99 at the top of the contact branch it follows (before the
+    # FMU stayed on its branch it jumped to the contact-free orbit at 1.092 and peaked at ~1.3).
+    assert peak_lin > 1.2 * peak_fmu, (peak_lin, peak_fmu)
     assert demo.peaks.value[demo.peaks.upper].max() > runup.GAP  # it does hit the stop
     assert os.path.getsize(demo.figure) > 10000
     assert os.path.getmtime(demo.figure) > time.time() - 600

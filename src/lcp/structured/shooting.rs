@@ -290,9 +290,17 @@ fn follow_offset(nt: &mut Newton<'_>, s_free: Vec<f64>, delta0: f64) -> Result<(
     tangent[d] = -1.0;
     let mut ds = 0.25 * delta0;
     let (min_ds, max_ds) = (1e-9 * delta0, 4.0 * delta0);
+    // Corrector failures at the current point: halving the step usually cures one; after three
+    // the point is taken to sit before a kink the corrector cannot cross.
+    let mut failures = 0;
     for step in 1..=settings.max_homotopy_steps {
-        let res = correct(nt, &here, &tangent, ds).or_else(|| cross_kink(nt, &here, &tangent, ds));
+        let mut res = correct(nt, &here, &tangent, ds);
+        if res.is_none() && failures >= 3 {
+            // Search the kink over the step that first failed here.
+            res = cross_kink(nt, &here, &tangent, ds * f64::from(1u32 << failures.min(30)));
+        }
         let Some((next, t_next, iterations)) = res else {
+            failures += 1;
             ds /= 2.0;
             if ds < min_ds {
                 return Err(step);
@@ -319,6 +327,7 @@ fn follow_offset(nt: &mut Newton<'_>, s_free: Vec<f64>, delta0: f64) -> Result<(
         }
         here = next;
         tangent = t_next;
+        failures = 0;
         if iterations <= 3 {
             ds = (ds * 1.6).min(max_ds);
         }
