@@ -1,10 +1,11 @@
 //! `continue`: pseudo-arclength continuation of a scene's periodic orbit in one parameter, with
 //! stability and located events: CSV, events JSON and PNG beside it.
+use crate::cmd_sweep::sibling;
 use crate::{Failure, ensure_writable, write_output};
 use indicatif::{ProgressBar, ProgressStyle};
 use periodic_contact::analysis::continuation::{self, ContinuationSettings, Parameter, output};
 use periodic_contact::scene::Scene;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 #[derive(clap::Args)]
@@ -29,11 +30,6 @@ pub struct Args {
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
-}
-
-fn sibling(path: &Path, suffix: &str, ext: &str) -> PathBuf {
-    let stem = path.file_stem().map_or("branch".into(), |s| s.to_string_lossy().to_string());
-    path.with_file_name(format!("{stem}{suffix}.{ext}"))
 }
 
 pub fn run(a: &Args) -> Result<(), Failure> {
