@@ -7,5 +7,6 @@
 //! own, beside [`sweep`] (a sweep is the simplest continuation: fixed steps, no predictor).
 //! [`accuracy`] gives every result an error estimate.
 pub mod accuracy;
+pub mod continuation;
 pub mod polish;
 pub mod sweep;

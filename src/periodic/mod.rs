@@ -19,6 +19,8 @@ pub use state_space::{MAX_STEP_MAP_DOFS, NoStepMap, step_map};
 pub use tuning::Tuning;
 
 use crate::error::{Error, ErrorKind};
+/// The step map's type, for analyses that march it (continuation, stability).
+pub use crate::lcp::StepMapLcp;
 pub use crate::lcp::{AUTO_LEMKE_MAX, DENSE_MAX, LcpMethod, solve_circulant_lcp};
 use crate::lcp::{LcpOutcome, LcpSolution};
 use crate::model::ModelError;

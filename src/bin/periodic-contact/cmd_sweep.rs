@@ -61,7 +61,8 @@ pub struct Args {
     pub quiet: bool,
 }
 
-fn sibling(path: &Path, suffix: &str, ext: &str) -> PathBuf {
+/// `<stem><suffix>.<ext>` beside `path` (also for `continue`).
+pub(crate) fn sibling(path: &Path, suffix: &str, ext: &str) -> PathBuf {
     let stem = path.file_stem().map_or("sweep".into(), |s| s.to_string_lossy().to_string());
     path.with_file_name(format!("{stem}{suffix}.{ext}"))
 }

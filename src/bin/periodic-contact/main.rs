@@ -1,6 +1,7 @@
 //! periodic-contact: the command-line tool.
 //! Exit status: 0 success, 1 the solver failed (typed outcome printed), 2 bad input.
 mod cmd_bench;
+mod cmd_continue;
 mod cmd_fmu;
 mod cmd_lcp;
 mod cmd_modes;
@@ -61,6 +62,9 @@ enum Command {
     },
     /// Frequency sweep: CSV, frequency-response PNG, spectra, comparison with time marching.
     Sweep(cmd_sweep::Args),
+    /// Continuation of a periodic orbit in one parameter through folds: stability (Floquet
+    /// multipliers) and located events; CSV, events JSON and PNG.
+    Continue(cmd_continue::Args),
     /// Benchmark over the class: time, pivots and peak memory per case and k, with random
     /// families (worst case first).
     Bench {
@@ -143,6 +147,7 @@ fn main() -> ExitCode {
         }
         Some(Command::Modes { scene, count }) => cmd_modes::run(&scene, count),
         Some(Command::Sweep(args)) => cmd_sweep::run(&args),
+        Some(Command::Continue(args)) => cmd_continue::run(&args),
         Some(Command::Lcp { file, output, method, tolerance }) => cmd_lcp::run(&file, &output, &method, tolerance),
         Some(Command::Study { study }) => cmd_study::run(study),
         Some(Command::Fmu { scene, output, binary }) => cmd_fmu::run(&scene, &output, binary.as_deref()),

@@ -117,6 +117,16 @@ impl StepMapLcp {
         Some((m.end, m.masks, m.z))
     }
 
+    /// One march with each step's active set imposed (w_a = 0, z_a free in sign): the affine
+    /// piece of P these sets belong to, so that its fixed point is (I − dP/ds0)⁻¹ P(0). `None`
+    /// when the sets do not fit k or a step's block is singular. For continuation.
+    pub fn march_frozen(&self, s0: &[f64], masks: &[u32]) -> Option<Vec<f64>> {
+        if masks.len() != self.k || s0.len() != self.d {
+            return None;
+        }
+        march(self, s0, 0.0, Contacts::Frozen(masks)).map(|m| m.end)
+    }
+
     /// [dP/ds0 | dP/dδ] (d×(d+1), δ a uniform offset of every pair's r_j) on the piece of these
     /// active sets; at a closed orbit dP/ds0 is the discrete monodromy matrix, whose eigenvalues
     /// are the orbit's Floquet multipliers as k grows (notes §7).

@@ -1,0 +1,89 @@
+//! `continue`: pseudo-arclength continuation of a scene's periodic orbit in one parameter, with
+//! stability and located events: CSV, events JSON and PNG beside it.
+use crate::cmd_sweep::sibling;
+use crate::{Failure, ensure_writable, write_output};
+use indicatif::{ProgressBar, ProgressStyle};
+use periodic_contact::analysis::continuation::{self, ContinuationSettings, Parameter, output};
+use periodic_contact::scene::Scene;
+use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(clap::Args)]
+pub struct Args {
+    pub scene: PathBuf,
+    /// The continued parameter: frequency (ω [rad/s]).
+    #[arg(long, default_value = "frequency")]
+    pub param: String,
+    #[arg(long, allow_negative_numbers = true)]
+    pub from: f64,
+    #[arg(long, allow_negative_numbers = true)]
+    pub to: f64,
+    /// Output CSV; the events JSON and the PNG go next to it (same stem).
+    #[arg(short, long, default_value = "branch.csv")]
+    pub output: PathBuf,
+    /// Largest arclength step (in the state and the parameter over |to − from|).
+    #[arg(long, default_value_t = 2e-2)]
+    pub max_step: f64,
+    /// No PNG.
+    #[arg(long)]
+    pub no_plot: bool,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+pub fn run(a: &Args) -> Result<(), Failure> {
+    let param = Parameter::parse(&a.param).map_err(Failure::from)?;
+    if !(a.from.is_finite() && a.to.is_finite() && a.from > 0.0 && a.to > 0.0 && a.from != a.to) {
+        return Err(Failure::input(format!("--from/--to: are {} and {}, must be finite, > 0 and different", a.from, a.to)));
+    }
+    if !(a.max_step.is_finite() && a.max_step > 0.0) {
+        return Err(Failure::input(format!("--max-step: is {}, must be finite and > 0", a.max_step)));
+    }
+    ensure_writable(&a.output, "--output")?;
+    let t_all = Instant::now();
+    let (scene, dir) = Scene::load(&a.scene).map_err(|e| Failure::input(e.to_string()))?;
+    let file = a.scene.display().to_string();
+    let built = scene.build_in(&file, &dir).map_err(|e| Failure::input(e.to_string()))?;
+    let problem = &built.problem;
+    let settings = ContinuationSettings { max_step: a.max_step, ..ContinuationSettings::default() };
+    let bar = if a.quiet { ProgressBar::hidden() } else { ProgressBar::new(1000) };
+    bar.set_style(ProgressStyle::with_template("{spinner} continue [{bar:40}] {msg}, {elapsed_precise} elapsed").unwrap().progress_chars("=> "));
+    let (from, to) = (a.from, a.to);
+    let on_point = |v: f64| {
+        bar.set_position((((v - from) / (to - from)).clamp(0.0, 1.0) * 1000.0) as u64);
+        bar.set_message(format!("{} = {v:.6}", a.param));
+    };
+    let branch = continuation::run(problem, param, a.from, a.to, &settings, &on_point).map_err(Failure::from)?;
+    bar.finish_and_clear();
+    let labels = &built.labels;
+    write_output(&a.output, &output::to_csv(&branch, problem, labels))?;
+    let json = sibling(&a.output, "-events", "json");
+    write_output(&json, &output::events_json(&branch, problem))?;
+    eprintln!(
+        "continue: {} points ({} events) in {:.3} s, {} marches of the period map; stop: {} → {}, {}",
+        branch.points.len(),
+        branch.events().count(),
+        t_all.elapsed().as_secs_f64(),
+        branch.marches,
+        branch.stop,
+        a.output.display(),
+        json.display()
+    );
+    for e in branch.events() {
+        eprintln!("  {:<16} {} = {:.7}  max |μ| = {:.6}  {}", e.event.map_or("", |k| k.name()), a.param, e.parameter, e.max_multiplier, e.detail);
+    }
+    #[cfg(feature = "plots")]
+    if !a.no_plot {
+        let stem = a.scene.file_stem().map_or(String::new(), |s| s.to_string_lossy().to_string());
+        for (i, d) in problem.outputs().displacement.iter().enumerate() {
+            let png = if i == 0 { sibling(&a.output, "", "png") } else { sibling(&a.output, &format!("-dof{d}"), "png") };
+            output::plot(&png, &branch, problem, i, labels, &format!("{stem}: branch")).map_err(Failure::from)?;
+            eprintln!("branch of {} → {}", labels.dof(*d), png.display());
+        }
+    }
+    if branch.stop != "reached" {
+        return Err(Failure::solver(format!("the continuation stopped before {} = {}: {}", a.param, a.to, branch.stop)));
+    }
+    Ok(())
+}

@@ -1,0 +1,115 @@
+//! Continuation of NLvib's Example 03 (notes §7) against the independent reference of
+//! validation/nlvib03 (exact piecewise-linear flows, shooting, long time integration).
+use periodic_contact::analysis::continuation::{self, ContinuationSettings, Parameter};
+use serde_json::Value;
+use std::time::Instant;
+
+fn scene(steps: usize) -> String {
+    format!(
+        r#"
+[structure]
+mass = [[1.0, 0.0], [0.0, 1.0]]
+stiffness = [[1.0, -1.0], [-1.0, 2.0]]
+[damping]
+matrix = [[0.03, -0.03], [-0.03, 0.06]]
+[excitation]
+frequency = 0.5
+[[force]]
+dof = 1
+amplitude = 0.1
+[[contact]]
+dof = 0
+gap = 1.0
+stiffness = 100.0
+[discretization]
+scheme = "cds"
+steps = {steps}
+"#
+    )
+}
+
+/// A reference point: Ω, amplitude_0, stable.
+type RefPoint = (f64, f64, bool);
+
+/// The reference's T branch points (Ω, amplitude_0, stable) and events (type, Ω).
+fn reference() -> (Vec<RefPoint>, Vec<(String, f64)>) {
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/validation/nlvib03/reference.json")).unwrap();
+    let r: Value = serde_json::from_str(&text).unwrap();
+    let t = &r["branches"][0];
+    assert_eq!(t["label"], "T");
+    let points = t["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| (p["omega"].as_f64().unwrap(), p["amplitude_0"].as_f64().unwrap(), p["stable"].as_bool().unwrap()))
+        .collect();
+    let events = r["events"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|e| e["branch"] == "T")
+        .map(|e| (e["type"].as_str().unwrap().to_string(), e["omega"].as_f64().unwrap()))
+        .collect();
+    (points, events)
+}
+
+/// NLvib 03 from Ω = 0.5 to 0.8 at k = 4096 (cds, same pairing: O(h²)).
+/// Tolerances: at k = 4096 and Ω ≈ 0.6, h = 2π/(Ωk) ≈ 2.6e-3 and the contact phase (ω_c = √101)
+/// has (ω_c·h)² ≈ 7e-4: O(h²) shifts of the orbits of that relative size move a crossing by
+/// about 7e-4 × (its Ω distance to the nearest event that shapes it, ≤ 0.3) ≈ 2e-4, so events
+/// must land within 3e-4 of the reference's Ω, and amplitudes within 0.5 %.
+#[test]
+fn nlvib03_branch_events_amplitudes_stability() {
+    let p = periodic_contact::scene::Scene::parse(&scene(4096), "nlvib03").unwrap().to_problem("nlvib03").unwrap();
+    let t = Instant::now();
+    let b = continuation::run(&p, Parameter::Frequency, 0.5, 0.8, &ContinuationSettings::default(), &|_| {}).unwrap();
+    let wall = t.elapsed().as_secs_f64();
+    eprintln!("{} points, stop {}, {} marches, {wall:.2} s", b.points.len(), b.stop, b.marches);
+    assert_eq!(b.stop, "reached");
+    assert!(b.points.iter().all(|p| p.certified), "every point is the certified LCP's");
+    let (ref_points, ref_events) = reference();
+    // Every reference event has ours of the same kind within 3e-4, and ours are all the reference's.
+    let ours: Vec<(&str, f64)> = b.events().map(|e| (e.event.unwrap().name(), e.parameter)).collect();
+    eprintln!("events: {ours:?}");
+    for (kind, omega) in &ref_events {
+        let err = ours.iter().filter(|(k, _)| k == kind).map(|(_, o)| (o - omega).abs()).fold(f64::INFINITY, f64::min);
+        eprintln!("{kind} at {omega:.7}: error {err:.1e}");
+        assert!(err < 3e-4, "{kind} at Ω = {omega}: nearest of ours {err:.1e} away");
+    }
+    assert_eq!(ours.len(), ref_events.len(), "as many events as the reference: {ours:?}");
+    // Amplitudes: the reference's points on our branch, interpolated between the two of our
+    // points that bracket its Ω (of the brackets, the one closest in amplitude: coexisting orbits).
+    let mut worst = 0.0f64;
+    let mut disagree = 0;
+    let near_event = |o: f64| ref_events.iter().any(|(_, e)| (o - e).abs() < 2e-3);
+    for &(omega, amp, stable) in &ref_points {
+        let best = b
+            .points
+            .windows(2)
+            .filter(|w| (w[0].parameter - omega) * (w[1].parameter - omega) <= 0.0 && w[0].parameter != w[1].parameter)
+            .map(|w| {
+                let f = (omega - w[0].parameter) / (w[1].parameter - w[0].parameter);
+                let a = w[0].amplitude[0] + f * (w[1].amplitude[0] - w[0].amplitude[0]);
+                (a, if f < 0.5 { w[0].stable } else { w[1].stable })
+            })
+            .min_by(|x, y| (x.0 - amp).abs().total_cmp(&(y.0 - amp).abs()))
+            .unwrap();
+        // Within 1e-5 of a fold our turning point's O(h²) shift may leave Ω off our branch.
+        if ref_events.iter().any(|(k, e)| k == "fold" && (omega - e).abs() < 1e-5) {
+            continue;
+        }
+        let rel = (best.0 - amp).abs() / amp;
+        if rel > 5e-3 {
+            eprintln!("amplitude at Ω = {omega}: ours {:.6}, reference {amp:.6}", best.0);
+        }
+        worst = worst.max(rel);
+        if !near_event(omega) && best.1 != stable {
+            disagree += 1;
+            eprintln!("stability differs at Ω = {omega}: ours {}, reference {stable}", best.1);
+        }
+    }
+    eprintln!("amplitude: worst relative error {worst:.1e} over {} reference points; stability differs at {disagree}", ref_points.len());
+    assert!(worst < 5e-3, "amplitudes within 0.5 %: worst {worst:.1e}");
+    assert_eq!(disagree, 0, "stability agrees away from the events (±2e-3)");
+    assert!(wall < 30.0, "continuation took {wall:.1} s");
+}
