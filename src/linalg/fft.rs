@@ -28,9 +28,13 @@ static DROP_PLANNER_AT_UNLOAD: extern "C" fn() = drop_planner;
 
 #[cfg(target_os = "linux")]
 extern "C" fn drop_planner() {
+    // try_lock: never wait at exit on a thread that is still planning (then the cache stays).
     if let Some(m) = PLANNER.get() {
-        let mut planner = m.lock().unwrap_or_else(|e| e.into_inner());
-        *planner = None;
+        match m.try_lock() {
+            Ok(mut planner) => *planner = None,
+            Err(std::sync::TryLockError::Poisoned(e)) => *e.into_inner() = None,
+            Err(std::sync::TryLockError::WouldBlock) => {}
+        }
     }
 }
 
