@@ -215,9 +215,14 @@ fn determinant(a: &[f64], n: usize) -> f64 {
 /// principal block is singular to working precision.
 fn solve_active(s: &[f64], m: usize, r: &[f64], mask: u32, z: &mut [f64]) -> bool {
     z.iter_mut().for_each(|v| *v = 0.0);
-    let idx: [usize; MAX_PAIRS] = std::array::from_fn(|i| i);
-    let act: Vec<usize> = idx[..m].iter().copied().filter(|&i| mask >> i & 1 == 1).collect();
-    let p = act.len();
+    // The active pairs on the stack: this runs at every step of every march (no allocation).
+    let mut members = [0usize; MAX_PAIRS];
+    let mut p = 0;
+    for i in (0..m).filter(|&i| mask >> i & 1 == 1) {
+        members[p] = i;
+        p += 1;
+    }
+    let act = &members[..p];
     if p == 0 {
         return true;
     }
