@@ -10,6 +10,20 @@ pub struct Series {
     pub markers: bool,
 }
 
+/// How a curve is drawn, when the caller chooses rather than the position in the list: a branch
+/// draws its stable runs solid and its unstable runs dashed in one colour, and its events as
+/// markers without a line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Look {
+    /// Index into the palette (Tableau 10).
+    pub color: usize,
+    pub dashed: bool,
+    /// false: markers only.
+    pub line: bool,
+    /// 0 circle, 1 triangle, 2 square.
+    pub marker: usize,
+}
+
 /// Axis scaling.
 #[derive(Clone, Copy, PartialEq, Eq)]
 pub enum Scale {
@@ -41,10 +55,10 @@ const TABLEAU10: [RGBColor; 10] = [
     RGBColor(23, 190, 207),
 ];
 
-/// The look of curve `i`: its colour, dashed or not, and its marker (0 circle, 1 triangle,
+/// The look of curve `i`: its colour (palette index), dashed or not, and its marker (0 circle, 1 triangle,
 /// 2 square).
-fn style(i: usize) -> (RGBColor, bool, usize) {
-    (TABLEAU10[i % 10], (i / 10) % 2 == 1, (i / 10) % 3)
+fn style(i: usize) -> (usize, bool, usize) {
+    (i % 10, (i / 10) % 2 == 1, (i / 10) % 3)
 }
 
 /// Marker outlines in pixels around the point: an octagon (a circle), a triangle, a square.
@@ -112,6 +126,16 @@ pub fn line_chart(path: &Path, chart: &Chart, series: &[Series], width: u32, hei
     panel_chart(path, &[(chart, series)], 1, width, height, Legend::Default)
 }
 
+/// As [`line_chart`], with the look of each series given (`looks[i]` for `series[i]`); a series
+/// with an empty label has no legend entry (the second run of a dashed branch, say).
+pub fn styled_chart(path: &Path, chart: &Chart, series: &[Series], looks: &[Look], width: u32, height: u32) -> Result<(), PlotError> {
+    let err = |e: &dyn std::fmt::Display| PlotError::new(path, e);
+    let root = BitMapBackend::new(path, (width, height)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    draw_chart(&root, chart, series, looks, Legend::Default, path)?;
+    root.present().map_err(|e| err(&e))
+}
+
 /// Where the legend goes.
 #[derive(Clone, Copy, PartialEq, Eq)]
 pub enum Legend {
@@ -135,7 +159,7 @@ fn draw_panels(path: &Path, panels: &[(&Chart, &[Series])], columns: usize, widt
     let rows = panels.len().div_ceil(columns).max(1);
     let areas = root.split_evenly((rows, columns));
     for ((chart, series), area) in panels.iter().zip(&areas) {
-        draw_chart(area, chart, series, legend, path)?;
+        draw_chart(area, chart, series, &[], legend, path)?;
     }
     root.present().map_err(|e| err(&e))
 }
@@ -144,6 +168,7 @@ fn draw_chart<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
     chart: &Chart,
     series: &[Series],
+    looks: &[Look],
     legend: Legend,
     path: &Path,
 ) -> Result<(), PlotError>
@@ -172,23 +197,31 @@ where
                 mesh.draw().map_err(|e| err(&e))?;
             }
             for (i, s) in series.iter().enumerate() {
-                let (color, dashed, marker) = style(i);
+                let look = looks.get(i).copied().unwrap_or_else(|| {
+                    let (color, dashed, marker) = style(i);
+                    Look { color, dashed, line: true, marker }
+                });
+                let (color, dashed, marker) = (TABLEAU10[look.color % 10], look.dashed, look.marker);
                 let pts: Vec<(f64, f64)> = s.points.iter().copied().filter(keep).collect();
                 let line = color.stroke_width(2);
-                let drawn = if dashed {
-                    ctx.draw_series(DashedLineSeries::new(pts.clone(), 8, 5, line)).map_err(|e| err(&e))?
-                } else {
-                    ctx.draw_series(LineSeries::new(pts.clone(), line)).map_err(|e| err(&e))?
+                let drawn = match (look.line, dashed) {
+                    (false, _) => ctx.draw_series(std::iter::empty::<PathElement<(f64, f64)>>()).map_err(|e| err(&e))?,
+                    (true, true) => ctx.draw_series(DashedLineSeries::new(pts.clone(), 8, 5, line)).map_err(|e| err(&e))?,
+                    (true, false) => ctx.draw_series(LineSeries::new(pts.clone(), line)).map_err(|e| err(&e))?,
                 };
-                // Legend: two segments (a gap between them when dashed) and the marker.
+                // Legend: two segments (a gap between them when dashed; none for markers only)
+                // and the marker.
                 let (gap, shape) = (if dashed { 13 } else { 8 }, marker_shape(marker));
                 let mark = if s.markers { color.filled() } else { color.mix(0.0).filled() };
-                drawn.label(s.label.clone()).legend(move |(x, y)| {
-                    EmptyElement::at((x, y))
-                        + PathElement::new(vec![(0, 0), (8, 0)], line)
-                        + PathElement::new(vec![(gap, 0), (21, 0)], line)
-                        + Polygon::new(shape.iter().map(|(a, b)| (a + 10, *b)).collect::<Vec<_>>(), mark)
-                });
+                let stroke = if look.line { line } else { color.mix(0.0).stroke_width(2) };
+                if !s.label.is_empty() {
+                    drawn.label(s.label.clone()).legend(move |(x, y)| {
+                        EmptyElement::at((x, y))
+                            + PathElement::new(vec![(0, 0), (8, 0)], stroke)
+                            + PathElement::new(vec![(gap, 0), (21, 0)], stroke)
+                            + Polygon::new(shape.iter().map(|(a, b)| (a + 10, *b)).collect::<Vec<_>>(), mark)
+                    });
+                }
                 if s.markers {
                     let shape = marker_shape(marker);
                     ctx.draw_series(pts.iter().map(|&p| EmptyElement::at(p) + Polygon::new(shape.clone(), color.filled()))).map_err(|e| err(&e))?;

@@ -47,29 +47,44 @@ pub fn events_json(branch: &Branch, problem: &PeriodicProblem) -> String {
     serde_json::to_string_pretty(&serde_json::json!({ "parameter": branch.parameter.name(), "stop": branch.stop, "events": events })).unwrap_or_default()
 }
 
-/// PNG of displacement output `i` along the branch: stable and unstable runs as separate curves
-/// (the plot module draws a curve per run), events as markers, axes named with units.
+/// PNG of displacement output `i` along the branch: stable runs solid, unstable runs dashed in the
+/// same colour, each event kind as markers of its own without a line; axes named with units.
 #[cfg(feature = "plots")]
 pub fn plot(path: &std::path::Path, branch: &Branch, problem: &PeriodicProblem, i: usize, labels: &Labels, title: &str) -> Result<(), crate::Error> {
-    use crate::plot::{Chart, Scale, Series, line_chart};
+    use crate::plot::{Chart, Look, Scale, Series, styled_chart};
     let d = problem.outputs().displacement[i];
-    let mut series: Vec<Series> = Vec::new();
+    let (mut series, mut looks): (Vec<Series>, Vec<Look>) = (Vec::new(), Vec::new());
+    let mut labelled = [false; 2];
+    let mut push_run = |run: Vec<(f64, f64)>, stable: bool, series: &mut Vec<Series>, looks: &mut Vec<Look>| {
+        // One legend entry per kind of run.
+        let label = if std::mem::replace(&mut labelled[stable as usize], true) {
+            ""
+        } else if stable {
+            "stable"
+        } else {
+            "unstable"
+        };
+        series.push(Series { label: label.into(), points: run, markers: false });
+        looks.push(Look { color: 0, dashed: !stable, line: true, marker: 0 });
+    };
     let mut run: Vec<(f64, f64)> = Vec::new();
     let mut stable = branch.points.first().is_some_and(|p| p.stable);
     for p in &branch.points {
         let xy = (p.parameter, p.amplitude[i]);
         if p.stable != stable {
             run.push(xy);
-            series.push(Series { label: if stable { "stable" } else { "unstable" }.into(), points: std::mem::take(&mut run), markers: false });
+            push_run(std::mem::take(&mut run), stable, &mut series, &mut looks);
             stable = p.stable;
         }
         run.push(xy);
     }
-    series.push(Series { label: if stable { "stable" } else { "unstable" }.into(), points: run, markers: false });
-    for kind in [super::EventKind::Fold, super::EventKind::Grazing, super::EventKind::PeriodDoubling, super::EventKind::NeimarkSacker] {
+    push_run(run, stable, &mut series, &mut looks);
+    let kinds = [super::EventKind::Fold, super::EventKind::Grazing, super::EventKind::PeriodDoubling, super::EventKind::NeimarkSacker];
+    for (j, kind) in kinds.into_iter().enumerate() {
         let pts: Vec<(f64, f64)> = branch.events().filter(|p| p.event == Some(kind)).map(|p| (p.parameter, p.amplitude[i])).collect();
         if !pts.is_empty() {
             series.push(Series { label: kind.name().into(), points: pts, markers: true });
+            looks.push(Look { color: j + 1, dashed: false, line: false, marker: j % 3 });
         }
     }
     let hz = labels.unit(Quantity::Frequency);
@@ -77,5 +92,5 @@ pub fn plot(path: &std::path::Path, branch: &Branch, problem: &PeriodicProblem, 
     let y_label = format!("amplitude of {} {} (peak-to-peak / 2)", labels.dof(d), labels.unit(Quantity::Length));
     let title = format!("{title} of {}", labels.dof(d));
     let chart = Chart { title: &title, x_label: &x_label, y_label: &y_label, x_scale: Scale::Linear, y_scale: Scale::Linear };
-    line_chart(path, &chart, &series, 1000, 650).map_err(crate::Error::from)
+    styled_chart(path, &chart, &series, &looks, 1000, 650).map_err(crate::Error::from)
 }
