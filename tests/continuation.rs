@@ -152,3 +152,30 @@ fn nlvib03_multipliers_converge_in_k() {
     eprintln!("observed order over k = 512 … 16384: {rate:.2}");
     assert!(rate > 1.0 && errors[errors.len() - 1] < 1e-3, "order {rate:.2}, errors {errors:?}");
 }
+
+/// Continuation in the force scale and the gap offset (issue 13, item 1) at Ω = 0.7 on NLvib 03:
+/// the contact-free orbit grazes where its amplitude reaches the clearance, known in closed form
+/// from the linear response X = (K − Ω²M + iΩD)⁻¹ f: scale s_g = gap/|X_0|, offset δ_g = |X_0| − gap.
+/// cds shifts the discrete linear response by O((ω h)²) ≈ 1e-5 at k = 4096.
+#[test]
+fn force_scale_and_gap_offset_graze_where_the_linear_orbit_reaches_the_gap() {
+    use num_complex::Complex64 as C;
+    let omega = 0.7;
+    // 2×2 complex solve of (K − Ω² + iΩD) X = (0, 0.1).
+    let (k, d) = ([[1.0, -1.0], [-1.0, 2.0]], [[0.03, -0.03], [-0.03, 0.06]]);
+    let a = |i: usize, j: usize| C::new(k[i][j] - if i == j { omega * omega } else { 0.0 }, omega * d[i][j]);
+    let det = a(0, 0) * a(1, 1) - a(0, 1) * a(1, 0);
+    let x0 = (-a(0, 1) * 0.1 / det).norm();
+    let mut text = scene(4096);
+    text = text.replace("frequency = 0.5", "frequency = 0.7");
+    let p = periodic_contact::scene::Scene::parse(&text, "nlvib03").unwrap().to_problem("nlvib03").unwrap();
+    for (param, from, to, want) in [(Parameter::ForceScale, 0.2, 1.0 / x0 + 0.05, 1.0 / x0), (Parameter::GapOffset, 0.0, x0 - 1.0 - 0.05, x0 - 1.0)] {
+        let b = continuation::run(&p, param, from, to, &ContinuationSettings::default(), &|_| {}).unwrap();
+        let graze = b.events().find(|e| e.event.map(|k| k.name()) == Some("grazing")).unwrap_or_else(|| panic!("{}: no grazing ({})", param.name(), b.stop));
+        let err = (graze.parameter - want).abs() / want.abs();
+        eprintln!("{}: grazing at {:.7}, closed form {want:.7}, relative {err:.1e}; {} points, stop {}", param.name(), graze.parameter, b.points.len(), b.stop);
+        assert!(err < 1e-4, "{}: grazing at {} vs {want}", param.name(), graze.parameter);
+        // Event points sit on kinks, where the certified solve may add or drop a step of contact.
+        assert!(b.points.iter().all(|p| p.certified || p.event.is_some()), "{}: an uncertified regular point", param.name());
+    }
+}

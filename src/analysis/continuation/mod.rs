@@ -31,6 +31,11 @@ use num_complex::Complex64;
 pub enum Parameter {
     /// The excitation frequency ω [rad/s] (the period T = 2π/ω; k steps per period).
     Frequency,
+    /// A factor on every force amplitude of the scene (1: the scene's forces).
+    ForceScale,
+    /// A length added to every contact's static clearance (0: the scene's gaps; negative closes
+    /// them, a preload).
+    GapOffset,
 }
 
 impl Parameter {
@@ -38,18 +43,44 @@ impl Parameter {
     pub fn parse(name: &str) -> Result<Parameter, Error> {
         match name {
             "frequency" => Ok(Parameter::Frequency),
-            other => Err(Error::input(format!("--param: is \"{other}\"; continuation takes frequency"))),
+            "force_scale" => Ok(Parameter::ForceScale),
+            "gap_offset" => Ok(Parameter::GapOffset),
+            other => Err(Error::input(format!("--param: is \"{other}\"; continuation takes frequency, force_scale or gap_offset"))),
         }
     }
     pub fn name(self) -> &'static str {
         match self {
             Parameter::Frequency => "frequency",
+            Parameter::ForceScale => "force_scale",
+            Parameter::GapOffset => "gap_offset",
         }
     }
-    /// Sets the parameter of `problem` to `value`, checked.
+    /// What the parameter is, for an axis or a column, with its quantity.
+    pub fn describe(self) -> (&'static str, crate::model::Quantity) {
+        use crate::model::Quantity;
+        match self {
+            Parameter::Frequency => ("excitation frequency ω", Quantity::Frequency),
+            Parameter::ForceScale => ("force scale (× the scene's forces)", Quantity::Ratio),
+            Parameter::GapOffset => ("gap offset (added to every clearance)", Quantity::Length),
+        }
+    }
+    /// Sets the parameter of `problem` (the scene's, unchanged until now) to `value`, checked.
     fn apply(self, problem: &mut PeriodicProblem, value: f64) -> Result<(), Error> {
         match self {
             Parameter::Frequency => problem.set_frequency(value).map_err(Error::from),
+            Parameter::ForceScale | Parameter::GapOffset => {
+                if !value.is_finite() {
+                    return Err(Error::input(format!("{}: is {value}, must be finite", self.name())));
+                }
+                let mut model = problem.model().clone();
+                if self == Parameter::ForceScale {
+                    model.forces.iter_mut().for_each(|f| f.term.amplitude *= value);
+                } else {
+                    model.contacts.iter_mut().for_each(|c| c.gap += value);
+                }
+                *problem = problem.with_model(model, problem.discretization())?;
+                Ok(())
+            }
         }
     }
 }
@@ -182,10 +213,26 @@ pub fn run(problem: &PeriodicProblem, param: Parameter, from: f64, to: f64, sett
                 next = Node::new(&mut fam, end, t);
             }
         }
+        let mut found: Vec<BranchPoint> = Vec::new();
         for (kind, node, detail) in events::between(&mut fam, &here, &next, m) {
-            points.push(point(&fam, &mut solver, &node, Some(kind), detail)?);
+            found.push(point(&fam, &mut solver, &node, Some(kind), detail)?);
         }
-        points.push(point(&fam, &mut solver, &next, None, String::new())?);
+        found.push(point(&fam, &mut solver, &next, None, String::new())?);
+        // The path's orbit must be the LCP's. At a kink the certified solve may add or drop a
+        // step of contact (flagged `certified = false`); where it lands on another orbit (the
+        // amplitude jumps by > 10 % from the last point) its amplitudes would be that orbit's,
+        // so the branch ends there.
+        let jumped = |p: &BranchPoint, last: &BranchPoint| p.amplitude.iter().zip(&last.amplitude).any(|(a, b)| (a - b).abs() > 0.1 * b.abs().max(a.abs()));
+        let last = points.last().expect("the start is a point").clone();
+        if let Some(bad) = found.iter().position(|p| !p.certified && jumped(p, &last)) {
+            let at = found[bad].parameter;
+            points.extend(found.into_iter().take(bad));
+            break format!(
+                "the orbit at {} = {at} is not the LCP's (the certified solve from its active sets changes them): the path cannot be trusted beyond",
+                param.name()
+            );
+        }
+        points.extend(found);
         on_point(next.solved.parameter(rho));
         if past_end {
             break "reached".to_string();

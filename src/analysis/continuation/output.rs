@@ -7,8 +7,8 @@ use crate::periodic::PeriodicProblem;
 /// per displacement output as in `sweep`, `stable`, `multiplier` (largest |μ|),
 /// `period_multiple`, `event`, `certified`.
 pub fn to_csv(branch: &Branch, problem: &PeriodicProblem, labels: &Labels) -> String {
-    let (hz, mm) = (labels.unit(Quantity::Frequency), labels.unit(Quantity::Length));
-    let mut head = vec![format!("{} {hz}", branch.parameter.name())];
+    let mm = labels.unit(Quantity::Length);
+    let mut head = vec![format!("{} {}", branch.parameter.name(), labels.unit(branch.parameter.describe().1))];
     head.extend(problem.outputs().displacement.iter().map(|d| format!("amplitude_{d} {mm}")));
     head.extend(["stable", "multiplier", "period_multiple", "event", "certified"].map(String::from));
     let mut s = head.join(",") + "\n";
@@ -87,8 +87,8 @@ pub fn plot(path: &std::path::Path, branch: &Branch, problem: &PeriodicProblem, 
             looks.push(Look { color: j + 1, dashed: false, line: false, marker: j % 3 });
         }
     }
-    let hz = labels.unit(Quantity::Frequency);
-    let x_label = format!("excitation frequency ω {hz}");
+    let (what, quantity) = branch.parameter.describe();
+    let x_label = format!("{what} {}", labels.unit(quantity));
     let y_label = format!("amplitude of {} {} (peak-to-peak / 2)", labels.dof(d), labels.unit(Quantity::Length));
     let title = format!("{title} of {}", labels.dof(d));
     let chart = Chart { title: &title, x_label: &x_label, y_label: &y_label, x_scale: Scale::Linear, y_scale: Scale::Linear };

@@ -11,7 +11,8 @@ use std::time::Instant;
 #[derive(clap::Args)]
 pub struct Args {
     pub scene: PathBuf,
-    /// The continued parameter: frequency (ω [rad/s]).
+    /// The continued parameter: frequency (ω [rad/s]), force_scale (× every force of the scene)
+    /// or gap_offset (added to every contact's clearance, length unit).
     #[arg(long, default_value = "frequency")]
     pub param: String,
     #[arg(long, allow_negative_numbers = true)]
