@@ -10,6 +10,35 @@ pub struct Series {
     pub markers: bool,
 }
 
+/// How one curve looks, when the caller chooses (curves of one method in one colour, an
+/// estimate as hollow markers beside its filled true value).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Look {
+    /// Index into the palette (Tableau 10).
+    pub colour: usize,
+    pub line: Line,
+    /// 0 circle, 1 triangle, 2 square; `None`: no marker.
+    pub marker: Option<usize>,
+    /// Marker outline only.
+    pub hollow: bool,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Line {
+    Solid,
+    Dashed,
+    /// Markers only.
+    None,
+}
+
+impl Look {
+    /// The default look of curve `i` (see [`panel_chart`]).
+    fn of(i: usize, markers: bool) -> Look {
+        let (_, dashed, marker) = style(i);
+        Look { colour: i % 10, line: if dashed { Line::Dashed } else { Line::Solid }, marker: markers.then_some(marker), hollow: false }
+    }
+}
+
 /// Axis scaling.
 #[derive(Clone, Copy, PartialEq, Eq)]
 pub enum Scale {
@@ -124,18 +153,33 @@ pub enum Legend {
 /// Several charts in one PNG, `columns` per row (each panel as [`line_chart`] draws it).
 /// The error is a [`PlotError`], in the caller's error type.
 pub fn panel_chart(path: &Path, panels: &[(&Chart, &[Series])], columns: usize, width: u32, height: u32, legend: Legend) -> Result<(), PlotError> {
+    let looks: Vec<Vec<Look>> = panels.iter().map(|(_, s)| s.iter().enumerate().map(|(i, s)| Look::of(i, s.markers)).collect()).collect();
+    let styled: Vec<(&Chart, &[Series], &[Look])> = panels.iter().zip(&looks).map(|((c, s), l)| (*c, *s, l.as_slice())).collect();
+    draw_panels(path, &styled, columns, width, height, legend)
+}
+
+/// As [`panel_chart`], each curve with the look the caller gives (`looks[i]` for `series[i]`).
+/// A series with an empty label has no legend entry (a legend-only series explains a look).
+pub fn styled_panel_chart(
+    path: &Path,
+    panels: &[(&Chart, &[Series], &[Look])],
+    columns: usize,
+    width: u32,
+    height: u32,
+    legend: Legend,
+) -> Result<(), PlotError> {
     draw_panels(path, panels, columns, width, height, legend)
 }
 
-fn draw_panels(path: &Path, panels: &[(&Chart, &[Series])], columns: usize, width: u32, height: u32, legend: Legend) -> Result<(), PlotError> {
+fn draw_panels(path: &Path, panels: &[(&Chart, &[Series], &[Look])], columns: usize, width: u32, height: u32, legend: Legend) -> Result<(), PlotError> {
     let err = |e: &dyn std::fmt::Display| PlotError::new(path, e);
     let root = BitMapBackend::new(path, (width, height)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
     let columns = columns.max(1);
     let rows = panels.len().div_ceil(columns).max(1);
     let areas = root.split_evenly((rows, columns));
-    for ((chart, series), area) in panels.iter().zip(&areas) {
-        draw_chart(area, chart, series, legend, path)?;
+    for ((chart, series, looks), area) in panels.iter().zip(&areas) {
+        draw_chart(area, chart, series, looks, legend, path)?;
     }
     root.present().map_err(|e| err(&e))
 }
@@ -144,6 +188,7 @@ fn draw_chart<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
     chart: &Chart,
     series: &[Series],
+    looks: &[Look],
     legend: Legend,
     path: &Path,
 ) -> Result<(), PlotError>
@@ -171,27 +216,38 @@ where
                 mesh.y_label_formatter(if chart.y_scale == Scale::Log { &log_fmt } else { &y_tick });
                 mesh.draw().map_err(|e| err(&e))?;
             }
-            for (i, s) in series.iter().enumerate() {
-                let (color, dashed, marker) = style(i);
+            for (s, look) in series.iter().zip(looks) {
+                let color = TABLEAU10[look.colour % 10];
                 let pts: Vec<(f64, f64)> = s.points.iter().copied().filter(keep).collect();
                 let line = color.stroke_width(2);
-                let drawn = if dashed {
-                    ctx.draw_series(DashedLineSeries::new(pts.clone(), 8, 5, line)).map_err(|e| err(&e))?
-                } else {
-                    ctx.draw_series(LineSeries::new(pts.clone(), line)).map_err(|e| err(&e))?
+                let drawn = match look.line {
+                    Line::Dashed => ctx.draw_series(DashedLineSeries::new(pts.clone(), 8, 5, line)).map_err(|e| err(&e))?,
+                    Line::Solid => ctx.draw_series(LineSeries::new(pts.clone(), line)).map_err(|e| err(&e))?,
+                    Line::None => ctx.draw_series(LineSeries::new(Vec::new(), line)).map_err(|e| err(&e))?,
                 };
-                // Legend: two segments (a gap between them when dashed) and the marker.
-                let (gap, shape) = (if dashed { 13 } else { 8 }, marker_shape(marker));
-                let mark = if s.markers { color.filled() } else { color.mix(0.0).filled() };
-                drawn.label(s.label.clone()).legend(move |(x, y)| {
-                    EmptyElement::at((x, y))
-                        + PathElement::new(vec![(0, 0), (8, 0)], line)
-                        + PathElement::new(vec![(gap, 0), (21, 0)], line)
-                        + Polygon::new(shape.iter().map(|(a, b)| (a + 10, *b)).collect::<Vec<_>>(), mark)
-                });
-                if s.markers {
-                    let shape = marker_shape(marker);
-                    ctx.draw_series(pts.iter().map(|&p| EmptyElement::at(p) + Polygon::new(shape.clone(), color.filled()))).map_err(|e| err(&e))?;
+                // Legend: two segments (a gap between them when dashed, none without a line) and the marker.
+                let shape = marker_shape(look.marker.unwrap_or(0));
+                let fill = if look.hollow { color.mix(0.0).filled() } else { color.filled() };
+                let (has_line, gap, has_marker) = (look.line != Line::None, if look.line == Line::Dashed { 13 } else { 8 }, look.marker.is_some());
+                if !s.label.is_empty() {
+                    drawn.label(s.label.clone()).legend(move |(x, y)| {
+                        let seg = |a: i32, b: i32| PathElement::new(if has_line { vec![(a, 0), (b, 0)] } else { vec![] }, line);
+                        let marker: Vec<(i32, i32)> = if has_marker { shape.iter().chain(shape.first()).map(|(a, b)| (a + 10, *b)).collect() } else { vec![] };
+                        EmptyElement::at((x, y)) + seg(0, 8) + seg(gap, 21) + Polygon::new(marker.clone(), fill) + PathElement::new(marker, line)
+                    });
+                }
+                if let Some(m) = look.marker {
+                    let shape = marker_shape(m);
+                    if look.hollow {
+                        let ring = |p| {
+                            let mut closed = shape.clone();
+                            closed.push(shape[0]);
+                            EmptyElement::at(p) + PathElement::new(closed, color.stroke_width(2))
+                        };
+                        ctx.draw_series(pts.iter().map(|&p| ring(p))).map_err(|e| err(&e))?;
+                    } else {
+                        ctx.draw_series(pts.iter().map(|&p| EmptyElement::at(p) + Polygon::new(shape.clone(), color.filled()))).map_err(|e| err(&e))?;
+                    }
                 }
             }
             let mut labels = ctx.configure_series_labels();
