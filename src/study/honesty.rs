@@ -24,9 +24,9 @@ pub struct HonestySettings {
 }
 
 impl HonestySettings {
-    /// 8 random members + the nominal one per family, k = 256, 512, 1024, seed 1.
+    /// 16 random members + the nominal one per family, k = 256, 512, 1024, seed 1.
     pub fn full() -> Self {
-        HonestySettings { families: Family::ALL.to_vec(), draws: 8, seed: 1, steps: vec![256, 512, 1024] }
+        HonestySettings { families: Family::ALL.to_vec(), draws: 16, seed: 1, steps: vec![256, 512, 1024] }
     }
     /// 2 random members, k = 256, 512.
     pub fn quick() -> Self {

@@ -66,7 +66,7 @@ pub struct AccuracySettings {
 
 impl AccuracySettings {
     /// The documented full study: k = 32 … 8192, marcher N = 32 … 8192, Siconos at k = 256,
-    /// 512, 1024, the estimates on 8 random members of each family at k = 256, 512, 1024.
+    /// 512, 1024, the estimates on 16 random members of each family at k = 256, 512, 1024.
     pub fn full() -> Self {
         let pow2 = |lo: u32, hi: u32| (lo..=hi).map(|e| 1usize << e).collect::<Vec<_>>();
         AccuracySettings {
