@@ -10,18 +10,33 @@ pub struct Series {
     pub markers: bool,
 }
 
-/// How a curve is drawn, when the caller chooses rather than the position in the list: a branch
-/// draws its stable runs solid and its unstable runs dashed in one colour, and its events as
-/// markers without a line.
+/// How one curve looks, when the caller chooses (curves of one method in one colour, an
+/// estimate as hollow markers beside its filled true value).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Look {
     /// Index into the palette (Tableau 10).
-    pub color: usize,
-    pub dashed: bool,
-    /// false: markers only.
-    pub line: bool,
-    /// 0 circle, 1 triangle, 2 square.
-    pub marker: usize,
+    pub colour: usize,
+    pub line: Line,
+    /// 0 circle, 1 triangle, 2 square; `None`: no marker.
+    pub marker: Option<usize>,
+    /// Marker outline only.
+    pub hollow: bool,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Line {
+    Solid,
+    Dashed,
+    /// Markers only.
+    None,
+}
+
+impl Look {
+    /// The default look of curve `i` (see [`panel_chart`]).
+    fn of(i: usize, markers: bool) -> Look {
+        let (_, dashed, marker) = style(i);
+        Look { colour: i % 10, line: if dashed { Line::Dashed } else { Line::Solid }, marker: markers.then_some(marker), hollow: false }
+    }
 }
 
 /// Axis scaling.
@@ -55,10 +70,10 @@ const TABLEAU10: [RGBColor; 10] = [
     RGBColor(23, 190, 207),
 ];
 
-/// The look of curve `i`: its colour (palette index), dashed or not, and its marker (0 circle, 1 triangle,
+/// The look of curve `i`: its colour, dashed or not, and its marker (0 circle, 1 triangle,
 /// 2 square).
-fn style(i: usize) -> (usize, bool, usize) {
-    (i % 10, (i / 10) % 2 == 1, (i / 10) % 3)
+fn style(i: usize) -> (RGBColor, bool, usize) {
+    (TABLEAU10[i % 10], (i / 10) % 2 == 1, (i / 10) % 3)
 }
 
 /// Marker outlines in pixels around the point: an octagon (a circle), a triangle, a square.
@@ -126,16 +141,6 @@ pub fn line_chart(path: &Path, chart: &Chart, series: &[Series], width: u32, hei
     panel_chart(path, &[(chart, series)], 1, width, height, Legend::Default)
 }
 
-/// As [`line_chart`], with the look of each series given (`looks[i]` for `series[i]`); a series
-/// with an empty label has no legend entry (the second run of a dashed branch, say).
-pub fn styled_chart(path: &Path, chart: &Chart, series: &[Series], looks: &[Look], width: u32, height: u32) -> Result<(), PlotError> {
-    let err = |e: &dyn std::fmt::Display| PlotError::new(path, e);
-    let root = BitMapBackend::new(path, (width, height)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| err(&e))?;
-    draw_chart(&root, chart, series, looks, Legend::Default, path)?;
-    root.present().map_err(|e| err(&e))
-}
-
 /// Where the legend goes.
 #[derive(Clone, Copy, PartialEq, Eq)]
 pub enum Legend {
@@ -148,18 +153,33 @@ pub enum Legend {
 /// Several charts in one PNG, `columns` per row (each panel as [`line_chart`] draws it).
 /// The error is a [`PlotError`], in the caller's error type.
 pub fn panel_chart(path: &Path, panels: &[(&Chart, &[Series])], columns: usize, width: u32, height: u32, legend: Legend) -> Result<(), PlotError> {
+    let looks: Vec<Vec<Look>> = panels.iter().map(|(_, s)| s.iter().enumerate().map(|(i, s)| Look::of(i, s.markers)).collect()).collect();
+    let styled: Vec<(&Chart, &[Series], &[Look])> = panels.iter().zip(&looks).map(|((c, s), l)| (*c, *s, l.as_slice())).collect();
+    draw_panels(path, &styled, columns, width, height, legend)
+}
+
+/// As [`panel_chart`], each curve with the look the caller gives (`looks[i]` for `series[i]`).
+/// A series with an empty label has no legend entry (a legend-only series explains a look).
+pub fn styled_panel_chart(
+    path: &Path,
+    panels: &[(&Chart, &[Series], &[Look])],
+    columns: usize,
+    width: u32,
+    height: u32,
+    legend: Legend,
+) -> Result<(), PlotError> {
     draw_panels(path, panels, columns, width, height, legend)
 }
 
-fn draw_panels(path: &Path, panels: &[(&Chart, &[Series])], columns: usize, width: u32, height: u32, legend: Legend) -> Result<(), PlotError> {
+fn draw_panels(path: &Path, panels: &[(&Chart, &[Series], &[Look])], columns: usize, width: u32, height: u32, legend: Legend) -> Result<(), PlotError> {
     let err = |e: &dyn std::fmt::Display| PlotError::new(path, e);
     let root = BitMapBackend::new(path, (width, height)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
     let columns = columns.max(1);
     let rows = panels.len().div_ceil(columns).max(1);
     let areas = root.split_evenly((rows, columns));
-    for ((chart, series), area) in panels.iter().zip(&areas) {
-        draw_chart(area, chart, series, &[], legend, path)?;
+    for ((chart, series, looks), area) in panels.iter().zip(&areas) {
+        draw_chart(area, chart, series, looks, legend, path)?;
     }
     root.present().map_err(|e| err(&e))
 }
@@ -196,35 +216,38 @@ where
                 mesh.y_label_formatter(if chart.y_scale == Scale::Log { &log_fmt } else { &y_tick });
                 mesh.draw().map_err(|e| err(&e))?;
             }
-            for (i, s) in series.iter().enumerate() {
-                let look = looks.get(i).copied().unwrap_or_else(|| {
-                    let (color, dashed, marker) = style(i);
-                    Look { color, dashed, line: true, marker }
-                });
-                let (color, dashed, marker) = (TABLEAU10[look.color % 10], look.dashed, look.marker);
+            for (s, look) in series.iter().zip(looks) {
+                let color = TABLEAU10[look.colour % 10];
                 let pts: Vec<(f64, f64)> = s.points.iter().copied().filter(keep).collect();
                 let line = color.stroke_width(2);
-                let drawn = match (look.line, dashed) {
-                    (false, _) => ctx.draw_series(std::iter::empty::<PathElement<(f64, f64)>>()).map_err(|e| err(&e))?,
-                    (true, true) => ctx.draw_series(DashedLineSeries::new(pts.clone(), 8, 5, line)).map_err(|e| err(&e))?,
-                    (true, false) => ctx.draw_series(LineSeries::new(pts.clone(), line)).map_err(|e| err(&e))?,
+                let drawn = match look.line {
+                    Line::Dashed => ctx.draw_series(DashedLineSeries::new(pts.clone(), 8, 5, line)).map_err(|e| err(&e))?,
+                    Line::Solid => ctx.draw_series(LineSeries::new(pts.clone(), line)).map_err(|e| err(&e))?,
+                    Line::None => ctx.draw_series(LineSeries::new(Vec::new(), line)).map_err(|e| err(&e))?,
                 };
-                // Legend: two segments (a gap between them when dashed; none for markers only)
-                // and the marker.
-                let (gap, shape) = (if dashed { 13 } else { 8 }, marker_shape(marker));
-                let mark = if s.markers { color.filled() } else { color.mix(0.0).filled() };
-                let stroke = if look.line { line } else { color.mix(0.0).stroke_width(2) };
+                // Legend: two segments (a gap between them when dashed, none without a line) and the marker.
+                let shape = marker_shape(look.marker.unwrap_or(0));
+                let fill = if look.hollow { color.mix(0.0).filled() } else { color.filled() };
+                let (has_line, gap, has_marker) = (look.line != Line::None, if look.line == Line::Dashed { 13 } else { 8 }, look.marker.is_some());
                 if !s.label.is_empty() {
                     drawn.label(s.label.clone()).legend(move |(x, y)| {
-                        EmptyElement::at((x, y))
-                            + PathElement::new(vec![(0, 0), (8, 0)], stroke)
-                            + PathElement::new(vec![(gap, 0), (21, 0)], stroke)
-                            + Polygon::new(shape.iter().map(|(a, b)| (a + 10, *b)).collect::<Vec<_>>(), mark)
+                        let seg = |a: i32, b: i32| PathElement::new(if has_line { vec![(a, 0), (b, 0)] } else { vec![] }, line);
+                        let marker: Vec<(i32, i32)> = if has_marker { shape.iter().chain(shape.first()).map(|(a, b)| (a + 10, *b)).collect() } else { vec![] };
+                        EmptyElement::at((x, y)) + seg(0, 8) + seg(gap, 21) + Polygon::new(marker.clone(), fill) + PathElement::new(marker, line)
                     });
                 }
-                if s.markers {
-                    let shape = marker_shape(marker);
-                    ctx.draw_series(pts.iter().map(|&p| EmptyElement::at(p) + Polygon::new(shape.clone(), color.filled()))).map_err(|e| err(&e))?;
+                if let Some(m) = look.marker {
+                    let shape = marker_shape(m);
+                    if look.hollow {
+                        let ring = |p| {
+                            let mut closed = shape.clone();
+                            closed.push(shape[0]);
+                            EmptyElement::at(p) + PathElement::new(closed, color.stroke_width(2))
+                        };
+                        ctx.draw_series(pts.iter().map(|&p| ring(p))).map_err(|e| err(&e))?;
+                    } else {
+                        ctx.draw_series(pts.iter().map(|&p| EmptyElement::at(p) + Polygon::new(shape.clone(), color.filled()))).map_err(|e| err(&e))?;
+                    }
                 }
             }
             let mut labels = ctx.configure_series_labels();

@@ -25,6 +25,12 @@ pub fn expected_order(problem: &PeriodicProblem, r: &Response) -> (Option<f64>, 
         let pairing = problem.pairing_at(i);
         let (p, what) = match c.compliance {
             Compliance::Compliant { .. } if pairing == Pairing::Forward => (Some(1.0), "compliant, forward: lags one step"),
+            // Measured on the compliant family (validation/study/accuracy.md): fourier's error at
+            // the force's kink is not C·h^p (observed orders −0.6 … 5.7 between k/2 and k).
+            Compliance::Compliant { .. } if scheme == Scheme::Fourier => (
+                Some(smooth),
+                "compliant (fourier converges erratically at the force's kink: the estimate follows the error's envelope, 0.1–24× the error measured)",
+            ),
             Compliance::Compliant { .. } => (Some(smooth), "compliant"),
             Compliance::Rigid => match (scheme, pairing) {
                 (Scheme::Bds1, Pairing::Same) => (Some(1.0), "rigid"),

@@ -4,6 +4,10 @@
 //! Everything is measured on one thread (`SolverSettings::parallel = false`, the marcher is
 //! single-threaded), so that the times are CPU times.
 pub mod accuracy;
+pub mod chain;
+pub mod families;
+pub mod honesty;
+pub mod peers;
 pub mod warmstart;
 
 use crate::Error;
@@ -11,6 +15,7 @@ use crate::exact::{CompliantStopOrbit, LinearOrbit, Oscillator, RigidStopOrbit};
 use crate::model::{Compliance, Model};
 use crate::periodic::{LcpMethod, OutputSelection, PeriodicProblem, SolverSettings};
 use crate::time::{Discretization, Pairing, Scheme};
+use chain::MarchedReference;
 
 /// The exact references of notes §6 used by the studies.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -26,6 +31,9 @@ pub enum Case {
     /// references the issue lists: added because its transient decays slowly (no sticking resets
     /// the state), which is where marching is expensive.
     Impacting,
+    /// A 2-DOF chain with a compliant stop on the second mass (tests/polish.rs): no closed form,
+    /// the reference is long time integration ([`chain`]).
+    Chain,
 }
 
 /// The compliant-stop oscillator of notes §6.2 (also the linear case's).
@@ -41,7 +49,7 @@ pub const IMPACTING_OSC: Oscillator = Oscillator { mass: 1.0, damping: 0.1, stif
 pub const IMPACTING_GAP: f64 = 0.6;
 
 impl Case {
-    pub const ALL: [Case; 4] = [Case::Compliant, Case::Rigid, Case::Linear, Case::Impacting];
+    pub const ALL: [Case; 5] = [Case::Compliant, Case::Rigid, Case::Impacting, Case::Chain, Case::Linear];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -49,6 +57,7 @@ impl Case {
             Case::Rigid => "rigid",
             Case::Linear => "linear",
             Case::Impacting => "impacting",
+            Case::Chain => "chain",
         }
     }
 
@@ -56,7 +65,7 @@ impl Case {
         Case::ALL
             .into_iter()
             .find(|c| c.name() == s)
-            .ok_or_else(|| Error::input(format!("unknown case \"{s}\"; expected compliant, rigid, linear or impacting")))
+            .ok_or_else(|| Error::input(format!("unknown case \"{s}\"; expected compliant, rigid, impacting, chain or linear")))
     }
 
     pub fn title(self) -> &'static str {
@@ -65,26 +74,34 @@ impl Case {
             Case::Rigid => "rigid stop with sticking (notes §6.3)",
             Case::Linear => "linear oscillator (notes §6.1)",
             Case::Impacting => "rigid stop, pure impacts (no sticking)",
+            Case::Chain => "2-DOF compliant chain (reference: long time integration)",
         }
     }
 
-    pub fn oscillator(self) -> Oscillator {
+    /// The 1-DOF oscillator of the case; `None` for the chain.
+    pub fn oscillator(self) -> Option<Oscillator> {
         match self {
-            Case::Compliant | Case::Linear => COMPLIANT_OSC,
-            Case::Rigid => RIGID_OSC,
-            Case::Impacting => IMPACTING_OSC,
+            Case::Compliant | Case::Linear => Some(COMPLIANT_OSC),
+            Case::Rigid => Some(RIGID_OSC),
+            Case::Impacting => Some(IMPACTING_OSC),
+            Case::Chain => None,
         }
     }
 
-    /// The 1-DOF model of the case.
+    /// The model of the case.
     pub fn model(self) -> Model {
-        let osc = self.oscillator();
+        let Some(osc) = self.oscillator() else { return chain::model() };
         match self {
             Case::Compliant => osc.model(vec![Oscillator::stop(COMPLIANT_GAP, Compliance::Compliant { stiffness: COMPLIANT_STIFFNESS })]),
             Case::Rigid => osc.model(vec![Oscillator::stop(RIGID_GAP, Compliance::Rigid)]),
             Case::Impacting => osc.model(vec![Oscillator::stop(IMPACTING_GAP, Compliance::Rigid)]),
-            Case::Linear => osc.model(vec![]),
+            Case::Linear | Case::Chain => osc.model(vec![]),
         }
+    }
+
+    /// The displacement DOFs compared with the reference.
+    pub fn dofs(self) -> Vec<usize> {
+        (0..self.model().n()).collect()
     }
 
     /// Whether the case has a contact (and so an LCP, a pairing and an impulse).
@@ -109,7 +126,7 @@ impl Case {
     /// Whether (scheme, pairing) converges to the exact orbit (notes §3 findings; the README table).
     pub fn converges(self, scheme: Scheme, pairing: Option<Pairing>) -> bool {
         match self {
-            Case::Linear | Case::Compliant => true,
+            Case::Linear | Case::Compliant | Case::Chain => true,
             Case::Rigid | Case::Impacting => matches!(
                 (scheme, pairing),
                 (Scheme::Bds1, Some(Pairing::Same)) | (Scheme::Cds, Some(Pairing::Forward)) | (Scheme::Galerkin, Some(Pairing::Forward))
@@ -119,7 +136,7 @@ impl Case {
 
     /// The problem at k instants, one thread, `auto` LCP method unless told.
     pub fn problem(self, scheme: Scheme, pairing: Option<Pairing>, k: usize, method: LcpMethod) -> Result<PeriodicProblem, Error> {
-        let outputs = OutputSelection { displacement: vec![0], velocity: vec![], acceleration: vec![], contacts: self.has_contact() };
+        let outputs = OutputSelection { displacement: self.dofs(), velocity: vec![], acceleration: vec![], contacts: self.has_contact() };
         let solver = SolverSettings { method, tolerance: 1e-9, parallel: false };
         PeriodicProblem::new(self.model(), Discretization { scheme, steps: k, pairing }, outputs, solver).map_err(Error::from)
     }
@@ -133,6 +150,7 @@ impl Case {
             Case::Rigid => Reference::Rigid(RigidStopOrbit::solve(&RIGID_OSC, RIGID_GAP).map_err(reference_error)?),
             Case::Impacting => Reference::Rigid(RigidStopOrbit::solve(&IMPACTING_OSC, IMPACTING_GAP).map_err(reference_error)?),
             Case::Linear => Reference::Linear(LinearOrbit::solve(&COMPLIANT_OSC).map_err(reference_error)?),
+            Case::Chain => Reference::Marched(chain::reference()?),
         })
     }
 }
@@ -156,21 +174,34 @@ pub enum Reference {
     Compliant(CompliantStopOrbit),
     Rigid(RigidStopOrbit),
     Linear(LinearOrbit),
+    Marched(MarchedReference),
 }
 
 impl Reference {
-    pub fn displacement(&self, t: f64) -> f64 {
+    /// x_dof(t); the marched reference only at the instants of its grid.
+    pub fn displacement(&self, dof: usize, t: f64) -> f64 {
         match self {
             Reference::Compliant(o) => o.eval(t).0,
             Reference::Rigid(o) => o.eval(t).0,
             Reference::Linear(o) => o.eval(t).0,
+            Reference::Marched(o) => o.displacement(dof, t),
         }
     }
+    /// Largest peak-to-peak amplitude over the DOFs.
     pub fn peak_to_peak(&self) -> f64 {
         match self {
             Reference::Compliant(o) => o.peak_to_peak(),
             Reference::Rigid(o) => o.peak_to_peak(),
             Reference::Linear(o) => o.peak_to_peak(),
+            Reference::Marched(o) => o.peak_to_peak(),
+        }
+    }
+    /// The reference's own error relative to the peak-to-peak amplitude (0 for the closed forms,
+    /// whose Newton solves reach round-off).
+    pub fn uncertainty(&self) -> f64 {
+        match self {
+            Reference::Marched(o) => o.uncertainty() / o.peak_to_peak(),
+            _ => 0.0,
         }
     }
     /// Impulse per period; None without contact.
@@ -178,14 +209,23 @@ impl Reference {
         match self {
             Reference::Compliant(o) => Some(o.impulse_per_period()),
             Reference::Rigid(o) => Some(o.impulse_per_period()),
-            Reference::Linear(_) => None,
+            Reference::Linear(_) | Reference::Marched(_) => None,
         }
     }
 
-    /// max_j |x_j − x(t_j)| / peak-to-peak over samples (t_j, x_j).
-    pub fn max_error(&self, t: &[f64], x: &[f64]) -> f64 {
-        let e = t.iter().zip(x).map(|(&t, &v)| (v - self.displacement(t)).abs()).fold(0.0, f64::max);
+    /// max over the DOFs and samples of |x_j − x(t_j)| / peak-to-peak; `x[d]` is DOF d's series.
+    pub fn max_error(&self, t: &[f64], x: &[&[f64]]) -> f64 {
+        let mut e = 0.0f64;
+        for (dof, x) in x.iter().enumerate() {
+            e = t.iter().zip(x.iter()).map(|(&t, &v)| (v - self.displacement(dof, t)).abs()).fold(e, f64::max);
+        }
         e / self.peak_to_peak()
+    }
+
+    /// [`Reference::max_error`] of a response's displacement outputs (DOFs 0, 1, … in order).
+    pub fn response_error(&self, r: &crate::response::Response) -> f64 {
+        let x: Vec<&[f64]> = (0..r.displacement.len()).map(|d| r.displacement[&d.to_string()].as_slice()).collect();
+        self.max_error(&r.time, &x)
     }
 
     /// |I − I_exact| / I_exact; None without contact.

@@ -51,7 +51,7 @@ pub fn events_json(branch: &Branch, problem: &PeriodicProblem) -> String {
 /// same colour, each event kind as markers of its own without a line; axes named with units.
 #[cfg(feature = "plots")]
 pub fn plot(path: &std::path::Path, branch: &Branch, problem: &PeriodicProblem, i: usize, labels: &Labels, title: &str) -> Result<(), crate::Error> {
-    use crate::plot::{Chart, Look, Scale, Series, styled_chart};
+    use crate::plot::{Chart, Legend, Line, Look, Scale, Series, styled_panel_chart};
     let d = problem.outputs().displacement[i];
     let (mut series, mut looks): (Vec<Series>, Vec<Look>) = (Vec::new(), Vec::new());
     let mut labelled = [false; 2];
@@ -65,7 +65,7 @@ pub fn plot(path: &std::path::Path, branch: &Branch, problem: &PeriodicProblem, 
             "unstable"
         };
         series.push(Series { label: label.into(), points: run, markers: false });
-        looks.push(Look { color: 0, dashed: !stable, line: true, marker: 0 });
+        looks.push(Look { colour: 0, line: if stable { Line::Solid } else { Line::Dashed }, marker: None, hollow: false });
     };
     let mut run: Vec<(f64, f64)> = Vec::new();
     let mut stable = branch.points.first().is_some_and(|p| p.stable);
@@ -84,7 +84,7 @@ pub fn plot(path: &std::path::Path, branch: &Branch, problem: &PeriodicProblem, 
         let pts: Vec<(f64, f64)> = branch.events().filter(|p| p.event == Some(kind)).map(|p| (p.parameter, p.amplitude[i])).collect();
         if !pts.is_empty() {
             series.push(Series { label: kind.name().into(), points: pts, markers: true });
-            looks.push(Look { color: j + 1, dashed: false, line: false, marker: j % 3 });
+            looks.push(Look { colour: j + 1, line: Line::None, marker: Some(j % 3), hollow: false });
         }
     }
     let (what, quantity) = branch.parameter.describe();
@@ -92,5 +92,5 @@ pub fn plot(path: &std::path::Path, branch: &Branch, problem: &PeriodicProblem, 
     let y_label = format!("amplitude of {} {} (peak-to-peak / 2)", labels.dof(d), labels.unit(Quantity::Length));
     let title = format!("{title} of {}", labels.dof(d));
     let chart = Chart { title: &title, x_label: &x_label, y_label: &y_label, x_scale: Scale::Linear, y_scale: Scale::Linear };
-    styled_chart(path, &chart, &series, &looks, 1000, 650).map_err(crate::Error::from)
+    styled_panel_chart(path, &[(&chart, &series, &looks)], 1, 1000, 650, Legend::Default).map_err(crate::Error::from)
 }

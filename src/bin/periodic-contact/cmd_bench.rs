@@ -8,6 +8,7 @@
 //! own and a `--timeout` can stop it.
 use crate::Failure;
 use periodic_contact::scene::Scene;
+use periodic_contact::study::families::{Family, SplitMix, pick};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -17,22 +18,6 @@ pub fn peak_rss_mib() -> Option<f64> {
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
     let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
     Some(kib / 1024.0)
-}
-
-/// SplitMix64 (Steele, Lea & Flood 2014): a seeded, dependency-free stream for the draws.
-struct SplitMix(u64);
-
-impl SplitMix {
-    fn next_f64(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn uniform(&mut self, (lo, hi): (f64, f64)) -> f64 {
-        lo + (hi - lo) * self.next_f64()
-    }
 }
 
 /// One member of a family: its scene text and a one-line summary of its parameters.
@@ -49,20 +34,19 @@ struct Case {
     member: fn(usize, Option<&mut SplitMix>) -> Member,
 }
 
-fn pick(rng: &mut Option<&mut SplitMix>, nominal: f64, range: (f64, f64)) -> f64 {
-    rng.as_deref_mut().map_or(nominal, |r| r.uniform(range))
-}
-
-/// m x'' + c x' + k x = F cos ωt against a stop at g0 (rigid, or compliant with stiffness kc).
-fn oscillator(steps: usize, c: f64, force: f64, gap: f64, omega: f64, stiffness: Option<f64>) -> Member {
-    let contact_stiffness = stiffness.map_or(String::new(), |kc| format!("stiffness = {kc}\n"));
+/// A 1-DOF family member (`study::families`) as a scene: m x'' + c x' + k x = F cos ωt against a
+/// stop at g0 (rigid, or compliant with stiffness kc).
+fn oscillator(steps: usize, family: Family, rng: Option<&mut SplitMix>) -> Member {
+    let m = family.member(rng);
+    let (o, gap) = (m.oscillator, m.gap);
+    let contact_stiffness = m.contact_stiffness.map_or(String::new(), |kc| format!("stiffness = {kc}\n"));
     let scene = format!(
-        "[structure]\nmass = [[1.0]]\nstiffness = [[1.0]]\n\n[damping]\nmatrix = [[{c}]]\n\n[excitation]\nfrequency = {omega}\n\n\
-         [[force]]\ndof = 0\namplitude = {force}\n\n[[contact]]\ndof = 0\ndirection = 1\ngap = {gap}\n{contact_stiffness}\n\
-         [discretization]\nscheme = \"cds\"\nsteps = {steps}\n\n[output]\ndisplacement = [0]\n"
+        "[structure]\nmass = [[1.0]]\nstiffness = [[1.0]]\n\n[damping]\nmatrix = [[{}]]\n\n[excitation]\nfrequency = {}\n\n\
+         [[force]]\ndof = 0\namplitude = {}\n\n[[contact]]\ndof = 0\ndirection = 1\ngap = {gap}\n{contact_stiffness}\n\
+         [discretization]\nscheme = \"cds\"\nsteps = {steps}\n\n[output]\ndisplacement = [0]\n",
+        o.damping, o.omega, o.force
     );
-    let kc = stiffness.map_or(String::new(), |kc| format!(" kc={kc:.3}"));
-    Member { scene, summary: format!("c={c:.3} F={force:.3} g0={gap:.3} ω={omega:.3}{kc}") }
+    Member { scene, summary: m.summary() }
 }
 
 /// The paper's case: the rigid reduced blade (23 DOFs after Craig–Bampton, 3 tip contacts).
@@ -72,33 +56,17 @@ const CASES: [Case; 5] = [
     Case {
         name: "rigid-stick",
         about: "rigid 1-DOF stop with sticking (0 < k·g0 < F; notes §6.3): m = k = 1, F = 1, cds, forward pairing",
-        member: |steps, mut rng| {
-            let c = pick(&mut rng, 0.1, (0.05, 0.2));
-            let gap = pick(&mut rng, 0.5, (0.3, 0.7));
-            let omega = pick(&mut rng, 1.0, (0.8, 1.2));
-            oscillator(steps, c, 1.0, gap, omega, None)
-        },
+        member: |steps, rng| oscillator(steps, Family::RigidStick, rng),
     },
     Case {
         name: "rigid-impact",
         about: "rigid 1-DOF stop, pure impacts (F < k·g0: the mass cannot stick): m = k = 1, g0 = 1, cds, forward pairing",
-        member: |steps, mut rng| {
-            let c = pick(&mut rng, 0.05, (0.02, 0.1));
-            let force = pick(&mut rng, 0.4, (0.3, 0.6));
-            let omega = pick(&mut rng, 1.0, (0.9, 1.1));
-            oscillator(steps, c, force, 1.0, omega, None)
-        },
+        member: |steps, rng| oscillator(steps, Family::RigidImpact, rng),
     },
     Case {
         name: "compliant",
         about: "compliant 1-DOF stop (notes §6.2: m = k = 1, g0 = 1), cds",
-        member: |steps, mut rng| {
-            let c = pick(&mut rng, 0.05, (0.02, 0.1));
-            let force = pick(&mut rng, 1.0, (0.7, 1.3));
-            let omega = pick(&mut rng, 1.3, (1.1, 1.5));
-            let kc = pick(&mut rng, 10.0, (5.0, 50.0));
-            oscillator(steps, c, force, 1.0, omega, Some(kc))
-        },
+        member: |steps, rng| oscillator(steps, Family::Compliant, rng),
     },
     Case {
         name: "chain",
@@ -140,9 +108,7 @@ fn member(c: &Case, steps: usize, draw: usize, seed: u64) -> Member {
     if draw == 0 {
         return (c.member)(steps, None);
     }
-    // One stream per (seed, draw): a member does not depend on how many were drawn before it.
-    let mut rng = SplitMix(seed ^ (draw as u64).wrapping_mul(0xD1B5_4A32_D192_ED03));
-    (c.member)(steps, Some(&mut rng))
+    (c.member)(steps, Some(&mut SplitMix::for_draw(seed, draw)))
 }
 
 /// One measurement in this process, printed as one tab-separated line for the parent.

@@ -6,13 +6,15 @@ use std::path::PathBuf;
 
 #[derive(Subcommand)]
 pub enum StudyCommand {
-    /// Error against CPU time per scheme and pairing, k = 32 … 8192, on the exact references
-    /// (compliant stop, rigid stop with sticking, linear), with time marching on the same axes.
-    /// Writes DIR/accuracy.csv, accuracy.md and accuracy.png. Total run capped (see accuracy.md).
+    /// What accuracy costs: error against wall time per scheme and pairing, k = 32 … 8192, with
+    /// the error estimates, the polish, time marching and Siconos on the same axes, on the exact
+    /// references (rigid stop with sticking and with pure impacts, compliant stop, linear) and a
+    /// 2-DOF compliant chain; then the estimates' honesty on random family members. Writes
+    /// DIR/accuracy.csv, estimate.csv, accuracy.md and accuracy.png (about 3 minutes).
     Accuracy {
         #[arg(short, long, default_value = "study")]
         output: PathBuf,
-        /// k = 32, 64, 128 only, for tests.
+        /// k = 32 … 256, no peers, 2 members per family: for tests.
         #[arg(long)]
         quick: bool,
         /// k values (default 32 … 8192, powers of two).
@@ -21,7 +23,7 @@ pub enum StudyCommand {
         /// Marcher steps per period (default as k).
         #[arg(long, value_delimiter = ',')]
         march_steps: Option<Vec<usize>>,
-        /// Cases: compliant, rigid, linear (default all).
+        /// Cases: compliant, rigid, impacting, chain, linear (default all).
         #[arg(long, value_delimiter = ',')]
         cases: Option<Vec<String>>,
         /// Only these methods, e.g. cds/forward,bds1/same (default all).
@@ -38,6 +40,15 @@ pub enum StudyCommand {
         export_lcp: Option<PathBuf>,
         #[arg(long, default_value_t = 4096)]
         export_max: usize,
+        /// Leave Siconos out (it runs in /usr/bin/python3 with python3-siconos).
+        #[arg(long)]
+        no_peers: bool,
+        /// Random members per family in the estimate-honesty table (0: the nominal members only).
+        #[arg(long)]
+        draws: Option<usize>,
+        /// Seed of the family draws.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
     },
     /// Pivots and LCP time, cold against warm: a frequency sweep of the rigid stop and re-solves
     /// after a small frequency change. Writes DIR/warmstart.csv, warmstart.md and warmstart.png.
@@ -54,7 +65,7 @@ pub enum StudyCommand {
 
 pub fn run(cmd: StudyCommand) -> Result<(), Failure> {
     match cmd {
-        StudyCommand::Accuracy { output, quick, steps, march_steps, cases, methods, no_march, budget, export_lcp, export_max } => {
+        StudyCommand::Accuracy { output, quick, steps, march_steps, cases, methods, no_march, budget, export_lcp, export_max, no_peers, draws, seed } => {
             crate::ensure_output_folder(&output, "--output")?;
             if let Some(dir) = &export_lcp {
                 crate::ensure_output_folder(dir, "--export-lcp")?;
@@ -83,15 +94,23 @@ pub fn run(cmd: StudyCommand) -> Result<(), Failure> {
             }
             s.export_lcp = export_lcp;
             s.export_max = export_max;
+            if no_peers {
+                s.peers = None;
+            }
+            if let Some(h) = s.honesty.as_mut() {
+                h.draws = draws.unwrap_or(h.draws);
+                h.seed = seed;
+            }
             let study = accuracy::run(&s, &mut |r| {
                 eprintln!(
-                    "{:<9} {:<16} {:>5}  {:<60} err {:>9}  imp {:>9}  t {:>9}",
+                    "{:<9} {:<16} {:<8} {:>5}  {:<60} err {:>9}  est {:>9}  t {:>9}",
                     r.case.name(),
                     r.method,
+                    r.kind.name(),
                     r.steps,
                     r.status.chars().take(60).collect::<String>(),
                     r.error_x.map(|v| format!("{v:.2e}")).unwrap_or_default(),
-                    r.error_impulse.map(|v| format!("{v:.2e}")).unwrap_or_default(),
+                    r.estimate.map(|v| format!("{v:.2e}")).unwrap_or_default(),
                     r.t_total.map(|v| format!("{v:.2e}")).unwrap_or_default()
                 )
             })
