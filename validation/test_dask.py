@@ -65,3 +65,37 @@ def test_the_example_runs_as_a_script(cli, workdir):
     rows = read_csv(out)
     assert [float(r["frequency"]) for r in rows] == [2250.0, 2275.0, 2300.0]
     assert all(r["status"] == "solved" for r in rows)
+
+
+def test_dask_continuation_over_force_levels(cli, workdir):
+    """validation/dask/continue_dask.py: one frequency branch per force level on a LocalCluster.
+    Level 0.05 of NLvib 03 never reaches the clearance, so its branch is the linear response,
+    known in closed form; level 1 is NLvib 03 itself, whose events the exact-flow reference lists."""
+    distributed = pytest.importorskip("distributed")
+    import json
+
+    import numpy as np
+    import continue_dask
+
+    scene = os.path.join(HERE, "nlvib03", "nlvib03.toml")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        with distributed.Client(cluster) as client:
+            results = continue_dask.run_levels(client, cli, scene, [0.05, 1.0], 0.5, 0.8, workdir)
+    low, full = results
+    assert low["stop"] == "reached" and full["stop"] == "reached"
+    # Closed form: X = (K − Ω² M + iΩD)⁻¹ f, amplitude of DOF 0 = |X_0|; cds at k = 4096 is O((ωh)²) ≈ 1e-5 off.
+    K = np.array([[1.0, -1.0], [-1.0, 2.0]])
+    D = 0.03 * K
+    worst = 0.0
+    for row in low["rows"]:
+        omega = float(row["frequency [rad/s]"])
+        x = np.linalg.solve(K - omega**2 * np.eye(2) + 1j * omega * D, np.array([0.0, 0.1 * 0.05]))
+        worst = max(worst, abs(float(row["amplitude_0 [m]"]) - abs(x[0])) / abs(x[0]))
+    assert worst < 1e-4, worst
+    assert low["events"] == [] and max(float(r["amplitude_0 [m]"]) for r in low["rows"]) < 1.0
+    with open(os.path.join(HERE, "nlvib03", "reference.json")) as f:
+        ref = [(e["type"], e["omega"]) for e in json.load(f)["events"] if e.get("branch") == "T"]
+    ours = [(e["type"], e["frequency"]) for e in full["events"]]
+    assert len(ours) == len(ref), ours
+    for kind, omega in ref:
+        assert min(abs(o - omega) for k, o in ours if k == kind) < 3e-4, (kind, omega, ours)

@@ -182,6 +182,7 @@ pub fn run(problem: &PeriodicProblem, param: Parameter, from: f64, to: f64, sett
     let mut points = vec![point(&fam, &mut solver, &here, None, String::new())?];
     on_point(from);
     let mut ds = settings.initial_step;
+    let mut bends = 0;
     let stop = loop {
         if points.len() >= settings.max_points {
             break format!("{} points (the limit)", settings.max_points);
@@ -198,6 +199,16 @@ pub fn run(problem: &PeriodicProblem, param: Parameter, from: f64, to: f64, sett
             ds /= 2.0;
             continue;
         };
+        // Curvature control: a step over which the tangent turns by more than ~37° may cut a
+        // bend (at a sharp resonance the smooth path would be taken backwards, a false fold);
+        // halve it, at most four times in a row, since at a kink the tangent jumps at any step.
+        let turn: f64 = t_next.iter().zip(&here.tangent).map(|(a, b)| a * b).sum();
+        if turn < 0.8 && bends < 4 {
+            bends += 1;
+            ds /= 2.0;
+            continue;
+        }
+        bends = 0;
         let mut next = Node::new(&mut fam, next, t_next);
         let lambda = next.solved.parameter(rho);
         let past_end = (lambda - to) * dir > 0.0;
