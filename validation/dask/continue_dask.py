@@ -35,7 +35,8 @@ import tempfile
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-DEFAULT_CLI = os.path.abspath(os.path.join(HERE, "..", "..", "target", "release", "periodic-contact"))
+sys.path.insert(0, HERE)
+from sweep_dask import DEFAULT_CLI, cluster_arguments  # noqa: E402
 
 _AMPLITUDE = re.compile(r"^(\s*amplitude\s*=\s*)([-+0-9.eE]+)(.*)$")
 
@@ -131,11 +132,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--from", dest="start", type=float, required=True)
     p.add_argument("--to", dest="stop", type=float, required=True)
     p.add_argument("--levels", required=True, help="force scales, comma-separated (1 = the scene's forces)")
-    p.add_argument("--workers", type=int, default=2, help="LocalCluster worker processes (ignored with --scheduler)")
-    p.add_argument("--scheduler", help="address of an existing Dask scheduler")
-    p.add_argument("--cli", default=os.environ.get("PC_CLI", DEFAULT_CLI))
-    p.add_argument("--workdir", help="folder for the per-level scenes and branches (default: a temporary one)")
-    p.add_argument("-o", "--output", default="levels.csv")
+    cluster_arguments(p, "per-level scenes and branches", "levels.csv")
     a = p.parse_args(argv)
     try:
         levels = [float(v) for v in a.levels.split(",")]

@@ -104,17 +104,22 @@ def write_csv(rows: list[dict], path: str) -> None:
         w.writerows(rows)
 
 
+def cluster_arguments(ap: argparse.ArgumentParser, files: str, output: str) -> None:
+    """The options every Dask example shares: the cluster, the CLI, the work folder, the output."""
+    ap.add_argument("--workers", type=int, default=2, help="LocalCluster worker processes (without --scheduler)")
+    ap.add_argument("--scheduler", help="address of an existing scheduler, e.g. tcp://host:8786")
+    ap.add_argument("--cli", default=os.environ.get("PC_CLI", DEFAULT_CLI))
+    ap.add_argument("--workdir", help=f"folder for the {files} (default: a temporary one)")
+    ap.add_argument("-o", "--output", default=output)
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("scene")
     ap.add_argument("--from", dest="start", type=float, required=True, help="first ω [rad/s]")
     ap.add_argument("--to", dest="stop", type=float, required=True, help="last ω [rad/s]")
     ap.add_argument("--points", type=int, default=20)
-    ap.add_argument("--workers", type=int, default=2, help="LocalCluster worker processes (without --scheduler)")
-    ap.add_argument("--scheduler", help="address of an existing scheduler, e.g. tcp://host:8786")
-    ap.add_argument("--cli", default=os.environ.get("PC_CLI", DEFAULT_CLI))
-    ap.add_argument("--workdir", help="folder for the per-point JSON files (default: a temporary one)")
-    ap.add_argument("-o", "--output", default="sweep_dask.csv")
+    cluster_arguments(ap, "per-point JSON files", "sweep_dask.csv")
     a = ap.parse_args(argv)
 
     from dask.distributed import Client, LocalCluster
