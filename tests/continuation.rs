@@ -197,3 +197,30 @@ fn nlvib03_switch_to_the_2t_branch() {
     assert_eq!(disagree, 0);
     assert!(wall < 40.0, "T branch and switch took {wall:.1} s");
 }
+
+/// An LCP over two forcing periods: 2k instants over 2T with the forcing at ω. At Ω = 0.745 a
+/// cold solve of NLvib 03 lands on the contact-free orbit, which is T-periodic: the 2T answer
+/// must be the T answer twice over (an independent solve on half the grid). p = 0 and p·k past
+/// the size limit are refused naming the field.
+#[test]
+fn period_multiple_grid_and_limits() {
+    let mut p = periodic_contact::scene::Scene::parse(&scene(512), "nlvib03").unwrap().to_problem("nlvib03").unwrap();
+    p.set_frequency(0.745).unwrap();
+    let one = p.solve().unwrap();
+    let mut two = p.clone();
+    two.set_period_multiple(2).unwrap();
+    assert_eq!((two.instants(), two.period_multiple()), (1024, 2));
+    let r = two.solve().unwrap();
+    assert_eq!((r.steps, r.period_multiple), (1024, 2));
+    assert!((r.period - 2.0 * one.period).abs() < 1e-12 * one.period);
+    let (x1, x2) = (&one.displacement["0"], &r.displacement["0"]);
+    let diff = (0..1024).map(|j| (x2[j] - x1[j % 512]).abs()).fold(0.0, f64::max);
+    assert!(diff < 1e-9, "2T solve of a T orbit repeats it: {diff:e}");
+    let e = two.clone().set_period_multiple(0).unwrap_err().to_string();
+    assert!(e.contains("discretization.period_multiple") && e.contains("is 0"), "{e}");
+    let e = two.clone().set_period_multiple(1 << 20).unwrap_err().to_string();
+    assert!(e.contains("discretization.period_multiple") && e.contains("reduce"), "{e}");
+    let bad = scene(512).replace("[discretization]", "[discretization]\nperiod_multiple = -1");
+    let e = periodic_contact::scene::Scene::parse(&bad, "nlvib03").unwrap().to_problem("nlvib03").unwrap_err().to_string();
+    assert!(e.contains("discretization.period_multiple") && e.contains("-1"), "{e}");
+}
