@@ -64,9 +64,12 @@ pub struct Timing {
 
 #[derive(Clone, Debug, Serialize)]
 pub struct Response {
-    /// T = 2π/ω [s].
+    /// The orbit's period p·T, T = 2π/ω [s].
     pub period: f64,
+    /// Instants over `period`: k per forcing period times `period_multiple`.
     pub steps: usize,
+    /// p: the orbit repeats every p forcing periods (1: T-periodic; 2: period doubled).
+    pub period_multiple: usize,
     pub scheme: String,
     pub pairing: String,
     pub effects: Vec<String>,

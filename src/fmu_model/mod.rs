@@ -115,6 +115,13 @@ impl ContactModel {
         let scene = Scene::parse(text, file)?;
         let built = scene.build(file)?;
         let problem = built.problem;
+        if problem.period_multiple() != 1 {
+            // Its output series and phase bookkeeping are one forcing period long.
+            return Err(Error::input(format!(
+                "{file}: discretization.period_multiple: is {}; the FMU reports T-periodic orbits only: remove the key (use `periodic-contact solve --period-multiple` for orbits of several periods)",
+                problem.period_multiple()
+            )));
+        }
         let shown = problem.outputs().clone();
         let model = problem.model();
         let Variables { table: t, roles, outputs, units } = Variables::of(&problem, &built.labels, built.error_estimate);

@@ -5,7 +5,7 @@
 use super::SolveError;
 use super::fft::PeriodFft;
 use crate::model::{Matrix, Model};
-use crate::time::{Discretization, Symbols};
+use crate::time::{Scheme, Symbols};
 use faer::Mat;
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::SymbolicLu;
@@ -34,10 +34,9 @@ pub struct Assembly {
     pub h_hat: Vec<C>,
 }
 
-/// Samples of the external force at the k instants, DOF by DOF, only for loaded DOFs.
-fn force_spectra(model: &Model, fft: &PeriodFft) -> Vec<(usize, Vec<C>)> {
+/// Samples of the external force at the k instants of `period`, DOF by DOF, only for loaded DOFs.
+fn force_spectra(model: &Model, period: f64, fft: &PeriodFft) -> Vec<(usize, Vec<C>)> {
     let k = fft.k();
-    let period = model.period();
     let mut dofs: Vec<usize> = model.forces.iter().map(|f| f.dof).collect();
     dofs.sort_unstable();
     dofs.dedup();
@@ -180,15 +179,16 @@ struct HarmonicBlock {
     h: Vec<C>,
 }
 
-/// Assembles Ĝ, X̂lin and Ẑ⁻¹Bᵀ at `dofs` for every distinct harmonic.
+/// Assembles Ĝ, X̂lin and Ẑ⁻¹Bᵀ at `dofs` for every distinct harmonic of the grid of `fft`
+/// (k instants over `period`: T, or p·T for an orbit of p forcing periods).
 /// `parallel`: spread the harmonics over rayon's threads (never from inside an FMU).
-pub fn assemble(model: &Model, disc: &Discretization, dofs: &[usize], fft: &PeriodFft, parallel: bool) -> Result<Assembly, SolveError> {
-    let k = disc.steps;
+pub fn assemble(model: &Model, scheme: Scheme, period: f64, dofs: &[usize], fft: &PeriodFft, parallel: bool) -> Result<Assembly, SolveError> {
+    let k = fft.k();
     let n = model.n();
     let m = model.contacts.len();
     let nh = k / 2 + 1;
-    let symbols = disc.scheme.symbols(k, model.period());
-    let forces = force_spectra(model, fft);
+    let symbols = scheme.symbols(k, period);
+    let forces = force_spectra(model, period, fft);
     // Finite amplitudes can still sum past f64 (two forces of 1e308 on one DOF): say so, rather
     // than let the NaN surface as a "singular operator".
     if let Some((d, _)) = forces.iter().find(|(_, s)| !s.iter().all(|c| c.re.is_finite() && c.im.is_finite())) {

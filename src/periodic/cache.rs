@@ -26,7 +26,7 @@ fn key(p: &PeriodicProblem) -> (u64, f64) {
     let disc = p.discretization();
     let mut h = std::collections::hash_map::DefaultHasher::new();
     model.frequency.to_bits().hash(&mut h);
-    disc.steps.hash(&mut h);
+    (disc.steps, p.period_multiple()).hash(&mut h);
     disc.scheme.name().hash(&mut h);
     p.recovery_dofs().hash(&mut h);
     let s = &model.structure;

@@ -23,6 +23,9 @@ pub struct PeriodicProblem {
     auto_steps: Option<String>,
     /// Per-contact pairing overrides (index = contact; empty: none), over `disc.pairing`.
     contact_pairing: Vec<Option<Pairing>>,
+    /// p: the orbit's period is p·T, discretised by p·k instants (k = `disc.steps` per forcing
+    /// period); the forcing keeps ω (harmonic p of the base 2π/(pT)).
+    period_multiple: usize,
 }
 
 /// Fewest instants per period that any scheme needs.
@@ -65,7 +68,7 @@ impl PeriodicProblem {
         auto_steps: Option<String>,
     ) -> Result<Self, SolveError> {
         // Size limits first: they are O(1), the validation below factorises M.
-        check_sizes(&model, &disc)?;
+        check_sizes(&model, &disc, 1)?;
         model.validate()?;
         check_grid(&model, &disc)?;
         check_solver(&solver)?;
@@ -75,7 +78,35 @@ impl PeriodicProblem {
             None => model.omega_max()?,
         };
         limits::check_stability(&model, &disc, omega_max)?;
-        Ok(PeriodicProblem { model, disc, outputs, solver, output_map: None, omega_max, auto_steps, contact_pairing: Vec::new() })
+        Ok(PeriodicProblem { model, disc, outputs, solver, output_map: None, omega_max, auto_steps, contact_pairing: Vec::new(), period_multiple: 1 })
+    }
+
+    /// The orbit's period in forcing periods, p (1: T-periodic).
+    pub fn period_multiple(&self) -> usize {
+        self.period_multiple
+    }
+
+    /// The discretised period p·T [s].
+    pub fn period(&self) -> f64 {
+        self.period_multiple as f64 * self.model.period()
+    }
+
+    /// Instants of the discretised period, p·k.
+    pub fn instants(&self) -> usize {
+        self.disc.steps * self.period_multiple
+    }
+
+    /// Seeks orbits of period p·T (p = 1: T-periodic), k steps per forcing period; checked
+    /// (p ≥ 1, p·k within the size limits), unchanged on error.
+    pub fn set_period_multiple(&mut self, p: usize) -> Result<(), SolveError> {
+        if p == 0 {
+            return Err(SolveError::Invalid(
+                "discretization.period_multiple: is 0, must be a whole number of forcing periods ≥ 1 (1: T-periodic orbits, 2: period doubled, …)".to_string(),
+            ));
+        }
+        check_sizes(&self.model, &self.disc, p)?;
+        self.period_multiple = p;
+        Ok(())
     }
 
     /// ω_max [rad/s] of the model as solved (compliant contacts closed), the bound of the
@@ -131,6 +162,7 @@ impl PeriodicProblem {
         let omega_max = same_spectrum(&self.model, &model).then_some(self.omega_max);
         let auto = self.auto_steps.clone().filter(|_| disc.steps == self.disc.steps);
         let mut p = PeriodicProblem::build(model, disc, OutputSelection::default(), self.solver.clone(), omega_max, auto)?;
+        p.set_period_multiple(self.period_multiple)?;
         // The overrides follow the contacts by index (a contact added later has none).
         p.contact_pairing = self.contact_pairing.iter().copied().take(p.model.contacts.len()).collect();
         match &self.output_map {
@@ -157,7 +189,7 @@ impl PeriodicProblem {
 
     /// Changes the scheme, k or the pairing, checked; unchanged on error.
     pub fn set_discretization(&mut self, disc: Discretization) -> Result<(), SolveError> {
-        check_sizes(&self.model, &disc)?;
+        check_sizes(&self.model, &disc, self.period_multiple)?;
         check_grid(&self.model, &disc)?;
         limits::check_stability(&self.model, &disc, self.omega_max)?;
         if disc.steps != self.disc.steps {
@@ -284,10 +316,10 @@ impl PeriodicProblem {
 
     /// Solves with a fresh FFT plan and no warm start.
     pub fn solve(&self) -> Result<Response, SolveError> {
-        self.solve_with(&PeriodFft::new(self.disc.steps), None)
+        self.solve_with(&PeriodFft::new(self.instants()), None)
     }
 
-    /// Solves reusing `fft` (planned for k = steps), warm-started from a previous active set.
+    /// Solves reusing `fft` (planned for [`Self::instants`]), warm-started from a previous active set.
     pub fn solve_with(&self, fft: &PeriodFft, warm_start: Option<&[usize]>) -> Result<Response, SolveError> {
         let t_start = Instant::now();
         let asm = self.assemble(fft)?;
@@ -296,7 +328,7 @@ impl PeriodicProblem {
 
     /// The harmonic solves of this problem (Ĝ, X̂lin and Ẑ⁻¹Bᵀ at the recovered DOFs).
     pub(super) fn assemble(&self, fft: &PeriodFft) -> Result<Assembly, SolveError> {
-        assembly::assemble(&self.model, &self.disc, &self.recovery_dofs(), fft, self.solver.parallel)
+        assembly::assemble(&self.model, self.disc.scheme, self.period(), &self.recovery_dofs(), fft, self.solver.parallel)
     }
 
     /// Solves with an assembly of this problem (a session's cached one); `t_start`: when the
@@ -326,7 +358,7 @@ impl PeriodicProblem {
         let nh = k / 2 + 1;
         let mut blocks = vec![0.0; k * m * m];
         let mut q = vec![0.0; k * m];
-        let period = self.model.period();
+        let period = self.period();
         let mut spec = vec![num_complex::Complex64::ZERO; nh];
         for (a, ca) in self.model.contacts.iter().enumerate() {
             let s = self.pairing_of(ca).offset();
@@ -404,7 +436,7 @@ impl PeriodicProblem {
 
     /// The LCP (A, q) of the period without solving it (for exports and studies).
     pub fn assemble_lcp(&self, fft: &PeriodFft) -> Result<(BlockCirculant, Vec<f64>), SolveError> {
-        let asm = assembly::assemble(&self.model, &self.disc, &[], fft, self.solver.parallel)?;
+        let asm = assembly::assemble(&self.model, self.disc.scheme, self.period(), &[], fft, self.solver.parallel)?;
         Ok(self.lcp(&asm, fft))
     }
 }
@@ -415,30 +447,41 @@ fn same_spectrum(a: &Model, b: &Model) -> bool {
     a.structure.mass == b.structure.mass && a.structure.stiffness == b.structure.stiffness && springs(a) == springs(b)
 }
 
-/// Sizes we refuse before any work: k, the LCP size and the dense assembly's cost.
-fn check_sizes(model: &Model, disc: &Discretization) -> Result<(), SolveError> {
+/// Sizes we refuse before any work: k, the p·k instants of p forcing periods, the LCP size and
+/// the dense assembly's cost.
+fn check_sizes(model: &Model, disc: &Discretization, p: usize) -> Result<(), SolveError> {
     let k = disc.steps;
     if !(MIN_STEPS..=MAX_STEPS).contains(&k) {
         return Err(SolveError::Invalid(format!("discretization.steps: is {k}, must be in {MIN_STEPS}..={MAX_STEPS}")));
     }
+    let instants = k.saturating_mul(p);
+    if instants > MAX_STEPS {
+        return Err(SolveError::Limit(format!(
+            "discretization.period_multiple: is {p} with steps = {k}, {instants} instants over the period (period_multiple × steps); at most {MAX_STEPS} are accepted: reduce period_multiple or steps"
+        )));
+    }
     let m = model.contacts.len();
     // Fourier collocation has no step map: only the dense methods solve it.
     let most = if disc.scheme == crate::time::Scheme::Fourier { DENSE_MAX } else { MAX_LCP_SIZE };
-    if k.saturating_mul(m) > most {
+    if instants.saturating_mul(m) > most {
+        let times = if p > 1 { format!(" × period_multiple {p}") } else { String::new() };
         return Err(SolveError::Limit(format!(
-            "discretization.steps: is {k} with {m} contact(s), an LCP of {} unknowns (steps × contacts); at most {most} are accepted{}: reduce steps",
-            k.saturating_mul(m),
-            if most == DENSE_MAX { " under fourier (no time-stepping map, dense methods only)" } else { "" }
+            "discretization.steps: is {k}{times} with {m} contact(s), an LCP of {} unknowns (steps{} × contacts); at most {most} are accepted{}: reduce steps{}",
+            instants.saturating_mul(m),
+            if p > 1 { " × period_multiple" } else { "" },
+            if most == DENSE_MAX { " under fourier (no time-stepping map, dense methods only)" } else { "" },
+            if p > 1 { " or period_multiple" } else { "" }
         )));
     }
     let s = &model.structure;
     let dense = !(s.mass.is_sparse() || s.stiffness.is_sparse() || s.damping.as_ref().is_some_and(crate::model::Matrix::is_sparse));
     let n = model.n();
-    let flops = (k / 2 + 1) as f64 * (8.0 / 3.0) * (n as f64).powi(3);
+    let flops = (instants / 2 + 1) as f64 * (8.0 / 3.0) * (n as f64).powi(3);
     if dense && flops > MAX_DENSE_FLOPS {
         return Err(SolveError::Limit(format!(
-            "structure.mass: a dense {n}×{n} model with steps = {k} needs {} complex {n}×{n} factorisations (≈ {flops:.1e} flops, at most {MAX_DENSE_FLOPS:.0e} accepted): give the matrices in sparse form, reduce the model (Craig–Bampton), or reduce steps",
-            k / 2 + 1
+            "structure.mass: a dense {n}×{n} model with steps = {k}{} needs {} complex {n}×{n} factorisations (≈ {flops:.1e} flops, at most {MAX_DENSE_FLOPS:.0e} accepted): give the matrices in sparse form, reduce the model (Craig–Bampton), or reduce steps",
+            if p > 1 { format!(" × period_multiple {p}") } else { String::new() },
+            instants / 2 + 1
         )));
     }
     Ok(())

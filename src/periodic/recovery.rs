@@ -11,7 +11,7 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
     let nh = k / 2 + 1;
     let nd = asm.dofs.len();
     let model = &problem.model();
-    let period = model.period();
+    let period = problem.period();
     let time: Vec<f64> = (0..k).map(|j| j as f64 * period / k as f64).collect();
 
     // ẑ_p for each contact.
@@ -119,6 +119,7 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
     Ok(Response {
         period,
         steps: k,
+        period_multiple: problem.period_multiple(),
         scheme: problem.discretization().scheme.name().to_string(),
         pairing,
         effects: model

@@ -41,7 +41,7 @@ pub struct PeriodicSolver {
 impl PeriodicSolver {
     /// Plans the FFT of the problem's k; the first solve is cold.
     pub fn new(problem: PeriodicProblem) -> Self {
-        let fft = PeriodFft::new(problem.discretization().steps);
+        let fft = PeriodFft::new(problem.instants());
         PeriodicSolver { problem, fft, warm_start: None, warm_starts: true, last_start: WarmStart::Cold, cache: None, assemblies: 0 }
     }
 
@@ -107,20 +107,34 @@ impl PeriodicSolver {
     /// Changes the grid: a new k re-plans the FFT and drops the active set, which indexes
     /// the old grid.
     pub fn update_discretization(&mut self, disc: Discretization) -> Result<(), SolveError> {
-        let old_k = self.problem.discretization().steps;
+        let old_k = self.problem.instants();
         self.problem.set_discretization(disc)?;
-        if disc.steps != old_k {
-            self.fft = PeriodFft::new(disc.steps);
+        self.replan(old_k);
+        Ok(())
+    }
+
+    /// Seeks orbits of p forcing periods ([`PeriodicProblem::set_period_multiple`]); a new p
+    /// re-plans the FFT and drops the active set, like a new k.
+    pub fn update_period_multiple(&mut self, p: usize) -> Result<(), SolveError> {
+        let old_k = self.problem.instants();
+        self.problem.set_period_multiple(p)?;
+        self.replan(old_k);
+        Ok(())
+    }
+
+    /// After a change of the grid from `old_k` instants: a new plan, and no warm start.
+    fn replan(&mut self, old_k: usize) {
+        if self.problem.instants() != old_k {
+            self.fft = PeriodFft::new(self.problem.instants());
             self.warm_start = None;
         }
-        Ok(())
     }
 
     /// Replaces the problem (a new model or tuning); the plan is kept when k is the same, and the
     /// active set when the LCP has the same size (same k and number of contacts).
     pub fn update_problem(&mut self, problem: PeriodicProblem) {
-        let (k0, m0) = (self.problem.discretization().steps, self.problem.model().contacts.len());
-        let (k, m) = (problem.discretization().steps, problem.model().contacts.len());
+        let (k0, m0) = (self.problem.instants(), self.problem.model().contacts.len());
+        let (k, m) = (problem.instants(), problem.model().contacts.len());
         if k != k0 {
             self.fft = PeriodFft::new(k);
         }

@@ -62,7 +62,8 @@ pub fn step_map(problem: &PeriodicProblem) -> Result<StepMapLcp, NoStepMap> {
     let Some((lead, a2, a1, a0)) = coefficients(disc.scheme) else {
         return Err(NoStepMap("fourier collocation is not a time-stepping scheme".to_string()));
     };
-    let (n, m, k) = (model.n(), model.contacts.len(), disc.steps);
+    // p·k steps over p·T for an orbit of p forcing periods (h = T/k either way).
+    let (n, m, k) = (model.n(), model.contacts.len(), problem.instants());
     if n > MAX_STEP_MAP_DOFS {
         return Err(NoStepMap(format!("the model has {n} DOFs; shooting takes at most {MAX_STEP_MAP_DOFS} (reduce it: Craig–Bampton)")));
     }
@@ -75,7 +76,7 @@ pub fn step_map(problem: &PeriodicProblem) -> Result<StepMapLcp, NoStepMap> {
     }
     let p = a2.len() - 1;
     let d = p * n;
-    let h = model.period() / k as f64;
+    let h = problem.period() / k as f64;
     let s = &model.structure;
     let (mass, stiffness) = (s.mass.to_dense(), s.stiffness.to_dense());
     let damping = s.damping.as_ref().map(|c| c.to_dense());

@@ -17,7 +17,7 @@ mod units;
 
 pub use casing::Casing;
 pub use error::{BuildError, SceneError};
-pub use settings::{discretization, error_estimate, solver_settings};
+pub use settings::{discretization, error_estimate, period_multiple, solver_settings};
 pub use spec::*;
 
 use crate::fe::{Blade, DofMap};
@@ -155,6 +155,7 @@ impl Scene {
         for (i, p) in pairings.into_iter().enumerate().filter(|(_, p)| p.is_some()) {
             problem.set_contact_pairing(i, p)?;
         }
+        problem.set_period_multiple(period_multiple(&self.discretization)?)?;
         let timings = BuildTimings { structure: t_structure, reduction: t_reduction, total: t0.elapsed().as_secs_f64() };
         Ok(SceneModel { problem, full, dofs, reduction, casing, contact_dofs, labels, timings, error_estimate: estimate, polish: self.discretization.polish })
     }

@@ -61,3 +61,16 @@ pub fn error_estimate(spec: &DiscretizationSpec) -> Result<bool, BuildError> {
         )),
     }
 }
+
+/// `[discretization] period_multiple`: p ≥ 1 forcing periods per orbit (default 1). Negative or
+/// zero values are refused here, sizes by the problem (p·steps instants).
+pub fn period_multiple(spec: &DiscretizationSpec) -> Result<usize, BuildError> {
+    match spec.period_multiple {
+        None => Ok(1),
+        Some(p) if p >= 1 => usize::try_from(p).map_err(|_| BuildError::field("discretization.period_multiple", format!("is {p}, too large"))),
+        Some(p) => Err(BuildError::field(
+            "discretization.period_multiple",
+            format!("is {p}, must be a whole number of forcing periods ≥ 1 (1: T-periodic orbits, the default; 2: period-doubled orbits, …)"),
+        )),
+    }
+}

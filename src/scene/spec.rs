@@ -210,6 +210,9 @@ pub struct DiscretizationSpec {
     /// Refine the LCP's orbit by the event-fitted polish (default false).
     #[serde(default)]
     pub polish: bool,
+    /// Orbits of period p·T (default 1): the LCP over p forcing periods, `steps` per forcing
+    /// period (`PeriodicProblem::set_period_multiple`).
+    pub period_multiple: Option<i64>,
 }
 
 /// `steps = 512` or `steps = "auto"`; anything else is kept to be refused naming the field.
@@ -240,7 +243,7 @@ fn default_steps() -> StepsSpec {
 
 impl Default for DiscretizationSpec {
     fn default() -> Self {
-        DiscretizationSpec { scheme: default_scheme(), steps: default_steps(), pairing: None, error_estimate: None, polish: false }
+        DiscretizationSpec { scheme: default_scheme(), steps: default_steps(), pairing: None, error_estimate: None, polish: false, period_multiple: None }
     }
 }
 

@@ -15,9 +15,11 @@ mod corrector;
 mod events;
 mod floquet;
 pub mod output;
+mod switch;
 
 pub use events::EventKind;
 pub use floquet::multipliers;
+pub use switch::{run_switching, switch_at};
 
 use crate::error::Error;
 use crate::periodic::{PeriodicProblem, PeriodicSolver};
@@ -133,6 +135,10 @@ pub struct BranchPoint {
     pub certified: bool,
     /// The orbit's initial state s_0 (the step map's state).
     pub state: Vec<f64>,
+    /// The active sets of the orbit's steps (bit c: contact c), for a switch of branch here.
+    pub(crate) masks: Vec<u32>,
+    /// The branch's unit tangent in (s_0, λ/ρ) here, for a switch of branch.
+    pub(crate) tangent: Vec<f64>,
 }
 
 /// A continued branch.
@@ -144,6 +150,10 @@ pub struct Branch {
     pub stop: String,
     /// Marches of the period map made.
     pub marches: usize,
+    /// The orbits' period in forcing periods (1: T, 2: the branch switched to at a period doubling).
+    pub period_multiple: usize,
+    /// "T", or "2T from frequency = 0.7386603" for a branch switched to at a period doubling.
+    pub label: String,
 }
 
 impl Branch {
@@ -161,10 +171,8 @@ pub fn run(problem: &PeriodicProblem, param: Parameter, from: f64, to: f64, sett
         return Err(Error::input(format!("--from/--to: are {from} and {to}, must be finite and different")));
     }
     let (rho, dir) = ((to - from).abs(), (to - from).signum());
-    let mut fam = Family::new(problem, param, rho);
-    fam.tolerance = settings.tolerance;
-    fam.smoothing = settings.smoothing;
-    let (k, m) = (problem.discretization().steps, problem.model().contacts.len());
+    let mut fam = family(problem, param, rho, settings);
+    let (k, m) = (problem.instants(), problem.model().contacts.len());
     fam.map_at(from)?;
     let mut solver = PeriodicSolver::new(fam.problem_at(from)?);
     let first = solver.solve().map_err(|e| Error::from(e).context(format!("the start of the continuation at {} = {from}", param.name())))?;
@@ -178,89 +186,144 @@ pub fn run(problem: &PeriodicProblem, param: Parameter, from: f64, to: f64, sett
     let d = start.v.len() - 1;
     let border: Vec<f64> = (0..=d).map(|i| if i == d { dir } else { 0.0 }).collect();
     let tangent = start.tangent(&border).ok_or_else(|| Error::solve(format!("continuation: singular Jacobian at {} = {from}", param.name())))?;
-    let mut here = Node::new(&mut fam, start, tangent);
-    let mut points = vec![point(&fam, &mut solver, &here, None, String::new())?];
+    let here = Node::new(&mut fam, start, tangent);
+    let points = vec![point(&fam, &mut solver, &here, None, String::new())?];
     on_point(from);
-    let mut ds = settings.initial_step;
-    let mut bends = 0;
-    let stop = loop {
-        if points.len() >= settings.max_points {
-            break format!("{} points (the limit)", settings.max_points);
+    let walk = Walk { from, to, secant: false, settings, on_point };
+    let (points, stop) = walk.follow(&mut fam, &mut solver, here, points, None)?;
+    let p = problem.period_multiple();
+    let label = if p == 1 { "T".to_string() } else { format!("{p}T") };
+    Ok(Branch { parameter: param, points, stop, marches: fam.marches, period_multiple: p, label })
+}
+
+/// The family of `problem`'s orbits with the settings' corrector tolerance and smoothing.
+fn family(problem: &PeriodicProblem, param: Parameter, rho: f64, settings: &ContinuationSettings) -> Family {
+    let mut fam = Family::new(problem, param, rho);
+    fam.tolerance = settings.tolerance;
+    fam.smoothing = settings.smoothing;
+    fam
+}
+
+/// The step below which a secant walk that keeps failing tries the Jacobian's tangent instead.
+const SECANT_GIVES_UP: f64 = 1e-6;
+
+/// Pseudo-arclength along a branch between the parameter values `from` and `to`.
+struct Walk<'a> {
+    from: f64,
+    to: f64,
+    /// Tangents by secants of the last two points instead of the piece Jacobian's kernel. Why:
+    /// near a branch point (the 2T branch at its period doubling) the branch runs along the
+    /// near-kernel of dF/ds_0, where the piece Jacobian differs most from the smoothed one and its
+    /// kernel points off the branch (NLvib 03, k = 4096: the 2T branch turned back at once).
+    secant: bool,
+    settings: &'a ContinuationSettings,
+    on_point: &'a dyn Fn(f64),
+}
+
+impl Walk<'_> {
+    /// The unit tangent at `next`, oriented along the branch from `here`.
+    fn tangent(&self, next: &corrector::Solved, here: &Node) -> Option<Vec<f64>> {
+        if !self.secant {
+            return next.tangent(&here.tangent);
         }
-        let pred: Vec<f64> = here.solved.v.iter().zip(&here.tangent).map(|(v, t)| v + ds * t).collect();
-        let Some((next, iterations)) = fam.correct(&pred, &here.tangent, &here.solved.masks) else {
-            ds /= 2.0;
-            if ds < settings.min_step {
-                break format!("no convergence at {} = {} with the smallest step", param.name(), here.solved.parameter(rho));
+        let sec: Vec<f64> = next.v.iter().zip(&here.solved.v).map(|(a, b)| a - b).collect();
+        let norm = sec.iter().map(|x| x * x).sum::<f64>().sqrt();
+        (norm.is_finite() && norm > 0.0).then(|| sec.iter().map(|x| x / norm).collect())
+    }
+
+    /// Follows the branch from `here` (already in `points`) until λ passes `to` ("reached", the
+    /// last point at `to` exactly) or `from` (the branch turned back), the step gets too small,
+    /// the points run out, or `rejoin` sees the branch meet the T branch again.
+    fn follow(
+        &self,
+        fam: &mut Family,
+        solver: &mut PeriodicSolver,
+        mut here: Node,
+        mut points: Vec<BranchPoint>,
+        mut rejoin: Option<&mut switch::Rejoin>,
+    ) -> Result<(Vec<BranchPoint>, String), Error> {
+        let (from, to, settings, rho) = (self.from, self.to, self.settings, fam.rho);
+        let dir = (to - from).signum();
+        let name = fam.param.name();
+        let m = solver.problem().model().contacts.len();
+        let d = here.solved.v.len() - 1;
+        let mut ds = settings.initial_step;
+        // Whether the tangent at `here` was already replaced by the Jacobian's (secant walks).
+        let mut turned = false;
+        let stop = loop {
+            if points.len() >= settings.max_points {
+                break format!("{} points (the limit)", settings.max_points);
             }
-            continue;
-        };
-        let Some(t_next) = next.tangent(&here.tangent) else {
-            ds /= 2.0;
-            continue;
-        };
-        // Curvature control: a step over which the tangent turns by more than ~37° may cut a
-        // bend (at a sharp resonance the smooth path would be taken backwards, a false fold);
-        // halve it, at most four times in a row, since at a kink the tangent jumps at any step.
-        let turn: f64 = t_next.iter().zip(&here.tangent).map(|(a, b)| a * b).sum();
-        if turn < 0.8 && bends < 4 {
-            bends += 1;
-            ds /= 2.0;
-            continue;
-        }
-        bends = 0;
-        let mut next = Node::new(&mut fam, next, t_next);
-        let lambda = next.solved.parameter(rho);
-        let past_end = (lambda - to) * dir > 0.0;
-        if past_end {
-            // The last point at λ = to exactly, interpolated between here and next.
-            let l0 = here.solved.parameter(rho);
-            let f = (to - l0) / (lambda - l0);
-            let pred: Vec<f64> = here.solved.v.iter().zip(&next.solved.v).map(|(a, b)| a + f * (b - a)).collect();
-            let normal: Vec<f64> = (0..=d).map(|i| if i == d { 1.0 } else { 0.0 }).collect();
-            if let Some((end, _)) = fam.correct(&pred, &normal, &here.solved.masks)
-                && let Some(t) = end.tangent(&here.tangent)
-            {
-                next = Node::new(&mut fam, end, t);
+            let pred: Vec<f64> = here.solved.v.iter().zip(&here.tangent).map(|(v, t)| v + ds * t).collect();
+            let Some((next, iterations)) = fam.correct(&pred, &here.tangent, &here.solved.masks) else {
+                ds /= 2.0;
+                // A secant cannot turn a corner of the branch (a contact change of the orbit):
+                // once it has failed down to small steps, try the piece Jacobian's tangent there.
+                if self.secant && ds < SECANT_GIVES_UP && !turned {
+                    if let Some(t) = here.solved.tangent(&here.tangent) {
+                        here.tangent = t;
+                        ds = settings.initial_step;
+                    }
+                    turned = true;
+                    continue;
+                }
+                if ds < settings.min_step {
+                    break format!("no convergence at {name} = {} with the smallest step", here.solved.parameter(rho));
+                }
+                continue;
+            };
+            let Some(t_next) = self.tangent(&next, &here) else {
+                ds /= 2.0;
+                continue;
+            };
+            let mut next = Node::new(fam, next, t_next);
+            let lambda = next.solved.parameter(rho);
+            // Past an end of the range: the last point at that end exactly, interpolated.
+            let end = [(to, (lambda - to) * dir > 0.0), (from, (lambda - from) * dir < 0.0)].into_iter().find(|e| e.1).map(|e| e.0);
+            if let Some(bound) = end {
+                let l0 = here.solved.parameter(rho);
+                let f = (bound - l0) / (lambda - l0);
+                let pred: Vec<f64> = here.solved.v.iter().zip(&next.solved.v).map(|(a, b)| a + f * (b - a)).collect();
+                let normal: Vec<f64> = (0..=d).map(|i| if i == d { 1.0 } else { 0.0 }).collect();
+                if let Some((end, _)) = fam.correct(&pred, &normal, &here.solved.masks)
+                    && let Some(t) = self.tangent(&end, &here)
+                {
+                    next = Node::new(fam, end, t);
+                }
             }
-        }
-        let mut found: Vec<BranchPoint> = Vec::new();
-        for (kind, node, detail) in events::between(&mut fam, &here, &next, m) {
-            found.push(point(&fam, &mut solver, &node, Some(kind), detail)?);
-        }
-        found.push(point(&fam, &mut solver, &next, None, String::new())?);
-        // The path's orbit must be the LCP's. At a kink the certified solve may add or drop a
-        // step of contact (flagged `certified = false`); where it lands on another orbit (the
-        // amplitude jumps by > 10 % from the last point) its amplitudes would be that orbit's,
-        // so the branch ends there.
-        let jumped = |p: &BranchPoint, last: &BranchPoint| p.amplitude.iter().zip(&last.amplitude).any(|(a, b)| (a - b).abs() > 0.1 * b.abs().max(a.abs()));
-        let last = points.last().expect("the start is a point").clone();
-        if let Some(bad) = found.iter().position(|p| !p.certified && jumped(p, &last)) {
-            let at = found[bad].parameter;
-            points.extend(found.into_iter().take(bad));
-            break format!(
-                "the orbit at {} = {at} is not the LCP's (the certified solve from its active sets changes them): the path cannot be trusted beyond",
-                param.name()
-            );
-        }
-        points.extend(found);
-        on_point(next.solved.parameter(rho));
-        if past_end {
-            break "reached".to_string();
-        }
-        if (next.solved.parameter(rho) - from) * dir < 0.0 {
-            break format!("the branch turned back below {} = {from}", param.name());
-        }
-        here = next;
-        if iterations <= 3 {
-            ds = (ds * 1.5).min(settings.max_step);
-        } else if iterations >= 6 {
-            ds *= 0.6;
-        }
-        ds = ds.max(settings.min_step);
-    };
-    merge_fold_pairs(&mut points, settings.fold_merge * rho);
-    Ok(Branch { parameter: param, points, stop, marches: fam.marches })
+            let joined = match rejoin.as_deref_mut() {
+                Some(r) => r.check(fam, &here, &next),
+                None => None,
+            };
+            let (last, detail) = match joined {
+                Some(node) => (node, "rejoins the T branch (its period doubling)".to_string()),
+                None => (next, String::new()),
+            };
+            for (kind, node, detail) in events::between(fam, &here, &last, m) {
+                points.push(point(fam, solver, &node, Some(kind), detail)?);
+            }
+            points.push(point(fam, solver, &last, None, detail.clone())?);
+            (self.on_point)(last.solved.parameter(rho));
+            if !detail.is_empty() {
+                break format!("rejoined the T branch at {name} = {}", last.solved.parameter(rho));
+            }
+            match end {
+                Some(b) if b == to => break "reached".to_string(),
+                Some(_) => break format!("the branch turned back below {name} = {from}"),
+                None => {}
+            }
+            here = last;
+            turned = false;
+            if iterations <= 3 {
+                ds = (ds * 1.5).min(settings.max_step);
+            } else if iterations >= 6 {
+                ds *= 0.6;
+            }
+            ds = ds.max(settings.min_step);
+        };
+        merge_fold_pairs(&mut points, settings.fold_merge * rho);
+        Ok((points, stop))
+    }
 }
 
 /// Drops successive fold events closer than `width` in the parameter, pairwise.
@@ -297,11 +360,13 @@ fn point(fam: &Family, solver: &mut PeriodicSolver, node: &Node, event: Option<E
         multipliers: node.mu.clone(),
         max_multiplier,
         stable: max_multiplier <= 1.0,
-        period_multiple: 1,
+        period_multiple: solver.problem().period_multiple(),
         event,
         detail,
         certified: got == set,
         state: node.solved.v[..node.solved.v.len() - 1].to_vec(),
+        masks: node.solved.masks.clone(),
+        tangent: node.tangent.clone(),
     })
 }
 

@@ -3,16 +3,18 @@ use super::Branch;
 use crate::model::{Labels, Quantity};
 use crate::periodic::PeriodicProblem;
 
-/// One row per point: the parameter (named as given, with its unit), `amplitude_<dof> [unit]`
-/// per displacement output as in `sweep`, `stable`, `multiplier` (largest |μ|),
-/// `period_multiple`, `event`, `certified`.
-pub fn to_csv(branch: &Branch, problem: &PeriodicProblem, labels: &Labels) -> String {
+/// One row per point of each branch, in order: the parameter (named as given, with its unit),
+/// `amplitude_<dof> [unit]` per displacement output as in `sweep` (over the orbit's period),
+/// `stable`, `multiplier` (largest |μ| of the orbit's own monodromy, over p·T), `period_multiple`,
+/// `event`, `certified`, `branch` (its index: 0 the T branch, then the switched ones).
+pub fn to_csv(branches: &[Branch], problem: &PeriodicProblem, labels: &Labels) -> String {
     let mm = labels.unit(Quantity::Length);
-    let mut head = vec![format!("{} {}", branch.parameter.name(), labels.unit(branch.parameter.describe().1))];
+    let Some(first) = branches.first() else { return String::new() };
+    let mut head = vec![format!("{} {}", first.parameter.name(), labels.unit(first.parameter.describe().1))];
     head.extend(problem.outputs().displacement.iter().map(|d| format!("amplitude_{d} {mm}")));
-    head.extend(["stable", "multiplier", "period_multiple", "event", "certified"].map(String::from));
+    head.extend(["stable", "multiplier", "period_multiple", "event", "certified", "branch"].map(String::from));
     let mut s = head.join(",") + "\n";
-    for p in &branch.points {
+    for (b, p) in branches.iter().enumerate().flat_map(|(b, branch)| branch.points.iter().map(move |p| (b, p))) {
         let mut row = vec![format!("{:e}", p.parameter)];
         row.extend(p.amplitude.iter().map(|a| format!("{a:e}")));
         row.push(p.stable.to_string());
@@ -20,22 +22,31 @@ pub fn to_csv(branch: &Branch, problem: &PeriodicProblem, labels: &Labels) -> St
         row.push(p.period_multiple.to_string());
         row.push(p.event.map_or(String::new(), |e| e.name().to_string()));
         row.push(p.certified.to_string());
+        row.push(b.to_string());
         s.push_str(&row.join(","));
         s.push('\n');
     }
     s
 }
 
-/// The events as a JSON array: kind, parameter, amplitudes, largest |μ|, multipliers, detail.
-pub fn events_json(branch: &Branch, problem: &PeriodicProblem) -> String {
+/// The events as JSON: per event its branch (index and label), period_multiple, kind, parameter,
+/// amplitudes, largest |μ|, multipliers, detail; and per branch its label and why it stopped.
+pub fn events_json(branches: &[Branch], problem: &PeriodicProblem) -> String {
     let dofs = &problem.outputs().displacement;
-    let events: Vec<serde_json::Value> = branch
-        .events()
-        .map(|p| {
+    let Some(first) = branches.first() else { return String::new() };
+    let name = first.parameter.name();
+    let events: Vec<serde_json::Value> = branches
+        .iter()
+        .enumerate()
+        .flat_map(|(b, branch)| branch.events().map(move |p| (b, branch, p)))
+        .map(|(b, branch, p)| {
             let amplitude: serde_json::Map<String, serde_json::Value> = dofs.iter().zip(&p.amplitude).map(|(d, a)| (d.to_string(), (*a).into())).collect();
             serde_json::json!({
                 "type": p.event.map(|e| e.name()),
-                branch.parameter.name(): p.parameter,
+                name: p.parameter,
+                "branch": b,
+                "branch_label": branch.label,
+                "period_multiple": p.period_multiple,
                 "amplitude": amplitude,
                 "max_multiplier": p.max_multiplier,
                 "multipliers": p.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
@@ -44,52 +55,56 @@ pub fn events_json(branch: &Branch, problem: &PeriodicProblem) -> String {
             })
         })
         .collect();
-    serde_json::to_string_pretty(&serde_json::json!({ "parameter": branch.parameter.name(), "stop": branch.stop, "events": events })).unwrap_or_default()
+    let list: Vec<serde_json::Value> = branches
+        .iter()
+        .map(|b| serde_json::json!({ "label": b.label, "period_multiple": b.period_multiple, "points": b.points.len(), "stop": b.stop }))
+        .collect();
+    serde_json::to_string_pretty(&serde_json::json!({ "parameter": name, "stop": first.stop, "branches": list, "events": events })).unwrap_or_default()
 }
 
 /// PNG of displacement output `i` along the branch: stable runs solid, unstable runs dashed in the
 /// same colour, each event kind as markers of its own without a line; axes named with units.
 #[cfg(feature = "plots")]
-pub fn plot(path: &std::path::Path, branch: &Branch, problem: &PeriodicProblem, i: usize, labels: &Labels, title: &str) -> Result<(), crate::Error> {
+pub fn plot(path: &std::path::Path, branches: &[Branch], problem: &PeriodicProblem, i: usize, labels: &Labels, title: &str) -> Result<(), crate::Error> {
     use crate::plot::{Chart, Legend, Line, Look, Scale, Series, styled_panel_chart};
     let d = problem.outputs().displacement[i];
     let (mut series, mut looks): (Vec<Series>, Vec<Look>) = (Vec::new(), Vec::new());
-    let mut labelled = [false; 2];
-    let mut push_run = |run: Vec<(f64, f64)>, stable: bool, series: &mut Vec<Series>, looks: &mut Vec<Look>| {
-        // One legend entry per kind of run.
-        let label = if std::mem::replace(&mut labelled[stable as usize], true) {
-            ""
-        } else if stable {
-            "stable"
-        } else {
-            "unstable"
+    for (b, branch) in branches.iter().enumerate() {
+        let tag = if branch.period_multiple == 1 { String::new() } else { format!("{}T ", branch.period_multiple) };
+        // One legend entry per branch and kind of run.
+        let mut labelled = [false; 2];
+        let mut push_run = |run: Vec<(f64, f64)>, stable: bool, series: &mut Vec<Series>, looks: &mut Vec<Look>| {
+            let first = !std::mem::replace(&mut labelled[stable as usize], true);
+            let label = if first { format!("{tag}{}", if stable { "stable" } else { "unstable" }) } else { String::new() };
+            series.push(Series { label, points: run, markers: false });
+            looks.push(Look { colour: b, line: if stable { Line::Solid } else { Line::Dashed }, marker: None, hollow: false });
         };
-        series.push(Series { label: label.into(), points: run, markers: false });
-        looks.push(Look { colour: 0, line: if stable { Line::Solid } else { Line::Dashed }, marker: None, hollow: false });
-    };
-    let mut run: Vec<(f64, f64)> = Vec::new();
-    let mut stable = branch.points.first().is_some_and(|p| p.stable);
-    for p in &branch.points {
-        let xy = (p.parameter, p.amplitude[i]);
-        if p.stable != stable {
+        let mut run: Vec<(f64, f64)> = Vec::new();
+        let mut stable = branch.points.first().is_some_and(|p| p.stable);
+        // A point whose certified solve changed its active sets may carry another orbit's
+        // amplitude (the CSV flags it `certified = false`): not drawn.
+        for p in branch.points.iter().filter(|p| p.certified || p.event.is_some()) {
+            let xy = (p.parameter, p.amplitude[i]);
+            if p.stable != stable {
+                run.push(xy);
+                push_run(std::mem::take(&mut run), stable, &mut series, &mut looks);
+                stable = p.stable;
+            }
             run.push(xy);
-            push_run(std::mem::take(&mut run), stable, &mut series, &mut looks);
-            stable = p.stable;
         }
-        run.push(xy);
+        push_run(run, stable, &mut series, &mut looks);
     }
-    push_run(run, stable, &mut series, &mut looks);
     let kinds = [super::EventKind::Fold, super::EventKind::Grazing, super::EventKind::PeriodDoubling, super::EventKind::NeimarkSacker];
     for (j, kind) in kinds.into_iter().enumerate() {
-        let pts: Vec<(f64, f64)> = branch.events().filter(|p| p.event == Some(kind)).map(|p| (p.parameter, p.amplitude[i])).collect();
+        let pts: Vec<(f64, f64)> = branches.iter().flat_map(|b| b.events()).filter(|p| p.event == Some(kind)).map(|p| (p.parameter, p.amplitude[i])).collect();
         if !pts.is_empty() {
             series.push(Series { label: kind.name().into(), points: pts, markers: true });
-            looks.push(Look { colour: j + 1, line: Line::None, marker: Some(j % 3), hollow: false });
+            looks.push(Look { colour: branches.len() + j, line: Line::None, marker: Some(j % 3), hollow: false });
         }
     }
-    let (what, quantity) = branch.parameter.describe();
+    let (what, quantity) = branches.first().map_or(("parameter", Quantity::Ratio), |b| b.parameter.describe());
     let x_label = format!("{what} {}", labels.unit(quantity));
-    let y_label = format!("amplitude of {} {} (peak-to-peak / 2)", labels.dof(d), labels.unit(Quantity::Length));
+    let y_label = format!("amplitude of {} {} (peak-to-peak / 2 over the orbit's period)", labels.dof(d), labels.unit(Quantity::Length));
     let title = format!("{title} of {}", labels.dof(d));
     let chart = Chart { title: &title, x_label: &x_label, y_label: &y_label, x_scale: Scale::Linear, y_scale: Scale::Linear };
     styled_panel_chart(path, &[(&chart, &series, &looks)], 1, 1000, 650, Legend::Default).map_err(crate::Error::from)

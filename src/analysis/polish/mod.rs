@@ -30,6 +30,12 @@ pub struct PolishFailure(pub String);
 /// Polishes the orbit of `r` (solved from `problem`).
 pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<PolishedOrbit, PolishFailure> {
     let model = problem.model();
+    if problem.period_multiple() != 1 {
+        return Err(PolishFailure(format!(
+            "the orbit spans period_multiple = {} forcing periods; the polish fits events over one period T only",
+            problem.period_multiple()
+        )));
+    }
     if r.contacts.len() != model.contacts.len() {
         return Err(PolishFailure("the result has no contact outputs ([output] contacts = false): the event sequence cannot be read".into()));
     }

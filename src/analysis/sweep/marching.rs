@@ -104,6 +104,12 @@ fn outputs(p: &PeriodicProblem, r: &Response) -> Vec<Vec<f64>> {
 /// Solves the LCP (cold) at `frequency`, a reference LCP with more instants, and marches from
 /// rest once per tolerance; compares the displacement outputs at the LCP's instants.
 pub fn compare(problem: &PeriodicProblem, frequency: f64, opts: &MarchOptions) -> Result<MarchComparison, Error> {
+    if problem.period_multiple() != 1 {
+        return Err(Error::input(format!(
+            "--march-at: the scene seeks orbits of period_multiple = {} forcing periods; the march comparison reads one period T: remove period_multiple for it",
+            problem.period_multiple()
+        )));
+    }
     let mut p = problem.clone();
     p.set_frequency(frequency).map_err(|e| Error::from(e).context("LCP"))?;
     p.set_parallel(false);

@@ -1,5 +1,6 @@
 //! Harmonic content of a periodic response: amplitudes of the harmonics of ω of a displacement
-//! and of the contact forces, by FFT of the k samples of one period.
+//! and of the contact forces, by FFT of the samples of the orbit's period. An orbit of p forcing
+//! periods (`period_multiple`) has harmonics of ω/p: index j is the harmonic j/p of ω.
 use crate::model::{Labels, Quantity};
 use crate::periodic::{PeriodFft, PeriodicProblem};
 use crate::response::Response;
@@ -23,16 +24,20 @@ pub fn harmonic_amplitudes(fft: &PeriodFft, series: &[f64]) -> Vec<f64> {
 pub struct Spectrum {
     /// ω [rad/s].
     pub frequency: f64,
+    /// p: index j of the amplitudes is the harmonic j/p of ω (1: integer harmonics).
+    pub period_multiple: usize,
     /// (output DOF, amplitudes of harmonics 0..=max_harmonic) per displacement output.
     pub displacement: Vec<(usize, Vec<f64>)>,
     /// (contact index, user DOF, amplitudes) per contact.
     pub force: Vec<(usize, usize, Vec<f64>)>,
 }
 
-/// Harmonics 0..=`max_harmonic` (capped at k/2) of every displacement output and contact force.
+/// Harmonics 0..=`max_harmonic` of ω (capped at the Nyquist index), in steps of ω/p for an orbit
+/// of p forcing periods, of every displacement output and contact force.
 pub fn spectrum(problem: &PeriodicProblem, response: &Response, max_harmonic: usize) -> Spectrum {
     let fft = PeriodFft::new(response.steps);
-    let h = max_harmonic.min(response.steps / 2);
+    let p = response.period_multiple.max(1);
+    let h = max_harmonic.saturating_mul(p).min(response.steps / 2);
     let cut = |mut v: Vec<f64>| {
         v.truncate(h + 1);
         v
@@ -44,11 +49,17 @@ pub fn spectrum(problem: &PeriodicProblem, response: &Response, max_harmonic: us
         .filter_map(|d| response.displacement.get(&d.to_string()).map(|s| (*d, cut(harmonic_amplitudes(&fft, s)))))
         .collect();
     let force = response.contacts.iter().enumerate().map(|(i, c)| (i, c.dof, cut(harmonic_amplitudes(&fft, &c.force)))).collect();
-    Spectrum { frequency: response_frequency(response), displacement, force }
+    Spectrum { frequency: response_frequency(response), period_multiple: p, displacement, force }
 }
 
+/// ω: the period is p·2π/ω.
 fn response_frequency(r: &Response) -> f64 {
-    2.0 * std::f64::consts::PI / r.period
+    2.0 * std::f64::consts::PI * r.period_multiple.max(1) as f64 / r.period
+}
+
+/// Harmonic index `j` of `sp` in units of ω ("3", or "1.5" for j = 3 of a 2T orbit).
+fn harmonic_of(sp: &Spectrum, j: usize) -> String {
+    (j as f64 / sp.period_multiple.max(1) as f64).to_string()
 }
 
 /// One CSV for several spectra: the parameter (and the frequency when the parameter is not the
@@ -73,7 +84,7 @@ pub fn to_csv(param: &str, values: &[f64], spectra: &[Spectrum], labels: &Labels
             if param != "frequency" {
                 row.push(sp.frequency.to_string());
             }
-            row.push(p.to_string());
+            row.push(harmonic_of(sp, p));
             row.extend(sp.displacement.iter().map(|(_, a)| format!("{:e}", a[p])));
             row.extend(sp.force.iter().map(|(_, _, a)| format!("{:e}", a[p])));
             s.push_str(&row.join(","));
@@ -94,7 +105,8 @@ pub fn plot(path: &std::path::Path, sp: &Spectrum, labels: &Labels, title: &str)
         curves
             .into_iter()
             .map(|(label, a)| {
-                let points: Vec<(f64, f64)> = a.iter().enumerate().filter(|(_, v)| **v > floor).map(|(p, v)| (p as f64, *v)).collect();
+                let points: Vec<(f64, f64)> =
+                    a.iter().enumerate().filter(|(_, v)| **v > floor).map(|(j, v)| (j as f64 / sp.period_multiple.max(1) as f64, *v)).collect();
                 let label = if points.is_empty() { format!("{label} (zero)") } else { label };
                 Series { label, points, markers: true }
             })
@@ -104,7 +116,7 @@ pub fn plot(path: &std::path::Path, sp: &Spectrum, labels: &Labels, title: &str)
     let forces = series(sp.force.iter().map(|(i, d, a)| (format!("contact {i} at {}", labels.dof(*d)), a)).collect());
     let (y1, y2) = (format!("displacement amplitude {}", labels.unit(Quantity::Length)), format!("contact force amplitude {}", labels.unit(Quantity::Force)));
     let (t1, t2) = (format!("{title}: displacement"), format!("{title}: contact force"));
-    let x_label = "harmonic p of ω (0: mean)";
+    let x_label = "harmonic of ω (0: mean; steps of ω/p for an orbit of p periods)";
     let c1 = Chart { title: &t1, x_label, y_label: &y1, x_scale: Scale::Linear, y_scale: Scale::Log };
     let c2 = Chart { title: &t2, x_label, y_label: &y2, x_scale: Scale::Linear, y_scale: Scale::Log };
     panel_chart(path, &[(&c1, &shown), (&c2, &forces)], 1, 1000, 1100, Legend::UpperRight).map_err(crate::Error::from)

@@ -25,6 +25,10 @@ pub struct Args {
     /// Largest arclength step (in the state and the parameter over |to − from|).
     #[arg(long, default_value_t = 2e-2)]
     pub max_step: f64,
+    /// At each period doubling of the T branch, switch to the 2T branch and continue it too
+    /// (same CSV with a `branch` column, same events JSON and PNG).
+    #[arg(long)]
+    pub switch_at_pd: bool,
     /// No PNG.
     #[arg(long)]
     pub no_plot: bool,
@@ -55,31 +59,40 @@ pub fn run(a: &Args) -> Result<(), Failure> {
         bar.set_position((((v - from) / (to - from)).clamp(0.0, 1.0) * 1000.0) as u64);
         bar.set_message(format!("{} = {v:.6}", a.param));
     };
-    let branch = continuation::run(problem, param, a.from, a.to, &settings, &on_point).map_err(Failure::from)?;
+    let (branches, failures) = if a.switch_at_pd {
+        continuation::run_switching(problem, param, a.from, a.to, &settings, &on_point).map_err(Failure::from)?
+    } else {
+        (vec![continuation::run(problem, param, a.from, a.to, &settings, &on_point).map_err(Failure::from)?], Vec::new())
+    };
     bar.finish_and_clear();
     let labels = &built.labels;
-    write_output(&a.output, &output::to_csv(&branch, problem, labels))?;
+    write_output(&a.output, &output::to_csv(&branches, problem, labels))?;
     let json = sibling(&a.output, "-events", "json");
-    write_output(&json, &output::events_json(&branch, problem))?;
-    eprintln!(
-        "continue: {} points ({} events) in {:.3} s, {} marches of the period map; stop: {} → {}, {}",
-        branch.points.len(),
-        branch.events().count(),
-        t_all.elapsed().as_secs_f64(),
-        branch.marches,
-        branch.stop,
-        a.output.display(),
-        json.display()
-    );
-    for e in branch.events() {
-        eprintln!("  {:<16} {} = {:.7}  max |μ| = {:.6}  {}", e.event.map_or("", |k| k.name()), a.param, e.parameter, e.max_multiplier, e.detail);
+    write_output(&json, &output::events_json(&branches, problem))?;
+    eprintln!("continue: {} branch(es) in {:.3} s → {}, {}", branches.len(), t_all.elapsed().as_secs_f64(), a.output.display(), json.display());
+    for (i, b) in branches.iter().enumerate() {
+        eprintln!(
+            "branch {i} ({}): {} points ({} events), {} marches of the period map; stop: {}",
+            b.label,
+            b.points.len(),
+            b.events().count(),
+            b.marches,
+            b.stop
+        );
+        for e in b.events() {
+            eprintln!("  {:<16} {} = {:.7}  max |μ| = {:.6}  {}", e.event.map_or("", |k| k.name()), a.param, e.parameter, e.max_multiplier, e.detail);
+        }
     }
+    for f in &failures {
+        eprintln!("warning: {f}");
+    }
+    let branch = &branches[0];
     #[cfg(feature = "plots")]
     if !a.no_plot {
         let stem = a.scene.file_stem().map_or(String::new(), |s| s.to_string_lossy().to_string());
         for (i, d) in problem.outputs().displacement.iter().enumerate() {
             let png = if i == 0 { sibling(&a.output, "", "png") } else { sibling(&a.output, &format!("-dof{d}"), "png") };
-            output::plot(&png, &branch, problem, i, labels, &format!("{stem}: branch")).map_err(Failure::from)?;
+            output::plot(&png, &branches, problem, i, labels, &format!("{stem}: branch")).map_err(Failure::from)?;
             eprintln!("branch of {} → {}", labels.dof(*d), png.display());
         }
     }

@@ -22,10 +22,27 @@ pub struct Refine {
     pub polish: bool,
 }
 
-pub fn load(scene: &Path, frequency: Option<f64>, flags: Refine) -> Result<(PeriodicProblem, Refine), Failure> {
+/// What the command line overrides in the scene.
+#[derive(Clone, Copy, Debug)]
+pub struct Overrides {
+    /// `--frequency`: ω [rad/s].
+    pub frequency: Option<f64>,
+    /// `--period-multiple`: orbits of p forcing periods.
+    pub period_multiple: Option<i64>,
+}
+
+pub fn load(scene: &Path, overrides: Overrides, flags: Refine) -> Result<(PeriodicProblem, Refine), Failure> {
     let (mut s, dir) = Scene::load(scene).map_err(|e| Failure::input(e.to_string()))?;
-    if let Some(f) = frequency {
+    if let Some(f) = overrides.frequency {
         s.set_frequency(f);
+    }
+    if let Some(p) = overrides.period_multiple {
+        if p < 1 {
+            return Err(Failure::input(format!(
+                "--period-multiple: is {p}, must be a whole number of forcing periods ≥ 1 (1: T-periodic, 2: period doubled, …)"
+            )));
+        }
+        s.discretization.period_multiple = Some(p);
     }
     let built = s.build_in(&scene.display().to_string(), &dir).map_err(|e| Failure::input(e.to_string()))?;
     let refine = Refine { estimate: flags.estimate && built.error_estimate, polish: flags.polish || built.polish };
@@ -53,7 +70,7 @@ const EXPORT_MAX: usize = 4096;
 
 /// Writes the scene's LCP (w = A z + q, z the contact forces) in Siconos' dense `.dat` format.
 fn export_lcp(problem: &PeriodicProblem, path: &Path) -> Result<(), Failure> {
-    let (k, m) = (problem.discretization().steps, problem.model().contacts.len());
+    let (k, m) = (problem.instants(), problem.model().contacts.len());
     if m == 0 {
         return Err(Failure::input("--export-lcp: the scene has no contact, so there is no LCP to export"));
     }
@@ -69,12 +86,12 @@ fn export_lcp(problem: &PeriodicProblem, path: &Path) -> Result<(), Failure> {
     Ok(())
 }
 
-pub fn run(scene: &Path, output: &Path, frequency: Option<f64>, export: Option<&Path>, flags: Refine) -> Result<(), Failure> {
+pub fn run(scene: &Path, output: &Path, overrides: Overrides, export: Option<&Path>, flags: Refine) -> Result<(), Failure> {
     ensure_writable(output, "--output")?;
     if let Some(p) = export {
         ensure_writable(p, "--export-lcp")?;
     }
-    let (problem, flags) = load(scene, frequency, flags)?;
+    let (problem, flags) = load(scene, overrides, flags)?;
     if let Some(p) = export {
         export_lcp(&problem, p)?;
     }

@@ -42,6 +42,10 @@ enum Command {
         /// Refine the orbit by the event-fitted polish (also `[discretization] polish = true`).
         #[arg(long)]
         polish: bool,
+        /// Seek an orbit of P forcing periods (period P·T; overrides `[discretization]
+        /// period_multiple`): the LCP over P periods, `steps` instants per forcing period.
+        #[arg(long)]
+        period_multiple: Option<i64>,
     },
     /// Package a scene as an FMI 2.0 co-simulation FMU (needs `cargo build --release -p periodic-contact-fmu`).
     Fmu {
@@ -142,8 +146,9 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         None => cmd_solve::run_default(),
-        Some(Command::Solve { scene, output, frequency, export_lcp, no_estimate, polish }) => {
-            cmd_solve::run(&scene, &output, frequency, export_lcp.as_deref(), cmd_solve::Refine { estimate: !no_estimate, polish })
+        Some(Command::Solve { scene, output, frequency, export_lcp, no_estimate, polish, period_multiple }) => {
+            let overrides = cmd_solve::Overrides { frequency, period_multiple };
+            cmd_solve::run(&scene, &output, overrides, export_lcp.as_deref(), cmd_solve::Refine { estimate: !no_estimate, polish })
         }
         Some(Command::Modes { scene, count }) => cmd_modes::run(&scene, count),
         Some(Command::Sweep(args)) => cmd_sweep::run(&args),
