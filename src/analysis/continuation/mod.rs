@@ -14,15 +14,17 @@
 mod corrector;
 mod events;
 mod floquet;
+mod follow;
 pub mod output;
 
 pub use events::EventKind;
 pub use floquet::multipliers;
+pub use follow::{Current, Followed, Jump, Resolved, Stability, amplitude, follow, resolve, stability};
 
 use crate::error::Error;
 use crate::periodic::{PeriodicProblem, PeriodicSolver};
 use crate::response::Response;
-use corrector::Family;
+use corrector::{Family, Path};
 use events::Node;
 use num_complex::Complex64;
 
@@ -130,7 +132,7 @@ pub fn run(problem: &PeriodicProblem, param: Parameter, from: f64, to: f64, sett
         return Err(Error::input(format!("--from/--to: are {from} and {to}, must be finite and different")));
     }
     let (rho, dir) = ((to - from).abs(), (to - from).signum());
-    let mut fam = Family::new(problem, param, rho);
+    let mut fam = Family::new(problem, Path::Parameter(param), rho);
     fam.tolerance = settings.tolerance;
     fam.smoothing = settings.smoothing;
     let (k, m) = (problem.discretization().steps, problem.model().contacts.len());
