@@ -159,6 +159,27 @@ const char *pc_result_warning(const pc_result *r, size_t i);
 const char *pc_result_json(const pc_result *r);
 void pc_result_free(pc_result *r);
 
+/* ---- branches and stability (issue 13) ----------------------------------------------- */
+/* Each pc_problem_solve continues the previous result's orbit along its branch (same number of
+ * instants, a difference scheme's step map): where the branch ends at a fold between the old and
+ * the new values the answer is the orbit that exists, and pc_result_jump says so. */
+
+/* Whether every solve also computes the orbit's Floquet stability (on = 1; default 0, or the
+ * scene's [output] stability). */
+int pc_problem_set_stability(pc_problem *p, int on);
+/* The Floquet stability (the discrete monodromy of the step map on the orbit's active sets, as
+ * periodic-contact continue): *computed = 1 with *stable (1: every multiplier inside the unit
+ * circle) and *multiplier (the largest modulus), or *computed = 0, both 0 and *why saying why
+ * not (owned by the result; "" when computed). Any output may be NULL. */
+int pc_result_stability(const pc_result *r, int *computed, int *stable, double *multiplier,
+                        const char **why);
+/* *jumped = 1 when this solve jumped because the branch ended at a fold: *fold_frequency
+ * [rad/s] where it turned back, the amplitudes (half the largest peak-to-peak of the
+ * displacement outputs) before and after; else all 0. *jumps: the problem's jumps so far. Any
+ * output may be NULL. */
+int pc_result_jump(const pc_result *r, int *jumped, double *fold_frequency,
+                   double *from_amplitude, double *to_amplitude, size_t *jumps);
+
 #ifdef __cplusplus
 }
 #endif

@@ -18,6 +18,8 @@ use crate::periodic::{OutputSelection, PeriodicProblem, PeriodicSolver, SolveErr
 use crate::response::{Accuracy, Response};
 use crate::scene::Scene;
 use crate::time::{Discretization, Pairing, Scheme};
+mod branch;
+pub use branch::{pc_problem_set_stability, pc_result_jump, pc_result_stability};
 mod estimate;
 mod inspect;
 
@@ -115,6 +117,8 @@ pub struct PcProblem {
     estimate: bool,
     /// Built at the first solve.
     session: Option<PeriodicSolver>,
+    /// The stability and the branch followed (`branch`).
+    branch: branch::BranchState,
 }
 
 /// An opaque result handle.
@@ -128,11 +132,13 @@ pub struct PcResult {
     accuracy_method: CString,
     /// The JSON, made on first request; a `OnceLock` so that const readers may run concurrently.
     json: std::sync::OnceLock<CString>,
+    /// Its stability and jump (`branch`).
+    branch: branch::BranchResult,
 }
 
 impl PcProblem {
     fn new(base: PeriodicProblem) -> Box<Self> {
-        Box::new(PcProblem { tuning: Tuning::of(&base), base, estimate: true, session: None })
+        Box::new(PcProblem { tuning: Tuning::of(&base), base, estimate: true, session: None, branch: Default::default() })
     }
     /// Rebuilds the base problem after an edit, keeping the old one if the edit is invalid.
     fn edit(&mut self, f: impl FnOnce(&mut Model, &mut OutputSelection)) -> Result<(), (c_int, String)> {
@@ -173,6 +179,7 @@ fn from_scene(scene: &Scene, file: &str) -> Result<Box<PcProblem>, (c_int, Strin
     let built = scene.build(file).map_err(input)?;
     let mut p = PcProblem::new(built.problem);
     p.estimate = built.error_estimate;
+    p.branch.stability = built.stability;
     Ok(p)
 }
 
@@ -366,8 +373,9 @@ pub unsafe extern "C" fn pc_problem_frequency(p: *const PcProblem) -> f64 {
     catch_unwind(AssertUnwindSafe(|| unsafe { p.as_ref() }.map_or(f64::NAN, |p| p.tuning.frequency))).unwrap_or(f64::NAN)
 }
 
-/// Solves with the current values, warm-started from this problem's previous solve (same
-/// number of instants). NULL on failure.
+/// Solves with the current values, continuing this problem's previous orbit along its branch
+/// (same number of instants; a jump when the branch ended at a fold: `pc_result_jump`). NULL on
+/// failure.
 ///
 /// # Safety
 /// `p` is NULL or a live problem handle.
@@ -375,14 +383,10 @@ pub unsafe extern "C" fn pc_problem_frequency(p: *const PcProblem) -> f64 {
 pub unsafe extern "C" fn pc_problem_solve(p: *mut PcProblem) -> *mut PcResult {
     guarded_ptr(|| {
         let p = unsafe { problem(p) }?;
-        let problem = p.tuning.apply(&p.base, p.base.discretization()).map_err(solver_error)?;
-        // The session keeps the plan and the active set across solves of the same grid.
-        match &mut p.session {
-            Some(s) => s.update_problem(problem),
-            None => p.session = Some(PeriodicSolver::new(problem)),
-        }
-        let session = p.session.as_mut().expect("just set");
-        let mut response = session.solve().map_err(solver_error)?;
+        // The session keeps the plan, the active set and the assembly across solves of the same
+        // grid; `branch::solve` continues the last orbit along its branch.
+        let (mut response, branch) = branch::solve(p)?;
+        let session = p.session.as_ref().expect("made by branch::solve");
         response.accuracy = if p.estimate {
             accuracy::estimate(session.problem(), &response)
         } else {
@@ -391,7 +395,7 @@ pub unsafe extern "C" fn pc_problem_solve(p: *mut PcProblem) -> *mut PcResult {
         let accuracy_method = to_cstring(&response.accuracy.method);
         let warnings = response.warnings.iter().map(|w| to_cstring(w)).collect();
         let (warm_start, path) = (to_cstring(&response.lcp.warm_start.outcome), to_cstring(&response.lcp.path));
-        Ok(Box::new(PcResult { response, warnings, warm_start, path, accuracy_method, json: std::sync::OnceLock::new() }))
+        Ok(Box::new(PcResult { response, warnings, warm_start, path, accuracy_method, json: std::sync::OnceLock::new(), branch }))
     })
 }
 

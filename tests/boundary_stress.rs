@@ -332,8 +332,11 @@ struct CApi {
     result_free: unsafe extern "C" fn(P),
 }
 
-const C_API_FUNCTIONS: [&str; 43] = [
+const C_API_FUNCTIONS: [&str; 46] = [
     "pc_version",
+    "pc_problem_set_stability",
+    "pc_result_stability",
+    "pc_result_jump",
     "pc_problem_set_error_estimate",
     "pc_result_accuracy",
     "pc_problem_dof_count",

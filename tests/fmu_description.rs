@@ -36,7 +36,8 @@ fn variables_follow_the_effects() {
     assert_eq!(names(&forced), set(&[&common[..], &["force_scale", "force_scale_in"]].concat()));
     // A static rigid obstacle: gap offset and contact outputs, no motion parameters.
     let contact = format!("{forced}[[contact]]\ndof = 0\ngap = 0.5\n");
-    let c = ["gap_offset", "gap_offset_in", "contact[0].force", "contact[0].gap", "lcp.pivots", "lcp.residual"];
+    // With a contact and a step map (cds by default) the re-solves follow a branch: `jumps`.
+    let c = ["gap_offset", "gap_offset_in", "contact[0].force", "contact[0].gap", "lcp.pivots", "lcp.residual", "jumps"];
     assert_eq!(names(&contact), set(&[&common[..], &["force_scale", "force_scale_in"], &c].concat()));
     // A moving obstacle: motion_scale too.
     let moving = format!("{contact}motion = [{{ amplitude = 0.1, harmonic = 2 }}]\n");
@@ -47,6 +48,12 @@ fn variables_follow_the_effects() {
     assert!(n.contains("velocity[0]") && n.contains("acceleration[0]") && !n.contains("displacement[0]") && !n.contains("contact[0].force"));
     assert!(n.contains("lcp.pivots"), "with a contact the LCP diagnostics are there, even without contact outputs");
     assert!(!n.contains("accuracy.estimate"), "no displacement output, nothing to estimate");
+    // [output] stability = true: the orbit's stability too; fourier has no step map, so neither.
+    let stable = format!("{contact}[output]\ndisplacement = [0]\nstability = true\n");
+    assert_eq!(names(&stable), set(&[&common[..], &["force_scale", "force_scale_in"], &c, &["stable", "multiplier"]].concat()));
+    let fourier = stable.replace("[output]", "[discretization]\nscheme = \"fourier\"\n[output]");
+    let n = names(&fourier);
+    assert!(!n.contains("stable") && !n.contains("multiplier") && !n.contains("jumps"), "{n:?}");
     // error_estimate = "none": no second solve, no accuracy outputs.
     let fast = format!("{BASE}[discretization]\nerror_estimate = \"none\"\n");
     assert_eq!(names(&fast), set(&common[..5]));

@@ -11,8 +11,11 @@ CLI sweep of the same scene. See demo/README.md and demo/runup.py.
     ramp-drift tolerance of the CLI's peak of the same side at the frequency the FMU used, or,
     where two orbits coexist, on the contact branch the FMU stays on, checked against time
     integration; the only discontinuity of the output is where the FMU leaves its contact orbit;
-  - test_nonlinear_differs_from_linear: the stop caps the resonance (the linear peak is > 1.2x the
-    peak of the contact branch the FMU follows), and the figure figures/demo_runup.png is written.
+  - test_nonlinear_differs_from_linear: the stop bends and caps the resonance (the linear peak is
+    > 1.05x the peak of the contact branch the FMU follows, which lies above 1.3 rad/s), and the figure figures/demo_runup.png is written;
+  - test_hysteresis (issue 13): a run-up and a run-down through the resonance (demo/hysteresis.py)
+    each jump once, as the FMU's log says, at the folds of `periodic-contact continue`, and every
+    amplitude in between lies on a stable continued branch; figures/demo_hysteresis.png.
 Skipped while the CLI is absent (PC_REQUIRE_BINARIES=1: failed instead).
 """
 import os
@@ -21,7 +24,7 @@ import time
 import numpy as np
 import pytest
 
-from demo import runup
+from demo import hysteresis, runup
 from harness import engine
 
 pytestmark = pytest.mark.engine
@@ -109,12 +112,56 @@ def test_envelope_matches_cli_sweep(demo, cli, workdir):
 
 
 def test_nonlinear_differs_from_linear(demo):
-    peak_fmu = demo.peaks.value[demo.agr["compared"]].max()
+    c = demo.agr["compared"]
+    peak_fmu = demo.peaks.value[c].max()
+    w_peak = demo.peaks.omega[c][np.argmax(demo.peaks.value[c])]
     peak_lin = demo.linear.amp.max()
-    # Measured: linear 4.00, FMU 2.99 at the top of the contact branch it follows (before the
-    # FMU stayed on its branch it jumped to the contact-free orbit at 1.092 and peaked at ~1.3).
-    assert peak_lin > 1.2 * peak_fmu, (peak_lin, peak_fmu)
+    # Measured: linear 4.00 at 1.000 rad/s; the FMU, which follows its contact branch up to the
+    # fold (~1.3715 rad/s, issue 13), 3.69 at 1.37 on the free side: the stop bends the resonance
+    # to higher frequency and caps it.
+    assert peak_lin > 1.05 * peak_fmu, (peak_lin, peak_fmu)
+    assert w_peak > 1.3, w_peak
     assert demo.peaks.value[demo.peaks.upper].max() > runup.GAP  # it does hit the stop
     assert os.path.getsize(demo.figure) > 10000
     assert os.path.getmtime(demo.figure) > time.time() - 600
     assert demo.timings["total"] < 120, demo.timings
+
+
+@pytest.fixture(scope="module")
+def hyst(cli, workdir):
+    h = hysteresis.run_hysteresis(cli, os.path.join(workdir, "hysteresis"))
+    print("\n" + hysteresis.summary(h))
+    return h
+
+
+def test_hysteresis(hyst):
+    """Run-up 0.9 -> 1.6 rad/s and run-down 1.6 -> 0.9 in libcosim, FrequencyRamp driving our
+    frequency_in. References: `periodic-contact continue` up and down (the stable and unstable
+    branches, their folds). Tolerances:
+      - a jump: 1e-3 of the fold's frequency (the retreat that tells a fold from a wiggle of the
+        discrete branch, the FMU's criterion) plus one ramp step;
+      - an amplitude: the sampling bound of the communication and CLI grids plus the linear
+        interpolation bound of the continued branch (hysteresis.envelope, on_stable_branch)."""
+    for name, run, fold in (("up", hyst.up, hyst.fold_upper), ("down", hyst.down, hyst.fold_lower)):
+        step = float(np.max(np.abs(np.diff(run.w_in[1:]))))
+        assert len(run.jumps) == 1, f"run-{name}: {len(run.jumps)} jumps in the FMU log: {run.jumps}"
+        _, w_fold, w_before, w_after, a_before, a_after = run.jumps[0]
+        assert abs(w_fold - fold) <= 1e-3 * fold + step, f"run-{name} jumps at {w_fold}, the continuation's fold is {fold}"
+        assert min(w_before, w_after) - step <= w_fold <= max(w_before, w_after) + step
+        if name == "up":
+            assert a_before > 2.5 and a_after < 0.3, (a_before, a_after)   # contact branch -> contact-free
+        else:
+            assert abs(a_before - runup.GAP) < 0.01 and a_after > 1.2, (a_before, a_after)   # grazing -> contact branch
+        w, a, tol = hysteresis.envelope(run, with_tolerance=True)
+        d, ref, interp = hysteresis.on_stable_branch(w, a, hyst.branches)
+        assert w.size >= 150, f"run-{name}: only {w.size} amplitudes"
+        bad = np.nonzero(~(d <= tol + interp))[0]
+        assert bad.size == 0, f"run-{name}: off every stable branch:\n" + "\n".join(
+            f"  ω = {w[i]:.5f}: FMU {a[i]:.6f}, branch {ref[i]:.6f}, d = {d[i]:.2e}, tol {tol[i] + interp[i]:.2e}" for i in bad[:20])
+        # The FMU's multiplier output: finite; above 1 only next to the fold (a multiplier -> 1 there).
+        m = run.mult[1:]
+        assert np.all(np.isfinite(m)) and m.min() > 0
+        over = run.w_in[1:][m > 1.0]
+        assert np.all(np.abs(over - fold) <= 1e-3 * fold), f"run-{name}: unstable orbits reported at {over}"
+    assert os.path.getsize(hyst.figure) > 10000
+    assert os.path.getmtime(hyst.figure) > time.time() - 600

@@ -19,6 +19,7 @@
 //!   `fmi2GetRealOutputDerivatives` (order 1) is the exact time derivative of the interpolant:
 //!   for `displacement[d]` it is the velocity.
 use crate::analysis::accuracy;
+use crate::analysis::continuation::{self, Current, Jump};
 use crate::error::{Error, Result};
 use crate::fmi::state::{StateReader, StateWriter};
 use crate::fmi::{CoSimModel, DefaultExperiment, EventLog, ModelDescription};
@@ -97,6 +98,8 @@ pub struct ContactModel {
     /// Each solve also estimates its error (a second solve at k/2): the scene's
     /// `[discretization] error_estimate`, exposed as `accuracy.estimate`.
     estimate: bool,
+    /// Each solve also computes the orbit's Floquet stability (`[output] stability`).
+    stability: bool,
     solution: Option<Arc<Solution>>,
     /// τ(t) = t + phase_offset (mod T): keeps the phase continuous across frequency changes.
     phase_offset: f64,
@@ -124,8 +127,9 @@ impl ContactModel {
         }
         let shown = problem.outputs().clone();
         let model = problem.model();
-        let Variables { table: t, roles, outputs, units } = Variables::of(&problem, &built.labels, built.error_estimate);
+        let Variables { table: t, roles, outputs, units } = Variables::of(&problem, &built.labels, built.error_estimate, built.stability);
         let estimate = outputs.iter().any(|o| matches!(o, Output::Accuracy));
+        let stability = outputs.iter().any(|o| matches!(o, Output::Stable));
         let k = problem.discretization().steps;
         let mut base = problem.clone();
         // No rayon inside an FMU: its global pool would outlive the instance and keep the
@@ -163,6 +167,7 @@ impl ContactModel {
             values: start,
             session: PeriodicSolver::new(base.clone()),
             estimate,
+            stability,
             base,
             solution: None,
             phase_offset: 0.0,
@@ -183,21 +188,37 @@ impl ContactModel {
         self.roles.get(vr as usize).copied().ok_or_else(|| Error::input(format!("unknown value reference {vr}")))
     }
 
-    /// Solves `cfg`, warm-started from the current solution when the grid is the same.
-    fn solve(&mut self, cfg: Config) -> Result<Solution> {
+    /// Solves `cfg`, continuing the current orbit along its branch when the grid is the same
+    /// (`continuation::resolve`): the jump, when the branch ended at a fold on the way.
+    fn solve(&mut self, cfg: Config) -> Result<(Solution, Option<Jump>)> {
         let disc = Discretization { scheme: cfg.scheme, steps: cfg.steps, pairing: self.base.discretization().pairing };
-        let problem = cfg.tuning.apply(&self.base, disc)?;
-        self.session.update_problem(problem);
-        // The warm start is the current solution's (which an FMU-state restore may have changed).
-        match self.solution.as_ref().filter(|s| s.k == cfg.steps) {
-            Some(s) => self.session.set_warm_start(&s.active_set),
-            None => self.session.reset_warm_start(),
-        }
-        let mut r = self.session.solve()?;
+        // The current orbit is the current solution's (which an FMU-state restore may have changed).
+        let current = self.solution.as_deref().filter(|s| s.k == cfg.steps && s.config.scheme == cfg.scheme);
+        let current = current.map(|s| Current { tuning: s.config.tuning, disc, active_set: &s.active_set, amplitude: s.amplitude });
+        let jumps = self.solution.as_ref().map_or(0, |s| s.jumps);
+        let resolved = continuation::resolve(&mut self.session, &self.base, disc, cfg.tuning, current)?;
+        let mut r = resolved.response;
         if self.estimate {
             r.accuracy = accuracy::estimate(self.session.problem(), &r);
         }
-        Ok(self.solution_of(cfg, self.session.problem(), &r, self.session.fft()))
+        let stability = match self.stability {
+            true => {
+                Some(continuation::stability(self.session.problem(), &r.active_set).map_err(|why| Error::solve(format!("the stability of the orbit: {why}")))?)
+            }
+            false => None,
+        };
+        let jumps = jumps + u32::from(resolved.jump.is_some());
+        let mut sol = self.solution_of(cfg, self.session.problem(), &r, self.session.fft());
+        for (series, q) in sol.series.iter_mut().zip(&self.outputs) {
+            match (q, &stability) {
+                (Output::Stable, Some(st)) => *series = Series::Constant(f64::from(u8::from(st.stable))),
+                (Output::Multiplier, Some(st)) => *series = Series::Constant(st.largest),
+                (Output::Jumps, _) => *series = Series::Constant(f64::from(jumps)),
+                _ => {}
+            }
+        }
+        sol.jumps = jumps;
+        Ok((sol, resolved.jump))
     }
 
     fn solution_of(&self, config: Config, problem: &PeriodicProblem, r: &Response, fft: &PeriodFft) -> Solution {
@@ -229,6 +250,8 @@ impl ContactModel {
                 Output::Pivots => Series::Constant(r.lcp.pivots as f64),
                 Output::Accuracy => Series::Constant(r.accuracy.estimate.unwrap_or(0.0)),
                 Output::AccuracyAvailable => Series::Constant(f64::from(u8::from(r.accuracy.estimate.is_some()))),
+                // Set by `solve`, which knows the stability and the jumps.
+                Output::Stable | Output::Multiplier | Output::Jumps => Series::Constant(0.0),
             })
             .collect();
         Solution {
@@ -242,6 +265,8 @@ impl ContactModel {
             residual: r.lcp.residual,
             active_set: r.active_set.clone(),
             warnings: r.warnings.clone(),
+            amplitude: continuation::amplitude(r),
+            jumps: 0,
         }
     }
 
@@ -290,7 +315,7 @@ impl ContactModel {
         }
         let cfg = self.values.config();
         if self.solution.as_ref().is_none_or(|s| s.config != cfg) {
-            let sol = self.solve(cfg)?;
+            let (sol, _) = self.solve(cfg)?;
             self.phase_offset = 0.0;
             self.solution = None;
             self.install(sol, self.start_time);
@@ -401,6 +426,16 @@ impl CoSimModel for ContactModel {
         })
     }
 
+    fn get_boolean(&mut self, vr: u32) -> Result<bool> {
+        match self.role(vr)? {
+            Role::Output(slot) => {
+                self.ensure_outputs()?;
+                Ok(self.out[slot] != 0.0)
+            }
+            _ => Err(Error::input(format!("value reference {vr} is not Boolean"))),
+        }
+    }
+
     fn exit_initialization(&mut self, start_time: f64, log: &dyn EventLog) -> Result<Vec<String>> {
         self.start_time = start_time;
         self.ensure_outputs()?;
@@ -413,7 +448,14 @@ impl CoSimModel for ContactModel {
     fn do_step(&mut self, t: f64, h: f64, log: &dyn EventLog) -> Result<()> {
         let cfg = self.values.config();
         if self.solution.as_ref().is_none_or(|s| s.config != cfg) {
-            let sol = self.solve(cfg)?;
+            let old = self.solution.as_ref().map(|s| s.config.tuning.frequency);
+            let (sol, jump) = self.solve(cfg)?;
+            if let (Some(j), Some(old)) = (jump, old) {
+                log.event(&format!(
+                    "jump at t = {t}: the branch ended at a fold (frequency {:.9} rad/s) between frequency {old:.9} and {:.9}; amplitude {:.6e} -> {:.6e} (jump {})",
+                    j.fold.frequency, cfg.tuning.frequency, j.from_amplitude, j.to_amplitude, sol.jumps
+                ));
+            }
             log.event(&format!("re-solved at t = {t} for {:?}: {} pivots, residual {:.3e}", cfg.tuning, sol.pivots, sol.residual));
             self.install(sol, t);
         }

@@ -90,6 +90,10 @@ pub(crate) struct Solution {
     pub(super) residual: f64,
     pub(super) active_set: Vec<usize>,
     pub(super) warnings: Vec<String>,
+    /// `continuation::amplitude` of the response (a jump's "before").
+    pub(super) amplitude: f64,
+    /// Jumps off a branch since initialisation, this solve's included.
+    pub(super) jumps: u32,
 }
 
 impl Solution {

@@ -11,7 +11,7 @@ use num_complex::Complex64 as C;
 use std::sync::Arc;
 
 /// Raise when [`write`] changes (older states are then refused by name).
-pub const STATE_VERSION: u16 = 1;
+pub const STATE_VERSION: u16 = 2;
 
 /// What `fmi2GetFMUstate` keeps of a [`ContactModel`].
 #[derive(Clone, Debug, PartialEq)]
@@ -72,9 +72,10 @@ pub fn write(s: &ContactSnapshot, w: &mut StateWriter) {
 fn write_solution(w: &mut StateWriter, sol: &Solution) {
     write_tuning(w, &sol.config.tuning);
     write_config(w, sol.config.steps, sol.config.scheme);
-    for v in [sol.period, sol.h, sol.omega, sol.residual] {
+    for v in [sol.period, sol.h, sol.omega, sol.residual, sol.amplitude] {
         w.f64(v);
     }
+    w.usize(sol.jumps as usize);
     w.usize(sol.k);
     w.i32(sol.pivots);
     w.usizes(&sol.active_set);
@@ -129,7 +130,8 @@ impl ContactModel {
         let tuning = read_tuning(r)?;
         let (steps, scheme) = read_config(r)?;
         let config = Config { tuning, steps, scheme };
-        let (period, h, omega, residual) = (r.f64()?, r.f64()?, r.f64()?, r.f64()?);
+        let (period, h, omega, residual, amplitude) = (r.f64()?, r.f64()?, r.f64()?, r.f64()?, r.f64()?);
+        let jumps = u32::try_from(r.usize()?).map_err(|_| bad("the jump count is past u32"))?;
         if !(period.is_finite() && period > 0.0 && h.is_finite() && h > 0.0 && omega.is_finite()) {
             return Err(bad(format!("period {period}, step {h} and frequency {omega} must be finite and > 0")));
         }
@@ -150,7 +152,7 @@ impl ContactModel {
             return Err(bad(format!("the state has {ns} series, this model {} outputs", self.outputs.len())));
         }
         let series = (0..ns).map(|_| read_series(r, k)).collect::<Result<Vec<_>>>()?;
-        Ok(Solution { config, period, h, omega, k, series, pivots, residual, active_set, warnings })
+        Ok(Solution { config, period, h, omega, k, series, pivots, residual, active_set, warnings, amplitude, jumps })
     }
 }
 

@@ -8,7 +8,7 @@
 use super::scheme_code;
 use crate::fmi::table::{Kind, UnitDefinition, Variability, Variable, VariableTable};
 use crate::model::{Compliance, Labels, Quantity};
-use crate::periodic::{MIN_STEPS, PeriodicProblem};
+use crate::periodic::{MIN_STEPS, PeriodicProblem, step_map};
 use crate::time::Scheme;
 use Variability::*;
 
@@ -42,6 +42,12 @@ pub(super) enum Output {
     /// The error estimate of the last solve (`analysis::accuracy`) and whether there is one.
     Accuracy,
     AccuracyAvailable,
+    /// The Floquet stability of the current orbit (`[output] stability`): all multipliers inside
+    /// the unit circle, and the largest modulus.
+    Stable,
+    Multiplier,
+    /// Jumps off a branch that ended at a fold, since initialisation.
+    Jumps,
 }
 
 /// The table with the role of each value reference and the quantity of each output slot.
@@ -66,7 +72,7 @@ impl Variables {
     /// The variables of `problem` (the scene's, before the FMU changes its outputs), labelled
     /// with the scene's units and DOF names.
     /// With `estimate`, the error estimate of each solve is an output too.
-    pub fn of(problem: &PeriodicProblem, labels: &Labels, estimate: bool) -> Variables {
+    pub fn of(problem: &PeriodicProblem, labels: &Labels, estimate: bool, stability: bool) -> Variables {
         let mut b = Variables { table: VariableTable::new(), roles: Vec::new(), outputs: Vec::new(), units: Vec::new() };
         parameters(&mut b, problem, labels);
         inputs(&mut b, problem, labels);
@@ -79,6 +85,7 @@ impl Variables {
             let what = "1 when accuracy.estimate holds an estimate; 0 when none can be given (a scheme that does not converge for this contact, k/2 beyond the stability limit)";
             b.output(Variable::output("accuracy.estimated", Discrete, kind, what), Output::AccuracyAvailable);
         }
+        branch(&mut b, problem, labels, stability);
         b
     }
 
@@ -213,5 +220,21 @@ fn outputs(b: &mut Variables, problem: &PeriodicProblem, labels: &Labels) {
             Variable::output("lcp.residual", Discrete, kind, "Residual max|min(z, Az+q)| of the last LCP solve (forces and clearances: no unit)"),
             Output::Residual,
         );
+    }
+}
+
+/// The branch outputs (issue 13 item 6), only where the scheme has a step map and the scene has
+/// contacts: `jumps` always, `stable` and `multiplier` when the scene asks (`[output] stability`).
+fn branch(b: &mut Variables, problem: &PeriodicProblem, labels: &Labels, stability: bool) {
+    if problem.model().contacts.is_empty() || step_map(problem).is_err() {
+        return;
+    }
+    let what = "Jumps since initialisation: re-solves where the branch of the current orbit ended at a fold between the old and the new values, so the response jumped to the orbit that exists (each logged in logEvents with the frequency and the amplitudes)";
+    b.output(Variable::output("jumps", Discrete, Kind::Integer { start: None, min: None, max: None }, what), Output::Jumps);
+    if stability {
+        let what = "true when every Floquet multiplier of the current orbit is inside the unit circle (the discrete monodromy of the step map on the orbit's active sets, as periodic-contact continue)";
+        b.output(Variable::output("stable", Discrete, Kind::Boolean { start: None }, what), Output::Stable);
+        let kind = b.real(None, Quantity::Ratio, labels);
+        b.output(Variable::output("multiplier", Discrete, kind, "Largest Floquet modulus of the current orbit (> 1: unstable)"), Output::Multiplier);
     }
 }

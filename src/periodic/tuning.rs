@@ -20,6 +20,16 @@ impl Tuning {
     pub fn of(p: &PeriodicProblem) -> Self {
         Tuning { frequency: p.model().frequency, force_scale: 1.0, gap_offset: 0.0, motion_scale: 1.0 }
     }
+    /// The point at fraction `lambda` of the straight way from these values to `to` (0: these).
+    pub fn towards(&self, to: &Tuning, lambda: f64) -> Tuning {
+        let at = |x: f64, y: f64| x + lambda * (y - x);
+        Tuning {
+            frequency: at(self.frequency, to.frequency),
+            force_scale: at(self.force_scale, to.force_scale),
+            gap_offset: at(self.gap_offset, to.gap_offset),
+            motion_scale: at(self.motion_scale, to.motion_scale),
+        }
+    }
     /// `base` with these values and discretisation `disc`, validated again.
     pub fn apply(&self, base: &PeriodicProblem, disc: Discretization) -> Result<PeriodicProblem, SolveError> {
         let mut model = base.model().clone();

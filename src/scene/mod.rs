@@ -53,6 +53,9 @@ pub struct SceneModel {
     pub error_estimate: bool,
     /// `[discretization] polish`: refine by the event-fitted polish (default false).
     pub polish: bool,
+    /// `[output] stability`: the front ends report the Floquet stability of every result
+    /// (default false).
+    pub stability: bool,
 }
 
 /// Wall times of [`Scene::build`] [s].
@@ -157,6 +160,19 @@ impl Scene {
         }
         problem.set_period_multiple(period_multiple(&self.discretization)?)?;
         let timings = BuildTimings { structure: t_structure, reduction: t_reduction, total: t0.elapsed().as_secs_f64() };
-        Ok(SceneModel { problem, full, dofs, reduction, casing, contact_dofs, labels, timings, error_estimate: estimate, polish: self.discretization.polish })
+        let stability = self.output.as_ref().is_some_and(|o| o.stability);
+        Ok(SceneModel {
+            problem,
+            full,
+            dofs,
+            reduction,
+            casing,
+            contact_dofs,
+            labels,
+            timings,
+            error_estimate: estimate,
+            polish: self.discretization.polish,
+            stability,
+        })
     }
 }

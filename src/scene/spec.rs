@@ -259,6 +259,10 @@ pub struct OutputSpec {
     /// Contact forces and gaps (default true).
     #[serde(default = "yes")]
     pub contacts: bool,
+    /// The Floquet stability of every result (front ends: FMU outputs `stable` and `multiplier`,
+    /// C API `pc_result_stability`; default false).
+    #[serde(default)]
+    pub stability: bool,
 }
 
 #[derive(Debug, Clone, Deserialize)]

@@ -95,6 +95,7 @@ class CosimRun:
     w_driver: np.ndarray   # the driver's output at each sample
     h: float               # communication step [s]
     wall_s: float
+    extra: dict | None = None  # further Real outputs of our FMU asked by `extra`, by name
 
 
 def _samples(obs, idx: int, vr: int, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -108,8 +109,9 @@ def _samples(obs, idx: int, vr: int, n: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def cosimulate(pc_fmu: str, ramp_fmu: str, w_start: float = W_START, w_end: float = W_END, t_ramp: float = T_RAMP,
-               samples_per_period: int = SAMPLES_PER_PERIOD) -> CosimRun:
-    """Runs driver + PeriodicContact in libcosim over [0, t_ramp] (the ramp spans all of it)."""
+               samples_per_period: int = SAMPLES_PER_PERIOD, extra: tuple = ()) -> CosimRun:
+    """Runs driver + PeriodicContact in libcosim over [0, t_ramp] (the ramp spans all of it);
+    `extra`: names of further Real outputs of our FMU to observe."""
     from libcosimpy.CosimEnums import CosimVariableType
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
@@ -144,6 +146,7 @@ def cosimulate(pc_fmu: str, ramp_fmu: str, w_start: float = W_START, w_end: floa
     obs = CosimObserver.create_time_series(buffer_size=n_steps + 10)
     ex.add_observer(observer=obs)
     series = [(i_p, "displacement[0]"), (i_p, "velocity[0]"), (i_p, "contact[0].force"), (i_p, "frequency_in"), (i_r, "frequency")]
+    series += [(i_p, name) for name in extra]
     for i, name in series:
         vr = (vr_p if i == i_p else vr_r)[name]
         obs.start_time_series(i, value_reference=vr, variable_type=CosimVariableType.REAL)
@@ -160,7 +163,8 @@ def cosimulate(pc_fmu: str, ramp_fmu: str, w_start: float = W_START, w_end: floa
         out[(i, name)] = vals
         t = tt
     return CosimRun(t=t, x=out[(i_p, "displacement[0]")], v=out[(i_p, "velocity[0]")], force=out[(i_p, "contact[0].force")],
-                    w_in=out[(i_p, "frequency_in")], w_driver=out[(i_r, "frequency")], h=h_ns * 1e-9, wall_s=wall)
+                    w_in=out[(i_p, "frequency_in")], w_driver=out[(i_r, "frequency")], h=h_ns * 1e-9, wall_s=wall,
+                    extra={name: out[(i_p, name)] for name in extra})
 
 
 # ----------------------------------------------------------------------------- envelope

@@ -7,7 +7,8 @@
 //! sets (P is smooth in λ on a piece).
 use super::Parameter;
 use crate::error::Error;
-use crate::periodic::{PeriodicProblem, StepMapLcp, step_map};
+use crate::periodic::{PeriodicProblem, StepMapLcp, Tuning, step_map};
+use crate::time::Discretization;
 use nalgebra::{DMatrix, DVector};
 
 /// Relative defect accepted when Newton stalls at a kink of the discrete map (NLvib 03, 2T
@@ -15,10 +16,34 @@ use nalgebra::{DMatrix, DVector};
 /// 1e-10; the orbits' discretisation error is O(h²) ≈ 1e-4 there).
 const STALL_FLOOR: f64 = 1e-8;
 
+/// What λ moves: a parameter of the problem, or the straight path between two tunings of a base
+/// problem (λ = 0 at `from`, 1 at `to`: a front end's re-solve after its knobs changed).
+#[derive(Clone, Copy, Debug)]
+pub(super) enum Path {
+    Parameter(Parameter),
+    Tuning { from: Tuning, to: Tuning, disc: Discretization },
+}
+
+impl Path {
+    fn apply(&self, base: &PeriodicProblem, lambda: f64) -> Result<PeriodicProblem, Error> {
+        match *self {
+            Path::Parameter(param) => {
+                let mut p = base.clone();
+                param.apply(&mut p, lambda)?;
+                Ok(p)
+            }
+            Path::Tuning { from, to, disc } => {
+                let t = from.towards(&to, lambda);
+                t.apply(base, disc).map_err(Error::from)
+            }
+        }
+    }
+}
+
 /// The orbits of one problem as the parameter varies.
 pub(super) struct Family {
     base: PeriodicProblem,
-    pub param: Parameter,
+    path: Path,
     /// The parameter's range |to − from|: λ enters the unknowns as λ/ρ.
     pub rho: f64,
     /// Relative defect ‖F‖∞ / max(‖s_0‖∞, scale) at which the corrector stops.
@@ -63,19 +88,29 @@ fn bordered(jacobian: &DMatrix<f64>, border: &[f64]) -> DMatrix<f64> {
 }
 
 impl Family {
-    pub fn new(base: &PeriodicProblem, param: Parameter, rho: f64) -> Self {
+    /// The continued parameter's name ("knobs" for a front end's tuning path).
+    pub fn name(&self) -> &'static str {
+        match self.path {
+            Path::Parameter(p) => p.name(),
+            Path::Tuning { .. } => "knobs",
+        }
+    }
+
+    pub fn new(base: &PeriodicProblem, path: Path, rho: f64) -> Self {
         let mut base = base.clone();
         // One orbit per call: the solver's inner parallelism would only compete with itself.
         base.set_parallel(false);
-        let blocks = (step_map(&base).map_or(2, |sm| sm.state_size()) / base.model().n().max(1)).max(1);
-        Family { base, param, rho, tolerance: 1e-10, max_iterations: 12, marches: 0, smoothing: 0.0, blocks }
+        let mut fam = Family { base, path, rho, tolerance: 1e-10, max_iterations: 12, marches: 0, smoothing: 0.0, blocks: 2 };
+        // The base as it is for a parameter (its λ may be any value), the path's start for tunings.
+        let start = if matches!(path, Path::Tuning { .. }) { fam.problem_at(0.0).ok() } else { Some(fam.base.clone()) };
+        let sized = start.and_then(|p| step_map(&p).ok().map(|sm| sm.state_size() / p.model().n().max(1)));
+        fam.blocks = sized.unwrap_or(2).max(1);
+        fam
     }
 
     /// The problem at parameter λ.
     pub fn problem_at(&self, lambda: f64) -> Result<PeriodicProblem, Error> {
-        let mut p = self.base.clone();
-        self.param.apply(&mut p, lambda)?;
-        Ok(p)
+        self.path.apply(&self.base, lambda)
     }
 
     /// The step map at λ.

@@ -14,17 +14,19 @@
 mod corrector;
 mod events;
 mod floquet;
+mod follow;
 pub mod output;
 mod switch;
 
 pub use events::EventKind;
 pub use floquet::multipliers;
+pub use follow::{Current, Followed, Jump, Resolved, Stability, amplitude, follow, resolve, stability};
 pub use switch::{run_switching, switch_at};
 
 use crate::error::Error;
 use crate::periodic::{PeriodicProblem, PeriodicSolver};
 use crate::response::Response;
-use corrector::Family;
+use corrector::{Family, Path};
 use events::Node;
 use num_complex::Complex64;
 
@@ -198,7 +200,7 @@ pub fn run(problem: &PeriodicProblem, param: Parameter, from: f64, to: f64, sett
 
 /// The family of `problem`'s orbits with the settings' corrector tolerance and smoothing.
 fn family(problem: &PeriodicProblem, param: Parameter, rho: f64, settings: &ContinuationSettings) -> Family {
-    let mut fam = Family::new(problem, param, rho);
+    let mut fam = Family::new(problem, Path::Parameter(param), rho);
     fam.tolerance = settings.tolerance;
     fam.smoothing = settings.smoothing;
     fam
@@ -244,7 +246,7 @@ impl Walk<'_> {
     ) -> Result<(Vec<BranchPoint>, String), Error> {
         let (from, to, settings, rho) = (self.from, self.to, self.settings, fam.rho);
         let dir = (to - from).signum();
-        let name = fam.param.name();
+        let name = fam.name();
         let m = solver.problem().model().contacts.len();
         let d = here.solved.v.len() - 1;
         let mut ds = settings.initial_step;
