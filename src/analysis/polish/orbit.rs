@@ -187,6 +187,26 @@ impl PolishedOrbit {
         Some(j)
     }
 
+    /// Row weights that put the residual in length units: 1 on displacements and clearances,
+    /// 1/ω_d on the velocity of DOF d (ω_d = max(√(K_dd/M_dd), ω)), 1/K_dd on a release's force.
+    /// In raw units the velocity of a stiff DOF (a Craig–Bampton constraint mode, a closed
+    /// contact spring: ω_d ≈ 6e5 rad/s on the coarse blade) outweighs every clearance, and the
+    /// line search then refuses Newton steps that are right (the coarse blade's stall).
+    fn weights(&self) -> DVector<f64> {
+        let (n, s) = (self.model.n(), &self.model.structure);
+        let rate = |d: usize| (s.stiffness.get(d, d) / s.mass.get(d, d)).abs().sqrt().max(self.model.frequency);
+        let ne = self.events.len();
+        DVector::from_fn(2 * n + ne, |i, _| match i {
+            i if i < n => 1.0,
+            i if i < 2 * n => 1.0 / rate(i - n),
+            i => {
+                let e = self.events[i - 2 * n];
+                let k = s.stiffness.get(self.model.contacts[e.contact].dof, self.model.contacts[e.contact].dof).abs();
+                if e.kind == EventKind::Release && k > 0.0 { 1.0 / k } else { 1.0 }
+            }
+        })
+    }
+
     fn ordered(&self, u: &DVector<f64>) -> bool {
         let n2 = 2 * self.model.n();
         let tau: Vec<f64> = u.iter().skip(n2).copied().collect();
@@ -214,6 +234,12 @@ impl PolishedOrbit {
         }
         let ys = y0.amax().max(1e-300);
         let scale = DVector::from_fn(n2 + ne, |i, _| if i < n2 { ys } else { self.period });
+        let w = self.weights();
+        // The merit: the max norm of the residual in length units (see `weights`).
+        let size = y0.component_mul(&w.rows(0, n2)).amax().max(1e-300);
+        // Below this the residual is round-off of the flows (ε·‖Â τ‖ of the exponentials).
+        let floor = 1e-10 * size;
+        let merit = |r: &DVector<f64>| r.component_mul(&w).amax();
         let mut r = self.residual_of(&u).ok_or_else(|| fail("the seeded event sequence cannot be flowed"))?;
         let mut converged = false;
         for it in 0..MAX_ITERATIONS {
@@ -224,7 +250,7 @@ impl PolishedOrbit {
                 let cand = &u + &du * lambda;
                 if self.ordered(&cand)
                     && let Some(rc) = self.residual_of(&cand)
-                    && (rc.amax() < r.amax() || rc.amax() < 1e-13 * ys.max(1.0))
+                    && (merit(&rc) < merit(&r) || merit(&rc) < floor)
                 {
                     break (cand, rc);
                 }
@@ -235,18 +261,20 @@ impl PolishedOrbit {
             };
             let step = du.iter().enumerate().map(|(i, v)| (v * lambda).abs() / scale[i]).fold(0.0, f64::max);
             self.correction = du.rows(0, self.model.n()).amax() * lambda;
+            // Converged: a negligible step, or the residual at round-off and no longer halving.
+            let stagnant = merit(&rn) < floor && merit(&rn) > 0.5 * merit(&r);
             u = next;
             r = rn;
             self.iterations = it + 1;
-            if step < 1e-14 || (step < 1e-11 && r.amax() < 1e-12 * ys.max(1.0)) {
+            if step < 1e-14 || (step < 1e-11 && merit(&r) < 1e-12 * size) || stagnant {
                 converged = true;
                 break;
             }
         }
         if !converged {
-            return Err(fail(&format!("Newton did not converge in {MAX_ITERATIONS} iterations (residual {:.2e})", r.amax())));
+            return Err(fail(&format!("Newton did not converge in {MAX_ITERATIONS} iterations (residual {:.2e})", merit(&r))));
         }
-        self.residual = r.amax();
+        self.residual = merit(&r);
         // Times into [0, T): a shift by whole periods changes nothing.
         let shift = (u[n2.min(u.len() - 1)] / self.period).floor() * self.period;
         self.y0 = u.rows(0, n2).into_owned();
@@ -328,6 +356,11 @@ impl PolishedOrbit {
         &self.monodromy
     }
 
+    /// The period T [s].
+    pub fn period(&self) -> f64 {
+        self.period
+    }
+
     /// The section's time: the first event's (0 without events).
     pub fn section_time(&self) -> f64 {
         self.times[0]
@@ -355,6 +388,12 @@ impl PolishedOrbit {
     pub fn state(&self, t: f64) -> DVector<f64> {
         let (e, tt) = self.locate(t);
         self.phases[e].flow(self.times[e], &self.after[e], tt)
+    }
+
+    /// Clearance of contact `i` at `t` (negative: a compliant contact's penetration).
+    pub fn clearance_at(&self, i: usize, t: f64) -> f64 {
+        let (_, tt) = self.locate(t);
+        self.clearance(i, &self.state(tt), tt)
     }
 
     /// Acceleration of every DOF at `t` (between events).
