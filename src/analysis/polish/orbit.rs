@@ -4,7 +4,7 @@ use super::PolishFailure;
 use super::events::{self, Event, EventKind};
 use super::phase::{self, Phase};
 use crate::model::Model;
-use crate::periodic::PeriodicProblem;
+use crate::periodic::{OutputMap, PeriodicProblem};
 use crate::response::{EventRecord, Response};
 use nalgebra::{DMatrix, DVector};
 
@@ -19,12 +19,23 @@ struct Shot {
     impulses: Vec<f64>,
 }
 
+/// A polished orbit's definition, from which [`PolishedOrbit::rebuild`] makes it again (the FMU
+/// keeps it in a serialized FMU state).
+#[derive(Clone, Debug, PartialEq)]
+pub struct OrbitParts {
+    pub events: Vec<Event>,
+    pub always: Vec<usize>,
+    pub y0: Vec<f64>,
+}
+
 /// A periodic orbit made of exact linear phases between events.
 #[derive(Clone, Debug)]
 pub struct PolishedOrbit {
     pub(super) model: Model,
     pub(super) period: f64,
     pub(super) events: Vec<Event>,
+    /// Contacts closed all period long (no event).
+    always: Vec<usize>,
     /// Event times, increasing, times[0] ∈ [0, T) (a single 0 when there is no event).
     pub(super) times: Vec<f64>,
     /// The phase after each event (phases[e] runs from times[e] to times[e+1]).
@@ -43,6 +54,36 @@ pub struct PolishedOrbit {
 
 impl PolishedOrbit {
     pub(super) fn solve(model: &Model, evs: Vec<Event>, always: &[usize]) -> Result<Self, PolishFailure> {
+        let mut o = Self::new(model, evs, always)?;
+        o.newton()?;
+        Ok(o)
+    }
+
+    /// The orbit of [`Self::parts`] again, for `model` (the model it was polished on): the
+    /// phases are rebuilt and one period is flowed, without Newton.
+    pub fn rebuild(model: &Model, parts: &OrbitParts) -> Result<Self, PolishFailure> {
+        let fail = |w: &str| PolishFailure(format!("the stored polished orbit does not fit this model: {w}"));
+        let (m, n) = (model.contacts.len(), model.n());
+        if parts.y0.len() != 2 * n || parts.events.iter().map(|e| e.contact).chain(parts.always.iter().copied()).any(|i| i >= m) {
+            return Err(fail("its state or a contact index is out of range"));
+        }
+        let mut o = Self::new(model, parts.events.clone(), &parts.always)?;
+        o.y0 = DVector::from_column_slice(&parts.y0);
+        if !o.ordered(&DVector::from_iterator(2 * n + o.events.len(), o.y0.iter().copied().chain(o.times.iter().copied().take(o.events.len())))) {
+            return Err(fail("its event times are not increasing within one period"));
+        }
+        o.finish().map_err(|e| fail(&e.0))?;
+        Ok(o)
+    }
+
+    /// What [`Self::rebuild`] needs: the events with their converged times (as `seed`), the
+    /// contacts closed all period long, and the state just after event 0.
+    pub fn parts(&self) -> OrbitParts {
+        let events = self.events.iter().zip(&self.times).map(|(e, &t)| Event { seed: t, ..*e }).collect();
+        OrbitParts { events, always: self.always.clone(), y0: self.y0.iter().copied().collect() }
+    }
+
+    fn new(model: &Model, evs: Vec<Event>, always: &[usize]) -> Result<Self, PolishFailure> {
         let sets = events::phase_sets(model, &evs, always);
         let mut phases = Vec::new();
         let empty = vec![always.to_vec()];
@@ -62,7 +103,8 @@ impl PolishedOrbit {
         let gaps = (0..model.contacts.len()).map(|i| phase::gap_harmonics(model, i)).collect();
         let times = if evs.is_empty() { vec![0.0] } else { evs.iter().map(|e| e.seed).collect() };
         let n = model.n();
-        let mut o = PolishedOrbit {
+        Ok(PolishedOrbit {
+            always: always.to_vec(),
             model: model.clone(),
             period: model.period(),
             events: evs,
@@ -76,9 +118,7 @@ impl PolishedOrbit {
             residual: f64::INFINITY,
             correction: f64::INFINITY,
             monodromy: DMatrix::zeros(2 * n, 2 * n),
-        };
-        o.newton()?;
-        Ok(o)
+        })
     }
 
     fn gap(&self, i: usize, t: f64, order: u32) -> f64 {
@@ -281,6 +321,12 @@ impl PolishedOrbit {
         if ne > 0 {
             self.times = u.iter().skip(n2).map(|t| t - shift).collect();
         }
+        self.finish()
+    }
+
+    /// The states after the events, the impulses and the monodromy of the orbit at y0 and times.
+    fn finish(&mut self) -> Result<(), PolishFailure> {
+        let fail = |w: &str| PolishFailure(w.to_string());
         let shot = self.shoot(&self.y0, &self.times).ok_or_else(|| fail("the converged orbit cannot be flowed"))?;
         self.after = shot.after;
         self.impulses = shot.impulses;
@@ -390,10 +436,25 @@ impl PolishedOrbit {
         self.phases[e].flow(self.times[e], &self.after[e], tt)
     }
 
+    /// Displacement and velocity of user DOF `dof` at `t` (through the reduction's output map
+    /// when there is one); `None` for a DOF the map does not hold.
+    pub fn user_state(&self, map: Option<&OutputMap>, dof: usize, t: f64) -> Option<(f64, f64)> {
+        let y = self.state(t);
+        let n = self.model.n();
+        Some((user_value(map, dof, &y, 0, n)?, user_value(map, dof, &y, n, n)?))
+    }
+
     /// Clearance of contact `i` at `t` (negative: a compliant contact's penetration).
     pub fn clearance_at(&self, i: usize, t: f64) -> f64 {
         let (_, tt) = self.locate(t);
         self.clearance(i, &self.state(tt), tt)
+    }
+
+    /// Time derivative of contact `i`'s clearance at `t`: gap'(t) − s·v_d.
+    pub fn clearance_rate(&self, i: usize, t: f64) -> f64 {
+        let (_, tt) = self.locate(t);
+        let c = &self.model.contacts[i];
+        self.gap(i, tt, 1) - c.direction * self.state(tt)[self.model.n() + c.dof]
     }
 
     /// Acceleration of every DOF at `t` (between events).
@@ -449,11 +510,7 @@ impl PolishedOrbit {
         let states: Vec<DVector<f64>> = r.time.iter().map(|&t| self.state(t)).collect();
         let accs: Vec<DVector<f64>> = if r.acceleration.is_empty() { vec![] } else { r.time.iter().map(|&t| self.acceleration(t)).collect() };
         let label = |key: &str, v: &DVector<f64>, off: usize| -> f64 {
-            let l: usize = key.parse().unwrap_or(usize::MAX);
-            match problem.output_map() {
-                Some(map) => map.rows.get(&l).map_or(f64::NAN, |row| row.iter().map(|&(d, c)| c * v[off + d]).sum()),
-                None => v.get(off + l).copied().unwrap_or(f64::NAN),
-            }
+            user_value(problem.output_map(), key.parse().unwrap_or(usize::MAX), v, off, n).unwrap_or(f64::NAN)
         };
         for (key, series) in r.displacement.iter_mut() {
             series.iter_mut().zip(&states).for_each(|(x, y)| *x = label(key, y, 0));
@@ -473,5 +530,21 @@ impl PolishedOrbit {
             let k = rc.gap.len();
             rc.paired_gap = (0..k).map(|j| rc.gap[(j + s) % k]).collect();
         }
+    }
+}
+
+/// User DOF `dof`'s value in the model vector `v` from offset `off` (displacements at 0,
+/// velocities at n of an n-DOF model): the output map's row, or the model DOF itself without a map.
+pub fn user_value(map: Option<&OutputMap>, dof: usize, v: &DVector<f64>, off: usize, n: usize) -> Option<f64> {
+    match map {
+        Some(map) => map.rows.get(&dof).map(|row| row.iter().map(|&(d, c)| c * v[off + d]).sum()),
+        None => (dof < n).then(|| v[off + dof]),
+    }
+}
+
+/// Two orbits are equal when their definitions are ([`PolishedOrbit::parts`]) on the same period.
+impl PartialEq for PolishedOrbit {
+    fn eq(&self, other: &Self) -> bool {
+        self.period == other.period && self.parts() == other.parts()
     }
 }
