@@ -11,7 +11,11 @@
  * the error message of a scene file that does not exist. With a second scene (with contacts)
  * and one pairing per contact: the problem's DOF count and each contact's DOF, direction and
  * pairing as set, each contact's force, gap and paired gap, max |force*paired_gap|, and the
- * warm-start outcome and solver path of a cold solve and of a warm re-solve.
+ * warm-start outcome and solver path of a cold solve and of a warm re-solve. Last, a rigid stop
+ * with sticking (notes 6.3: m = 1, c = 0.1, k = 1, F = 1, w = 1, gap 0.5, cds, k = 256) solved
+ * with the polish: its status, events, and displacement, velocity, force and gap at times
+ * between the instants (exact), a fallback (no contact outputs: the events cannot be read), then
+ * the same without the polish (interpolated samples).
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -120,6 +124,66 @@ static int contacts_demo(const char *path, int npairing, char **pairing) {
     return 0;
 }
 
+/* Section 6: the event-fitted polish and the response between the instants. */
+static int polish_demo(void) {
+    const double m = 1.0, k = 1.0, c = 0.1;
+    const double t[6] = {0.37, 1.234, 2.5, 3.95, 5.9, -1.31}; /* between instants; any real */
+    for (int on = 1; on >= 0; on--) {
+        const char *pre = on ? "polish" : "plain";
+        pc_problem *p = pc_problem_from_matrices(1, &m, &k, &c, 1.0, "cds", 256);
+        if (!p) return fail("pc_problem_from_matrices (polish)");
+        if (pc_problem_add_force(p, 0, 1.0, 1, 0.0) != PC_OK) return fail("add_force (polish)");
+        if (pc_problem_add_contact(p, 0, 1, 0.5, 0.0, NULL) != PC_OK) return fail("add_contact (polish)");
+        if (pc_problem_set_error_estimate(p, 0) != PC_OK) return fail("set_error_estimate");
+        if (pc_problem_set_polish(p, on) != PC_OK) return fail("set_polish");
+        pc_result *r = pc_problem_solve(p);
+        if (!r) return fail("pc_problem_solve (polish)");
+        int status = -1;
+        const char *reason = NULL;
+        if (pc_result_polish(r, &status, &reason) != PC_OK) return fail("pc_result_polish");
+        printf("%s.status 0 %d\n%s.reason 0 %s\n", pre, status, pre, reason);
+        size_t n = pc_result_event_count(r);
+        printf("%s.events 0 %zu\n", pre, n);
+        for (size_t i = 0; i < n; i++) {
+            double time = 0, impulse = 0;
+            size_t contact = 9;
+            const char *kind = NULL;
+            if (pc_result_event(r, i, &time, &contact, &kind, &impulse) != PC_OK) return fail("pc_result_event");
+            printf("%s.event_time %zu %.17g\n%s.event_kind %zu %s\n%s.event_impulse %zu %.17g\n", pre, i,
+                   time, pre, i, kind, pre, i, impulse);
+        }
+        printf("%s.bad_event 0 %d\n", pre, pc_result_event(r, n, NULL, NULL, NULL, NULL));
+        for (int i = 0; i < 6; i++) {
+            double x = 0, v = 0, f = 0, g = 0;
+            int exact = -1, exact_c = -1;
+            if (pc_result_state_at(r, 0, t[i], &x, &v, &exact) != PC_OK) return fail("pc_result_state_at");
+            if (pc_result_contact_at(r, 0, t[i], &f, &g, &exact_c) != PC_OK) return fail("pc_result_contact_at");
+            printf("%s.t %d %.17g\n%s.x %d %.17g\n%s.v %d %.17g\n%s.force %d %.17g\n%s.gap %d %.17g\n",
+                   pre, i, t[i], pre, i, x, pre, i, v, pre, i, f, pre, i, g);
+            printf("%s.exact %d %d\n%s.exact_contact %d %d\n", pre, i, exact, pre, i, exact_c);
+        }
+        printf("%s.bad_dof 0 %d\n", pre, pc_result_state_at(r, 5, 1.0, NULL, NULL, NULL));
+        pc_result_free(r);
+        if (on) {
+            /* Without contact outputs the events cannot be read: a fallback, with its reason. */
+            const size_t dof = 0;
+            if (pc_problem_set_outputs(p, &dof, 1, &dof, 1, NULL, 0, 0) != PC_OK) return fail("set_outputs");
+            r = pc_problem_solve(p);
+            if (!r) return fail("pc_problem_solve (fallback)");
+            double x = 0;
+            int exact = -1;
+            if (pc_result_polish(r, &status, &reason) != PC_OK) return fail("pc_result_polish (fallback)");
+            if (pc_result_state_at(r, 0, 1.0, &x, NULL, &exact) != PC_OK) return fail("state_at (fallback)");
+            printf("fallback.status 0 %d\nfallback.reason 0 %s\nfallback.exact 0 %d\n", status, reason, exact);
+            for (size_t i = 0; i < pc_result_warning_count(r); i++)
+                printf("fallback.warning %zu %s\n", i, pc_result_warning(r, i));
+            pc_result_free(r);
+        }
+        pc_problem_free(p);
+    }
+    return 0;
+}
+
 int main(int argc, char **argv) {
     if (argc < 2) {
         fprintf(stderr, "usage: %s SCENE.toml\n", argv[0]);
@@ -172,5 +236,7 @@ int main(int argc, char **argv) {
 
     /* 5. Contacts: per-contact pairing, the problem's and the result's inspection accessors. */
     if (argc >= 3 && contacts_demo(argv[2], argc - 3, argv + 3)) return 1;
-    return 0;
+
+    /* 6. The event-fitted polish: outcome, events, the exact orbit between the instants. */
+    return polish_demo();
 }

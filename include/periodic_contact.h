@@ -15,9 +15,11 @@
  * Lifetimes and ownership
  *   - A pc_problem lives until pc_problem_free; a pc_result until pc_result_free. A result does
  *     not borrow its problem: either may be freed first. Free each handle exactly once.
- *   - Strings from pc_result_warning, pc_result_json, pc_result_warm_start and
- *     pc_result_lcp_path are owned by their result: valid until pc_result_free, never free them.
- *   - pc_version and the pairing names ("same", "forward") have static storage.
+ *   - Strings from pc_result_warning, pc_result_json, pc_result_warm_start,
+ *     pc_result_lcp_path, pc_result_accuracy's method and pc_result_polish's reason are owned by
+ *     their result: valid until pc_result_free, never free them.
+ *   - pc_version, the pairing names ("same", "forward") and the event kinds of pc_result_event
+ *     have static storage.
  *   - pc_last_error's string is thread-local: valid until the next failing call on the same
  *     thread (a successful call makes it ""; copy it if you need it longer). Never free it.
  *   - Copy functions write into caller buffers; the library keeps no caller pointer.
@@ -50,6 +52,11 @@ extern "C" {
 #define PC_ERROR_INPUT 2    /* invalid scene or model (the message names field and value)   */
 #define PC_ERROR_SOLVER 3   /* singular operator, LCP not solved, non-finite response        */
 #define PC_ERROR_INTERNAL 4 /* internal error (a caught panic)                               */
+
+/* pc_result_polish's status. */
+#define PC_POLISH_OFF 0      /* not asked                                                     */
+#define PC_POLISH_POLISHED 1 /* the samples and pc_result_state_at are the exact orbit's      */
+#define PC_POLISH_FALLBACK 2 /* the polish failed (reason given): the LCP's samples are kept  */
 
 typedef struct PcProblem pc_problem;
 typedef struct PcResult pc_result;
@@ -114,6 +121,13 @@ const char *pc_problem_contact_pairing(const pc_problem *p, size_t i);
 /* on = 1 (default, or the scene's [discretization] error_estimate): every solve also
  * estimates its error by a second solve at k/2 (Richardson); 0: skip it, for speed. */
 int pc_problem_set_error_estimate(pc_problem *p, int on);
+/* on = 1 (or the scene's [discretization] polish = true): every solve is refined by the
+ * event-fitted polish (exact flows between the events read from the LCP, Newton on the event
+ * times and states): the samples become the exact orbit's, with its events and an exact
+ * interpolant (pc_result_polish, pc_result_event, pc_result_state_at). A failed polish is no
+ * error: the result keeps the LCP's orbit, with PC_POLISH_FALLBACK, its reason and a warning.
+ * 0 (default): no polish. */
+int pc_problem_set_polish(pc_problem *p, int on);
 /* Solves; warm-started from this problem's previous solve. NULL on failure. */
 pc_result *pc_problem_solve(pc_problem *p);
 void pc_problem_free(pc_problem *p);
@@ -150,6 +164,28 @@ const char *pc_result_lcp_path(const pc_result *r);
  * Any output may be NULL. */
 int pc_result_accuracy(const pc_result *r, int *estimated, double *estimate, double *relative,
                        const char **method);
+/* The polish's outcome: *status = PC_POLISH_OFF, PC_POLISH_POLISHED or PC_POLISH_FALLBACK;
+ * *reason = the fallback's cause ("" otherwise; owned by the result). Outputs may be NULL. */
+int pc_result_polish(const pc_result *r, int *status, const char **reason);
+/* Events of the polished orbit in time order (0 without one). Event i: *time in [0, T),
+ * *contact, *kind = "impact", "release", "contact_on" or "contact_off" (static storage),
+ * *impulse (> 0 at an impact, else 0). Outputs may be NULL; PC_ERROR_ARGUMENT when i is out
+ * of range. */
+size_t pc_result_event_count(const pc_result *r);
+int pc_result_event(const pc_result *r, size_t i, double *time, size_t *contact,
+                    const char **kind, double *impulse);
+/* Displacement and velocity of `dof` at any time t (taken modulo T). *exact = 1: the polished
+ * orbit's, exact between the instants (any DOF of the user's numbering); *exact = 0: the samples
+ * interpolated (trigonometric for fourier, cubic Hermite through (x_j, v_j) otherwise; the DOF
+ * needs displacement and velocity outputs). Outputs may be NULL. */
+int pc_result_state_at(const pc_result *r, size_t dof, double t, double *displacement,
+                       double *velocity, int *exact);
+/* Contact i's compressive force and clearance at any time t. *exact = 1: the polished orbit's
+ * (a stuck rigid contact's force or stiffness*penetration; an impact is an impulse, see
+ * pc_result_event); *exact = 0: the samples interpolated linearly (a rigid contact's force
+ * samples are impulse per step / h). Outputs may be NULL. */
+int pc_result_contact_at(const pc_result *r, size_t i, double t, double *force, double *gap,
+                         int *exact);
 size_t pc_result_warning_count(const pc_result *r);
 /* Warning i, owned by the result (valid until pc_result_free); NULL when out of range. */
 const char *pc_result_warning(const pc_result *r, size_t i);

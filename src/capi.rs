@@ -22,6 +22,7 @@ mod branch;
 pub use branch::{pc_problem_set_stability, pc_result_jump, pc_result_stability};
 mod estimate;
 mod inspect;
+mod polish;
 
 use std::cell::RefCell;
 use std::ffi::{CStr, CString, c_char, c_int};
@@ -115,6 +116,8 @@ pub struct PcProblem {
     tuning: Tuning,
     /// Estimate the error of every result (`[discretization] error_estimate`, default true).
     estimate: bool,
+    /// Refine every result by the event-fitted polish (`[discretization] polish`, default false).
+    polish: bool,
     /// Built at the first solve.
     session: Option<PeriodicSolver>,
     /// The stability and the branch followed (`branch`).
@@ -130,6 +133,8 @@ pub struct PcResult {
     path: CString,
     /// `accuracy.method`, owned by the result.
     accuracy_method: CString,
+    /// The polish's outcome and the response between the instants (`polish.rs`).
+    refined: polish::Refined,
     /// The JSON, made on first request; a `OnceLock` so that const readers may run concurrently.
     json: std::sync::OnceLock<CString>,
     /// Its stability and jump (`branch`).
@@ -138,7 +143,7 @@ pub struct PcResult {
 
 impl PcProblem {
     fn new(base: PeriodicProblem) -> Box<Self> {
-        Box::new(PcProblem { tuning: Tuning::of(&base), base, estimate: true, session: None, branch: Default::default() })
+        Box::new(PcProblem { tuning: Tuning::of(&base), base, estimate: true, polish: false, session: None, branch: Default::default() })
     }
     /// Rebuilds the base problem after an edit, keeping the old one if the edit is invalid.
     fn edit(&mut self, f: impl FnOnce(&mut Model, &mut OutputSelection)) -> Result<(), (c_int, String)> {
@@ -178,7 +183,7 @@ pub extern "C" fn pc_last_error() -> *const c_char {
 fn from_scene(scene: &Scene, file: &str) -> Result<Box<PcProblem>, (c_int, String)> {
     let built = scene.build(file).map_err(input)?;
     let mut p = PcProblem::new(built.problem);
-    p.estimate = built.error_estimate;
+    (p.estimate, p.polish) = (built.error_estimate, built.polish);
     p.branch.stability = built.stability;
     Ok(p)
 }
@@ -392,10 +397,11 @@ pub unsafe extern "C" fn pc_problem_solve(p: *mut PcProblem) -> *mut PcResult {
         } else {
             Accuracy { method: "none: not requested (pc_problem_set_error_estimate)".into(), ..Accuracy::default() }
         };
+        let refined = polish::Refined::new(session.problem(), &mut response, session.fft(), p.polish);
         let accuracy_method = to_cstring(&response.accuracy.method);
         let warnings = response.warnings.iter().map(|w| to_cstring(w)).collect();
         let (warm_start, path) = (to_cstring(&response.lcp.warm_start.outcome), to_cstring(&response.lcp.path));
-        Ok(Box::new(PcResult { response, warnings, warm_start, path, accuracy_method, json: std::sync::OnceLock::new(), branch }))
+        Ok(Box::new(PcResult { response, warnings, warm_start, path, accuracy_method, refined, json: std::sync::OnceLock::new(), branch }))
     })
 }
 

@@ -71,3 +71,28 @@ fn no_estimate_where_the_scheme_does_not_converge() {
     let a = accuracy::estimate(&p, &r);
     assert!(a.estimate.is_none() && a.method.contains("do not converge"), "{a:?}");
 }
+
+/// A stiff compliant stop under cds near its stability limit: at k = 256 ω_max·h = 1.1 < 2, but
+/// at k/2 it is 2.2, past the limit, so the estimate switches to a second solve at 2k and says
+/// so. It is checked against the true error from the exact orbit (notes §6.2) and against a
+/// reference solve at 4k (max_j |x_j^{(k)} − x_{4j}^{(4k)}|, which is e_k(1 − 4^{-p})).
+#[test]
+fn past_the_stability_limit_at_k_over_2_the_estimate_comes_from_2k() {
+    let osc = Oscillator::new(1.0, 0.05, 1.0, 1.0, 1.3);
+    let kc = 58.0f64.powi(2) - 1.0; // ω_max = 58 rad/s with the contact closed
+    let stop = || Oscillator::stop(1.0, Compliance::Compliant { stiffness: kc });
+    let k = 256;
+    let p = problem(&osc, stop(), Scheme::Cds, k);
+    let wh = p.omega_max() * osc.period() / k as f64;
+    assert!(wh < 2.0 && 2.0 * wh >= 2.0, "ω_max·h = {wh:.3} at k, {:.3} at k/2", 2.0 * wh);
+    let r = p.solve().unwrap();
+    let a = accuracy::estimate(&p, &r);
+    assert!(a.method.contains("2k = 512") && a.method.contains("stability limit"), "{}", a.method);
+    let est = a.estimate.unwrap();
+    let exact = CompliantStopOrbit::solve(&osc, kc, 1.0, None).unwrap();
+    let truth = r.time.iter().zip(&r.displacement["0"]).map(|(&t, &x)| (x - exact.eval(t).0).abs()).fold(0.0, f64::max);
+    check("stiff compliant cds, estimate from 2k vs exact", est, truth, &a.method);
+    let r4 = problem(&osc, stop(), Scheme::Cds, 4 * k).solve().unwrap();
+    let to_4k = r.displacement["0"].iter().enumerate().map(|(j, x)| (x - r4.displacement["0"][4 * j]).abs()).fold(0.0, f64::max);
+    check("stiff compliant cds, estimate from 2k vs a 4k solve", est, to_4k, &a.method);
+}

@@ -71,7 +71,7 @@ fn cdylib_dir() -> PathBuf {
     let how = "build it first with `cargo build` (same profile as the tests)";
     let built = std::fs::metadata(&so).and_then(|m| m.modified()).unwrap_or_else(|_| panic!("{} is missing; {how}", so.display()));
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    for src in ["src/capi.rs", "include/periodic_contact.h"] {
+    for src in ["src/capi.rs", "src/capi/polish.rs", "include/periodic_contact.h"] {
         let changed = std::fs::metadata(root.join(src)).and_then(|m| m.modified()).unwrap();
         assert!(built >= changed, "{} is older than {src}; {how}", so.display());
     }
@@ -205,6 +205,79 @@ fn the_c_example_links_solves_and_prints_what_the_rust_api_computes() {
     let warm = &out["contacts.warm.warm_start"][0];
     assert!(["accepted", "repaired", "rejected"].contains(&warm.as_str()), "{warm}");
     assert!(!out["contacts.cold.path"][0].is_empty() && !out["contacts.warm.path"][0].is_empty());
+
+    polish_section(&out);
+}
+
+/// Section 6: the rigid stop with sticking (notes §6.3) through the C API with the polish, at
+/// times between the instants, against the exact orbit (`periodic_contact::exact`, closed-form
+/// flows of its own) to 1e-8 of the peak-to-peak amplitude; without the polish, the cubic Hermite
+/// through the Rust API's samples, computed here.
+fn polish_section(out: &HashMap<String, Vec<String>>) {
+    use periodic_contact::exact::{Oscillator, RigidStopOrbit};
+    let osc = Oscillator::new(1.0, 0.1, 1.0, 1.0, 1.0);
+    let exact = RigidStopOrbit::solve(&osc, 0.5).unwrap();
+    assert!(exact.has_sticking());
+    let ptp = exact.peak_to_peak();
+    assert_eq!(out["polish.status"][0], "1", "PC_POLISH_POLISHED: {:?}", out["polish.reason"]);
+    assert_eq!(out["polish.reason"][0], "");
+    let kinds = &out["polish.event_kind"];
+    assert_eq!(kinds.len(), 2, "{kinds:?}");
+    assert!(kinds.contains(&"impact".to_string()) && kinds.contains(&"release".to_string()), "{kinds:?}");
+    let times = numbers(out, "polish.event_time");
+    let impulses = numbers(out, "polish.event_impulse");
+    let impact = kinds.iter().position(|k| k == "impact").unwrap();
+    let ti = exact.impact_time().unwrap().rem_euclid(exact.period());
+    assert!((times[impact] - ti).abs() < 1e-8 * exact.period(), "impact at {} vs exact {ti}", times[impact]);
+    assert!((impulses[impact] - exact.impact_impulse()).abs() < 1e-8 * exact.impact_impulse(), "impulse {} vs {}", impulses[impact], exact.impact_impulse());
+    assert_eq!(out["polish.bad_event"][0], "1", "PC_ERROR_ARGUMENT");
+    assert_eq!(out["plain.bad_dof"][0], "1", "PC_ERROR_ARGUMENT");
+    let (t, x, v, f, g) =
+        (numbers(out, "polish.t"), numbers(out, "polish.x"), numbers(out, "polish.v"), numbers(out, "polish.force"), numbers(out, "polish.gap"));
+    let h = exact.period() / 256.0;
+    let mut worst = 0f64;
+    for j in 0..t.len() {
+        assert!((t[j] / h - (t[j] / h).round()).abs() > 0.05, "t = {} falls between instants", t[j]);
+        assert_eq!(out["polish.exact"][j], "1");
+        assert_eq!(out["polish.exact_contact"][j], "1");
+        let (xe, ve, fe) = exact.eval(t[j]);
+        for (got, want) in [(x[j], xe), (v[j], ve), (g[j], 0.5 - xe), (f[j], fe)] {
+            worst = worst.max((got - want).abs() / ptp);
+        }
+    }
+    eprintln!("C API polish: max error at 6 times between instants {worst:.2e} of ptp");
+    assert!(worst < 1e-8, "{worst:e}");
+    assert!(f.iter().any(|&z| z > 0.1), "a time in the sticking arc: {f:?}");
+
+    // A fallback is a typed outcome with its reason, also a warning; state_at then interpolates.
+    assert_eq!(out["fallback.status"][0], "2", "PC_POLISH_FALLBACK");
+    assert!(out["fallback.reason"][0].contains("no contact outputs"), "{:?}", out["fallback.reason"]);
+    assert_eq!(out["fallback.exact"][0], "0");
+    assert!(
+        out["fallback.warning"].iter().any(|w| w.starts_with("polish: fell back") && w.contains(&out["fallback.reason"][0])),
+        "{:?}",
+        out["fallback.warning"]
+    );
+
+    // Without the polish: exact = 0 and the cubic Hermite through the LCP's (x_j, v_j).
+    assert_eq!(out["plain.status"][0], "0", "PC_POLISH_OFF");
+    assert_eq!(out["plain.events"][0], "0");
+    let model = osc.model(vec![Oscillator::stop(0.5, periodic_contact::model::Compliance::Rigid)]);
+    let outputs = periodic_contact::periodic::OutputSelection { displacement: vec![0], velocity: vec![0], acceleration: vec![], contacts: true };
+    let disc = periodic_contact::time::Discretization { scheme: periodic_contact::time::Scheme::Cds, steps: 256, pairing: None };
+    let r = periodic_contact::periodic::PeriodicProblem::new(model, disc, outputs, Default::default()).unwrap().solve().unwrap();
+    let (xs, vs) = (&r.displacement["0"], &r.velocity["0"]);
+    let (t, x, v) = (numbers(out, "plain.t"), numbers(out, "plain.x"), numbers(out, "plain.v"));
+    for j in 0..t.len() {
+        assert_eq!(out["plain.exact"][j], "0");
+        let u = t[j].rem_euclid(exact.period()) / h;
+        let (i, s) = (u.floor() as usize, u - u.floor());
+        let i1 = (i + 1) % 256;
+        let (h00, h10, h01, h11) = (2.0 * s.powi(3) - 3.0 * s * s + 1.0, s.powi(3) - 2.0 * s * s + s, -2.0 * s.powi(3) + 3.0 * s * s, s.powi(3) - s * s);
+        let xh = h00 * xs[i] + h10 * h * vs[i] + h01 * xs[i1] + h11 * h * vs[i1];
+        let vh = (6.0 * s * s - 6.0 * s) * (xs[i] - xs[i1]) / h + (3.0 * s * s - 4.0 * s + 1.0) * vs[i] + (3.0 * s * s - 2.0 * s) * vs[i1];
+        assert!((x[j] - xh).abs() < 1e-12 * ptp && (v[j] - vh).abs() < 1e-12 * ptp, "t = {}: C ({}, {}) vs Hermite ({xh}, {vh})", t[j], x[j], v[j]);
+    }
 }
 
 #[test]

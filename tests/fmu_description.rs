@@ -34,10 +34,11 @@ fn variables_follow_the_effects() {
     // A force: its scale and input.
     let forced = format!("{BASE}[[force]]\ndof = 0\namplitude = 1.0\n");
     assert_eq!(names(&forced), set(&[&common[..], &["force_scale", "force_scale_in"]].concat()));
-    // A static rigid obstacle: gap offset and contact outputs, no motion parameters.
+    // A static rigid obstacle: gap offset and contact outputs, the polish switch and its outcome,
+    // no motion parameters.
     let contact = format!("{forced}[[contact]]\ndof = 0\ngap = 0.5\n");
     // With a contact and a step map (cds by default) the re-solves follow a branch: `jumps`.
-    let c = ["gap_offset", "gap_offset_in", "contact[0].force", "contact[0].gap", "lcp.pivots", "lcp.residual", "jumps"];
+    let c = ["gap_offset", "gap_offset_in", "contact[0].force", "contact[0].gap", "lcp.pivots", "lcp.residual", "polish", "polish.status", "jumps"];
     assert_eq!(names(&contact), set(&[&common[..], &["force_scale", "force_scale_in"], &c].concat()));
     // A moving obstacle: motion_scale too.
     let moving = format!("{contact}motion = [{{ amplitude = 0.1, harmonic = 2 }}]\n");
@@ -85,11 +86,13 @@ fn model_description_order_outputs_and_initial_unknowns() {
     assert!(doc.contains("variableNamingConvention=\"structured\""));
     assert!(doc.contains("modelIdentifier=\"PeriodicContact\""));
     assert!(doc.contains("<Integer min=\"1\" max=\"5\" start=\"3\"/>"), "scheme is an Integer (libcosim ignores Enumerations)");
+    assert!(doc.contains("name=\"polish\"") && doc.contains("<Boolean start=\"false\"/>"), "polish: a Boolean parameter, off unless the scene says so");
     // Outputs have no start; parameters and inputs have one.
     for (_, v) in d.variables.iter() {
         let start = match &v.kind {
             periodic_contact::fmi::table::Kind::Real { start, .. } => start.is_some(),
             periodic_contact::fmi::table::Kind::Integer { start, .. } | periodic_contact::fmi::table::Kind::Enumeration { start, .. } => start.is_some(),
+            periodic_contact::fmi::table::Kind::Boolean { start } => start.is_some(),
             _ => unreachable!(),
         };
         assert_eq!(start, v.causality != Causality::Output, "{}", v.name);

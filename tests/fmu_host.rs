@@ -795,3 +795,67 @@ fn moving_obstacle_and_compliant_stop_match_the_cli() {
     s.init(0.0);
     compare_two_periods(&compliant, &s, &cli_solve(&compliant.scene), 0.0);
 }
+
+/// With `polish` on, the outputs at communication points between the instants are the exact
+/// orbit's (`periodic_contact::exact`, the rigid stop with sticking of notes §6.3) to 1e-8 of the
+/// peak-to-peak amplitude, `polish.status` = 1, and a serialized FMU state restores the polished
+/// orbit; without contact outputs the polish falls back (`polish.status` = 2, a logged warning).
+#[test]
+fn polish_gives_the_exact_orbit_between_the_instants() {
+    use periodic_contact::exact::{Oscillator, RigidStopOrbit};
+    let exact = RigidStopOrbit::solve(&Oscillator::new(1.0, 0.1, 1.0, 1.0, 1.0), 0.5).unwrap();
+    let ptp = exact.peak_to_peak();
+    let fmu = rigid();
+    let s = fmu.instantiate("polish").unwrap();
+    assert_eq!(s.set_boolean("polish", true), OK);
+    s.init(0.0);
+    assert_eq!(s.integer("polish.status"), 1, "{:?}", s.log.all());
+    let names = ["displacement[0]", "velocity[0]", "contact[0].force", "contact[0].gap"];
+    // 1.37 steps of the grid: communication points fall between the instants.
+    let h = 1.37 * exact.period() / 256.0;
+    let rows = run(&s, 0.0, h, 400, &names);
+    let mut worst = 0f64;
+    for (i, row) in rows.iter().enumerate() {
+        let t = (i + 1) as f64 * h;
+        let (x, v, f) = exact.eval(t);
+        for (got, want) in row.iter().zip([x, v, f, 0.5 - x]) {
+            worst = worst.max((got - want).abs() / ptp);
+        }
+    }
+    eprintln!("FMU polish: max error over 400 communication points {worst:.2e} of ptp");
+    assert!(worst < 1e-8, "{worst:e}");
+    assert!((s.derivative("displacement[0]") - s.real("velocity[0]")).abs() < 1e-12);
+    // A serialized state restores the polished orbit in another instance.
+    let a = &fmu.api;
+    let mut st: *mut c_void = std::ptr::null_mut();
+    assert_eq!(unsafe { (a.get_fmu_state)(s.c, &mut st) }, OK);
+    let later = run(&s, 400.0 * h, h, 5, &names);
+    let mut size = 0usize;
+    assert_eq!(unsafe { (a.serialized_fmu_state_size)(s.c, st, &mut size) }, OK);
+    let mut bytes = vec![0 as c_char; size];
+    assert_eq!(unsafe { (a.serialize_fmu_state)(s.c, st, bytes.as_mut_ptr(), size) }, OK);
+    let other = fmu.instantiate("polish-2").unwrap();
+    let mut st2: *mut c_void = std::ptr::null_mut();
+    assert_eq!(unsafe { (a.deserialize_fmu_state)(other.c, bytes.as_ptr(), size, &mut st2) }, OK, "{:?}", other.log.all());
+    assert_eq!(unsafe { (a.set_fmu_state)(other.c, st2) }, OK);
+    assert_eq!(run(&other, 400.0 * h, h, 5, &names), later);
+    for (c, p) in [(s.c, &mut st), (other.c, &mut st2)] {
+        assert_eq!(unsafe { (a.free_fmu_state)(c, p) }, OK);
+    }
+    // Off again (tunable): the next step re-solves and interpolates the samples.
+    assert_eq!(s.set_boolean("polish", false), OK);
+    run(&s, 405.0 * h, h, 1, &[]);
+    assert_eq!(s.integer("polish.status"), 0);
+
+    // No contact outputs: the events cannot be read, the polish falls back and says why.
+    let text = shipped("rigid-stop.toml").replace("velocity = [0]", "velocity = [0]\ncontacts = false").replace("steps = 256", "steps = 256\npolish = true");
+    let fallback = Fmu::package("rigid-stop-fallback", &text);
+    let s = fallback.instantiate("fallback").unwrap();
+    s.init(0.0);
+    assert_eq!(s.integer("polish.status"), 2);
+    assert!(
+        s.log.all().iter().any(|l| l.status == WARNING && l.message.contains("polish: fell back") && l.message.contains("no contact outputs")),
+        "{:?}",
+        s.log.all()
+    );
+}

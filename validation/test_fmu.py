@@ -192,3 +192,35 @@ def test_fmu_communication_step_not_on_grid(fmus):
     bound = compare.tolerance(case, run.scheme, run.pairing, run.steps) + np.max(h * np.max(np.abs(v), axis=1) / ptp)
     err = np.max(np.abs(X - x) / ptp[:, None])
     assert err <= bound, (err, bound)
+
+
+def test_fmu_polish_exact_between_samples(cli, workdir):
+    """The shipped fmu/scenes/rigid-stop.toml (cds, k = 256) with the parameter polish = true set
+    through fmpy's start values: at communication points between the samples (step 1.37 T/k over
+    two periods) displacement, velocity, contact force and gap are the exact orbit's
+    (marching/exact.py, rigid stop with sticking, notes §6.3) within 1e-8 of the peak-to-peak
+    amplitude, and polish.status = 1. Without the polish the same outputs are the interpolated
+    samples, off by far more (the LCP's own error), which shows the check can fail."""
+    import os
+
+    from fmpy import simulate_fmu
+    from marching.exact import rigid_stop_sticking
+
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    with open(os.path.join(root, "fmu", "scenes", "rigid-stop.toml")) as fh:
+        fmu = engine.build_fmu(cli, fh.read(), workdir, "fmu_rigid_stop_polish")
+    orbit = rigid_stop_sticking(1.0, 0.1, 1.0, 1.0, 0.5, 1.0)
+    T = orbit.T
+    names = ["displacement[0]", "velocity[0]", "contact[0].force", "contact[0].gap", "polish.status"]
+    errs = {}
+    for polish in (True, False):
+        res = simulate_fmu(fmu, fmi_type="CoSimulation", start_time=0.0, stop_time=2 * T,
+                           output_interval=1.37 * T / 256, start_values={"polish": polish}, output=names)
+        t = np.asarray(res["time"], dtype=float)
+        assert np.all(np.asarray(res["polish.status"]) == (1 if polish else 0)), res["polish.status"]
+        x, v = orbit.state(t)
+        want = {"displacement[0]": x, "velocity[0]": v, "contact[0].force": orbit.force(t), "contact[0].gap": 0.5 - x}
+        ptp = np.ptp(x)
+        errs[polish] = max(float(np.max(np.abs(np.asarray(res[n], dtype=float) - w))) / ptp for n, w in want.items())
+    assert errs[True] <= 1e-8, f"polished FMU outputs off the exact orbit by {errs[True]:.3e} of ptp"
+    assert errs[False] > 1e3 * errs[True], errs

@@ -8,7 +8,12 @@
 //!   warm-started from the previous active set, reusing the FFT plan. The phase θ of the
 //!   excitation is kept continuous across a change of ω (a frequency change is a chirp, not a
 //!   phase jump): outputs are the response at τ = θ/ω mod T.
-//! - Interpolation between the k instants, consistent with the scheme:
+//! - With the parameter `polish` (scenes with contacts), each solve is refined by the
+//!   event-fitted polish (`analysis::polish`) and displacement, velocity, contact force and gap
+//!   at a communication point are the polished orbit's, exact between the instants (a matrix
+//!   exponential per point: `fmi2DoStep` then allocates); `polish.status` says whether it
+//!   succeeded (1) or fell back to the interpolation below (2, with a logged warning).
+//! - Interpolation between the k instants, consistent with the scheme (`analysis::interpolant`):
 //!   - `fourier`: the trigonometric interpolant of the samples (exact for the collocation);
 //!   - the other schemes: displacement by cubic Hermite through (x_j, v_j) with the scheme's own
 //!     velocity v_j, velocity as its derivative (so velocity = d/dt displacement exactly, and
@@ -18,8 +23,9 @@
 //!
 //!   `fmi2GetRealOutputDerivatives` (order 1) is the exact time derivative of the interpolant:
 //!   for `displacement[d]` it is the velocity.
-use crate::analysis::accuracy;
 use crate::analysis::continuation::{self, Current, Jump};
+use crate::analysis::interpolant::{fill_powers, locate};
+use crate::analysis::{accuracy, polish};
 use crate::error::{Error, Result};
 use crate::fmi::state::{StateReader, StateWriter};
 use crate::fmi::{CoSimModel, DefaultExperiment, EventLog, ModelDescription};
@@ -53,6 +59,7 @@ struct Values {
     inputs: Tuning,
     steps: usize,
     scheme: Scheme,
+    polish: bool,
 }
 
 /// Everything a solve depends on.
@@ -61,6 +68,7 @@ struct Config {
     tuning: Tuning,
     steps: usize,
     scheme: Scheme,
+    polish: bool,
 }
 
 impl Values {
@@ -73,7 +81,7 @@ impl Values {
             gap_offset: p.gap_offset + i.gap_offset,
             motion_scale: p.motion_scale * i.motion_scale,
         };
-        Config { tuning, steps: self.steps, scheme: self.scheme }
+        Config { tuning, steps: self.steps, scheme: self.scheme, polish: self.polish }
     }
 }
 
@@ -127,7 +135,7 @@ impl ContactModel {
         }
         let shown = problem.outputs().clone();
         let model = problem.model();
-        let Variables { table: t, roles, outputs, units } = Variables::of(&problem, &built.labels, built.error_estimate, built.stability);
+        let Variables { table: t, roles, outputs, units } = Variables::of(&problem, &built.labels, built.error_estimate, built.stability, built.polish);
         let estimate = outputs.iter().any(|o| matches!(o, Output::Accuracy));
         let stability = outputs.iter().any(|o| matches!(o, Output::Stable));
         let k = problem.discretization().steps;
@@ -156,7 +164,8 @@ impl ContactModel {
         };
         let scene_tuning = Tuning::of(&problem);
         let neutral = Tuning { frequency: 0.0, force_scale: 1.0, gap_offset: 0.0, motion_scale: 1.0 };
-        let start = Values { params: scene_tuning, inputs: neutral, steps: k, scheme: problem.discretization().scheme };
+        let polish = built.polish && !model.contacts.is_empty();
+        let start = Values { params: scene_tuning, inputs: neutral, steps: k, scheme: problem.discretization().scheme, polish };
         let nout = outputs.len();
         Ok(ContactModel {
             desc,
@@ -208,7 +217,9 @@ impl ContactModel {
             false => None,
         };
         let jumps = jumps + u32::from(resolved.jump.is_some());
+        let orbit = if cfg.polish { polish::apply(self.session.problem(), &mut r).map(Arc::new) } else { None };
         let mut sol = self.solution_of(cfg, self.session.problem(), &r, self.session.fft());
+        sol.polished = orbit;
         for (series, q) in sol.series.iter_mut().zip(&self.outputs) {
             match (q, &stability) {
                 (Output::Stable, Some(st)) => *series = Series::Constant(f64::from(u8::from(st.stable))),
@@ -223,7 +234,7 @@ impl ContactModel {
 
     fn solution_of(&self, config: Config, problem: &PeriodicProblem, r: &Response, fft: &PeriodFft) -> Solution {
         let omega = problem.model().frequency;
-        let fourier = config.scheme == Scheme::Fourier;
+        let fourier = (config.scheme == Scheme::Fourier).then_some(fft);
         let key = |d: usize| d.to_string();
         let series = self
             .outputs
@@ -231,18 +242,13 @@ impl ContactModel {
             .map(|q| match *q {
                 Output::Displacement(d) | Output::Velocity(d) => {
                     let level = u8::from(matches!(q, Output::Velocity(_)));
-                    let x = &r.displacement[&key(d)];
-                    if fourier {
-                        Series::trig(x, fft, |p| if level == 0 { C::ONE } else { C::new(0.0, p as f64 * omega) })
-                    } else {
-                        Series::Hermite { x: x.clone(), v: r.velocity[&key(d)].clone(), level }
-                    }
+                    Series::motion(&r.displacement[&key(d)], &r.velocity[&key(d)], level, fourier, omega)
                 }
                 // fourier: the samples are σ2 X̂ with σ2 = −(pω)² at every p, so their trigonometric
                 // interpolant is the second derivative of the displacement's.
                 Output::Acceleration(d) => {
                     let a = &r.acceleration[&key(d)];
-                    if fourier { Series::trig(a, fft, |_| C::ONE) } else { Series::Linear(a.clone()) }
+                    if let Some(fft) = fourier { Series::trig(a, fft, |_| C::ONE) } else { Series::Linear(a.clone()) }
                 }
                 Output::Force(i) => Series::Linear(r.contacts[i].force.clone()),
                 Output::Gap(i) => Series::Linear(r.contacts[i].gap.clone()),
@@ -252,6 +258,11 @@ impl ContactModel {
                 Output::AccuracyAvailable => Series::Constant(f64::from(u8::from(r.accuracy.estimate.is_some()))),
                 // Set by `solve`, which knows the stability and the jumps.
                 Output::Stable | Output::Multiplier | Output::Jumps => Series::Constant(0.0),
+                Output::PolishStatus => Series::Constant(match r.polish.as_ref().map(|p| p.status.as_str()) {
+                    None => 0.0,
+                    Some("polished") => 1.0,
+                    Some(_) => 2.0,
+                }),
             })
             .collect();
         Solution {
@@ -267,6 +278,7 @@ impl ContactModel {
             warnings: r.warnings.clone(),
             amplitude: continuation::amplitude(r),
             jumps: 0,
+            polished: None,
         }
     }
 
@@ -288,23 +300,17 @@ impl ContactModel {
     fn evaluate(&mut self, t: f64) {
         let Some(sol) = self.solution.as_deref() else { return };
         let tau = (t + self.phase_offset).rem_euclid(sol.period);
-        let u = tau / sol.h;
-        let j = (u.floor().max(0.0) as usize).min(sol.k - 1);
-        let s = u - j as f64;
-        let j1 = if j + 1 == sol.k { 0 } else { j + 1 };
-        let maxp = self.powers.len();
-        if maxp > 1 {
-            // e^{ipωτ} by recurrence, restarted from sin/cos every 32 harmonics to bound round-off.
-            let step = C::from_polar(1.0, sol.omega * tau);
-            self.powers[0] = C::ONE;
-            for p in 1..maxp {
-                self.powers[p] = if p % 32 == 0 { C::from_polar(1.0, p as f64 * sol.omega * tau) } else { self.powers[p - 1] * step };
-            }
+        let (j, j1, s) = locate(tau, sol.h, sol.k);
+        if self.powers.len() > 1 {
+            fill_powers(&mut self.powers, sol.omega, tau);
         }
         for (i, series) in sol.series.iter().enumerate() {
             let (v, d) = series.eval(j, j1, s, sol.h, sol.omega, &self.powers);
             self.out[i] = v;
             self.der[i] = d;
+        }
+        if let Some(orbit) = &sol.polished {
+            sol.eval_polished(orbit, &self.outputs, self.base.output_map(), tau, &mut self.out, &mut self.der);
         }
     }
 
@@ -410,8 +416,16 @@ impl CoSimModel for ContactModel {
                 self.ensure_outputs()?;
                 self.out[slot]
             }
-            Role::Steps | Role::Scheme => return Err(Error::input(format!("value reference {vr} is not Real"))),
+            Role::Steps | Role::Scheme | Role::Polish => return Err(Error::input(format!("value reference {vr} is not Real"))),
         })
+    }
+
+    fn set_boolean(&mut self, vr: u32, v: bool) -> Result<()> {
+        match self.role(vr)? {
+            Role::Polish => self.values.polish = v,
+            _ => return Err(Error::input(format!("value reference {vr} cannot be set as Boolean"))),
+        }
+        Ok(())
     }
 
     fn get_integer(&mut self, vr: u32) -> Result<i32> {
@@ -428,6 +442,7 @@ impl CoSimModel for ContactModel {
 
     fn get_boolean(&mut self, vr: u32) -> Result<bool> {
         match self.role(vr)? {
+            Role::Polish => Ok(self.values.polish),
             Role::Output(slot) => {
                 self.ensure_outputs()?;
                 Ok(self.out[slot] != 0.0)

@@ -3,10 +3,11 @@
 //! so that a state of another scene or a corrupted one is refused, never truncated.
 use super::series::{Series, Solution};
 use super::{Config, ContactModel, Values, scheme_code};
+use crate::analysis::polish::{Event, EventKind, OrbitParts, PolishedOrbit};
 use crate::error::{Error, Result};
 use crate::fmi::state::{StateReader, StateWriter};
 use crate::periodic::{MAX_STEPS, MIN_STEPS, Tuning};
-use crate::time::Scheme;
+use crate::time::{Discretization, Scheme};
 use num_complex::Complex64 as C;
 use std::sync::Arc;
 
@@ -37,27 +38,29 @@ fn read_tuning(r: &mut StateReader<'_>) -> Result<Tuning> {
     Ok(Tuning { frequency: r.f64()?, force_scale: r.f64()?, gap_offset: r.f64()?, motion_scale: r.f64()? })
 }
 
-fn write_config(w: &mut StateWriter, steps: usize, scheme: Scheme) {
+fn write_config(w: &mut StateWriter, steps: usize, scheme: Scheme, polish: bool) {
     w.usize(steps);
     w.i32(scheme_code(scheme));
+    w.bool(polish);
 }
 
-/// `steps` within the solver's bounds and a known scheme code.
-fn read_config(r: &mut StateReader<'_>) -> Result<(usize, Scheme)> {
+/// `steps` within the solver's bounds, a known scheme code, the polish switch.
+fn read_config(r: &mut StateReader<'_>) -> Result<(usize, Scheme, bool)> {
     let steps = r.usize()?;
     if !(MIN_STEPS..=MAX_STEPS).contains(&steps) {
         return Err(bad(format!("steps = {steps} is outside {MIN_STEPS}..={MAX_STEPS}")));
     }
     let code = r.i32()?;
     let scheme = usize::try_from(code).ok().and_then(|c| c.checked_sub(1)).and_then(|i| Scheme::ALL.get(i)).copied();
-    Ok((steps, scheme.ok_or_else(|| bad(format!("{code} is not a scheme code")))?))
+    let scheme = scheme.ok_or_else(|| bad(format!("{code} is not a scheme code")))?;
+    Ok((steps, scheme, r.bool()?))
 }
 
 /// The snapshot after the shell's fields.
 pub fn write(s: &ContactSnapshot, w: &mut StateWriter) {
     write_tuning(w, &s.values.params);
     write_tuning(w, &s.values.inputs);
-    write_config(w, s.values.steps, s.values.scheme);
+    write_config(w, s.values.steps, s.values.scheme, s.values.polish);
     w.f64(s.phase_offset);
     w.bool(s.initialized);
     w.f64(s.start_time);
@@ -71,7 +74,7 @@ pub fn write(s: &ContactSnapshot, w: &mut StateWriter) {
 
 fn write_solution(w: &mut StateWriter, sol: &Solution) {
     write_tuning(w, &sol.config.tuning);
-    write_config(w, sol.config.steps, sol.config.scheme);
+    write_config(w, sol.config.steps, sol.config.scheme, sol.config.polish);
     for v in [sol.period, sol.h, sol.omega, sol.residual, sol.amplitude] {
         w.f64(v);
     }
@@ -83,6 +86,50 @@ fn write_solution(w: &mut StateWriter, sol: &Solution) {
     sol.warnings.iter().for_each(|x| w.str(x));
     w.count(sol.series.len());
     sol.series.iter().for_each(|s| write_series(w, s));
+    w.bool(sol.polished.is_some());
+    if let Some(orbit) = &sol.polished {
+        let parts = orbit.parts();
+        w.count(parts.events.len());
+        for e in &parts.events {
+            w.usize(e.contact);
+            w.u8(event_code(e.kind));
+            w.f64(e.seed);
+        }
+        w.usizes(&parts.always);
+        w.f64s(&parts.y0);
+    }
+}
+
+fn event_code(kind: EventKind) -> u8 {
+    match kind {
+        EventKind::Impact { stick: false } => 0,
+        EventKind::Impact { stick: true } => 1,
+        EventKind::Release => 2,
+        EventKind::On => 3,
+        EventKind::Off => 4,
+    }
+}
+
+/// The polished orbit of a solution of `config`, rebuilt on its model.
+fn read_orbit(model: &ContactModel, config: &Config, r: &mut StateReader<'_>) -> Result<PolishedOrbit> {
+    let ne = r.count(17)?;
+    let mut events = Vec::with_capacity(ne);
+    for _ in 0..ne {
+        let contact = r.usize()?;
+        let kind = match r.u8()? {
+            0 => EventKind::Impact { stick: false },
+            1 => EventKind::Impact { stick: true },
+            2 => EventKind::Release,
+            3 => EventKind::On,
+            4 => EventKind::Off,
+            t => return Err(bad(format!("{t} is not an event kind"))),
+        };
+        events.push(Event { contact, kind, seed: r.f64()? });
+    }
+    let parts = OrbitParts { events, always: r.usizes()?, y0: r.f64s()? };
+    let disc = Discretization { scheme: config.scheme, steps: config.steps, pairing: model.base.discretization().pairing };
+    let problem = config.tuning.apply(&model.base, disc)?;
+    PolishedOrbit::rebuild(problem.model(), &parts).map_err(|e| bad(e.0))
 }
 
 fn write_series(w: &mut StateWriter, series: &Series) {
@@ -114,8 +161,8 @@ impl ContactModel {
     /// Reads what [`write`] wrote, checked against this model.
     pub(super) fn read_snapshot(&self, r: &mut StateReader<'_>) -> Result<ContactSnapshot> {
         let (params, inputs) = (read_tuning(r)?, read_tuning(r)?);
-        let (steps, scheme) = read_config(r)?;
-        let values = Values { params, inputs, steps, scheme };
+        let (steps, scheme, polish) = read_config(r)?;
+        let values = Values { params, inputs, steps, scheme, polish };
         let (phase_offset, initialized, start_time) = (r.f64()?, r.bool()?, r.f64()?);
         let (out, der) = (r.f64s()?, r.f64s()?);
         let n = self.outputs.len();
@@ -128,8 +175,8 @@ impl ContactModel {
 
     fn read_solution(&self, r: &mut StateReader<'_>) -> Result<Solution> {
         let tuning = read_tuning(r)?;
-        let (steps, scheme) = read_config(r)?;
-        let config = Config { tuning, steps, scheme };
+        let (steps, scheme, polish) = read_config(r)?;
+        let config = Config { tuning, steps, scheme, polish };
         let (period, h, omega, residual, amplitude) = (r.f64()?, r.f64()?, r.f64()?, r.f64()?, r.f64()?);
         let jumps = u32::try_from(r.usize()?).map_err(|_| bad("the jump count is past u32"))?;
         if !(period.is_finite() && period > 0.0 && h.is_finite() && h > 0.0 && omega.is_finite()) {
@@ -152,7 +199,8 @@ impl ContactModel {
             return Err(bad(format!("the state has {ns} series, this model {} outputs", self.outputs.len())));
         }
         let series = (0..ns).map(|_| read_series(r, k)).collect::<Result<Vec<_>>>()?;
-        Ok(Solution { config, period, h, omega, k, series, pivots, residual, active_set, warnings, amplitude, jumps })
+        let polished = if r.bool()? { Some(Arc::new(read_orbit(self, &config, r)?)) } else { None };
+        Ok(Solution { config, period, h, omega, k, series, pivots, residual, active_set, warnings, amplitude, jumps, polished })
     }
 }
 

@@ -21,6 +21,8 @@ pub(super) enum Role {
     MotionScale,
     Steps,
     Scheme,
+    /// The event-fitted polish on (Boolean).
+    Polish,
     FrequencyIn,
     ForceScaleIn,
     GapOffsetIn,
@@ -48,6 +50,8 @@ pub(super) enum Output {
     Multiplier,
     /// Jumps off a branch that ended at a fold, since initialisation.
     Jumps,
+    /// 0 polish off, 1 polished, 2 fell back to the interpolated samples.
+    PolishStatus,
 }
 
 /// The table with the role of each value reference and the quantity of each output slot.
@@ -72,9 +76,10 @@ impl Variables {
     /// The variables of `problem` (the scene's, before the FMU changes its outputs), labelled
     /// with the scene's units and DOF names.
     /// With `estimate`, the error estimate of each solve is an output too.
-    pub fn of(problem: &PeriodicProblem, labels: &Labels, estimate: bool, stability: bool) -> Variables {
+    /// `polish`: the start value of the parameter `polish` (scenes with contacts only).
+    pub fn of(problem: &PeriodicProblem, labels: &Labels, estimate: bool, stability: bool, polish: bool) -> Variables {
         let mut b = Variables { table: VariableTable::new(), roles: Vec::new(), outputs: Vec::new(), units: Vec::new() };
-        parameters(&mut b, problem, labels);
+        parameters(&mut b, problem, labels, polish);
         inputs(&mut b, problem, labels);
         outputs(&mut b, problem, labels);
         if estimate && !problem.outputs().displacement.is_empty() {
@@ -123,7 +128,7 @@ fn effects(problem: &PeriodicProblem) -> (bool, usize, bool) {
     (!model.forces.is_empty(), model.contacts.len(), model.contacts.iter().any(|c| !c.motion.is_empty()))
 }
 
-fn parameters(b: &mut Variables, problem: &PeriodicProblem, labels: &Labels) {
+fn parameters(b: &mut Variables, problem: &PeriodicProblem, labels: &Labels, problem_polish: bool) {
     let model = problem.model();
     let (has_forces, m, has_motion) = effects(problem);
     let kind = b.real(Some(model.frequency), Quantity::Frequency, labels);
@@ -151,6 +156,10 @@ fn parameters(b: &mut Variables, problem: &PeriodicProblem, labels: &Labels) {
     let codes: Vec<String> = Scheme::ALL.iter().map(|s| format!("{} {}", scheme_code(*s), s)).collect();
     let scheme = Kind::Integer { start: Some(scheme_code(problem.discretization().scheme)), min: Some(1), max: Some(Scheme::ALL.len() as i32) };
     b.add(Variable::parameter("scheme", Fixed, scheme, &format!("Time scheme on the period: {}", codes.join(", "))), Role::Scheme);
+    if m > 0 {
+        let text = "Refine each solve by the event-fitted polish: displacement, velocity, contact force and gap then come from the exact orbit between the events (see polish.status); default: the scene's [discretization] polish";
+        b.add(Variable::parameter("polish", Tunable, Kind::Boolean { start: Some(problem_polish) }, text), Role::Polish);
+    }
 }
 
 fn inputs(b: &mut Variables, problem: &PeriodicProblem, labels: &Labels) {
@@ -220,6 +229,9 @@ fn outputs(b: &mut Variables, problem: &PeriodicProblem, labels: &Labels) {
             Variable::output("lcp.residual", Discrete, kind, "Residual max|min(z, Az+q)| of the last LCP solve (forces and clearances: no unit)"),
             Output::Residual,
         );
+        let kind = Kind::Integer { start: None, min: None, max: None };
+        let what = "Event-fitted polish of the last solve: 0 off (parameter polish = false), 1 polished (outputs exact between the instants), 2 fell back to the interpolated samples (the reason is logged as a warning)";
+        b.output(Variable::output("polish.status", Discrete, kind, what), Output::PolishStatus);
     }
 }
 

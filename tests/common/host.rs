@@ -451,6 +451,9 @@ impl<'a> Slave<'a> {
     pub fn set_real(&self, name: &str, v: f64) -> c_int {
         unsafe { (self.fmu.api.set_real)(self.c, &self.vr(name), 1, &v) }
     }
+    pub fn set_boolean(&self, name: &str, v: bool) -> c_int {
+        unsafe { (self.fmu.api.set_boolean)(self.c, &self.vr(name), 1, &c_int::from(v)) }
+    }
     pub fn set_integer(&self, name: &str, v: i32) -> c_int {
         unsafe { (self.fmu.api.set_integer)(self.c, &self.vr(name), 1, &v) }
     }

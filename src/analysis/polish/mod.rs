@@ -16,7 +16,7 @@ mod phase;
 mod verify;
 
 pub use events::{Event, EventKind};
-pub use orbit::PolishedOrbit;
+pub use orbit::{OrbitParts, PolishedOrbit, user_value};
 
 use crate::periodic::PeriodicProblem;
 use crate::response::{EventRecord, PolishSummary, Response};
@@ -47,9 +47,10 @@ pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<PolishedOrbit, 
 }
 
 /// Polishes `r` in place: on success its series are the polished orbit's at the same instants,
-/// `polish` lists the events and `accuracy` says the orbit is exact to the Newton residual; on
-/// failure the LCP's orbit stays, with a warning and `polish.status = "fallback"`.
-pub fn apply(problem: &PeriodicProblem, r: &mut Response) {
+/// `polish` lists the events and `accuracy` says the orbit is exact to the Newton residual, and
+/// the orbit is returned (its interpolant for the front ends); on failure the LCP's orbit stays,
+/// with a warning and `polish.status = "fallback"`.
+pub fn apply(problem: &PeriodicProblem, r: &mut Response) -> Option<PolishedOrbit> {
     let t0 = Instant::now();
     match polish(problem, r) {
         Ok(orbit) => {
@@ -72,6 +73,7 @@ pub fn apply(problem: &PeriodicProblem, r: &mut Response) {
                 residual: orbit.residual(),
                 time_s: t0.elapsed().as_secs_f64(),
             });
+            Some(orbit)
         }
         Err(e) => {
             r.warnings.push(format!("polish: fell back to the LCP's orbit: {e}"));
@@ -83,6 +85,7 @@ pub fn apply(problem: &PeriodicProblem, r: &mut Response) {
                 residual: 0.0,
                 time_s: t0.elapsed().as_secs_f64(),
             });
+            None
         }
     }
 }

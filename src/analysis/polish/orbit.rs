@@ -4,7 +4,7 @@ use super::PolishFailure;
 use super::events::{self, Event, EventKind};
 use super::phase::{self, Phase};
 use crate::model::Model;
-use crate::periodic::PeriodicProblem;
+use crate::periodic::{OutputMap, PeriodicProblem};
 use crate::response::{EventRecord, Response};
 use nalgebra::{DMatrix, DVector};
 
@@ -19,12 +19,23 @@ struct Shot {
     impulses: Vec<f64>,
 }
 
+/// A polished orbit's definition, from which [`PolishedOrbit::rebuild`] makes it again (the FMU
+/// keeps it in a serialized FMU state).
+#[derive(Clone, Debug, PartialEq)]
+pub struct OrbitParts {
+    pub events: Vec<Event>,
+    pub always: Vec<usize>,
+    pub y0: Vec<f64>,
+}
+
 /// A periodic orbit made of exact linear phases between events.
 #[derive(Clone, Debug)]
 pub struct PolishedOrbit {
     pub(super) model: Model,
     pub(super) period: f64,
     pub(super) events: Vec<Event>,
+    /// Contacts closed all period long (no event).
+    always: Vec<usize>,
     /// Event times, increasing, times[0] ∈ [0, T) (a single 0 when there is no event).
     pub(super) times: Vec<f64>,
     /// The phase after each event (phases[e] runs from times[e] to times[e+1]).
@@ -43,6 +54,36 @@ pub struct PolishedOrbit {
 
 impl PolishedOrbit {
     pub(super) fn solve(model: &Model, evs: Vec<Event>, always: &[usize]) -> Result<Self, PolishFailure> {
+        let mut o = Self::new(model, evs, always)?;
+        o.newton()?;
+        Ok(o)
+    }
+
+    /// The orbit of [`Self::parts`] again, for `model` (the model it was polished on): the
+    /// phases are rebuilt and one period is flowed, without Newton.
+    pub fn rebuild(model: &Model, parts: &OrbitParts) -> Result<Self, PolishFailure> {
+        let fail = |w: &str| PolishFailure(format!("the stored polished orbit does not fit this model: {w}"));
+        let (m, n) = (model.contacts.len(), model.n());
+        if parts.y0.len() != 2 * n || parts.events.iter().map(|e| e.contact).chain(parts.always.iter().copied()).any(|i| i >= m) {
+            return Err(fail("its state or a contact index is out of range"));
+        }
+        let mut o = Self::new(model, parts.events.clone(), &parts.always)?;
+        o.y0 = DVector::from_column_slice(&parts.y0);
+        if !o.ordered(&DVector::from_iterator(2 * n + o.events.len(), o.y0.iter().copied().chain(o.times.iter().copied().take(o.events.len())))) {
+            return Err(fail("its event times are not increasing within one period"));
+        }
+        o.finish().map_err(|e| fail(&e.0))?;
+        Ok(o)
+    }
+
+    /// What [`Self::rebuild`] needs: the events with their converged times (as `seed`), the
+    /// contacts closed all period long, and the state just after event 0.
+    pub fn parts(&self) -> OrbitParts {
+        let events = self.events.iter().zip(&self.times).map(|(e, &t)| Event { seed: t, ..*e }).collect();
+        OrbitParts { events, always: self.always.clone(), y0: self.y0.iter().copied().collect() }
+    }
+
+    fn new(model: &Model, evs: Vec<Event>, always: &[usize]) -> Result<Self, PolishFailure> {
         let sets = events::phase_sets(model, &evs, always);
         let mut phases = Vec::new();
         let empty = vec![always.to_vec()];
@@ -62,7 +103,8 @@ impl PolishedOrbit {
         let gaps = (0..model.contacts.len()).map(|i| phase::gap_harmonics(model, i)).collect();
         let times = if evs.is_empty() { vec![0.0] } else { evs.iter().map(|e| e.seed).collect() };
         let n = model.n();
-        let mut o = PolishedOrbit {
+        Ok(PolishedOrbit {
+            always: always.to_vec(),
             model: model.clone(),
             period: model.period(),
             events: evs,
@@ -76,9 +118,7 @@ impl PolishedOrbit {
             residual: f64::INFINITY,
             correction: f64::INFINITY,
             monodromy: DMatrix::zeros(2 * n, 2 * n),
-        };
-        o.newton()?;
-        Ok(o)
+        })
     }
 
     fn gap(&self, i: usize, t: f64, order: u32) -> f64 {
@@ -187,6 +227,26 @@ impl PolishedOrbit {
         Some(j)
     }
 
+    /// Row weights that put the residual in length units: 1 on displacements and clearances,
+    /// 1/ω_d on the velocity of DOF d (ω_d = max(√(K_dd/M_dd), ω)), 1/K_dd on a release's force.
+    /// In raw units the velocity of a stiff DOF (a Craig–Bampton constraint mode, a closed
+    /// contact spring: ω_d ≈ 6e5 rad/s on the coarse blade) outweighs every clearance, and the
+    /// line search then refuses Newton steps that are right (the coarse blade's stall).
+    fn weights(&self) -> DVector<f64> {
+        let (n, s) = (self.model.n(), &self.model.structure);
+        let rate = |d: usize| (s.stiffness.get(d, d) / s.mass.get(d, d)).abs().sqrt().max(self.model.frequency);
+        let ne = self.events.len();
+        DVector::from_fn(2 * n + ne, |i, _| match i {
+            i if i < n => 1.0,
+            i if i < 2 * n => 1.0 / rate(i - n),
+            i => {
+                let e = self.events[i - 2 * n];
+                let k = s.stiffness.get(self.model.contacts[e.contact].dof, self.model.contacts[e.contact].dof).abs();
+                if e.kind == EventKind::Release && k > 0.0 { 1.0 / k } else { 1.0 }
+            }
+        })
+    }
+
     fn ordered(&self, u: &DVector<f64>) -> bool {
         let n2 = 2 * self.model.n();
         let tau: Vec<f64> = u.iter().skip(n2).copied().collect();
@@ -214,6 +274,12 @@ impl PolishedOrbit {
         }
         let ys = y0.amax().max(1e-300);
         let scale = DVector::from_fn(n2 + ne, |i, _| if i < n2 { ys } else { self.period });
+        let w = self.weights();
+        // The merit: the max norm of the residual in length units (see `weights`).
+        let size = y0.component_mul(&w.rows(0, n2)).amax().max(1e-300);
+        // Below this the residual is round-off of the flows (ε·‖Â τ‖ of the exponentials).
+        let floor = 1e-10 * size;
+        let merit = |r: &DVector<f64>| r.component_mul(&w).amax();
         let mut r = self.residual_of(&u).ok_or_else(|| fail("the seeded event sequence cannot be flowed"))?;
         let mut converged = false;
         for it in 0..MAX_ITERATIONS {
@@ -224,7 +290,7 @@ impl PolishedOrbit {
                 let cand = &u + &du * lambda;
                 if self.ordered(&cand)
                     && let Some(rc) = self.residual_of(&cand)
-                    && (rc.amax() < r.amax() || rc.amax() < 1e-13 * ys.max(1.0))
+                    && (merit(&rc) < merit(&r) || merit(&rc) < floor)
                 {
                     break (cand, rc);
                 }
@@ -235,24 +301,32 @@ impl PolishedOrbit {
             };
             let step = du.iter().enumerate().map(|(i, v)| (v * lambda).abs() / scale[i]).fold(0.0, f64::max);
             self.correction = du.rows(0, self.model.n()).amax() * lambda;
+            // Converged: a negligible step, or the residual at round-off and no longer halving.
+            let stagnant = merit(&rn) < floor && merit(&rn) > 0.5 * merit(&r);
             u = next;
             r = rn;
             self.iterations = it + 1;
-            if step < 1e-14 || (step < 1e-11 && r.amax() < 1e-12 * ys.max(1.0)) {
+            if step < 1e-14 || (step < 1e-11 && merit(&r) < 1e-12 * size) || stagnant {
                 converged = true;
                 break;
             }
         }
         if !converged {
-            return Err(fail(&format!("Newton did not converge in {MAX_ITERATIONS} iterations (residual {:.2e})", r.amax())));
+            return Err(fail(&format!("Newton did not converge in {MAX_ITERATIONS} iterations (residual {:.2e})", merit(&r))));
         }
-        self.residual = r.amax();
+        self.residual = merit(&r);
         // Times into [0, T): a shift by whole periods changes nothing.
         let shift = (u[n2.min(u.len() - 1)] / self.period).floor() * self.period;
         self.y0 = u.rows(0, n2).into_owned();
         if ne > 0 {
             self.times = u.iter().skip(n2).map(|t| t - shift).collect();
         }
+        self.finish()
+    }
+
+    /// The states after the events, the impulses and the monodromy of the orbit at y0 and times.
+    fn finish(&mut self) -> Result<(), PolishFailure> {
+        let fail = |w: &str| PolishFailure(w.to_string());
         let shot = self.shoot(&self.y0, &self.times).ok_or_else(|| fail("the converged orbit cannot be flowed"))?;
         self.after = shot.after;
         self.impulses = shot.impulses;
@@ -328,6 +402,11 @@ impl PolishedOrbit {
         &self.monodromy
     }
 
+    /// The period T [s].
+    pub fn period(&self) -> f64 {
+        self.period
+    }
+
     /// The section's time: the first event's (0 without events).
     pub fn section_time(&self) -> f64 {
         self.times[0]
@@ -355,6 +434,27 @@ impl PolishedOrbit {
     pub fn state(&self, t: f64) -> DVector<f64> {
         let (e, tt) = self.locate(t);
         self.phases[e].flow(self.times[e], &self.after[e], tt)
+    }
+
+    /// Displacement and velocity of user DOF `dof` at `t` (through the reduction's output map
+    /// when there is one); `None` for a DOF the map does not hold.
+    pub fn user_state(&self, map: Option<&OutputMap>, dof: usize, t: f64) -> Option<(f64, f64)> {
+        let y = self.state(t);
+        let n = self.model.n();
+        Some((user_value(map, dof, &y, 0, n)?, user_value(map, dof, &y, n, n)?))
+    }
+
+    /// Clearance of contact `i` at `t` (negative: a compliant contact's penetration).
+    pub fn clearance_at(&self, i: usize, t: f64) -> f64 {
+        let (_, tt) = self.locate(t);
+        self.clearance(i, &self.state(tt), tt)
+    }
+
+    /// Time derivative of contact `i`'s clearance at `t`: gap'(t) − s·v_d.
+    pub fn clearance_rate(&self, i: usize, t: f64) -> f64 {
+        let (_, tt) = self.locate(t);
+        let c = &self.model.contacts[i];
+        self.gap(i, tt, 1) - c.direction * self.state(tt)[self.model.n() + c.dof]
     }
 
     /// Acceleration of every DOF at `t` (between events).
@@ -410,11 +510,7 @@ impl PolishedOrbit {
         let states: Vec<DVector<f64>> = r.time.iter().map(|&t| self.state(t)).collect();
         let accs: Vec<DVector<f64>> = if r.acceleration.is_empty() { vec![] } else { r.time.iter().map(|&t| self.acceleration(t)).collect() };
         let label = |key: &str, v: &DVector<f64>, off: usize| -> f64 {
-            let l: usize = key.parse().unwrap_or(usize::MAX);
-            match problem.output_map() {
-                Some(map) => map.rows.get(&l).map_or(f64::NAN, |row| row.iter().map(|&(d, c)| c * v[off + d]).sum()),
-                None => v.get(off + l).copied().unwrap_or(f64::NAN),
-            }
+            user_value(problem.output_map(), key.parse().unwrap_or(usize::MAX), v, off, n).unwrap_or(f64::NAN)
         };
         for (key, series) in r.displacement.iter_mut() {
             series.iter_mut().zip(&states).for_each(|(x, y)| *x = label(key, y, 0));
@@ -434,5 +530,21 @@ impl PolishedOrbit {
             let k = rc.gap.len();
             rc.paired_gap = (0..k).map(|j| rc.gap[(j + s) % k]).collect();
         }
+    }
+}
+
+/// User DOF `dof`'s value in the model vector `v` from offset `off` (displacements at 0,
+/// velocities at n of an n-DOF model): the output map's row, or the model DOF itself without a map.
+pub fn user_value(map: Option<&OutputMap>, dof: usize, v: &DVector<f64>, off: usize, n: usize) -> Option<f64> {
+    match map {
+        Some(map) => map.rows.get(&dof).map(|row| row.iter().map(|&(d, c)| c * v[off + d]).sum()),
+        None => (dof < n).then(|| v[off + dof]),
+    }
+}
+
+/// Two orbits are equal when their definitions are ([`PolishedOrbit::parts`]) on the same period.
+impl PartialEq for PolishedOrbit {
+    fn eq(&self, other: &Self) -> bool {
+        self.period == other.period && self.parts() == other.parts()
     }
 }

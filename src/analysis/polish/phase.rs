@@ -29,8 +29,10 @@ pub(super) struct Phase {
     force: Harmonics,
     /// Prescribed displacement of every DOF (nonzero only at stuck DOFs).
     presc: Harmonics,
-    /// First-order form of the free DOFs.
+    /// First-order form of the free DOFs, balanced: ŷ = [x_f; v_f/speed] (see [`Phase::exp`]).
     a: DMatrix<f64>,
+    /// The balancing rate [rad/s]: √‖M_ff⁻¹K_ff‖∞ ≥ ω_max of the phase.
+    speed: f64,
     mff_inv: DMatrix<f64>,
     /// Particular periodic solution of the free state [x_f; v_f].
     part: Harmonics,
@@ -108,9 +110,13 @@ impl Phase {
         let sub = |a: &DMatrix<f64>, r: &[usize], cl: &[usize]| DMatrix::from_fn(r.len(), cl.len(), |i, j| a[(r[i], cl[j])]);
         let mff_inv = if nf == 0 { DMatrix::zeros(0, 0) } else { sub(&m, &free, &free).try_inverse()? };
         let mut a = DMatrix::zeros(2 * nf, 2 * nf);
+        let mut speed = 1.0;
         if nf > 0 {
+            let mk = -&mff_inv * sub(&k, &free, &free);
+            let norm = mk.row_iter().map(|r| r.iter().map(|v| v.abs()).sum::<f64>()).fold(0.0, f64::max);
+            speed = if norm > 0.0 && norm.is_finite() { norm.sqrt() } else { 1.0 };
             a.view_mut((0, nf), (nf, nf)).fill_with_identity();
-            a.view_mut((nf, 0), (nf, nf)).copy_from(&(-&mff_inv * sub(&k, &free, &free)));
+            a.view_mut((nf, 0), (nf, nf)).copy_from(&mk);
             a.view_mut((nf, nf), (nf, nf)).copy_from(&(-&mff_inv * sub(&c, &free, &free)));
         }
         // Free forcing per harmonic: f_f − (−(pω)² M_f· + ipω C_f· + K_f·) x_presc.
@@ -138,7 +144,12 @@ impl Phase {
             }
             part.push((p, y));
         }
-        Some(Phase { n, omega, free, stuck, closed: closed.to_vec(), m, c, k, force, presc, a, mff_inv, part })
+        // The particular solution above uses the unbalanced A; the exponential the balanced one.
+        if nf > 0 {
+            a.view_mut((0, nf), (nf, nf)).scale_mut(speed);
+            a.view_mut((nf, 0), (nf, nf)).scale_mut(1.0 / speed);
+        }
+        Some(Phase { n, omega, free, stuck, closed: closed.to_vec(), m, c, k, force, presc, a, speed, mff_inv, part })
     }
 
     /// Whether compliant contact `i` is closed in this phase.
@@ -150,9 +161,18 @@ impl Phase {
         self.stuck.iter().map(|s| s.2)
     }
 
-    /// e^{A τ} of the free state.
+    /// e^{A τ} of the free state [x_f; v_f], computed as D e^{Â τ} D⁻¹ with D = diag(I, speed·I):
+    /// in [x; v] a stiff phase's A has entries up to ω_max² beside 1, and scaling and squaring
+    /// (nalgebra's Padé `exp`) then loses about ω_max/ω_ref digits; balanced, ‖Â‖ ≈ ω_max
+    /// (Higham, "Functions of Matrices", §10.3; the coarse blade's stall at ω_max = 6.3e5 rad/s).
     pub fn exp(&self, tau: f64) -> DMatrix<f64> {
-        (&self.a * tau).exp()
+        let nf = self.free.len();
+        let mut e = (&self.a * tau).exp();
+        if nf > 0 {
+            e.view_mut((0, nf), (nf, nf)).scale_mut(1.0 / self.speed);
+            e.view_mut((nf, 0), (nf, nf)).scale_mut(self.speed);
+        }
+        e
     }
 
     fn free_state(&self, y: &DVector<f64>) -> DVector<f64> {

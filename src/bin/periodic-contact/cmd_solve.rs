@@ -58,7 +58,7 @@ fn refine(problem: &PeriodicProblem, r: &mut Response, refine: Refine) {
     }
     if refine.polish {
         let n = r.warnings.len();
-        polish::apply(problem, r);
+        let _ = polish::apply(problem, r);
         for w in &r.warnings[n..] {
             eprintln!("warning: {w}");
         }
