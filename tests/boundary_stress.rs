@@ -332,8 +332,14 @@ struct CApi {
     result_free: unsafe extern "C" fn(P),
 }
 
-const C_API_FUNCTIONS: [&str; 46] = [
+const C_API_FUNCTIONS: [&str; 52] = [
     "pc_version",
+    "pc_problem_set_polish",
+    "pc_result_polish",
+    "pc_result_event_count",
+    "pc_result_event",
+    "pc_result_state_at",
+    "pc_result_contact_at",
     "pc_problem_set_stability",
     "pc_result_stability",
     "pc_result_jump",
