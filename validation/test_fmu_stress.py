@@ -211,7 +211,14 @@ class Variable:
             if self.variability == "constant":
                 initial = "exact"
         self.initial = initial
-        self.start = None if v.start is None else (float(v.start) if v.type == "Real" else int(v.start))
+        if v.start is None:
+            self.start = None
+        elif v.type == "Real":
+            self.start = float(v.start)
+        elif v.type == "Boolean":
+            self.start = int(v.start == "true")
+        else:
+            self.start = int(v.start)
 
 
 class Fmu:
@@ -303,6 +310,9 @@ class Model:
             return 4 <= value <= 1 << 22
         if v.name == "scheme":
             return 1 <= value <= 5
+        if v.name == "polish":
+            # fmi2Boolean: any value is one (non-zero is true).
+            return True
         return False
 
     def snapshot(self):
