@@ -197,7 +197,7 @@ class Hysteresis:
     up: Run
     down: Run
     branches: list
-    fold_upper: float      # the largest frequency of the continued contact branch
+    fold_upper: float      # the fold at the contact branch's resonance tip (its largest frequency)
     fold_lower: float      # the fold of the run-down continuation (the contact-free orbit's grazing)
     figure: str
     timings: dict
@@ -217,12 +217,16 @@ def run_hysteresis(cli: str, workdir: str, figure: str = FIGURE) -> Hysteresis:
     up = cosimulate(pc, ramp, W_LOW, W_HIGH, workdir)
     down = cosimulate(pc, ramp, W_HIGH, W_LOW, workdir)
     tm["cosim_up"], tm["cosim_down"] = up.wall_s, down.wall_s
-    with open(os.path.join(workdir, "branch_down-events.json")) as fh:
-        import json
+    import json
 
-        events = json.load(fh)["events"]
-    folds = [e["frequency"] for e in events if e["type"] == "fold" and e["frequency"] < 1.2]
-    h = Hysteresis(up, down, [up_b, down_b], float(up_b.omega.max()), float(folds[0]) if folds else float("nan"), "", tm)
+    def folds_of(name: str) -> list:
+        with open(os.path.join(workdir, f"{name}-events.json")) as fh:
+            return [e["frequency"] for e in json.load(fh)["events"] if e["type"] == "fold"]
+
+    # The run-up's walk goes round the whole S-curve to W_HIGH: its upper fold is the resonance tip.
+    upper = [f for f in folds_of("branch_up") if f > 1.2]
+    folds = [f for f in folds_of("branch_down") if f < 1.2]
+    h = Hysteresis(up, down, [up_b, down_b], max(upper) if upper else float(up_b.omega.max()), float(folds[0]) if folds else float("nan"), "", tm)
     if figure:
         h.figure = plot(h, figure)
     return h

@@ -71,6 +71,12 @@ impl Solved {
     pub fn parameter(&self, rho: f64) -> f64 {
         self.v[self.v.len() - 1] * rho
     }
+    /// The sign of det [dF; tᵀ]: constant along a regular branch, also across the kinks of a
+    /// piecewise-affine map (Allgower & Georg 1990, §12.1), where tᵀ·(the last tangent) is not.
+    pub fn orientation(&self, tangent: &[f64]) -> f64 {
+        bordered(&self.jacobian, tangent).determinant().signum()
+    }
+
     /// The unit tangent of the branch: [dF; borderᵀ] t = e_last, normalised (so tᵀ·border > 0).
     pub fn tangent(&self, border: &[f64]) -> Option<Vec<f64>> {
         let n = self.v.len();
@@ -79,6 +85,14 @@ impl Solved {
         let norm = t.norm();
         (norm.is_finite() && norm > 0.0).then(|| t.iter().map(|v| v / norm).collect())
     }
+}
+
+/// A kink of the map crossed by [`Family::cross_kink`].
+pub(super) struct Kink {
+    /// The orbit a step beyond it, on the next piece.
+    pub next: Solved,
+    /// The next piece's unit tangent, oriented along the branch.
+    pub turn: Vec<f64>,
 }
 
 /// [dF; borderᵀ], (d+1)×(d+1).
@@ -194,6 +208,74 @@ impl Family {
             solved = st;
         }
         None
+    }
+
+    /// [dF/ds_0 | dF/d(λ/ρ)] at v on the piece of `masks` (the sets imposed, not solved for).
+    fn frozen_jacobian(&mut self, v: &[f64], masks: &[u32]) -> Option<DMatrix<f64>> {
+        let d = v.len() - 1;
+        let lambda = v[d] * self.rho;
+        let j = self.map_at(lambda).ok()?.period_jacobian(masks);
+        let eps = 1e-6 * lambda.abs().max(1e-3 * self.rho);
+        let up = self.map_at(lambda + eps).ok()?.march_frozen(&v[..d], masks)?;
+        let down = self.map_at(lambda - eps).ok()?.march_frozen(&v[..d], masks)?;
+        self.marches += 2;
+        Some(DMatrix::from_fn(d, d + 1, |r, c| if c < d { j[(r, c)] - if r == c { 1.0 } else { 0.0 } } else { (up[r] - down[r]) / (2.0 * eps) * self.rho }))
+    }
+
+    /// The active sets of the march from the state of v at its λ, `guess` tried first.
+    fn masks_at(&mut self, v: &[f64], guess: &[u32]) -> Option<Vec<u32>> {
+        let d = v.len() - 1;
+        let sm = self.map_at(v[d] * self.rho).ok()?;
+        self.marches += 1;
+        Some(sm.march_period(&v[..d], Some(guess))?.1)
+    }
+
+    /// Crosses the kink of the map that the step `ds` along `tangent` from `here` runs into,
+    /// when it is one pair's change of status at one step: returns the orbit a step of at most
+    /// `ds` beyond it on the next piece, and that piece's tangent. Why: where the branch turns back at a kink by more than a right angle (a
+    /// nonsmooth fold: the coarse blade's contact branch at ω ≈ 2796 rad/s, where the next
+    /// piece's line runs back almost along this one), the hyperplane ahead meets no orbit and
+    /// the corrector fails at every step. The next piece's direction is the one that keeps the
+    /// sign of det [dF; tᵀ], the orientation of a piecewise-linear path (Allgower & Georg,
+    /// *Numerical Continuation Methods*, 1990, §12.1); its λ turns back at a fold.
+    pub fn cross_kink(&mut self, here: &Solved, tangent: &[f64], ds: f64) -> Option<Kink> {
+        let at = |tau: f64| -> Vec<f64> { here.v.iter().zip(tangent).map(|(v, t)| v + tau * t).collect() };
+        let beyond = self.masks_at(&at(ds), &here.masks)?;
+        let changed: usize = here.masks.iter().zip(&beyond).map(|(a, b)| (a ^ b).count_ones() as usize).sum();
+        if changed != 1 {
+            return None;
+        }
+        let (mut lo, mut hi) = (0.0, ds);
+        while hi - lo > 1e-12 * ds {
+            let mid = 0.5 * (lo + hi);
+            if self.masks_at(&at(mid), &here.masks)? == here.masks {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let next_sets = self.masks_at(&at(hi), &here.masks)?;
+        let (_, kink) = self.evaluate(&at(lo), &here.masks)?;
+        if kink.masks != here.masks || next_sets == here.masks {
+            return None;
+        }
+        let next_jacobian = self.frozen_jacobian(&kink.v, &next_sets)?;
+        let on_next = Solved { v: kink.v.clone(), masks: next_sets.clone(), jacobian: next_jacobian, monodromy: kink.monodromy.clone() };
+        let turn = on_next.tangent(tangent)?;
+        let sign = if on_next.orientation(&turn) == kink.orientation(tangent) { 1.0 } else { -1.0 };
+        let turn: Vec<f64> = turn.iter().map(|t| sign * t).collect();
+        // A step that stays on the next piece: near a fold the pieces are short (NLvib-like
+        // zigzags of the discrete branch), and a longer step would skip the next turn.
+        let mut step = ds;
+        let along = |step: f64| -> Vec<f64> { kink.v.iter().zip(&turn).map(|(v, t)| v + step * t).collect() };
+        while self.masks_at(&along(step), &next_sets)? != next_sets {
+            step /= 2.0;
+            if step < 1e-6 * ds {
+                return None;
+            }
+        }
+        let (next, _) = self.correct(&along(step), &turn, &next_sets)?;
+        (next.masks != here.masks).then_some(Kink { next, turn })
     }
 
     /// The monodromy for stability: central differences of P over a width δ·(the state block's

@@ -102,15 +102,16 @@ pub struct ContinuationSettings {
     /// Width of the differences of the stability monodromy, relative to the state's blocks
     /// (0: the piece's Jacobian, exact for the discrete map but jumping at its kinks).
     pub smoothing: f64,
-    /// Two successive folds closer than this (relative to |to − from|) are the path's wiggle
-    /// across kinks of the discrete map, not a turn: both are dropped (NLvib 03, k = 4096: pairs
-    /// 3e-5 to 2e-4 apart near the peak, none between the true folds 0.102 apart).
+    /// Successive folds closer than this (relative to |to − from|) are the path's wiggles
+    /// across kinks of the discrete map, not turns ([`merge_fold_pairs`]; NLvib 03, k = 4096:
+    /// pairs 3e-5 to 2e-4 apart near the peak, none between the true folds 0.102 apart; the
+    /// demo's oscillator at k = 256: wiggles 5e-4 to 6e-3 apart on its unstable branch).
     pub fold_merge: f64,
 }
 
 impl Default for ContinuationSettings {
     fn default() -> Self {
-        ContinuationSettings { initial_step: 2e-3, min_step: 1e-9, max_step: 2e-2, max_points: 5000, tolerance: 1e-10, smoothing: 5e-3, fold_merge: 1e-3 }
+        ContinuationSettings { initial_step: 2e-3, min_step: 1e-9, max_step: 2e-2, max_points: 5000, tolerance: 1e-10, smoothing: 5e-3, fold_merge: 1e-2 }
     }
 }
 
@@ -148,7 +149,7 @@ pub struct BranchPoint {
 pub struct Branch {
     pub parameter: Parameter,
     pub points: Vec<BranchPoint>,
-    /// Why the continuation stopped ("reached", or the reason).
+    /// Why the continuation stopped ("reached", "reached from both ends: …", or the reason).
     pub stop: String,
     /// Marches of the period map made.
     pub marches: usize,
@@ -159,6 +160,11 @@ pub struct Branch {
 }
 
 impl Branch {
+    /// The branch spans the whole range (in one walk, or in two that meet at a fold).
+    pub fn reached(&self) -> bool {
+        self.stop.starts_with("reached")
+    }
+
     /// The event points, in order along the branch.
     pub fn events(&self) -> impl Iterator<Item = &BranchPoint> {
         self.points.iter().filter(|p| p.event.is_some())
@@ -172,30 +178,91 @@ pub fn run(problem: &PeriodicProblem, param: Parameter, from: f64, to: f64, sett
     if !(from.is_finite() && to.is_finite() && from != to) {
         return Err(Error::input(format!("--from/--to: are {from} and {to}, must be finite and different")));
     }
-    let (rho, dir) = ((to - from).abs(), (to - from).signum());
+    let rho = (to - from).abs();
     let mut fam = family(problem, param, rho, settings);
-    let (k, m) = (problem.instants(), problem.model().contacts.len());
     fam.map_at(from)?;
     let mut solver = PeriodicSolver::new(fam.problem_at(from)?);
-    let first = solver.solve().map_err(|e| Error::from(e).context(format!("the start of the continuation at {} = {from}", param.name())))?;
+    let up = walk_from(&mut fam, &mut solver, from, to, settings, on_point)?;
+    let (mut points, mut stop) = (up.points, up.stop);
+    // A walk stopped in a zigzag (a fold of the orbit finer than the discrete branch's kinks,
+    // the coarse blade's resonance tip): the rest of the curve from the other end, which meets
+    // it there.
+    if let Some(band) = up.zigzag {
+        let down = walk_from(&mut fam, &mut solver, to, from, settings, on_point)?;
+        match down.zigzag {
+            Some(other) if (other.0 - band.0).abs() <= ZIGZAG_MEET * rho => {
+                let (lo, hi) = (band.1.min(other.1), band.2.max(other.2));
+                join_at_fold(&mut points, down.points, (lo, hi));
+                stop = format!("reached from both ends: the walks from {from} and from {to} meet at a fold in [{lo}, {hi}]");
+            }
+            _ => stop = format!("{stop}; the walk from {to} did not meet it ({})", down.stop),
+        }
+    }
+    let p = problem.period_multiple();
+    let label = if p == 1 { "T".to_string() } else { format!("{p}T") };
+    Ok(Branch { parameter: param, points, stop, marches: fam.marches, period_multiple: p, label })
+}
+
+/// Two zigzags meet when their centres are this close (relative to the range): a fold's two
+/// sides at the coarse blade's tip, k = 1024: 2796.02 and 2795.94 rad/s over a range of 750.
+const ZIGZAG_MEET: f64 = 1e-3;
+
+/// One walk's outcome.
+struct Walked {
+    points: Vec<BranchPoint>,
+    stop: String,
+    /// Stopped in a zigzag: (its centre, lowest, highest parameter).
+    zigzag: Option<(f64, f64, f64)>,
+}
+
+/// The branch from the orbit the session's solve finds at λ = `from`, towards `to`.
+fn walk_from(
+    fam: &mut Family,
+    solver: &mut PeriodicSolver,
+    from: f64,
+    to: f64,
+    settings: &ContinuationSettings,
+    on_point: &dyn Fn(f64),
+) -> Result<Walked, Error> {
+    let name = fam.name();
+    let dir = (to - from).signum();
+    solver.update_problem(fam.problem_at(from)?);
+    solver.set_warm_start(&[]);
+    let first = solver.solve().map_err(|e| Error::from(e).context(format!("the start of the continuation at {name} = {from}")))?;
+    let (k, m) = (solver.problem().instants(), solver.problem().model().contacts.len());
     let mut masks = vec![0u32; k];
     for &i in &first.active_set {
         masks[i / m] |= 1 << (i % m);
     }
-    let start = fam
-        .start(from, &masks)
-        .ok_or_else(|| Error::solve(format!("continuation: the orbit at {} = {from} did not close on its active sets", param.name())))?;
+    let start = fam.start(from, &masks).ok_or_else(|| Error::solve(format!("continuation: the orbit at {name} = {from} did not close on its active sets")))?;
     let d = start.v.len() - 1;
     let border: Vec<f64> = (0..=d).map(|i| if i == d { dir } else { 0.0 }).collect();
-    let tangent = start.tangent(&border).ok_or_else(|| Error::solve(format!("continuation: singular Jacobian at {} = {from}", param.name())))?;
-    let here = Node::new(&mut fam, start, tangent);
-    let points = vec![point(&fam, &mut solver, &here, None, String::new())?];
+    let tangent = start.tangent(&border).ok_or_else(|| Error::solve(format!("continuation: singular Jacobian at {name} = {from}")))?;
+    let here = Node::new(fam, start, tangent);
+    let points = vec![point(fam, solver, &here, None, String::new())?];
     on_point(from);
     let walk = Walk { from, to, secant: false, settings, on_point };
-    let (points, stop) = walk.follow(&mut fam, &mut solver, here, points, None)?;
-    let p = problem.period_multiple();
-    let label = if p == 1 { "T".to_string() } else { format!("{p}T") };
-    Ok(Branch { parameter: param, points, stop, marches: fam.marches, period_multiple: p, label })
+    walk.follow(fam, solver, here, points, None)
+}
+
+/// Joins a walk that ended in a zigzag with the walk from the range's other end that ended in
+/// the same zigzag: the second reversed after the first, the events inside the zigzag (the
+/// discrete branch's turns back and forth) dropped, one fold where they meet.
+fn join_at_fold(points: &mut Vec<BranchPoint>, mut other: Vec<BranchPoint>, band: (f64, f64)) {
+    let inside = |p: &BranchPoint| p.parameter >= band.0 && p.parameter <= band.1;
+    for p in points.iter_mut().chain(other.iter_mut()).filter(|p| inside(p)) {
+        p.event = None;
+        p.detail.clear();
+    }
+    if let Some(tip) = points.iter_mut().rev().find(|p| p.certified) {
+        tip.event = Some(EventKind::Fold);
+        tip.detail = format!("the walks from both ends meet in a zigzag of the discrete branch over [{}, {}]: the fold lies there", band.0, band.1);
+    }
+    other.reverse();
+    for p in &mut other {
+        p.tangent.iter_mut().for_each(|t| *t = -*t);
+    }
+    points.extend(other);
 }
 
 /// The family of `problem`'s orbits with the settings' corrector tolerance and smoothing.
@@ -226,7 +293,10 @@ impl Walk<'_> {
     /// The unit tangent at `next`, oriented along the branch from `here`.
     fn tangent(&self, next: &corrector::Solved, here: &Node) -> Option<Vec<f64>> {
         if !self.secant {
-            return next.tangent(&here.tangent);
+            // Oriented as the path is, not by the last tangent: a step may end past a sharp turn.
+            let t = next.tangent(&here.tangent)?;
+            let flip = next.orientation(&t) != here.solved.orientation(&here.tangent);
+            return Some(if flip { t.iter().map(|x| -x).collect() } else { t });
         }
         let sec: Vec<f64> = next.v.iter().zip(&here.solved.v).map(|(a, b)| a - b).collect();
         let norm = sec.iter().map(|x| x * x).sum::<f64>().sqrt();
@@ -243,7 +313,7 @@ impl Walk<'_> {
         mut here: Node,
         mut points: Vec<BranchPoint>,
         mut rejoin: Option<&mut switch::Rejoin>,
-    ) -> Result<(Vec<BranchPoint>, String), Error> {
+    ) -> Result<Walked, Error> {
         let (from, to, settings, rho) = (self.from, self.to, self.settings, fam.rho);
         let dir = (to - from).signum();
         let name = fam.name();
@@ -252,12 +322,27 @@ impl Walk<'_> {
         let mut ds = settings.initial_step;
         // Whether the tangent at `here` was already replaced by the Jacobian's (secant walks).
         let mut turned = false;
+        // The parameter of the last steps: a walk that only goes back and forth is in a zigzag.
+        let mut recent: Vec<f64> = Vec::new();
+        let mut left: std::collections::VecDeque<Vec<u32>> = std::collections::VecDeque::new();
+        let mut zigzag = None;
         let stop = loop {
             if points.len() >= settings.max_points {
                 break format!("{} points (the limit)", settings.max_points);
             }
             let pred: Vec<f64> = here.solved.v.iter().zip(&here.tangent).map(|(v, t)| v + ds * t).collect();
-            let Some((next, iterations)) = fam.correct(&pred, &here.tangent, &here.solved.masks) else {
+            // A branch crosses each piece of the map once: an orbit on a piece it has left is a
+            // return along the branch (near a sharp turn the hyperplane ahead meets both arms).
+            let fresh = |c: &(corrector::Solved, usize)| !left.contains(&c.0.masks);
+            let corrected = fam.correct(&pred, &here.tangent, &here.solved.masks).filter(fresh);
+            // The hyperplane ahead met no orbit: a kink the branch turns at (a nonsmooth fold)?
+            let crossed = match corrected {
+                None if ds <= CROSS_BELOW => fam.cross_kink(&here.solved, &here.tangent, ds).filter(|k| !left.contains(&k.next.masks)),
+                _ => None,
+            };
+            let turn = crossed.as_ref().map(|k| k.turn.clone());
+            let corrected = corrected.or_else(|| crossed.map(|k| (k.next, 3)));
+            let Some((next, iterations)) = corrected else {
                 ds /= 2.0;
                 // A secant cannot turn a corner of the branch (a contact change of the orbit):
                 // once it has failed down to small steps, try the piece Jacobian's tangent there.
@@ -274,7 +359,11 @@ impl Walk<'_> {
                 }
                 continue;
             };
-            let Some(t_next) = self.tangent(&next, &here) else {
+            let t_next = match &turn {
+                Some(turn) => next.tangent(turn),
+                None => self.tangent(&next, &here),
+            };
+            let Some(t_next) = t_next else {
                 ds /= 2.0;
                 continue;
             };
@@ -301,7 +390,19 @@ impl Walk<'_> {
                 Some(node) => (node, "rejoins the T branch (its period doubling)".to_string()),
                 None => (next, String::new()),
             };
-            for (kind, node, detail) in events::between(fam, &here, &last, m) {
+            // Across a kink where λ turned back: the fold at the last point before it (within a
+            // step of at most CROSS_BELOW), and the events beyond it from that point.
+            let mut from_node = here.clone();
+            if let Some(turn) = turn {
+                if turn[d] * here.tangent[d] < 0.0
+                    && let Some(p) = points.last_mut().filter(|p| p.event.is_none())
+                {
+                    p.event = Some(EventKind::Fold);
+                    p.detail = "at a kink of the map (a nonsmooth fold), within one step".to_string();
+                }
+                from_node.tangent = turn;
+            }
+            for (kind, node, detail) in events::between(fam, &from_node, &last, m) {
                 points.push(point(fam, solver, &node, Some(kind), detail)?);
             }
             points.push(point(fam, solver, &last, None, detail.clone())?);
@@ -314,6 +415,20 @@ impl Walk<'_> {
                 Some(_) => break format!("the branch turned back below {name} = {from}"),
                 None => {}
             }
+            recent.push(last.solved.parameter(rho));
+            if let Some(band) = zigzag_in(&recent, ZIGZAG_BAND * rho) {
+                zigzag = Some(band);
+                break format!(
+                    "the discrete branch zigzags about {name} = {} (over [{}, {}], {ZIGZAG_STEPS} steps): a fold of the orbit sharper than the kinks of the map at this k",
+                    band.0, band.1, band.2
+                );
+            }
+            if last.solved.masks != here.solved.masks {
+                left.push_back(std::mem::take(&mut here.solved.masks));
+                if left.len() > PIECES_REMEMBERED {
+                    left.pop_front();
+                }
+            }
             here = last;
             turned = false;
             if iterations <= 3 {
@@ -324,23 +439,69 @@ impl Walk<'_> {
             ds = ds.max(settings.min_step);
         };
         merge_fold_pairs(&mut points, settings.fold_merge * rho);
-        Ok((points, stop))
+        Ok(Walked { points, stop, zigzag })
     }
 }
 
-/// Drops successive fold events closer than `width` in the parameter, pairwise.
+/// The step below which a failed corrector looks for a kink to cross ([`Family::cross_kink`]),
+/// small enough that the predictor's line stays within round-off of the branch up to the kink.
+const CROSS_BELOW: f64 = 1e-4;
+
+/// Pieces of the map a walk remembers having left.
+const PIECES_REMEMBERED: usize = 64;
+
+/// Steps looked back at for a zigzag, the width of its band (relative to the range) and the
+/// least number of turns in it. The coarse blade at its tip (k = 1024): pieces of 1e-7 m, turns
+/// every 2–3 steps, over 0.15 rad/s of a range of 750.
+const ZIGZAG_STEPS: usize = 24;
+const ZIGZAG_BAND: f64 = 5e-4;
+const ZIGZAG_TURNS: usize = 6;
+
+/// (centre, lowest, highest) of the last [`ZIGZAG_STEPS`] parameters when they stay within
+/// `width` and turn back at least [`ZIGZAG_TURNS`] times.
+fn zigzag_in(recent: &[f64], width: f64) -> Option<(f64, f64, f64)> {
+    let last = recent.get(recent.len().checked_sub(ZIGZAG_STEPS)?..)?;
+    let (lo, hi) = last.iter().fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
+    let turns = last.windows(3).filter(|w| (w[1] - w[0]) * (w[2] - w[1]) < 0.0).count();
+    (hi - lo <= width && turns >= ZIGZAG_TURNS).then_some((0.5 * (lo + hi), lo, hi))
+}
+
+/// Folds in a chain of successive folds each closer than `width` to the last are the discrete
+/// branch's wiggles across its kinks, except one: a chain of odd length turns the branch back
+/// once, at its extreme parameter (the tip of a resonance, whose sides wiggle near it); one of
+/// even length does not turn it.
 fn merge_fold_pairs(points: &mut [BranchPoint], width: f64) {
     let folds: Vec<usize> = (0..points.len()).filter(|&i| points[i].event == Some(EventKind::Fold)).collect();
-    let mut i = 0;
-    while i + 1 < folds.len() {
-        let (a, b) = (folds[i], folds[i + 1]);
-        if (points[a].parameter - points[b].parameter).abs() < width {
-            points[a].event = None;
-            points[b].event = None;
-            i += 2;
-        } else {
-            i += 1;
+    let mut start = 0;
+    while start < folds.len() {
+        let mut end = start + 1;
+        while end < folds.len() && (points[folds[end]].parameter - points[folds[end - 1]].parameter).abs() < width {
+            end += 1;
         }
+        // An odd chain turns the branch once, where its parameter is extreme (the largest when it
+        // came in rising) among the certified points the chain spans: the pieces' tangents that
+        // detect folds disagree in sign with the path's own motion near a sharp tip.
+        let (first, last) = (folds[start], folds[end - 1]);
+        let rising = first == 0 || points[first].parameter >= points[first - 1].parameter;
+        let extreme = |range: &mut dyn Iterator<Item = usize>| {
+            range.max_by(|&a, &b| {
+                let o = points[a].parameter.total_cmp(&points[b].parameter);
+                if rising { o } else { o.reverse() }
+            })
+        };
+        let turn = extreme(&mut (first..=last).filter(|&i| points[i].certified)).or_else(|| extreme(&mut folds[start..end].iter().copied()));
+        let detail = turn.map(|t| points[t].detail.clone()).unwrap_or_default();
+        for &i in &folds[start..end] {
+            points[i].event = None;
+            points[i].detail.clear();
+        }
+        if (end - start) % 2 == 1
+            && let Some(t) = turn
+        {
+            points[t].event = Some(EventKind::Fold);
+            points[t].detail = detail;
+        }
+        start = end;
     }
 }
 
@@ -380,4 +541,50 @@ fn active_set(masks: &[u32], m: usize) -> Vec<usize> {
 /// Peak-to-peak/2 of each displacement output.
 fn amplitudes(problem: &PeriodicProblem, r: &Response) -> Vec<f64> {
     problem.outputs().displacement.iter().map(|d| r.displacement.get(&d.to_string()).map_or(0.0, |s| Response::peak_to_peak(s) / 2.0)).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn at(parameter: f64, event: Option<EventKind>) -> BranchPoint {
+        BranchPoint {
+            parameter,
+            amplitude: vec![],
+            multipliers: vec![],
+            max_multiplier: 0.0,
+            stable: true,
+            period_multiple: 1,
+            event,
+            detail: String::new(),
+            certified: true,
+            state: vec![],
+            masks: vec![],
+            tangent: vec![],
+        }
+    }
+
+    #[test]
+    fn a_zigzag_is_a_narrow_band_walked_back_and_forth() {
+        let back_and_forth: Vec<f64> = (0..ZIGZAG_STEPS).map(|i| 10.0 + if i % 2 == 0 { 0.0 } else { 0.01 }).collect();
+        let (centre, lo, hi) = zigzag_in(&back_and_forth, 0.02).unwrap();
+        assert!((centre - 10.005).abs() < 1e-12 && lo == 10.0 && hi == 10.01);
+        assert_eq!(zigzag_in(&back_and_forth, 0.005), None, "wider than the band");
+        assert_eq!(zigzag_in(&back_and_forth[1..], 0.02), None, "too few steps");
+        let slow: Vec<f64> = (0..ZIGZAG_STEPS).map(|i| 10.0 + 1e-4 * i as f64).collect();
+        assert_eq!(zigzag_in(&slow, 0.02), None, "a slow walk is not a zigzag");
+    }
+
+    #[test]
+    fn an_odd_chain_of_folds_is_one_turn_at_its_extreme() {
+        let fold = Some(EventKind::Fold);
+        // Rising to a tip at 2.0 whose folds were detected late (1.99, 1.995, 1.98), then a real
+        // fold far below (1.0), and an even pair of wiggles (1.5, 1.499).
+        let params = [1.9, 1.99, 2.0, 1.995, 1.985, 1.98, 1.5, 1.499, 1.2, 1.0, 1.1];
+        let events = [None, fold, None, fold, None, fold, fold, fold, None, fold, None];
+        let mut points: Vec<BranchPoint> = params.iter().zip(events).map(|(&p, e)| at(p, e)).collect();
+        merge_fold_pairs(&mut points, 0.05);
+        let folds: Vec<f64> = points.iter().filter(|p| p.event == fold).map(|p| p.parameter).collect();
+        assert_eq!(folds, vec![2.0, 1.0]);
+    }
 }

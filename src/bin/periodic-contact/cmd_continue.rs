@@ -96,7 +96,7 @@ pub fn run(a: &Args) -> Result<(), Failure> {
             eprintln!("branch of {} → {}", labels.dof(*d), png.display());
         }
     }
-    if branch.stop != "reached" {
+    if !branch.reached() {
         return Err(Failure::solver(format!("the continuation stopped before {} = {}: {}", a.param, a.to, branch.stop)));
     }
     Ok(())
