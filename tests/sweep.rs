@@ -222,3 +222,24 @@ fn cli_sweep_writes_the_csv_the_curves_and_the_spectra() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("--param"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A sequential sweep stays on the coarse blade's contact branch up to just below its resonance
+/// tip (2796.03 rad/s by continuation; [2792, 2800] by time marching, tests/blade_fold.rs), above
+/// the contact-free orbit that coexists there: where the active-set warm start lands on that
+/// orbit (it did at 2720 rad/s with these 10 rad/s steps), the last orbit is continued to the new
+/// frequency instead. Every point is in contact and the amplitude rises to the tip.
+#[test]
+fn a_sequential_sweep_stays_on_the_blades_contact_branch_up_to_the_tip() {
+    let p = problem();
+    let freqs: Vec<f64> = (0..=49).map(|i| 2300.0 + 10.0 * i as f64).collect();
+    let one = SweepSettings { threads: 1, chunks_per_thread: 1, ..Default::default() };
+    let points = sweep::run(&p, &freqs, &one, &|| {}).unwrap();
+    assert!(points.iter().all(|q| q.error.is_none() && q.contact_fraction.iter().any(|&c| c > 0.0)), "every point touches the casing");
+    let amp: Vec<f64> = points.iter().map(|q| q.amplitude[0]).collect();
+    assert!(amp.windows(2).all(|w| w[1] > w[0]), "the amplitude rises to the tip: {amp:?}");
+    let mut free = p.clone();
+    free.set_frequency(2790.0).unwrap();
+    let cold = free.solve().unwrap();
+    let cold_amp = periodic_contact::response::Response::peak_to_peak(&cold.displacement[&p.outputs().displacement[0].to_string()]) / 2.0;
+    assert!(amp[49] > 10.0 * cold_amp, "at 2790 rad/s the branch ({}) lies far above the orbit a cold solve finds ({cold_amp})", amp[49]);
+}

@@ -16,8 +16,9 @@
 pub mod marching;
 pub mod spectrum;
 
+use crate::analysis::continuation;
 use crate::model::{Labels, Quantity};
-use crate::periodic::{PeriodicProblem, PeriodicSolver, WarmStart};
+use crate::periodic::{PeriodicProblem, PeriodicSolver, Tuning, WarmStart};
 use crate::response::Response;
 use rayon::prelude::*;
 use std::time::Instant;
@@ -134,7 +135,8 @@ pub fn run(template: &PeriodicProblem, frequencies: &[f64], settings: &SweepSett
     // Parallelism is over points: each solve stays on its thread.
     template.set_parallel(false);
     // One plan for every chunk: the chunks clone this session.
-    let session = PeriodicSolver::new(template).with_warm_starts(settings.warm_start);
+    let base = &template;
+    let session = PeriodicSolver::new(template.clone()).with_warm_starts(settings.warm_start);
     let pool = rayon::ThreadPoolBuilder::new().num_threads(settings.threads).build().map_err(|e| crate::Error::input(format!("threads: {e}")))?;
     let threads = pool.current_num_threads().max(1);
     let n = frequencies.len();
@@ -146,9 +148,19 @@ pub fn run(template: &PeriodicProblem, frequencies: &[f64], settings: &SweepSett
             .map(|&(lo, hi)| {
                 let mut solver = session.clone();
                 let mut out = Vec::with_capacity(hi - lo);
+                let mut last: Option<(f64, Response)> = None;
                 for &f in &frequencies[lo..hi] {
                     let t = Instant::now();
-                    let r = solver.update_frequency(f).and_then(|()| solver.solve());
+                    let mut r = solver.update_frequency(f).and_then(|()| solver.solve());
+                    if let (Some((f0, before)), Ok(now)) = (&last, &r)
+                        && settings.warm_start
+                        && left_the_branch(before, now)
+                    {
+                        // Kept as it is when the branch cannot be followed.
+                        if let Ok(followed) = follow_from(&mut solver, base, *f0, before, f) {
+                            r = Ok(followed);
+                        }
+                    }
                     let mut point = match &r {
                         Ok(r) => SweepPoint::from_response(solver.problem(), f, r),
                         Err(e) => SweepPoint { frequency: f, error: Some(e.to_string()), ..Default::default() },
@@ -156,9 +168,13 @@ pub fn run(template: &PeriodicProblem, frequencies: &[f64], settings: &SweepSett
                     point.warm_start_used = r.is_ok() && solver.last_start() == WarmStart::Used;
                     point.cold_fallback = solver.last_start() == WarmStart::ColdFallback;
                     point.time_s = t.elapsed().as_secs_f64();
-                    if r.is_err() {
-                        // The next point starts cold, as after any failure.
-                        solver.reset_warm_start();
+                    match r {
+                        Ok(r) => last = Some((f, r)),
+                        Err(_) => {
+                            // The next point starts cold, as after any failure.
+                            solver.reset_warm_start();
+                            last = None;
+                        }
                     }
                     out.push(point);
                     on_point();
@@ -171,6 +187,26 @@ pub fn run(template: &PeriodicProblem, frequencies: &[f64], settings: &SweepSett
 }
 
 /// The CSV of a sweep: the parameter, amplitude per displacement output (nonlinear, then
+/// A warm-started answer whose amplitude differs from the last point's (an orbit in contact) by
+/// more than this (relative) is checked by continuing the last orbit to the new frequency: the
+/// active-set warm start alone can land on a coexisting orbit (the coarse blade's contact branch,
+/// lost at 2720 rad/s with 10 rad/s steps and at 2790 with 2, below its tip at 2796).
+const BRANCH_CHECK: f64 = 0.1;
+
+fn left_the_branch(before: &Response, now: &Response) -> bool {
+    let (a, b) = (continuation::amplitude(before), continuation::amplitude(now));
+    !before.active_set.is_empty() && (a - b).abs() > BRANCH_CHECK * a.max(b)
+}
+
+/// The orbit at `f` continued along its branch from the last point's (`continuation::resolve`,
+/// the FMU's re-solve): where the branch ends at a fold on the way, the orbit the solver finds.
+fn follow_from(solver: &mut PeriodicSolver, base: &PeriodicProblem, f0: f64, before: &Response, f: f64) -> Result<Response, crate::Error> {
+    let disc = solver.problem().discretization();
+    let tuning = Tuning { frequency: f0, ..Tuning::of(base) };
+    let current = continuation::Current { tuning, disc, active_set: &before.active_set, amplitude: continuation::amplitude(before) };
+    continuation::resolve(solver, base, disc, Tuning { frequency: f, ..tuning }, Some(current)).map(|r| r.response)
+}
+
 /// linear), max force and contact fraction per contact, LCP size, pivots, warm start, fallback,
 /// time and status. A column with a unit names it after its key, `amplitude_1903 [mm]`, in the
 /// scene's units (`labels`); the key before " [" is stable.
