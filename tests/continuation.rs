@@ -175,6 +175,23 @@ fn force_scale_and_gap_offset_graze_where_the_linear_orbit_reaches_the_gap() {
     }
 }
 
+/// Continuation in the casing's speed Ω, the excitation at ω = lobes·Ω (`--param speed`; 3 lobes
+/// here): NLvib 03's events land at the reference's frequencies over the lobes.
+#[test]
+fn continuation_in_speed_finds_the_events_at_frequency_over_lobes() {
+    let p = periodic_contact::scene::Scene::parse(&scene(4096), "nlvib03").unwrap().to_problem("nlvib03").unwrap();
+    let speed = Parameter::Speed { lobes: 3 };
+    let b = continuation::run(&p, speed, 0.5 / 3.0, 0.8 / 3.0, &ContinuationSettings::default(), &|_| {}).unwrap();
+    assert!(b.reached(), "{}", b.stop);
+    assert_eq!(b.parameter.name(), "speed");
+    let (_, ref_events) = reference();
+    let ours: Vec<(&str, f64)> = b.events().map(|e| (e.event.unwrap().name(), e.parameter)).collect();
+    for (kind, omega) in &ref_events {
+        let err = ours.iter().filter(|(k, _)| k == kind).map(|(_, o)| (3.0 * o - omega).abs()).fold(f64::INFINITY, f64::min);
+        assert!(err < 3e-4, "{kind} at ω = {omega}: nearest of ours (×3) {err:.1e} away; {ours:?}");
+    }
+}
+
 /// A reference branch's points (Ω, amplitude_0, stable).
 fn branch_points(b: &Value) -> Vec<RefPoint> {
     b["points"].as_array().unwrap().iter().map(|p| (p["omega"].as_f64().unwrap(), p["amplitude_0"].as_f64().unwrap(), p["stable"].as_bool().unwrap())).collect()

@@ -40,6 +40,9 @@ pub enum Parameter {
     /// A length added to every contact's static clearance (0: the scene's gaps; negative closes
     /// them, a preload).
     GapOffset,
+    /// The casing's rotation speed Ω [rad/s]: the excitation frequency is ω = lobes·Ω (engine
+    /// order; the front end reads `lobes` from the scene's casing).
+    Speed { lobes: u32 },
 }
 
 impl Parameter {
@@ -49,7 +52,8 @@ impl Parameter {
             "frequency" => Ok(Parameter::Frequency),
             "force_scale" => Ok(Parameter::ForceScale),
             "gap_offset" => Ok(Parameter::GapOffset),
-            other => Err(Error::input(format!("--param: is \"{other}\"; continuation takes frequency, force_scale or gap_offset"))),
+            "speed" => Err(Error::input("--param speed: the casing's lobes are needed (ω = lobes·Ω): the scene's [casing] gives them")),
+            other => Err(Error::input(format!("--param: is \"{other}\"; continuation takes frequency, speed, force_scale or gap_offset"))),
         }
     }
     pub fn name(self) -> &'static str {
@@ -57,6 +61,7 @@ impl Parameter {
             Parameter::Frequency => "frequency",
             Parameter::ForceScale => "force_scale",
             Parameter::GapOffset => "gap_offset",
+            Parameter::Speed { .. } => "speed",
         }
     }
     /// What the parameter is, for an axis or a column, with its quantity.
@@ -66,12 +71,14 @@ impl Parameter {
             Parameter::Frequency => ("excitation frequency ω", Quantity::Frequency),
             Parameter::ForceScale => ("force scale (× the scene's forces)", Quantity::Ratio),
             Parameter::GapOffset => ("gap offset (added to every clearance)", Quantity::Length),
+            Parameter::Speed { .. } => ("casing speed Ω (ω = lobes·Ω)", Quantity::Frequency),
         }
     }
     /// Sets the parameter of `problem` (the scene's, unchanged until now) to `value`, checked.
     fn apply(self, problem: &mut PeriodicProblem, value: f64) -> Result<(), Error> {
         match self {
             Parameter::Frequency => problem.set_frequency(value).map_err(Error::from),
+            Parameter::Speed { lobes } => problem.set_frequency(f64::from(lobes) * value).map_err(Error::from),
             Parameter::ForceScale | Parameter::GapOffset => {
                 if !value.is_finite() {
                     return Err(Error::input(format!("{}: is {value}, must be finite", self.name())));

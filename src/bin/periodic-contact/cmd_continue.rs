@@ -11,8 +11,9 @@ use std::time::Instant;
 #[derive(clap::Args)]
 pub struct Args {
     pub scene: PathBuf,
-    /// The continued parameter: frequency (ω [rad/s]), force_scale (× every force of the scene)
-    /// or gap_offset (added to every contact's clearance, length unit).
+    /// The continued parameter: frequency (ω [rad/s]), speed (Ω [rad/s] of the casing; ω =
+    /// lobes·Ω), force_scale (× every force of the scene) or gap_offset (added to every contact's
+    /// clearance, length unit).
     #[arg(long, default_value = "frequency")]
     pub param: String,
     #[arg(long, allow_negative_numbers = true)]
@@ -38,7 +39,10 @@ pub struct Args {
 }
 
 pub fn run(a: &Args) -> Result<(), Failure> {
-    let param = Parameter::parse(&a.param).map_err(Failure::from)?;
+    // The name checked before the scene is built (speed needs the casing's lobes, read after).
+    if a.param != "speed" {
+        Parameter::parse(&a.param).map_err(Failure::from)?;
+    }
     if !(a.from.is_finite() && a.to.is_finite() && a.from > 0.0 && a.to > 0.0 && a.from != a.to) {
         return Err(Failure::input(format!("--from/--to: are {} and {}, must be finite, > 0 and different", a.from, a.to)));
     }
@@ -51,6 +55,16 @@ pub fn run(a: &Args) -> Result<(), Failure> {
     let file = a.scene.display().to_string();
     let built = scene.build_in(&file, &dir).map_err(|e| Failure::input(e.to_string()))?;
     let problem = &built.problem;
+    let param = match a.param.as_str() {
+        "speed" => Parameter::Speed {
+            lobes: built
+                .casing
+                .as_ref()
+                .map(|c| c.lobes)
+                .ok_or_else(|| Failure::input(format!("{file}: --param speed needs a [casing] section (ω = lobes·Ω)")))?,
+        },
+        other => Parameter::parse(other).map_err(Failure::from)?,
+    };
     let settings = ContinuationSettings { max_step: a.max_step, ..ContinuationSettings::default() };
     let bar = if a.quiet { ProgressBar::hidden() } else { ProgressBar::new(1000) };
     bar.set_style(ProgressStyle::with_template("{spinner} continue [{bar:40}] {msg}, {elapsed_precise} elapsed").unwrap().progress_chars("=> "));
