@@ -232,10 +232,10 @@ impl Family {
 
     /// Crosses the kink of the map that the step `ds` along `tangent` from `here` runs into,
     /// when it is one pair's change of status at one step: returns the orbit a step of at most
-    /// `ds` beyond it on the next piece, and that piece's tangent. Why: where the branch turns back at a kink by more than a right angle (a
-    /// nonsmooth fold: the coarse blade's contact branch at ω ≈ 2796 rad/s, where the next
-    /// piece's line runs back almost along this one), the hyperplane ahead meets no orbit and
-    /// the corrector fails at every step. The next piece's direction is the one that keeps the
+    /// `ds` beyond it on the next piece, and that piece's tangent. Why: where the branch turns
+    /// back at a kink by more than a right angle (a nonsmooth fold: the coarse blade's contact
+    /// branch at ω ≈ 2796 rad/s, where the next piece's line runs back almost along this one),
+    /// the hyperplane ahead meets no orbit and the corrector fails at every step. The next piece's direction is the one that keeps the
     /// sign of det [dF; tᵀ], the orientation of a piecewise-linear path (Allgower & Georg,
     /// *Numerical Continuation Methods*, 1990, §12.1); its λ turns back at a fold.
     pub fn cross_kink(&mut self, here: &Solved, tangent: &[f64], ds: f64) -> Option<Kink> {
