@@ -234,7 +234,8 @@ fn walk_from(
     let name = fam.name();
     let dir = (to - from).signum();
     solver.update_problem(fam.problem_at(from)?);
-    solver.set_warm_start(&[]);
+    // A cold solve, as `solve` makes: an empty warm start would be Newton from the contact-free guess.
+    solver.reset_warm_start();
     let first = solver.solve().map_err(|e| Error::from(e).context(format!("the start of the continuation at {name} = {from}")))?;
     let (k, m) = (solver.problem().instants(), solver.problem().model().contacts.len());
     let mut masks = vec![0u32; k];
