@@ -1,5 +1,5 @@
 //! Error estimates (`analysis::accuracy`) against the true error, measured on the exact
-//! references of notes §6 (`periodic_contact::exact`, independent of the solver): the estimate
+//! references of src/formulation.md §6 (`periodic_contact::exact`, independent of the solver): the estimate
 //! must lie within a factor of 10 of max_j |x_j − x(t_j)| at k = 512.
 use periodic_contact::analysis::accuracy;
 use periodic_contact::exact::{CompliantStopOrbit, Oscillator, RigidRegime, RigidStopOrbit};
@@ -74,7 +74,7 @@ fn no_estimate_where_the_scheme_does_not_converge() {
 
 /// A stiff compliant stop under cds near its stability limit: at k = 256 ω_max·h = 1.1 < 2, but
 /// at k/2 it is 2.2, past the limit, so the estimate switches to a second solve at 2k and says
-/// so. It is checked against the true error from the exact orbit (notes §6.2) and against a
+/// so. It is checked against the true error from the exact orbit (src/formulation.md §6.2) and against a
 /// reference solve at 4k (max_j |x_j^{(k)} − x_{4j}^{(4k)}|, which is e_k(1 − 4^{-p})).
 #[test]
 fn past_the_stability_limit_at_k_over_2_the_estimate_comes_from_2k() {

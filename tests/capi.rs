@@ -209,7 +209,7 @@ fn the_c_example_links_solves_and_prints_what_the_rust_api_computes() {
     polish_section(&out);
 }
 
-/// Section 6: the rigid stop with sticking (notes §6.3) through the C API with the polish, at
+/// Section 6: the rigid stop with sticking (src/formulation.md §6.3) through the C API with the polish, at
 /// times between the instants, against the exact orbit (`periodic_contact::exact`, closed-form
 /// flows of its own) to 1e-8 of the peak-to-peak amplitude; without the polish, the cubic Hermite
 /// through the Rust API's samples, computed here.

@@ -1,4 +1,4 @@
-//! Continuation of NLvib's Example 03 (notes §7) against the independent reference of
+//! Continuation of NLvib's Example 03 (src/formulation.md §7) against the independent reference of
 //! validation/nlvib03 (exact piecewise-linear flows, shooting, long time integration).
 use periodic_contact::analysis::continuation::{self, ContinuationSettings, Parameter};
 use serde_json::Value;

@@ -1,4 +1,4 @@
-//! Contact cases against semi-analytic periodic orbits (notes §6; `periodic_contact::exact`):
+//! Contact cases against semi-analytic periodic orbits (src/formulation.md §6; `periodic_contact::exact`):
 //! convergence orders of each scheme, error bounds, impulse per period, persistent contact.
 use periodic_contact::exact::{CompliantStopOrbit, Oscillator, PersistentContact, RigidRegime, RigidStopOrbit};
 use periodic_contact::model::{Compliance, Harmonic};
@@ -169,7 +169,7 @@ fn persistent_contact_follows_the_obstacle_and_the_force_converges() {
 }
 
 /// The periodic LCP with cds and forward pairing is the steady state of the explicit
-/// central-difference marcher with forward-increment multipliers (notes §5) on the same grid:
+/// central-difference marcher with forward-increment multipliers (src/formulation.md §5) on the same grid:
 /// marching from rest until the transients die must land on the same samples.
 #[test]
 fn cds_forward_equals_the_steady_state_of_explicit_time_marching() {

@@ -108,7 +108,7 @@ fn osc_problem(osc: &Oscillator, contacts: Vec<Contact>, scheme: Scheme, k: usiz
 const STICKING: Oscillator = Oscillator { mass: 1.0, damping: 0.1, stiffness: 1.0, force: 1.0, omega: 1.0 };
 const COMPLIANT: Oscillator = Oscillator { mass: 1.0, damping: 0.05, stiffness: 1.0, force: 1.0, omega: 1.3 };
 
-/// The rigid stop with sticking (notes §6.3), for each converging scheme and several k: the fast
+/// The rigid stop with sticking (src/formulation.md §6.3), for each converging scheme and several k: the fast
 /// path solves it and agrees with lemke; the answer is the exact orbit within the scheme's error.
 #[test]
 fn fast_path_agrees_with_lemke_on_the_rigid_stop_reference() {
@@ -141,7 +141,7 @@ fn fast_path_agrees_with_lemke_with_two_contacts() {
     }
 }
 
-/// The compliant stop (notes §6.2): `auto` agrees with lemke for every scheme at several k (on
+/// The compliant stop (src/formulation.md §6.2): `auto` agrees with lemke for every scheme at several k (on
 /// the fast path where it succeeds, through the fallback where it does not).
 #[test]
 fn auto_agrees_with_lemke_on_the_compliant_stop_reference() {
@@ -158,7 +158,7 @@ fn auto_agrees_with_lemke_on_the_compliant_stop_reference() {
     }
 }
 
-/// A case where block pivoting fails: the compliant stop of notes §6.2 under fourier (no
+/// A case where block pivoting fails: the compliant stop of src/formulation.md §6.2 under fourier (no
 /// time-stepping map, so `auto` takes the block-circulant chain) at k = 512 and 1024. Block
 /// pivoting does not reach a solution and its finishing Lemke run from the best basis ends on a
 /// ray; `pivoting` alone therefore fails, and `auto` falls back to full lexicographic Lemke and

@@ -161,7 +161,7 @@ fn fourier_interpolates_trigonometrically_the_continuous_response() {
 }
 
 /// The FMU's error estimate lies within a factor of 10 of the true error of its samples against
-/// the exact continuous linear response (notes §6.1, `exact::LinearResponse`).
+/// the exact continuous linear response (src/formulation.md §6.1, `exact::LinearResponse`).
 #[test]
 fn the_error_estimate_output_is_within_a_factor_of_ten_of_the_true_error() {
     let fmu = cds();
@@ -797,7 +797,7 @@ fn moving_obstacle_and_compliant_stop_match_the_cli() {
 }
 
 /// With `polish` on, the outputs at communication points between the instants are the exact
-/// orbit's (`periodic_contact::exact`, the rigid stop with sticking of notes §6.3) to 1e-8 of the
+/// orbit's (`periodic_contact::exact`, the rigid stop with sticking of src/formulation.md §6.3) to 1e-8 of the
 /// peak-to-peak amplitude, `polish.status` = 1, and a serialized FMU state restores the polished
 /// orbit; without contact outputs the polish falls back (`polish.status` = 2, a logged warning).
 #[test]

@@ -1,5 +1,5 @@
 //! Linear periodic response (no contact): every scheme reproduces its exact discrete response
-//! x_j = Re[w (σ2 M + σ1 C + w K)⁻¹ F e^{iωt_j}] (notes §6.1) and fourier the continuous one.
+//! x_j = Re[w (σ2 M + σ1 C + w K)⁻¹ F e^{iωt_j}] (src/formulation.md §6.1) and fourier the continuous one.
 //! The symbols are written out here again, independently of `time::Scheme::symbols`.
 use num_complex::Complex64 as C;
 use periodic_contact::scene::Scene;

@@ -1,4 +1,4 @@
-//! The event-fitted polish (`analysis::polish`) against the exact orbits of notes §6
+//! The event-fitted polish (`analysis::polish`) against the exact orbits of src/formulation.md §6
 //! (`periodic_contact::exact`, independent closed-form references) at k = 256: within 1e-8 of
 //! the peak-to-peak amplitude, in under a second each, and against long time integration on a
 //! 2-DOF compliant chain (`periodic_contact::marching`).

@@ -1,4 +1,4 @@
-//! The independent references (`exact`, `marching`) against the numbers of notes §6 and against
+//! The independent references (`exact`, `marching`) against the numbers of src/formulation.md §6 and against
 //! each other. Measured values quoted in comments come from runs of these tests.
 use periodic_contact::exact::*;
 use periodic_contact::marching::*;
@@ -383,7 +383,7 @@ fn march_linear_is_the_discrete_cds_orbit_and_second_order() {
         };
         let r = march(&model, &s).unwrap();
         assert!(r.converged, "n {n}: defect {:e}", r.defect);
-        // Discrete steady state (notes §6.1): Z(θ) = K + σ2 M + σ1 C with σ2 = −(2 sin(θ/2)/h)²,
+        // Discrete steady state (src/formulation.md §6.1): Z(θ) = K + σ2 M + σ1 C with σ2 = −(2 sin(θ/2)/h)²,
         // σ1 = i sin θ / h, θ = hω per harmonic. Rescale M and C so that the continuous helper
         // evaluates it harmonic by harmonic.
         let mut disc = vec![vec![0.0; 2]; n];

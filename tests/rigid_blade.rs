@@ -1,7 +1,7 @@
 //! The paper's case, the coarse blade with rigid tip contacts (fmu/scenes/blade-casing-rigid.toml):
 //! with `steps = "auto"` a sweep across the first bending resonance (2 265 rad/s) solves and
 //! certifies at every point; the same scene with cds at k = 512 is refused before solving with
-//! the limit named (notes §7: ω_max·h ≈ 3.2, 31 477 pivots and the pivot limit when tried).
+//! the limit named (src/formulation.md §7: ω_max·h ≈ 3.2, 31 477 pivots and the pivot limit when tried).
 use periodic_contact::periodic::{PeriodicSolver, SolveError};
 use periodic_contact::scene::{Scene, SceneError};
 use periodic_contact::sweep;

@@ -9,7 +9,7 @@ For every (case, scheme, pairing, k) of harness/cases.py:
                          phase of the first impact within 2/k;
   - test_cli_vs_discrete_marcher: the same k-periodic equations marched in time give the same
                          samples to 1e-6 (cds, galerkin, bds1, bds2; fourier cannot be marched);
-  - linear case: every scheme against the exact discrete formula of notes §6.1 to 1e-9.
+  - linear case: every scheme against the exact discrete formula of src/formulation.md §6.1 to 1e-9.
 Skipped while the CLI is absent (PC_REQUIRE_BINARIES=1: failed instead).
 """
 import pytest
@@ -111,6 +111,6 @@ def test_cli_linear_exact_discrete(solved, run):
     res = solved(case.name, run)
     assert not res.problems, res.problems
     d = checks.vs_linear_discrete(case, run, res.X(case.output_dofs), res.V(case.output_dofs))
-    REPORT.add(Row(case.name, f"CLI {run.label} vs exact discrete (notes §6.1)", d["x_max"], d["x_rms"],
+    REPORT.add(Row(case.name, f"CLI {run.label} vs exact discrete (src/formulation.md §6.1)", d["x_max"], d["x_rms"],
                    checks.LINEAR_DISCRETE_TOL, "", "", "", "pass" if not d["fails"] else "FAIL"))
     assert not d["fails"], "\n".join(d["fails"])

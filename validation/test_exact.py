@@ -1,4 +1,4 @@
-"""The exact references (marching/exact.py) reproduce the numbers of notes §6."""
+"""The exact references (marching/exact.py) reproduce the numbers of src/formulation.md §6."""
 import numpy as np
 import pytest
 

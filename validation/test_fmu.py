@@ -198,7 +198,7 @@ def test_fmu_polish_exact_between_samples(cli, workdir):
     """The shipped fmu/scenes/rigid-stop.toml (cds, k = 256) with the parameter polish = true set
     through fmpy's start values: at communication points between the samples (step 1.37 T/k over
     two periods) displacement, velocity, contact force and gap are the exact orbit's
-    (marching/exact.py, rigid stop with sticking, notes §6.3) within 1e-8 of the peak-to-peak
+    (marching/exact.py, rigid stop with sticking, src/formulation.md §6.3) within 1e-8 of the peak-to-peak
     amplitude, and polish.status = 1. Without the polish the same outputs are the interpolated
     samples, off by far more (the LCP's own error), which shows the check can fail."""
     import os

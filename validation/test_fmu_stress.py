@@ -60,7 +60,7 @@ INST, INIT, COMPLETE, FAILED, TERMINATED, ERRSTATE = ("instantiated", "initializ
 STATE_CODE = {INST: 0, INIT: 1, COMPLETE: 2, FAILED: 3, TERMINATED: 4, ERRSTATE: 5}
 ANY = frozenset(STATE_CODE)
 GETTERS = frozenset({INIT, COMPLETE, FAILED, TERMINATED, ERRSTATE})
-# The allowed-call table (notes §1.3). stepInProgress and stepCanceled never occur (this FMU
+# The allowed-call table (src/formulation.md §1.3). stepInProgress and stepCanceled never occur (this FMU
 # never returns fmi2Pending). In the error state only getters (incl. status and derivative
 # getters), Reset, FreeInstance, the FMU-state functions and SetDebugLogging are accepted.
 ALLOWED = {

@@ -15,7 +15,7 @@ from marching.model import Contact, Force, Motion, System, relative_errors
 from marching.multistep import march_multistep, stencils
 from marching.rigid import march_rigid
 
-# ------------------------------------------------------------------ exact references of notes §6
+# ------------------------------------------------------------------ exact references of src/formulation.md §6
 
 COMPLIANT = (1, 0.05, 1, 10, 1, 1, 1.3)   # m, c, k, kc, g0, F, Ω
 STICKING = (1, 0.1, 1, 1, 0.5, 1)          # m, c, k, F, g0, Ω
@@ -54,7 +54,7 @@ def test_compliant_marcher_vs_exact():
     di = abs(r.impulse[0] - o.impulse()) / o.impulse()
     dph = abs(r.first_onset_phase() - o.t0 / o.T)
     ok = ex < 1e-7 and ev < 1e-7 and di < 1e-8 and dph < 1e-8
-    _row("compliant_1dof", "compliant.py vs exact (notes §6.2)", ex, er, 1e-7,
+    _row("compliant_1dof", "compliant.py vs exact (src/formulation.md §6.2)", ex, er, 1e-7,
          f"{r.impulse[0]:.8f} (exact {o.impulse():.8f})", f"{r.first_onset_phase():.9f} (exact {o.t0 / o.T:.9f})",
          _cost(r), ok)
     assert ex < 1e-7 and ev < 1e-7, (ex, ev)
@@ -64,7 +64,7 @@ def test_compliant_marcher_vs_exact():
 
 
 def test_rigid_marcher_vs_exact_sticking():
-    """rigid.py reproduces the sticking orbit of notes §6.3: x, v to 1e-8 (measured ~1e-10),
+    """rigid.py reproduces the sticking orbit of src/formulation.md §6.3: x, v to 1e-8 (measured ~1e-10),
     impulse 2.80804 to 1e-8 relative, the impact instant and the sticking force."""
     r = continuous("rigid_stick_1dof")
     o = rigid_stop_sticking(*STICKING)
@@ -74,7 +74,7 @@ def test_rigid_marcher_vs_exact_sticking():
     di = abs(r.impulse[0] - o.impulse) / o.impulse
     (t_imp, i_imp, P), = r.impacts
     ok = ex < 1e-8 and ev < 1e-8 and di < 1e-8
-    _row("rigid_stick_1dof", "rigid.py vs exact (notes §6.3)", ex, er, 1e-8,
+    _row("rigid_stick_1dof", "rigid.py vs exact (src/formulation.md §6.3)", ex, er, 1e-8,
          f"{r.impulse[0]:.8f} (exact {o.impulse:.8f})", f"{t_imp / o.T:.9f} (exact {(o.th % o.T) / o.T:.9f})",
          _cost(r), ok)
     assert ex < 1e-8 and ev < 1e-8, (ex, ev)
@@ -175,7 +175,7 @@ def test_cds_compliant_orders(pairing, p, C):
                                           ("rigid_3dof_two_contacts", "forward"), ("compliant_2dof", "forward")])
 def test_multistep_cds_equals_central_difference(name, pairing):
     """The generic implicit marcher with the cds stencil and the explicit predictor/corrector of
-    notes §5 are the same recursion: equal to round-off."""
+    src/formulation.md §5 are the same recursion: equal to round-off."""
     s = CASES[name].system
     a = march_cds(s, 256, pairing=pairing, tol=1e-12)
     b = march_multistep(s, "cds", 256, pairing=pairing, tol=1e-12)
@@ -190,7 +190,7 @@ def test_multistep_cds_equals_central_difference(name, pairing):
     ("compliant_1dof", "cds", "same"), ("rigid_3dof_two_contacts", "cds", "forward"),
     ("moving_obstacle", "bds2", "same")])
 def test_discrete_marcher_solves_periodic_equations(name, scheme, pairing):
-    """The last period of a discrete marcher satisfies the periodic equations of notes §2-3:
+    """The last period of a discrete marcher satisfies the periodic equations of src/formulation.md §2-3:
     Σ_l (α_l M + β_l C + γ_l K) x_{j+l} + B^T z_j = Σ_l γ_l f_{j+l} (cyclic), z >= 0, and
     complementarity with the clearance at j + π (π = 1 forward, 0 same; a compliant contact
     z = k_c max(0, penetration))."""
@@ -224,7 +224,7 @@ def test_discrete_marcher_solves_periodic_equations(name, scheme, pairing):
 
 
 def test_discrete_marchers_linear_equal_symbols():
-    """Without contact the discrete marchers converge to the symbol formula of notes §6.1 (x, v, a)."""
+    """Without contact the discrete marchers converge to the symbol formula of src/formulation.md §6.1 (x, v, a)."""
     s = CASES["linear_2dof"].system
     for scheme in ("bds1", "bds2", "cds", "galerkin"):
         r = march_cds(s, 128, pairing="same", tol=1e-12) if scheme == "cds" else \

@@ -1,5 +1,5 @@
 //! An error estimate on every result: a second solve at k/2 and Richardson's extrapolation with
-//! the order the scheme has on this kind of contact (notes §3, README "Which scheme and pairing
+//! the order the scheme has on this kind of contact (src/formulation.md §3, README "Which scheme and pairing
 //! converge"). If the error is e_k ≈ C·h^p, then x_{k/2} − x_k ≈ C·h^p·(2^p − 1), so
 //! e_k ≈ max_j |x_{2j}^{(k)} − x_j^{(k/2)}| / (2^p − 1).
 //!
@@ -16,7 +16,7 @@ use crate::time::{Discretization, Pairing, Scheme};
 /// instants of a forward-paired scheme, its impulse spread over at most two steps).
 const STICK_RUN: usize = 4;
 
-/// The order of convergence of `problem`'s scheme on `r`'s contact regime and why (notes §3);
+/// The order of convergence of `problem`'s scheme on `r`'s contact regime and why (src/formulation.md §3);
 /// `None` when the combination is known not to converge.
 pub fn expected_order(problem: &PeriodicProblem, r: &Response) -> (Option<f64>, String) {
     let scheme = problem.discretization().scheme;

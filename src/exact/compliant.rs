@@ -1,4 +1,4 @@
-//! Bilinear oscillator (compliant stop, notes §6.2):
+//! Bilinear oscillator (compliant stop, src/formulation.md §6.2):
 //!
 //!   m x'' + c x' + k x + k_c·max(0, x − g0) = F cos Ωt,
 //!

@@ -1,4 +1,4 @@
-//! Closed-form flow of one linear phase  m x'' + c x' + κ x = F cos Ωt + b  (notes §6.2).
+//! Closed-form flow of one linear phase  m x'' + c x' + κ x = F cos Ωt + b  (src/formulation.md §6.2).
 //!
 //! The state s = (x, v) is split into the particular periodic solution
 //! P(t) = (Re[X e^{iΩt}] + b/κ, Re[iΩ X e^{iΩt}]), X = F / (κ − Ω² m + iΩc),

@@ -1,4 +1,4 @@
-//! Contact-free steady states (notes §6.1): x(t) = Re[(K − Ω²M + iΩC)⁻¹ F e^{iΩt}].
+//! Contact-free steady states (src/formulation.md §6.1): x(t) = Re[(K − Ω²M + iΩC)⁻¹ F e^{iΩt}].
 use super::{ExactError, Oscillator};
 use crate::model::{Force, Model};
 use faer::Mat;
@@ -6,7 +6,7 @@ use faer::linalg::solvers::Solve;
 use num_complex::Complex64 as C64;
 
 /// Steady state of m x'' + c x' + k x = F cos Ωt: x(t) = Re[X e^{iΩt}],
-/// X = F / (k − Ω² m + iΩc)  (notes §6.1).
+/// X = F / (k − Ω² m + iΩc)  (src/formulation.md §6.1).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LinearOrbit {
     osc: Oscillator,

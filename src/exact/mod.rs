@@ -1,8 +1,8 @@
 //! Independent references: semi-analytic periodic orbits of the 1-DOF oscillator
 //! m x'' + c x' + k x = F cos Ωt (forcing phase 0), with and without a unilateral stop
-//! (notes §6), and the multi-DOF linear steady state (notes §6.1).
+//! (src/formulation.md §6), and the multi-DOF linear steady state (src/formulation.md §6.1).
 //!
-//! Sign convention (notes §1, `model` module): the stop acts on x with direction s = +1, i.e.
+//! Sign convention (src/formulation.md §1, `model` module): the stop acts on x with direction s = +1, i.e.
 //! x ≤ g0 (clearance g0 − x ≥ 0), and its compressive force z ≥ 0 pushes the mass by −z:
 //! m x'' + c x' + k x = F cos Ωt − z.
 //!

@@ -1,4 +1,4 @@
-//! Persistent contact with a moving obstacle (notes §6.4): the obstacle clearance
+//! Persistent contact with a moving obstacle (src/formulation.md §6.4): the obstacle clearance
 //! gap(t) = g0 + Σ a_h cos(hΩt + φ_h) keeps a rigid contact closed on the 1-DOF oscillator.
 //!
 //! Contact direction s ∈ {+1, −1} (s·x ≤ gap(t)); closed contact: x(t) = s·gap(t). The

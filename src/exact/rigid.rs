@@ -1,4 +1,4 @@
-//! Rigid stop with a perfectly plastic impact (restitution 0), notes §6.3:
+//! Rigid stop with a perfectly plastic impact (restitution 0), src/formulation.md §6.3:
 //!
 //!   m x'' + c x' + k x = F cos Ωt − z,   x ≤ g0,  z ≥ 0,  z·(g0 − x) = 0,
 //!
@@ -266,7 +266,7 @@ impl RigidStopOrbit {
             _ => None,
         }
     }
-    /// Impulse per period = m v(t_h⁻) + ∫_{stick} (F cos Ωt − k g0) dt (notes §6.3), exact.
+    /// Impulse per period = m v(t_h⁻) + ∫_{stick} (F cos Ωt − k g0) dt (src/formulation.md §6.3), exact.
     pub fn impulse_per_period(&self) -> f64 {
         let (f, k, w, g0) = (self.osc.force, self.osc.stiffness, self.osc.omega, self.gap);
         let period = self.osc.period();

@@ -1,4 +1,4 @@
-//! Explicit time-marching reference (notes §5): central differences with forward-increment
+//! Explicit time-marching reference (src/formulation.md §5): central differences with forward-increment
 //! Lagrange multipliers (Carpenter, Taylor & Katona 1991), for dense multi-DOF models.
 //!
 //! In the user-facing signs of [`crate::model`] (contact i: `s_i·x[d_i] ≤ gap_i(t)`, row i of B is

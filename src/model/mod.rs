@@ -1,5 +1,5 @@
 //! The mechanical model: M x'' + C x' + K x = f(t) − Bᵀ z on the circle of period T = 2π/ω,
-//! with m unilateral contacts (notes §1).
+//! with m unilateral contacts (src/formulation.md §1).
 //!
 //! Sign conventions (user-facing, the paper's λ = −force, g = −gap):
 //! - contact `i` with direction s ∈ {+1, −1} acts on DOF d: s·x[d] ≤ gap(t);

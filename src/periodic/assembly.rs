@@ -1,4 +1,4 @@
-//! Frequency-domain assembly (notes §2–3): one complex n×n factorisation per distinct harmonic
+//! Frequency-domain assembly (src/formulation.md §2–3): one complex n×n factorisation per distinct harmonic
 //! p = 0..=k/2 of Ẑ_p = σ2_p M + σ1_p C + w_p K, never the kn×kn system.
 //! From it: the receptance between contacts Ĝ_p = B Ẑ_p⁻¹ Bᵀ, the contact-free response
 //! X̂lin_p = Ẑ_p⁻¹ w_p F̂_p, and Ẑ_p⁻¹ Bᵀ at the DOFs that are output.

@@ -3,7 +3,7 @@
 //!
 //! Why refuse rather than try: past its limit a scheme's recurrence is unstable, its periodic
 //! operator has near-singular harmonics and the LCP is ill-posed (the coarse rigid blade at
-//! ω = 2300 rad/s, k = 512 under cds: ω_max·h ≈ 3.2, Lemke wanders for 31 477 pivots; notes §7).
+//! ω = 2300 rad/s, k = 512 under cds: ω_max·h ≈ 3.2, Lemke wanders for 31 477 pivots; src/formulation.md §7).
 use super::SolveError;
 use crate::model::Model;
 use crate::time::{Discretization, Scheme};

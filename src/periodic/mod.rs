@@ -1,5 +1,5 @@
 //! The periodic contact problem: assembly in the frequency domain, one LCP over the period,
-//! recovery of the requested responses (notes §2–3).
+//! recovery of the requested responses (src/formulation.md §2–3).
 mod assembly;
 mod cache;
 pub mod limits;
@@ -114,11 +114,11 @@ impl From<SolveError> for Error {
 }
 
 /// The typed failure of an LCP solve, with the remedies to try. Scheme limits are refused before
-/// solving, so the remedies left are the ones of notes §3.
+/// solving, so the remedies left are the ones of src/formulation.md §3.
 pub(crate) fn lcp_failure(sol: LcpSolution) -> SolveError {
     let hint = match sol.outcome {
         LcpOutcome::RayTermination => {
-            "no periodic solution was reached (the LCP matrix is not a P-matrix above the first resonance); remedies: for rigid contact use cds or galerkin with pairing = \"forward\" or bds1 with pairing = \"same\" (notes §3), add damping, or make the contact compliant (stiffness = …)"
+            "no periodic solution was reached (the LCP matrix is not a P-matrix above the first resonance); remedies: for rigid contact use cds or galerkin with pairing = \"forward\" or bds1 with pairing = \"same\" (src/formulation.md §3), add damping, or make the contact compliant (stiffness = …)"
         }
         LcpOutcome::PivotLimit => {
             "the pivot budget ran out (a degenerate or ill-posed LCP); remedies: for rigid contact use cds or galerkin with pairing = \"forward\" or bds1 with pairing = \"same\", add damping, or make the contact compliant (stiffness = …)"

@@ -1,4 +1,4 @@
-//! Recovery (notes §3): X̂_p = X̂lin_p − (Ẑ_p⁻¹Bᵀ) ẑ_p at the output DOFs only, velocities and
+//! Recovery (src/formulation.md §3): X̂_p = X̂lin_p − (Ẑ_p⁻¹Bᵀ) ẑ_p at the output DOFs only, velocities and
 //! accelerations by the symbols σ1, σ2; contact gaps from B X̂_p = B X̂lin_p − Ĝ_p ẑ_p.
 use super::{Assembly, PeriodFft, PeriodicProblem, SolveError};
 use crate::lcp::{AUTO_LEMKE_MAX, LcpMethod, LcpSolution, LcpStep, WarmOutcome};

@@ -1,7 +1,7 @@
 //! The period's LCP as a time-stepping map (for `lcp`'s shooting solver): the difference schemes
 //! in state-space form.
 //!
-//! Row j of the global system Z X + (I ⊗ B)ᵀ z = F̄ (notes §2) for a difference scheme reads
+//! Row j of the global system Z X + (I ⊗ B)ᵀ z = F̄ (src/formulation.md §2) for a difference scheme reads
 //! Σ_{i=0..p} N_i x_{j+L−i} + Bᵀ z_j = f̄_j, N_i = a2_i M + a1_i C + a0_i K, with the coefficients
 //! of the symbols (z = one-step delay):
 //!

@@ -1,4 +1,4 @@
-//! Craig–Bampton reduction (notes §4).
+//! Craig–Bampton reduction (src/formulation.md §4).
 //!
 //! Boundary DOFs x_b (every contact DOF, plus any extra DOF: forced or observed DOFs are best kept
 //! there too) stay physical; internal DOFs x_i are represented by static modes

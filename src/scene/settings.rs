@@ -47,7 +47,7 @@ pub fn solver_settings(spec: Option<&SolverSpec>) -> Result<SolverSettings, Buil
 }
 
 /// Why `[solver] regularization` is refused, and what to write instead.
-const REGULARIZATION_REMOVED: &str = "was removed: its retry solved A + ε·max|A|·I, which is exactly the LCP of every contact made compliant with stiffness 1/(ε·max|A|), a different physical problem presented as the rigid one; remedy: delete the key and, if a compliant contact is what you mean, declare it on the contact with stiffness = … (a scale: the structure's own stiffness at the contact DOF, the diagonal entry of K there; larger is closer to rigid); for rigid contact use cds or galerkin with pairing = \"forward\" or bds1 with pairing = \"same\" (notes §3), or add damping";
+const REGULARIZATION_REMOVED: &str = "was removed: its retry solved A + ε·max|A|·I, which is exactly the LCP of every contact made compliant with stiffness 1/(ε·max|A|), a different physical problem presented as the rigid one; remedy: delete the key and, if a compliant contact is what you mean, declare it on the contact with stiffness = … (a scale: the structure's own stiffness at the contact DOF, the diagonal entry of K there; larger is closer to rigid); for rigid contact use cds or galerkin with pairing = \"forward\" or bds1 with pairing = \"same\" (src/formulation.md §3), or add damping";
 
 /// `[discretization] error_estimate`: whether every result gets an error estimate (default
 /// `"richardson"`, a second solve at k/2; `"none"` skips it).

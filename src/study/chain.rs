@@ -1,6 +1,6 @@
 //! The 2-DOF compliant chain of tests/polish.rs (M = I, K = [[2, −1], [−1, 2]], C = 0.1·I,
 //! 1.0·cos 1.2t on DOF 0, a stop of stiffness 20 at 0.3 on DOF 1) and its reference: no closed
-//! form, so long explicit time integration (notes §5, `marching::march`, independent of the
+//! form, so long explicit time integration (src/formulation.md §5, `marching::march`, independent of the
 //! periodic LCP), Richardson-extrapolated over the marcher's O(h²) error. Finer marches do not
 //! help: past 2^15 steps per period the marcher's round-off grows (measured: |polish − march| =
 //! 1.9e-6, 5.4e-7, 1.5e-7, 2.0e-7 at 2^13 … 2^16, and no steady state to 1e-10 at 2^17).

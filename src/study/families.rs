@@ -1,7 +1,7 @@
 //! The 1-DOF families of `bench` and of the estimate study: a nominal member and members drawn
 //! uniformly within each family's ranges (seeded), so that a claim is measured on a family,
 //! worst case first, rather than on a favourite case. The exact orbit of every member is known
-//! (notes §6.2, §6.3).
+//! (src/formulation.md §6.2, §6.3).
 use crate::exact::Oscillator;
 
 /// SplitMix64 (Steele, Lea & Flood 2014): a seeded, dependency-free stream for the draws.

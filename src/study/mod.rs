@@ -1,5 +1,5 @@
 //! Studies of what accuracy costs (issue 6): the accuracy–cost study against the exact references
-//! of notes §6 with the explicit time-marching reference on the same axes, and warm starts.
+//! of src/formulation.md §6 with the explicit time-marching reference on the same axes, and warm starts.
 //!
 //! Everything is measured on one thread (`SolverSettings::parallel = false`, the marcher is
 //! single-threaded), so that the times are CPU times.
@@ -17,7 +17,7 @@ use crate::periodic::{LcpMethod, OutputSelection, PeriodicProblem, SolverSetting
 use crate::time::{Discretization, Pairing, Scheme};
 use chain::MarchedReference;
 
-/// The exact references of notes §6 used by the studies.
+/// The exact references of src/formulation.md §6 used by the studies.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Case {
     /// §6.2: m = 1, c = 0.05, k = 1, k_c = 10, g0 = 1, F = 1, Ω = 1.3.
@@ -36,12 +36,12 @@ pub enum Case {
     Chain,
 }
 
-/// The compliant-stop oscillator of notes §6.2 (also the linear case's).
+/// The compliant-stop oscillator of src/formulation.md §6.2 (also the linear case's).
 pub const COMPLIANT_OSC: Oscillator = Oscillator { mass: 1.0, damping: 0.05, stiffness: 1.0, force: 1.0, omega: 1.3 };
-/// Contact stiffness and gap of notes §6.2.
+/// Contact stiffness and gap of src/formulation.md §6.2.
 pub const COMPLIANT_STIFFNESS: f64 = 10.0;
 pub const COMPLIANT_GAP: f64 = 1.0;
-/// The rigid stop with sticking of notes §6.3.
+/// The rigid stop with sticking of src/formulation.md §6.3.
 pub const RIGID_OSC: Oscillator = Oscillator { mass: 1.0, damping: 0.1, stiffness: 1.0, force: 1.0, omega: 1.0 };
 pub const RIGID_GAP: f64 = 0.5;
 /// The pure-impact rigid stop (see [`Case::Impacting`]).
@@ -70,9 +70,9 @@ impl Case {
 
     pub fn title(self) -> &'static str {
         match self {
-            Case::Compliant => "compliant stop (notes §6.2)",
-            Case::Rigid => "rigid stop with sticking (notes §6.3)",
-            Case::Linear => "linear oscillator (notes §6.1)",
+            Case::Compliant => "compliant stop (src/formulation.md §6.2)",
+            Case::Rigid => "rigid stop with sticking (src/formulation.md §6.3)",
+            Case::Linear => "linear oscillator (src/formulation.md §6.1)",
             Case::Impacting => "rigid stop, pure impacts (no sticking)",
             Case::Chain => "2-DOF compliant chain (reference: long time integration)",
         }
@@ -123,7 +123,7 @@ impl Case {
         v
     }
 
-    /// Whether (scheme, pairing) converges to the exact orbit (notes §3 findings; the README table).
+    /// Whether (scheme, pairing) converges to the exact orbit (src/formulation.md §3 findings; the README table).
     pub fn converges(self, scheme: Scheme, pairing: Option<Pairing>) -> bool {
         match self {
             Case::Linear | Case::Compliant | Case::Chain => true,

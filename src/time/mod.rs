@@ -1,5 +1,5 @@
 //! Discretisation of the period: k instants t_j = j·T/k on the circle, time derivatives as
-//! circulant operators described by their DFT symbols (notes §2).
+//! circulant operators described by their DFT symbols (src/formulation.md §2).
 mod scheme;
 pub use scheme::{Pairing, Scheme, SchemeParseError, Symbols};
 

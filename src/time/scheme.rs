@@ -1,4 +1,4 @@
-//! Circulant symbols of each time scheme (notes §2, table). With the DFT
+//! Circulant symbols of each time scheme (src/formulation.md §2, table). With the DFT
 //! X̂_p = Σ_j x_j e^{−2πi jp/k}, a one-step delay has the symbol z = e^{−iθ}, θ = 2πp/k.
 use num_complex::Complex64 as C;
 use std::fmt;
@@ -43,7 +43,7 @@ impl Scheme {
     /// The largest ω_max·h (h = T/k, ω_max the model's highest undamped angular frequency) for
     /// which the scheme's recurrence is stable; `None`: no limit (A-stable, or not a time stepper).
     ///
-    /// From the symbols of notes §2 applied to one mode m x'' + k x = 0, Ω = ω_r·h, z the one-step
+    /// From the symbols of src/formulation.md §2 applied to one mode m x'' + k x = 0, Ω = ω_r·h, z the one-step
     /// shift of x_j = zʲ:
     /// - cds: z − 2 + z⁻¹ + Ω² = 0, so z + z⁻¹ = 2 − Ω²; both roots lie on the unit circle iff
     ///   |2 − Ω²| < 2, i.e. Ω < 2 (explicit central differences, Ω = 2 a double root −1 that
@@ -61,7 +61,7 @@ impl Scheme {
         }
     }
 
-    /// The pairing that converges for rigid contact (notes §3, findings).
+    /// The pairing that converges for rigid contact (src/formulation.md §3, findings).
     pub fn default_pairing(self, rigid: bool) -> Pairing {
         match self {
             Scheme::Cds | Scheme::Galerkin if rigid => Pairing::Forward,

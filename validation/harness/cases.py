@@ -70,19 +70,19 @@ def _add(case: Case) -> None:
     CASES[case.name] = case
 
 
-# 1. notes §6.3: m = 1, c = 0.1, k = 1, F = 1, g0 = 0.5, Ω = 1 -> min x = -1.869854, impulse 2.80804.
+# 1. src/formulation.md §6.3: m = 1, c = 0.1, k = 1, F = 1, g0 = 0.5, Ω = 1 -> min x = -1.869854, impulse 2.80804.
 #    Rigid: cds and galerkin with forward pairing (2nd order with sticking), bds1 same (1st order).
 _add(Case(
-    "rigid_stick_1dof", "1-DOF rigid stop with sticking (notes §6.3)",
+    "rigid_stick_1dof", "1-DOF rigid stop with sticking (src/formulation.md §6.3)",
     System.build([[1.0]], [[1.0]], 1.0, forces=[Force(0, 1.0)], contacts=[Contact(0, 0.5)], damping=[[0.1]]),
     "rigid",
     (Run("cds", "forward", 512), Run("galerkin", "forward", 512), Run("bds1", "same", 512)),
     Run("cds", "forward", 512)))
 
-# 2. notes §6.2: bilinear oscillator, t0/T = 0.9389205916, t1/T = 1.1343892296, v0 = 4.460827031.
+# 2. src/formulation.md §6.2: bilinear oscillator, t0/T = 0.9389205916, t1/T = 1.1343892296, v0 = 4.460827031.
 #    Compliant: every scheme with the same-instant pairing.
 _add(Case(
-    "compliant_1dof", "1-DOF compliant stop (notes §6.2)",
+    "compliant_1dof", "1-DOF compliant stop (src/formulation.md §6.2)",
     System.build([[1.0]], [[1.0]], 1.3, forces=[Force(0, 1.0)], contacts=[Contact(0, 1.0, stiffness=10.0)],
                  damping=[[0.05]]),
     "compliant",

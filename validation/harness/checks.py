@@ -15,7 +15,7 @@ from .cases import Case, Run
 # distance to the periodic sequence < 1e-9). 1e-6 leaves room for the LCP residual and
 # conditioning; anything larger means different equations (or another of several solutions).
 TIGHT = 1e-6
-# Engine vs the exact discrete formula of notes §6.1 (linear case): round-off.
+# Engine vs the exact discrete formula of src/formulation.md §6.1 (linear case): round-off.
 LINEAR_DISCRETE_TOL = 1e-9
 
 

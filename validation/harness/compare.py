@@ -54,7 +54,7 @@ CONSTANTS = {
     ("linear", "cds", "same"): {"x": 0.35, "v": 0.5, "impulse": None},           # 0.108, 0.156
     ("linear", "galerkin", "same"): {"x": 0.35, "v": 0.4, "impulse": None},      # 0.106, 0.120
 }
-# fourier on a linear case reproduces the continuous solution to round-off (notes §6.1)
+# fourier on a linear case reproduces the continuous solution to round-off (src/formulation.md §6.1)
 FOURIER_LINEAR_TOL = 1e-9
 
 

@@ -1,4 +1,4 @@
-"""Explicit central differences with forward-increment Lagrange multipliers (notes §5; Carpenter,
+"""Explicit central differences with forward-increment Lagrange multipliers (src/formulation.md §5; Carpenter,
 Taylor & Katona 1991), in the user-facing signs (clearance c = gap - B x >= 0, force z >= 0):
 
     Ŵ = (M/h² + C/(2h))^-1

@@ -1,8 +1,8 @@
-"""Exact periodic references (notes §6), independent of any marcher and of the Rust engine.
+"""Exact periodic references (src/formulation.md §6), independent of any marcher and of the Rust engine.
 
 - `linear_response`: continuous steady state without contact, any number of DOFs and harmonics.
 - `linear_discrete`: the same for a discretised period (bds1, bds2, cds, galerkin, fourier), from
-  the schemes' symbols (notes §2 and §6.1): what the engine must reproduce to round-off.
+  the schemes' symbols (src/formulation.md §2 and §6.1): what the engine must reproduce to round-off.
 - `compliant_stop`: 1-DOF bilinear oscillator m x'' + c x' + k x + k_c max(0, x - g0) = F cos Ωt,
   closed-form flows in both phases, Newton (scipy `root`) on (t0, t1, v0).
 - `rigid_stop_sticking`: 1-DOF, rigid stop x <= g0 with plastic impact and a sticking phase.
@@ -50,7 +50,7 @@ def linear_response(sys_: System, t):
 
 def scheme_symbols(scheme: str, theta: float, h: float, p: int | None = None, k: int | None = None,
                    omega: float | None = None):
-    """(σ1, σ2, w) of a scheme at θ (notes §2), z = e^{-iθ}. Fourier needs the signed wavenumber p,
+    """(σ1, σ2, w) of a scheme at θ (src/formulation.md §2), z = e^{-iθ}. Fourier needs the signed wavenumber p,
     k and ω instead."""
     z = np.exp(-1j * theta)
     if scheme == "bds1":
@@ -71,7 +71,7 @@ def scheme_symbols(scheme: str, theta: float, h: float, p: int | None = None, k:
 
 
 def linear_discrete(sys_: System, scheme: str, steps: int):
-    """Discrete contact-free periodic solution at t_j = j T/k (notes §6.1): x, v, a (n, k), where
+    """Discrete contact-free periodic solution at t_j = j T/k (src/formulation.md §6.1): x, v, a (n, k), where
     v and a are the scheme's derivative symbols applied to x."""
     k = steps
     T = sys_.period
@@ -250,7 +250,7 @@ def _seed_compliant(m, c, k, kc, g0, F, Omega, max_periods=2000):
 
 
 def compliant_stop(m, c, k, kc, g0, F, Omega, guess=None) -> CompliantStopOrbit:
-    """Solve for the orbit with one contact phase per period (notes §6.2); t0 in [0, T)."""
+    """Solve for the orbit with one contact phase per period (src/formulation.md §6.2); t0 in [0, T)."""
     args = (m, c, k, kc, g0, F, Omega)
     u = np.asarray(guess, dtype=float) if guess is not None else _seed_compliant(*args)
     sol = root(_compliant_residual, u, args=args, method="hybr", options={"xtol": 1e-15})

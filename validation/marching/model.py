@@ -2,7 +2,7 @@
 
     M x'' + C x' + K x = f(t) - B^T z(t)
 
-Sign conventions (notes §1, user-facing): contact i with direction s in {+1, -1} acts on DOF d and
+Sign conventions (src/formulation.md §1, user-facing): contact i with direction s in {+1, -1} acts on DOF d and
 enforces s*x[d] <= gap(t). Its clearance is gap(t) - s*x[d] >= 0, its force z >= 0 is compressive
 and pushes DOF d by -s*z, so row i of B is s*e_d^T. A compliant (penalty) contact of stiffness k_c
 carries z = k_c * max(0, s*x[d] - gap(t)); a rigid one satisfies Signorini's conditions.

@@ -1,4 +1,4 @@
-"""Implicit time marching of the engine's *discrete* equations (notes §2), one step at a time.
+"""Implicit time marching of the engine's *discrete* equations (src/formulation.md §2), one step at a time.
 
 The periodic schemes are linear multistep stencils. Row j of the periodic system reads
 
@@ -13,7 +13,7 @@ periodic LCP for that scheme and pairing exactly, so it is a *discrete* referenc
 different algorithm (marching instead of one LCP over the period), sharing no code with the
 engine. `fourier` is global in time and cannot be marched.
 
-Galerkin: the weight w = (2 + cos θ)/3 multiplies K and f (notes §2); the contact force sample is
+Galerkin: the weight w = (2 + cos θ)/3 multiplies K and f (src/formulation.md §2); the contact force sample is
 taken unweighted here (assumption, to be confirmed against the engine).
 """
 from __future__ import annotations

@@ -123,11 +123,11 @@ def ensure_siconos(install: bool = True, log=print) -> tuple[bool, str]:
 # gap(s), a few per cent, so the regime (sticking, two stops, compliant contact) stays the same.
 CASES = {
     "rigid": {"scene": "rigid-stop.toml", "steps_line": "steps = 256", "m": 1,
-              "what": "rigid stop with sticking (notes §6.3; cds, forward pairing; 1 contact, k = N)"},
+              "what": "rigid stop with sticking (src/formulation.md §6.3; cds, forward pairing; 1 contact, k = N)"},
     "chain": {"scene": "chain-3dof-two-stops.toml", "steps_line": "steps = 256", "m": 2,
               "what": "3-DOF chain with two rigid stops (cds, forward pairing; 2 contacts, k = N/2)"},
     "compliant": {"scene": "compliant-stop.toml", "steps_line": "steps = 512", "m": 1,
-                  "what": "compliant stop (notes §6.2; cds, same-instant pairing; 1 contact, k = N)"},
+                  "what": "compliant stop (src/formulation.md §6.2; cds, same-instant pairing; 1 contact, k = N)"},
 }
 FREQUENCY_SPREAD = 0.05  # a random member's frequency: nominal x U(1 - 0.05, 1 + 0.05)
 GAP_SPREAD = 0.10  # each gap: nominal x U(1 - 0.10, 1 + 0.10)
@@ -238,7 +238,7 @@ def short_path(path: str) -> str:
 def rigid_system():
     from marching.model import Contact, Force, System
 
-    # notes §6.3: m = 1, c = 0.1, k = 1, F = 1 cos t, rigid stop x <= 0.5 (fmu/scenes/rigid-stop.toml)
+    # src/formulation.md §6.3: m = 1, c = 0.1, k = 1, F = 1 cos t, rigid stop x <= 0.5 (fmu/scenes/rigid-stop.toml)
     return System.build([[1.0]], [[1.0]], 1.0, forces=[Force(0, 1.0)], contacts=[Contact(0, 0.5)], damping=[[0.1]])
 
 

@@ -2,7 +2,7 @@
 //!
 //! The multipliers are the eigenvalues of the discrete monodromy dP/ds_0 (the period map's
 //! Jacobian with the active sets frozen); they converge to the continuous orbit's as k grows
-//! (notes §7). The test functions change sign where a bifurcation lies between two points:
+//! (src/formulation.md §7). The test functions change sign where a bifurcation lies between two points:
 //! - period doubling: det(I + M) = Π(1 + μ) (complex pairs give |1 + μ|² > 0, so only a real
 //!   multiplier through −1 changes its sign; Kuznetsov, "Elements of Applied Bifurcation
 //!   Theory", §10.2);

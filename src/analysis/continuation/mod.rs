@@ -7,7 +7,7 @@
 //! arclength condition. P is piecewise affine in s_0 (a piece per active sets), so Newton is exact
 //! on a piece and the path crosses kinks (grazings, stick/release, nonsmooth folds) by
 //! shortening its step. Each point's Floquet multipliers are the eigenvalues of dP/ds_0 with the
-//! active sets frozen (the discrete monodromy, notes §7); events are located by bisection
+//! active sets frozen (the discrete monodromy, src/formulation.md §7); events are located by bisection
 //! ([`events`]). Every reported point is certified as the LCP `solve` solves: the branch's
 //! session ([`PeriodicSolver`]) solves it warm-started from the point's active sets, and its
 //! amplitudes are that certified response's.

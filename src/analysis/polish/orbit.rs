@@ -136,7 +136,7 @@ impl PolishedOrbit {
     }
 
     /// Plastic impact of contact `i` at `t`, the contacts `stuck` staying on their obstacles:
-    /// v⁺ = v⁻ − M⁻¹Bᵀ P with B v⁺ = ġ (notes §5's forward increment, in one instant).
+    /// v⁺ = v⁻ − M⁻¹Bᵀ P with B v⁺ = ġ (src/formulation.md §5's forward increment, in one instant).
     fn impact(&self, i: usize, stuck: &[usize], y: &DVector<f64>, t: f64) -> Option<(DVector<f64>, f64)> {
         let n = self.model.n();
         let mut set: Vec<usize> = stuck.to_vec();

@@ -3,7 +3,7 @@
 //! forcing. The stuck DOFs follow their obstacle, x_c = s·gap(t); the free DOFs obey
 //! M_ff x_f'' + C_ff x_f' + K_ff x_f = f_f − M_fc x_c'' − C_fc x_c' − K_fc x_c, whose flow is the
 //! periodic particular solution plus e^{Aτ} applied to the rest (the matrix exponential of the
-//! first-order form, as in notes §6.2 for one DOF).
+//! first-order form, as in src/formulation.md §6.2 for one DOF).
 use crate::model::{Compliance, Model};
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64 as C;

@@ -55,7 +55,7 @@ const BLADE: &str = include_str!("../../../fmu/scenes/blade-casing-rigid.toml");
 const CASES: [Case; 5] = [
     Case {
         name: "rigid-stick",
-        about: "rigid 1-DOF stop with sticking (0 < k·g0 < F; notes §6.3): m = k = 1, F = 1, cds, forward pairing",
+        about: "rigid 1-DOF stop with sticking (0 < k·g0 < F; src/formulation.md §6.3): m = k = 1, F = 1, cds, forward pairing",
         member: |steps, rng| oscillator(steps, Family::RigidStick, rng),
     },
     Case {
@@ -65,7 +65,7 @@ const CASES: [Case; 5] = [
     },
     Case {
         name: "compliant",
-        about: "compliant 1-DOF stop (notes §6.2: m = k = 1, g0 = 1), cds",
+        about: "compliant 1-DOF stop (src/formulation.md §6.2: m = k = 1, g0 = 1), cds",
         member: |steps, rng| oscillator(steps, Family::Compliant, rng),
     },
     Case {

@@ -143,6 +143,6 @@ pub fn run_default() -> Result<(), Failure> {
     for (k, v) in rows {
         println!("  {k:<34} {v:>14}");
     }
-    println!("  exact (notes §6.3): min displacement −1.869854, impulse per period 2.80804");
+    println!("  exact (src/formulation.md §6.3): min displacement −1.869854, impulse per period 2.80804");
     Ok(())
 }

@@ -1,4 +1,4 @@
-//! One FMU instance: the state machine of FMI 2.0 co-simulation (notes §1.3) over a model.
+//! One FMU instance: the state machine of FMI 2.0 co-simulation (src/formulation.md §1.3) over a model.
 use super::logger::{Logger, to_cstring};
 use super::machine::*;
 use super::types::*;

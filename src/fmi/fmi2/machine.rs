@@ -1,4 +1,4 @@
-//! The co-simulation state machine of FMI 2.0 (notes §1.3): the states, the masks of the
+//! The co-simulation state machine of FMI 2.0 (src/formulation.md §1.3): the states, the masks of the
 //! allowed-call table, and the clock an FMU state keeps.
 use crate::error::{Error, Result};
 use crate::fmi::state::{StateReader, StateWriter};

@@ -129,7 +129,7 @@ impl StepMapLcp {
 
     /// [dP/ds0 | dP/dδ] (d×(d+1), δ a uniform offset of every pair's r_j) on the piece of these
     /// active sets; at a closed orbit dP/ds0 is the discrete monodromy matrix, whose eigenvalues
-    /// are the orbit's Floquet multipliers as k grows (notes §7).
+    /// are the orbit's Floquet multipliers as k grows (src/formulation.md §7).
     pub fn period_jacobian(&self, masks: &[u32]) -> Mat<f64> {
         let mut j = Mat::zeros(self.d, self.d + 1);
         period_jacobian(self, masks, &PhiPowers::new(self), &mut j);

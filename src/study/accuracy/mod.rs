@@ -1,9 +1,9 @@
-//! `study accuracy`: what accuracy costs. For every case (notes §6's exact references, a pure-impact
+//! `study accuracy`: what accuracy costs. For every case (src/formulation.md §6's exact references, a pure-impact
 //! rigid stop, a 2-DOF compliant chain against long time integration) and every scheme and
 //! pairing, k = 32 … 8192: the periodic LCP's error against its wall time, its error estimate
 //! (`analysis::accuracy`, Richardson from k/2) beside the true error, the same result after the
 //! event-fitted polish (`analysis::polish`, time = solve + polish), the explicit time-marching
-//! reference (notes §5) and Siconos' Lemke on the same LCPs ([`super::peers`]), all on the same
+//! reference (src/formulation.md §5) and Siconos' Lemke on the same LCPs ([`super::peers`]), all on the same
 //! axes; then the estimates' honesty on random members of the exact families
 //! ([`super::honesty`]). Writes `accuracy.csv`, `estimate.csv`, `accuracy.md`, `accuracy.png`.
 //!
@@ -134,7 +134,7 @@ pub struct Row {
     pub kind: Kind,
     /// k (periodic) or steps per period (marching).
     pub steps: usize,
-    /// Converges to the exact orbit according to notes §3 (marching: the plastic-impact orbit).
+    /// Converges to the exact orbit according to src/formulation.md §3 (marching: the plastic-impact orbit).
     pub converges: bool,
     /// "ok", "failed: …" or "skipped: …".
     pub status: String,

@@ -156,7 +156,7 @@ impl AccuracyStudy {
         let _ = writeln!(
             s,
             "Error: max over the samples (and DOFs) of |x_j − x_ref(t_j)| divided by the reference's peak-to-peak amplitude. References: the exact \
-             orbits of `src/exact/` (notes §6) and, for the 2-DOF chain (no closed form), explicit time marching at {n} and {n2} steps per period, \
+             orbits of `src/exact/` (src/formulation.md §6) and, for the 2-DOF chain (no closed form), explicit time marching at {n} and {n2} steps per period, \
              Richardson-extrapolated; its own error bound, the Richardson correction, is {unc}, and a chain run reaches a tolerance only when its \
              error plus that bound is below it. Wall time of one thread: periodic = assembly + LCP + recovery (`timing_s`); polished = that + the \
              event-fitted polish; marching = explicit central differences with forward-increment multipliers (`marching::march`) from rest until \
@@ -183,7 +183,7 @@ impl AccuracyStudy {
         let _ = writeln!(s, "## The cheapest choice for a given accuracy\n");
         let _ = writeln!(
             s,
-            "Among the choices that converge (notes §3); a choice is a scheme/pairing with or without the polish, the marcher, or Siconos on \
+            "Among the choices that converge (src/formulation.md §3); a choice is a scheme/pairing with or without the polish, the marcher, or Siconos on \
              our LCP; the runner-up is the cheapest other choice.\n"
         );
         s.push_str(&self.cost_table());
@@ -232,7 +232,7 @@ impl AccuracyStudy {
             let _ = writeln!(s, "### {}\n", case.title());
             let _ = writeln!(
                 s,
-                "| method | converges (notes §3) | largest k run | error there | estimate there | polished error there | wall [s] there (LCP / + polish) | fitted order (k ≥ 128) | failed or skipped |"
+                "| method | converges (src/formulation.md §3) | largest k run | error there | estimate there | polished error there | wall [s] there (LCP / + polish) | fitted order (k ≥ 128) | failed or skipped |"
             );
             let _ = writeln!(s, "|---|---|---:|---:|---:|---:|---|---:|---|");
             let mut labels: Vec<String> = Vec::new();
