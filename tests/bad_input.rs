@@ -576,21 +576,36 @@ fn bad_contact_normals() {
     refused(&c("dofs = [0, 1, 2]\nnormal = [1.0, 1.0]"), &["contact[0].normal", "2 components", "3 DOFs"]);
     refused(&c("dofs = [0, 1, 2]\nnormal = \"up\""), &["contact[0].normal", "up", "radial"]);
     refused(&c("dofs = [0, 1, 2]\nnormal = \"radial\""), &["contact[0].normal", "radial", "casing.axis"]);
-    refused(&c("dofs = [0, 1, 2]\nnormal = \"radial\"\nposition = [0.0, 0.0, 2.0]\n[casing]\naxis = [0.0, 0.0, 1.0]\nradius = 1.0\nharmonics = [{ order = 1, amplitude = 0.1 }]"), &["contact[0].normal", "on the rotation axis", "normal = [nx, ny, nz]"]);
-    refused(&c("dofs = [0, 1, 2]\nnormal = \"radial\"\n[casing]\naxis = [0.0, 0.0, 1.0]\nradius = 1.0\nharmonics = [{ order = 1, amplitude = 0.1 }]"), &["contact[0].normal", "position = [x, y, z]"]);
+    refused(
+        &c(
+            "dofs = [0, 1, 2]\nnormal = \"radial\"\nposition = [0.0, 0.0, 2.0]\n[casing]\naxis = [0.0, 0.0, 1.0]\nradius = 1.0\nharmonics = [{ order = 1, amplitude = 0.1 }]",
+        ),
+        &["contact[0].normal", "on the rotation axis", "normal = [nx, ny, nz]"],
+    );
+    refused(
+        &c("dofs = [0, 1, 2]\nnormal = \"radial\"\n[casing]\naxis = [0.0, 0.0, 1.0]\nradius = 1.0\nharmonics = [{ order = 1, amplitude = 0.1 }]"),
+        &["contact[0].normal", "position = [x, y, z]"],
+    );
     refused(&c("dofs = [0, 1, 9]\nnormal = [0.0, 0.6, 0.8]"), &["contact[0].dofs[2]", "9"]);
     refused(&c("dofs = [0, 1, 2]\nnormal = [0.0, 0.6, 0.8]\ndirection = -1"), &["contact[0].direction", "normal"]);
     refused(&c("dof = 1\nnormal = [0.0, 0.6, 0.8]"), &["contact[0].dof", "normal"]);
     refused(&c("nodes = \"tip\""), &["contact[0].nodes", "structure.generator"]);
     // A node on the axis, from the casing's own axis and center.
-    refused(&c("dofs = [0, 1, 2]\nnormal = \"radial\"\nposition = [1.0, 2.0, 5.0]\n[casing]\naxis = [0.0, 0.0, 2.0]\ncenter = [1.0, 2.0, 0.0]\nradius = 1.0\nharmonics = [{ order = 1, amplitude = 0.1 }]"), &["on the rotation axis"]);
+    refused(
+        &c(
+            "dofs = [0, 1, 2]\nnormal = \"radial\"\nposition = [1.0, 2.0, 5.0]\n[casing]\naxis = [0.0, 0.0, 2.0]\ncenter = [1.0, 2.0, 0.0]\nradius = 1.0\nharmonics = [{ order = 1, amplitude = 0.1 }]",
+        ),
+        &["on the rotation axis"],
+    );
 }
 
 /// A scene and its casing profile in a scratch folder: the library and the CLI refuse it.
 fn profile_refused(profile: &str, needles: &[&str]) {
     let dir = scratch();
     std::fs::write(dir.join("casing.csv"), profile).unwrap();
-    let text = format!("{POINT}[[contact]]\ndofs = [0, 1, 2]\nnormal = \"radial\"\nposition = [0.0, 1.0, 0.0]\ngap = 0.5\n[casing]\naxis = [0.0, 0.0, 1.0]\nradius = 1.0\nprofile = \"casing.csv\"\n");
+    let text = format!(
+        "{POINT}[[contact]]\ndofs = [0, 1, 2]\nnormal = \"radial\"\nposition = [0.0, 1.0, 0.0]\ngap = 0.5\n[casing]\naxis = [0.0, 0.0, 1.0]\nradius = 1.0\nprofile = \"casing.csv\"\n"
+    );
     let scene = dir.join(FILE);
     std::fs::write(&scene, &text).unwrap();
     let f = scene.to_str().unwrap();

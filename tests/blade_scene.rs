@@ -479,14 +479,17 @@ fn radial_tip_contacts_solve_through_the_reduction() {
         let deg = 2.0 * j as f64;
         csv.push_str(&format!("{deg},{:e}\n", two_lobes(deg.to_radians(), 4e-5, 0.25)));
     }
-    let text = tip_scene("lobes = 2\nprofile = \"lobes.csv\"").replace("[excitation]", "[reduction]\nmethod = \"craig-bampton\"\nmodes = 6\n[damping]\nmodal_ratios = [0.005]\n[excitation]")
+    let text = tip_scene("lobes = 2\nprofile = \"lobes.csv\"")
+        .replace("[excitation]", "[reduction]\nmethod = \"craig-bampton\"\nmodes = 6\n[damping]\nmodal_ratios = [0.005]\n[excitation]")
         + "[output]\ndisplacement = [\"LE:x\", \"LE:y\", \"LE:z\", \"MC\"]\n";
     let b = write_scene(&dir, &text, Some(("lobes.csv", csv)));
     let r = b.problem.solve().unwrap();
     assert!(r.contacts.iter().any(|c| c.force.iter().any(|&f| f > 0.0)), "the lobes touch the tip");
     let le = &r.contacts[0];
     let keys: Vec<String> = le.normal.iter().map(|(d, _)| d.to_string()).collect();
-    let e = (0..r.steps).map(|j| (le.normal_displacement[j] - le.normal.iter().zip(&keys).map(|((_, v), k)| v * r.displacement[k][j]).sum::<f64>()).abs()).fold(0.0, f64::max);
+    let e = (0..r.steps)
+        .map(|j| (le.normal_displacement[j] - le.normal.iter().zip(&keys).map(|((_, v), k)| v * r.displacement[k][j]).sum::<f64>()).abs())
+        .fold(0.0, f64::max);
     let scale = le.normal_displacement.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     assert!(e < 1e-9 * scale, "normal displacement {e:e} vs {scale:e}");
     let _ = std::fs::remove_dir_all(&dir);
