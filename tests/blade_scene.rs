@@ -494,3 +494,29 @@ fn radial_tip_contacts_solve_through_the_reduction() {
     assert!(e < 1e-9 * scale, "normal displacement {e:e} vs {scale:e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Matrix Market-style contacts by DOF index: `dofs` + `position` + `normal = "radial"` about
+/// `casing.axis` through `casing.center`, and `dofs` + a given normal (normalised); θ = 0 at the
+/// first positioned contact, growing by the right-hand rule about the axis.
+#[test]
+fn contacts_by_dofs_take_radial_and_given_normals() {
+    let eye: Vec<String> = (0..6).map(|i| format!("[{}]", (0..6).map(|j| if i == j { "1.0" } else { "0.0" }).collect::<Vec<_>>().join(", "))).collect();
+    let text = format!(
+        "[structure]\nmass = [{m}]\nstiffness = [{m}]\n[excitation]\nfrequency = 3.0\n\
+         [casing]\naxis = [0.0, 0.0, 2.0]\ncenter = [1.0, 1.0, 7.0]\nradius = 1.0\nharmonics = [{{ order = 1, amplitude = 0.1, phase = 0.2 }}]\n\
+         [[contact]]\ndofs = [0, 1, 2]\nnormal = \"radial\"\nposition = [3.0, 1.0, 0.0]\ngap = 0.5\n\
+         [[contact]]\ndofs = [3, 4, 5]\nnormal = \"radial\"\nposition = [1.0, 4.0, -2.0]\ngap = 0.5\n\
+         [[contact]]\ndofs = [3, 4, 5]\nnormal = [3.0, 0.0, -4.0]\nposition = [-1.0, 1.0, 0.0]\ngap = 0.5\n",
+        m = eye.join(", ")
+    );
+    let b = build(&text);
+    assert_eq!(b.contact_rows, vec![vec![(0, 1.0)], vec![(4, 1.0)], vec![(3, 0.6), (5, -0.8)]]);
+    // θ = 0, π/2 and π: gap_i(t) = 0.5 + 0.1·cos(Ω t + θ_i + 0.2), Ω = ω (lobes = 1).
+    let model = b.problem.model();
+    for (c, theta) in model.contacts.iter().zip([0.0, std::f64::consts::FRAC_PI_2, std::f64::consts::PI]) {
+        for t in [0.0, 0.3, 1.7] {
+            let expected = 0.5 + 0.1 * (3.0 * t + theta + 0.2).cos();
+            assert!((c.gap_at(3.0, t) - expected).abs() < 1e-14, "θ = {theta}: {} vs {expected}", c.gap_at(3.0, t));
+        }
+    }
+}
