@@ -142,7 +142,7 @@ fn persistent_contact_follows_the_obstacle_and_the_force_converges() {
     // A constant load of 1 keeps the mass pressed on the obstacle.
     let build = |k: usize| {
         let mut model =
-            osc.model(vec![periodic_contact::model::Contact { dof: 0, direction: 1.0, gap: 0.2, compliance: Compliance::Rigid, motion: motion.clone() }]);
+            osc.model(vec![periodic_contact::model::Contact { row: vec![(0, 1.0)], gap: 0.2, compliance: Compliance::Rigid, motion: motion.clone() }]);
         model.forces.push(periodic_contact::model::Force { dof: 0, term: Harmonic { amplitude: 1.0, harmonic: 0, phase: 0.0 } });
         let outputs = OutputSelection { displacement: vec![0], velocity: vec![], acceleration: vec![], contacts: true };
         PeriodicProblem::new(model, Discretization { scheme: Scheme::Cds, steps: k, pairing: None }, outputs, SolverSettings::default()).unwrap()

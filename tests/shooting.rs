@@ -149,7 +149,7 @@ fn random_chain(draw: &mut Draw, n: usize, m: usize, rigid: bool) -> Model {
         let reach = x.iter().map(|v| direction * v).fold(f64::MIN, f64::max);
         let gap = reach * draw.range(0.4, 0.9);
         let compliance = if rigid { Compliance::Rigid } else { Compliance::Compliant { stiffness: draw.range(5.0, 50.0) } };
-        model.contacts.push(Contact { dof, direction, gap, compliance, motion: Vec::new() });
+        model.contacts.push(Contact { row: vec![(dof, direction)], gap, compliance, motion: Vec::new() });
     }
     model
 }

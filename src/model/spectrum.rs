@@ -23,18 +23,23 @@ impl Model {
     /// frequency and of the grid: compute once per structure.
     pub fn omega_max(&self) -> Result<f64, ModelError> {
         let n = self.n();
-        let springs: Vec<(usize, f64)> = self
+        // A compliant contact adds k_c B_iᵀ B_i to K.
+        let springs: Vec<(&[(usize, f64)], f64)> = self
             .contacts
             .iter()
             .filter_map(|c| match c.compliance {
-                Compliance::Compliant { stiffness } => Some((c.dof, stiffness)),
+                Compliance::Compliant { stiffness } => Some((c.row.as_slice(), stiffness)),
                 Compliance::Rigid => None,
             })
             .collect();
         let lmax = if n <= DENSE_MAX || !self.structure.mass.is_sparse() && n <= 2 * DENSE_MAX {
             let mut k = self.structure.stiffness.to_dense();
-            for &(d, kc) in &springs {
-                k[(d, d)] += kc;
+            for &(row, kc) in &springs {
+                for &(a, ca) in row {
+                    for &(b, cb) in row {
+                        k[(a, b)] += kc * ca * cb;
+                    }
+                }
             }
             dense_largest(&self.structure.mass.to_dense(), &k)?
         } else {
@@ -42,8 +47,11 @@ impl Model {
             let solve = mass_solver(mass)?;
             let mul_k = |x: &[f64], y: &mut [f64]| {
                 self.structure.stiffness.mul_vec(x, y);
-                for &(d, kc) in &springs {
-                    y[d] += kc * x[d];
+                for &(row, kc) in &springs {
+                    let bx: f64 = row.iter().map(|&(d, c)| c * x[d]).sum();
+                    for &(d, c) in row {
+                        y[d] += kc * c * bx;
+                    }
                 }
             };
             lanczos_largest(n, mul_k, |x: &[f64], y: &mut [f64]| mass.mul_vec(x, y), solve)

@@ -62,6 +62,36 @@ fn check_positive_definite(name: &str, a: &Matrix) -> Result<(), ModelError> {
     if ok { Ok(()) } else { Err(ModelError::new(name, "is not positive definite (every DOF must carry mass)")) }
 }
 
+/// Largest |‖n‖ − 1| accepted for a contact normal (the scene normalises; others must too).
+const UNIT_TOL: f64 = 1e-9;
+
+/// Row i of B: DOFs in range, each once, finite coefficients, unit length.
+fn check_row(i: usize, row: &[(usize, f64)], n: usize) -> Result<(), ModelError> {
+    if row.is_empty() {
+        return Err(ModelError::new(format!("contact[{i}].normal"), "is empty; give the contact a DOF (dof = …) or a normal over a node's DOFs"));
+    }
+    for (e, &(d, c)) in row.iter().enumerate() {
+        if d >= n {
+            return Err(ModelError::new(format!("contact[{i}].dof"), format!("is {d}, the model has DOFs 0..{}", n - 1)));
+        }
+        if row[..e].iter().any(|&(o, _)| o == d) {
+            return Err(ModelError::new(format!("contact[{i}].normal"), format!("names DOF {d} twice; give each DOF of the normal once")));
+        }
+        check_finite(format!("contact[{i}].normal[{e}]"), c)?;
+    }
+    let norm = row.iter().map(|&(_, c)| c * c).sum::<f64>().sqrt();
+    if !((norm - 1.0).abs() <= UNIT_TOL) {
+        let message = if row.len() == 1 {
+            format!("is {}, must be +1 or -1", row[0].1)
+        } else {
+            format!("has length {norm}, must be a unit normal (divide each coefficient by the length)")
+        };
+        let field = if row.len() == 1 { "direction" } else { "normal" };
+        return Err(ModelError::new(format!("contact[{i}].{field}"), message));
+    }
+    Ok(())
+}
+
 impl Model {
     /// ω alone: finite, > 0, and with a finite period (checked again when only ω changes).
     pub fn validate_frequency(&self) -> Result<(), ModelError> {
@@ -101,12 +131,7 @@ impl Model {
             check_finite(format!("force[{i}].phase"), f.term.phase)?;
         }
         for (i, c) in self.contacts.iter().enumerate() {
-            if c.dof >= n {
-                return Err(ModelError::new(format!("contact[{i}].dof"), format!("is {}, the model has DOFs 0..{}", c.dof, n - 1)));
-            }
-            if c.direction != 1.0 && c.direction != -1.0 {
-                return Err(ModelError::new(format!("contact[{i}].direction"), format!("is {}, must be +1 or -1", c.direction)));
-            }
+            check_row(i, &c.row, n)?;
             check_finite(format!("contact[{i}].gap"), c.gap)?;
             if c.gap < 0.0 {
                 return Err(ModelError::new(format!("contact[{i}].gap"), format!("is {}, a static clearance must be ≥ 0 (move the reference instead)", c.gap)));

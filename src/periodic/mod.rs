@@ -52,10 +52,18 @@ impl OutputSelection {
 pub struct OutputMap {
     /// For each user DOF that may be output: its (model DOF, coefficient) terms.
     pub rows: std::collections::BTreeMap<usize, Vec<(usize, f64)>>,
-    /// The user's DOF of each contact, in model order (reported as the contact's `dof`).
-    pub contact_dofs: Vec<usize>,
+    /// Each contact's row of B in the user's numbering, in model order (reported as the
+    /// contact's `normal`; its label DOF, the largest |coefficient|, as its `dof`).
+    pub contact_rows: Vec<Vec<(usize, f64)>>,
     /// Effects named in the result besides the model's own (e.g. `reduction`).
     pub effects: Vec<String>,
+}
+
+impl OutputMap {
+    /// Contact `a`'s row of B in the user's numbering, if the map has it.
+    pub fn contact_row(&self, a: usize) -> Option<&[(usize, f64)]> {
+        self.contact_rows.get(a).map(Vec::as_slice)
+    }
 }
 
 /// Solver settings with defaults.

@@ -45,6 +45,11 @@ pub const MAX_LCP_SIZE: usize = 1 << 20;
 pub const MAX_DENSE_FLOPS: f64 = 1e12;
 
 impl PeriodicProblem {
+    /// Contact `a`'s row of B in the user's numbering: the output map's, else the model's own.
+    pub fn user_row(&self, a: usize) -> &[(usize, f64)] {
+        self.output_map().and_then(|m| m.contact_row(a)).unwrap_or(&self.model().contacts[a].row)
+    }
+
     /// Checks everything, the scheme's stability limit included ([`crate::time::Scheme::stability_limit`]).
     pub fn new(model: Model, disc: Discretization, outputs: OutputSelection, solver: SolverSettings) -> Result<Self, SolveError> {
         Self::build(model, disc, outputs, solver, None, None)
@@ -240,8 +245,8 @@ impl PeriodicProblem {
         if let Some((l, _)) = map.rows.iter().find(|(_, r)| r.iter().any(|&(d, c)| d >= n || !c.is_finite())) {
             return Err(SolveError::Invalid(format!("output: the recovery of DOF {l} names a model DOF out of 0..{n} or a non-finite coefficient")));
         }
-        if !map.contact_dofs.is_empty() && map.contact_dofs.len() != self.model.contacts.len() {
-            return Err(SolveError::Invalid(format!("output: {} contact labels for {} contacts", map.contact_dofs.len(), self.model.contacts.len())));
+        if !map.contact_rows.is_empty() && map.contact_rows.len() != self.model.contacts.len() {
+            return Err(SolveError::Invalid(format!("output: {} contact labels for {} contacts", map.contact_rows.len(), self.model.contacts.len())));
         }
         self.outputs = outputs;
         self.output_map = Some(map);
@@ -443,7 +448,7 @@ impl PeriodicProblem {
 
 /// Whether two models have the same ω_max: the same M, K and contact compliances.
 fn same_spectrum(a: &Model, b: &Model) -> bool {
-    let springs = |m: &Model| -> Vec<(usize, crate::model::Compliance)> { m.contacts.iter().map(|c| (c.dof, c.compliance)).collect() };
+    let springs = |m: &Model| -> Vec<(Vec<(usize, f64)>, crate::model::Compliance)> { m.contacts.iter().map(|c| (c.row.clone(), c.compliance)).collect() };
     a.structure.mass == b.structure.mass && a.structure.stiffness == b.structure.stiffness && springs(a) == springs(b)
 }
 

@@ -91,12 +91,17 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
             let gap: Vec<f64> = time.iter().zip(&bx).map(|(&t, &b)| ca.gap_at(model.frequency, t) - b).collect();
             let force: Vec<f64> = (0..k).map(|j| sol.z[j * m + a]).collect();
             let gap = finite(gap, "contact gap", a)?;
+            let normal_displacement = finite(bx, "contact normal displacement", a)?;
+            let normal = problem.user_row(a).to_vec();
+            let (dof, direction) = crate::model::label_of(&normal);
             // Row j of the LCP pairs force sample j with the gap at t_{j+s} (`PeriodicProblem::lcp`).
             let s = problem.pairing_of(ca).offset();
             let paired_gap = (0..k).map(|j| gap[(j + s) % k]).collect();
             contacts.push(ContactResponse {
-                dof: problem.output_map().as_ref().and_then(|m| m.contact_dofs.get(a).copied()).unwrap_or(ca.dof),
-                direction: ca.direction as i32,
+                dof,
+                direction,
+                normal,
+                normal_displacement,
                 stiffness: match ca.compliance {
                     crate::model::Compliance::Rigid => None,
                     crate::model::Compliance::Compliant { stiffness } => Some(stiffness),

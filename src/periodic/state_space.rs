@@ -137,13 +137,17 @@ pub fn step_map(problem: &PeriodicProblem) -> Result<StepMapLcp, NoStepMap> {
     for (ci, contact) in model.contacts.iter().enumerate() {
         // Implicit (s = L) reads x_(j+L), y's first block; explicit (s = L − 1) reads
         // x_(j+L−1) = x_(j+L) − ∇x_(j+L), known before the step (Γ's blocks are equal: HΓ = 0).
-        hm[ci * d + contact.dof] = -contact.direction;
-        if offsets[ci] + 1 == lead {
-            hm[ci * d + n + contact.dof] = contact.direction;
+        // H_c = −B_c on x (and +B_c on ∇x when explicit); Γ's column c is −W B_cᵀ per block.
+        for &(dof, v) in &contact.row {
+            hm[ci * d + dof] = -v;
+            if offsets[ci] + 1 == lead {
+                hm[ci * d + n + dof] = v;
+            }
         }
         for row in 0..n {
+            let wb = contact.along(|dof| w[(row, dof)]);
             for b in 0..p {
-                gamma[(b * n + row) * m + ci] = -w[(row, contact.dof)] * contact.direction;
+                gamma[(b * n + row) * m + ci] = -wb;
             }
         }
         if let Compliance::Compliant { stiffness } = contact.compliance {

@@ -22,7 +22,7 @@ pub(super) fn reduce(
     full: FullModel,
     resolver: &Resolver,
     outputs: &OutputSelection,
-    contact_dofs: &[usize],
+    contact_rows: &[Vec<(usize, f64)>],
 ) -> Result<(Model, OutputMap, ReducedModel), BuildError> {
     if spec.method != "craig-bampton" {
         return Err(BuildError::field("reduction.method", format!("is \"{}\", expected \"craig-bampton\"", spec.method)));
@@ -56,19 +56,24 @@ pub(super) fn reduce(
             forces.push(Force { dof: q, term: Harmonic { amplitude: f.term.amplitude * c, ..f.term.clone() } });
         }
     }
-    let contacts = full.contacts.iter().map(|c| Contact { dof: red.reduced_dof(c.dof).expect("contacts are boundary DOFs"), ..c.clone() }).collect();
+    // Every DOF of a contact's row is a boundary DOF: the row keeps its coefficients.
+    let contacts = full
+        .contacts
+        .iter()
+        .map(|c| Contact { row: c.row.iter().map(|&(d, v)| (red.reduced_dof(d).expect("contacts are boundary DOFs"), v)).collect(), ..c.clone() })
+        .collect();
     let model = Model { structure: red.structure(), forces, contacts, frequency: full.frequency };
     let rows = outputs.dofs().into_iter().map(|u| (u, row(resolver.dofs.new_index(u).expect("checked")))).collect();
-    let map = OutputMap { rows, contact_dofs: contact_dofs.to_vec(), effects: vec!["reduction".into()] };
+    let map = OutputMap { rows, contact_rows: contact_rows.to_vec(), effects: vec!["reduction".into()] };
     Ok((model, map, red))
 }
 
 /// The boundary DOFs (full numbering): the contacts', then `extra_boundary`, each once.
 fn boundary(spec: &ReductionSpec, contacts: &[Contact], resolver: &Resolver) -> Result<Vec<usize>, BuildError> {
     let mut boundary: Vec<usize> = Vec::new();
-    for c in contacts {
-        if !boundary.contains(&c.dof) {
-            boundary.push(c.dof);
+    for &(d, _) in contacts.iter().flat_map(|c| &c.row) {
+        if !boundary.contains(&d) {
+            boundary.push(d);
         }
     }
     for (i, e) in spec.extra_boundary.iter().enumerate() {

@@ -95,7 +95,8 @@ impl PolishedOrbit {
                     .ok_or_else(|| PolishFailure("a phase's operator is singular at a forcing harmonic (undamped resonance)".into()))?,
             );
         }
-        let mut dofs: Vec<usize> = model.contacts.iter().map(|c| c.dof).collect();
+        // Stuck rows must stay orthonormal (phase.rs): contacts on disjoint DOFs.
+        let mut dofs: Vec<usize> = model.contacts.iter().flat_map(|c| c.row.iter().map(|e| e.0)).collect();
         dofs.sort_unstable();
         if dofs.windows(2).any(|w| w[0] == w[1]) {
             return Err(PolishFailure("two contacts act on the same DOF".into()));
@@ -129,10 +130,9 @@ impl PolishedOrbit {
             .sum()
     }
 
-    /// Clearance of contact `i` in state `y` at `t`: gap(t) − s·x_d.
+    /// Clearance of contact `i` in state `y` at `t`: gap(t) − B_i x.
     pub(super) fn clearance(&self, i: usize, y: &DVector<f64>, t: f64) -> f64 {
-        let c = &self.model.contacts[i];
-        self.gap(i, t, 0) - c.direction * y[c.dof]
+        self.gap(i, t, 0) - self.model.contacts[i].along(|d| y[d])
     }
 
     /// Plastic impact of contact `i` at `t`, the contacts `stuck` staying on their obstacles:
@@ -144,10 +144,7 @@ impl PolishedOrbit {
             set.push(i);
         }
         let m_inv = phase::dense(&self.model.structure.mass, n).try_inverse()?;
-        let b = DMatrix::from_fn(set.len(), n, |r, d| {
-            let c = &self.model.contacts[set[r]];
-            if c.dof == d { c.direction } else { 0.0 }
-        });
+        let b = DMatrix::from_fn(set.len(), n, |r, d| self.model.contacts[set[r]].row.iter().find(|e| e.0 == d).map_or(0.0, |e| e.1));
         let v = y.rows(n, n).into_owned();
         let rhs = &b * &v - DVector::from_fn(set.len(), |r, _| self.gap(set[r], t, 1));
         let p = (&b * &m_inv * b.transpose()).lu().solve(&rhs)?;
@@ -241,7 +238,9 @@ impl PolishedOrbit {
             i if i < 2 * n => 1.0 / rate(i - n),
             i => {
                 let e = self.events[i - 2 * n];
-                let k = s.stiffness.get(self.model.contacts[e.contact].dof, self.model.contacts[e.contact].dof).abs();
+                // n_iᵀ K n_i: the stiffness along the contact's normal.
+                let c = &self.model.contacts[e.contact];
+                let k = c.along(|a| c.along(|b| s.stiffness.get(a, b))).abs();
                 if e.kind == EventKind::Release && k > 0.0 { 1.0 / k } else { 1.0 }
             }
         })
@@ -450,11 +449,11 @@ impl PolishedOrbit {
         self.clearance(i, &self.state(tt), tt)
     }
 
-    /// Time derivative of contact `i`'s clearance at `t`: gap'(t) − s·v_d.
+    /// Time derivative of contact `i`'s clearance at `t`: gap'(t) − B_i v.
     pub fn clearance_rate(&self, i: usize, t: f64) -> f64 {
         let (_, tt) = self.locate(t);
-        let c = &self.model.contacts[i];
-        self.gap(i, tt, 1) - c.direction * self.state(tt)[self.model.n() + c.dof]
+        let y = self.state(tt);
+        self.gap(i, tt, 1) - self.model.contacts[i].along(|d| y[self.model.n() + d])
     }
 
     /// Acceleration of every DOF at `t` (between events).

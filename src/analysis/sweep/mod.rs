@@ -252,12 +252,9 @@ pub fn to_csv(param: &str, values: &[f64], problem: &PeriodicProblem, points: &[
     s
 }
 
-/// The user's DOF of each contact.
+/// The user's DOF that labels each contact (its normal's largest |coefficient|).
 pub fn contact_labels(problem: &PeriodicProblem) -> Vec<usize> {
-    match problem.output_map() {
-        Some(m) if !m.contact_dofs.is_empty() => m.contact_dofs.clone(),
-        _ => problem.model().contacts.iter().map(|c| c.dof).collect(),
-    }
+    (0..problem.model().contacts.len()).map(|a| crate::model::label_of(problem.user_row(a)).0).collect()
 }
 
 /// The frequency of the largest value of `amplitude(point)` over the solved points, if any.
