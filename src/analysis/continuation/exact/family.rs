@@ -33,6 +33,8 @@ pub(super) struct Family {
     pub ys: f64,
     pub sig: Signature,
     n2: usize,
+    /// The corrector's last solution and its Jacobian, for the point's tangent.
+    last_jacobian: std::cell::RefCell<Option<(Vec<f64>, DMatrix<f64>)>>,
 }
 
 /// A solved point with its unit tangent (oriented along the branch), orbit, multipliers and the
@@ -58,7 +60,7 @@ impl Node {
 
 impl Family {
     pub fn new(base: &Model, param: Parameter, rho: f64, ys: f64, sig: Signature) -> Family {
-        Family { base: base.clone(), param, rho, ys, sig, n2: 2 * base.n() }
+        Family { base: base.clone(), param, rho, ys, sig, n2: 2 * base.n(), last_jacobian: Default::default() }
     }
 
     /// The scene's model at λ.
@@ -159,6 +161,8 @@ impl Family {
             if step < 1e-9 {
                 let f = self.residual(&w)?;
                 if f.amax() < TOLERANCE {
+                    // The Jacobian of the last iterate, 1e-9 away: the tangent's.
+                    self.last_jacobian.replace(Some((w.clone(), jac)));
                     return Some(w);
                 }
             }
@@ -182,17 +186,24 @@ impl Family {
     }
 
     /// The point at the solution `w`: its tangent (oriented along `prev`), orbit, multipliers and
-    /// touches.
+    /// touches (none unless `touches`: a bisection for a multiplier event does not need them).
     pub fn node(&self, w: Vec<f64>, prev: &[f64]) -> Option<Node> {
+        self.node_with(w, prev, true)
+    }
+
+    pub fn node_with(&self, w: Vec<f64>, prev: &[f64], touches: bool) -> Option<Node> {
         let lambda = w[w.len() - 1] * self.rho;
-        let jac = self.jacobian(&w)?;
+        let jac = match self.last_jacobian.take() {
+            Some((at, j)) if at == w => j,
+            _ => self.jacobian(&w)?,
+        };
         let tangent = self.tangent(&jac, prev)?;
         let orbit = self.orbit(lambda)?;
         let (y, times) = self.unpack(&w, orbit.period());
         let defect = self.residual_with(&orbit, &w)?.amax() * self.ys;
         let orbit = orbit.at(&y, &times, defect).ok()?;
         let mu = floquet::multipliers(orbit.monodromy());
-        let touches = orbit.touches();
+        let touches = if touches { orbit.touches() } else { Vec::new() };
         Some(Node { w, tangent, orbit, mu, touches })
     }
 }

@@ -255,7 +255,7 @@ impl Walk<'_> {
     /// between its events: located, recorded, the pair of events inserted around the touch, and
     /// the first point of the branch with its phase [`NEW_PAIR`] long.
     fn insert_pair(&mut self, here: &Node, next: &Node, crossed: &dyn Fn(&Node) -> bool) -> Option<Node> {
-        let (lo, _) = bisect(&self.fam, here, next, &|n| !crossed(n))?;
+        let (lo, _) = bisect(&self.fam, here, next, &|n| !crossed(n), true)?;
         for (kind, node, detail) in self.events_between(here, &lo) {
             self.push(&node, Some(kind), detail);
         }
@@ -301,7 +301,7 @@ impl Walk<'_> {
                 continue;
             }
             let s = side(a, kind);
-            let node = bisect(&self.fam, a, b, &|n| side(n, kind) == s).map_or_else(|| b.clone(), |(_, hi)| hi);
+            let node = bisect(&self.fam, a, b, &|n| side(n, kind) == s, false).map_or_else(|| b.clone(), |(_, hi)| hi);
             let detail = detail_of(kind, &node);
             found.push((kind, node, detail));
         }
@@ -342,8 +342,8 @@ fn detail_of(kind: EventKind, node: &Node) -> String {
 
 /// Bisection on the arc between `a` (where `same` holds) and `b` (where it does not): each trial
 /// point is the orbit on the hyperplane through the bracket's midpoint normal to its secant.
-/// The last points on either side.
-fn bisect(fam: &Family, a: &Node, b: &Node, same: &dyn Fn(&Node) -> bool) -> Option<(Node, Node)> {
+/// The last points on either side (with their touches when `touches`).
+fn bisect(fam: &Family, a: &Node, b: &Node, same: &dyn Fn(&Node) -> bool, touches: bool) -> Option<(Node, Node)> {
     let (mut lo, mut hi) = (a.clone(), b.clone());
     for _ in 0..80 {
         let sec: Vec<f64> = hi.w.iter().zip(&lo.w).map(|(x, y)| x - y).collect();
@@ -355,7 +355,7 @@ fn bisect(fam: &Family, a: &Node, b: &Node, same: &dyn Fn(&Node) -> bool) -> Opt
         let pred: Vec<f64> = lo.w.iter().zip(&sec).map(|(x, s)| x + 0.5 * s).collect();
         let target = dot(&normal, &pred);
         let w = fam.correct(&pred, &normal, target)?;
-        let node = fam.node(w, &lo.tangent)?;
+        let node = fam.node_with(w, &lo.tangent, touches)?;
         if same(&node) {
             lo = node;
         } else {
