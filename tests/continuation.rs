@@ -242,6 +242,18 @@ fn random_family() {
     );
 }
 
+/// Where the exact orbit cannot be continued (a rigid stop: impacts and sticking), `run` falls
+/// back to the discrete walk and says so in `stop` and in every point's source.
+#[test]
+fn a_rigid_stop_falls_back_to_the_discrete_walk() {
+    let text = scene(256).replace("stiffness = 100.0\n", "").replace("scheme = \"cds\"", "scheme = \"bds1\"");
+    let p = periodic_contact::scene::Scene::parse(&text, "rigid").unwrap().to_problem("rigid").unwrap();
+    let b = continuation::run(&p, Parameter::Frequency, 0.5, 0.52, &ContinuationSettings::default(), &|_| {}).unwrap();
+    assert!(b.reached(), "{}", b.stop);
+    assert!(b.stop.contains("discrete walk") && b.stop.contains("rigid"), "{}", b.stop);
+    assert!(b.points.iter().all(|q| q.source == continuation::Source::Discrete));
+}
+
 /// The DISCRETE walk (the fallback where no exact orbit can be had) on NLvib 03 from Ω = 0.5 to
 /// 0.8 at k = 4096 (cds, same pairing: O(h²)): the case that needs its defences against the
 /// grid (fold-chain merging, the smoothed monodromy, kink crossing).

@@ -92,9 +92,10 @@ pub fn run(a: &Args) -> Result<(), Failure> {
     eprintln!("continue: {} branch(es) in {:.3} s → {}, {}", branches.len(), t_all.elapsed().as_secs_f64(), a.output.display(), json.display());
     for (i, b) in branches.iter().enumerate() {
         eprintln!(
-            "branch {i} ({}): {} points ({} events), {} marches of the period map; stop: {}",
+            "branch {i} ({}): {} points ({} from the exact orbit, {} events), {} marches of the period map; stop: {}",
             b.label,
             b.points.len(),
+            b.points.iter().filter(|p| p.source == continuation::Source::Exact).count(),
             b.events().count(),
             b.marches,
             b.stop
