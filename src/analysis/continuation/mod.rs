@@ -13,14 +13,17 @@
 //! amplitudes are that certified response's.
 mod corrector;
 mod events;
+mod exact;
 mod floquet;
 mod follow;
 pub mod output;
+mod parameter;
 mod switch;
 
 pub use events::EventKind;
 pub use floquet::multipliers;
 pub use follow::{Current, Followed, Jump, Resolved, Stability, amplitude, follow, resolve, stability};
+pub use parameter::Parameter;
 pub use switch::{run_switching, switch_at};
 
 use crate::error::Error;
@@ -29,72 +32,6 @@ use crate::response::Response;
 use corrector::{Family, Path};
 use events::Node;
 use num_complex::Complex64;
-
-/// The continued parameter.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Parameter {
-    /// The excitation frequency ω [rad/s] (the period T = 2π/ω; k steps per period).
-    Frequency,
-    /// A factor on every force amplitude of the scene (1: the scene's forces).
-    ForceScale,
-    /// A length added to every contact's static clearance (0: the scene's gaps; negative closes
-    /// them, a preload).
-    GapOffset,
-    /// The casing's rotation speed Ω [rad/s]: the excitation frequency is ω = lobes·Ω (engine
-    /// order; the front end reads `lobes` from the scene's casing).
-    Speed { lobes: u32 },
-}
-
-impl Parameter {
-    /// From its CLI name.
-    pub fn parse(name: &str) -> Result<Parameter, Error> {
-        match name {
-            "frequency" => Ok(Parameter::Frequency),
-            "force_scale" => Ok(Parameter::ForceScale),
-            "gap_offset" => Ok(Parameter::GapOffset),
-            "speed" => Err(Error::input("--param speed: the casing's lobes are needed (ω = lobes·Ω): the scene's [casing] gives them")),
-            other => Err(Error::input(format!("--param: is \"{other}\"; continuation takes frequency, speed, force_scale or gap_offset"))),
-        }
-    }
-    pub fn name(self) -> &'static str {
-        match self {
-            Parameter::Frequency => "frequency",
-            Parameter::ForceScale => "force_scale",
-            Parameter::GapOffset => "gap_offset",
-            Parameter::Speed { .. } => "speed",
-        }
-    }
-    /// What the parameter is, for an axis or a column, with its quantity.
-    pub fn describe(self) -> (&'static str, crate::model::Quantity) {
-        use crate::model::Quantity;
-        match self {
-            Parameter::Frequency => ("excitation frequency ω", Quantity::Frequency),
-            Parameter::ForceScale => ("force scale (× the scene's forces)", Quantity::Ratio),
-            Parameter::GapOffset => ("gap offset (added to every clearance)", Quantity::Length),
-            Parameter::Speed { .. } => ("casing speed Ω (ω = lobes·Ω)", Quantity::Frequency),
-        }
-    }
-    /// Sets the parameter of `problem` (the scene's, unchanged until now) to `value`, checked.
-    fn apply(self, problem: &mut PeriodicProblem, value: f64) -> Result<(), Error> {
-        match self {
-            Parameter::Frequency => problem.set_frequency(value).map_err(Error::from),
-            Parameter::Speed { lobes } => problem.set_frequency(f64::from(lobes) * value).map_err(Error::from),
-            Parameter::ForceScale | Parameter::GapOffset => {
-                if !value.is_finite() {
-                    return Err(Error::input(format!("{}: is {value}, must be finite", self.name())));
-                }
-                let mut model = problem.model().clone();
-                if self == Parameter::ForceScale {
-                    model.forces.iter_mut().for_each(|f| f.term.amplitude *= value);
-                } else {
-                    model.contacts.iter_mut().for_each(|c| c.gap += value);
-                }
-                *problem = problem.with_model(model, problem.discretization())?;
-                Ok(())
-            }
-        }
-    }
-}
 
 /// Settings with defaults. Steps are arclengths in (s_0, λ/|to − from|).
 #[derive(Clone, Debug)]
@@ -114,11 +51,24 @@ pub struct ContinuationSettings {
     /// pairs 3e-5 to 2e-4 apart near the peak, none between the true folds 0.102 apart; the
     /// demo's oscillator at k = 256: wiggles 5e-4 to 6e-3 apart on its unstable branch).
     pub fold_merge: f64,
+    /// Largest arclength step of the exact walk (in y0/y_s, the event times over the period and
+    /// λ/|to − from|): its branch is smooth between grazings, and the tangents' angle limits the
+    /// step where it turns.
+    pub exact_max_step: f64,
 }
 
 impl Default for ContinuationSettings {
     fn default() -> Self {
-        ContinuationSettings { initial_step: 2e-3, min_step: 1e-9, max_step: 2e-2, max_points: 5000, tolerance: 1e-10, smoothing: 5e-3, fold_merge: 1e-2 }
+        ContinuationSettings {
+            initial_step: 2e-3,
+            min_step: 1e-9,
+            max_step: 2e-2,
+            max_points: 5000,
+            tolerance: 1e-10,
+            smoothing: 5e-3,
+            fold_merge: 1e-2,
+            exact_max_step: 0.1,
+        }
     }
 }
 
@@ -149,6 +99,26 @@ pub struct BranchPoint {
     pub(crate) masks: Vec<u32>,
     /// The branch's unit tangent in (s_0, λ/ρ) here, for a switch of branch.
     pub(crate) tangent: Vec<f64>,
+    /// What produced the point: the exact orbit, or the discrete walk on the grid.
+    pub source: Source,
+}
+
+/// What produced a point of the branch.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Source {
+    /// The exact hybrid orbit (exact flows between events, event times; [`exact`]).
+    Exact,
+    /// The discrete orbit of the grid's step map (its error is the scheme's at k).
+    Discrete,
+}
+
+impl Source {
+    pub fn name(self) -> &'static str {
+        match self {
+            Source::Exact => "exact",
+            Source::Discrete => "discrete",
+        }
+    }
 }
 
 /// A continued branch.
@@ -178,13 +148,63 @@ impl Branch {
     }
 }
 
-/// Continues the orbit of `problem` at λ = `from` (the session's solve, warm starts as in a
-/// sweep) in the parameter up to λ = `to`, or until the branch leaves [from, to] the other way.
-/// `on_point(λ)` after each point (a progress bar).
+/// Continues the orbit of `problem` at λ = `from` in the parameter up to λ = `to`, or until the
+/// branch leaves [from, to] the other way: the exact orbit's branch where the polish applies
+/// (compliant contacts, one forcing period: [`exact`]), the discrete walk ([`run_discrete`])
+/// where it does not, and from where the exact walk stopped short. Each point says which
+/// ([`BranchPoint::source`]). `on_point(λ)` after each point (a progress bar).
 pub fn run(problem: &PeriodicProblem, param: Parameter, from: f64, to: f64, settings: &ContinuationSettings, on_point: &dyn Fn(f64)) -> Result<Branch, Error> {
+    check_range(from, to)?;
+    let walked = match exact::walk(problem, param, from, to, settings, on_point) {
+        Ok(w) => w,
+        Err(e) => {
+            let mut b = run_discrete(problem, param, from, to, settings, on_point)?;
+            b.stop = format!("{} (discrete walk: {e})", b.stop);
+            return Ok(b);
+        }
+    };
+    let label = "T".to_string();
+    if walked.reached || walked.turned_back {
+        return Ok(Branch { parameter: param, points: walked.points, stop: walked.stop, marches: 0, period_multiple: 1, label });
+    }
+    // The rest of the range by the discrete walk, from where the exact one stopped.
+    let at = walked.points.last().map_or(from, |p| p.parameter);
+    let mut points = walked.points;
+    match run_discrete(problem, param, at, to, settings, on_point) {
+        Ok(rest) => {
+            points.extend(rest.points.into_iter().skip(1));
+            let stop = format!("{}; exact orbit up to {} = {at} ({}), discrete walk from there", rest.stop, param.name(), walked.stop);
+            Ok(Branch { parameter: param, points, stop, marches: rest.marches, period_multiple: 1, label })
+        }
+        Err(e) => Ok(Branch {
+            parameter: param,
+            points,
+            stop: format!("{}; the discrete walk from there failed: {e}", walked.stop),
+            marches: 0,
+            period_multiple: 1,
+            label,
+        }),
+    }
+}
+
+fn check_range(from: f64, to: f64) -> Result<(), Error> {
     if !(from.is_finite() && to.is_finite() && from != to) {
         return Err(Error::input(format!("--from/--to: are {from} and {to}, must be finite and different")));
     }
+    Ok(())
+}
+
+/// The discrete branch: pseudo-arclength on the grid's step map (its kinks, zigzags and fold
+/// chains handled as below), from the session's solve at λ = `from`.
+pub fn run_discrete(
+    problem: &PeriodicProblem,
+    param: Parameter,
+    from: f64,
+    to: f64,
+    settings: &ContinuationSettings,
+    on_point: &dyn Fn(f64),
+) -> Result<Branch, Error> {
+    check_range(from, to)?;
     let rho = (to - from).abs();
     let mut fam = family(problem, param, rho, settings);
     fam.map_at(from)?;
@@ -538,6 +558,7 @@ fn point(fam: &Family, solver: &mut PeriodicSolver, node: &Node, event: Option<E
         state: node.solved.v[..node.solved.v.len() - 1].to_vec(),
         masks: node.solved.masks.clone(),
         tangent: node.tangent.clone(),
+        source: Source::Discrete,
     })
 }
 
@@ -569,6 +590,7 @@ mod tests {
             state: vec![],
             masks: vec![],
             tangent: vec![],
+            source: Source::Discrete,
         }
     }
 

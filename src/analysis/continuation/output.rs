@@ -6,13 +6,14 @@ use crate::periodic::PeriodicProblem;
 /// One row per point of each branch, in order: the parameter (named as given, with its unit),
 /// `amplitude_<dof> [unit]` per displacement output as in `sweep` (over the orbit's period),
 /// `stable`, `multiplier` (largest |μ| of the orbit's own monodromy, over p·T), `period_multiple`,
-/// `event`, `certified`, `branch` (its index: 0 the T branch, then the switched ones).
+/// `event`, `certified`, `branch` (its index: 0 the T branch, then the switched ones), `source`
+/// (`exact`: the exact orbit's branch; `discrete`: the grid's).
 pub fn to_csv(branches: &[Branch], problem: &PeriodicProblem, labels: &Labels) -> String {
     let mm = labels.unit(Quantity::Length);
     let Some(first) = branches.first() else { return String::new() };
     let mut head = vec![format!("{} {}", first.parameter.name(), labels.unit(first.parameter.describe().1))];
     head.extend(problem.outputs().displacement.iter().map(|d| format!("amplitude_{d} {mm}")));
-    head.extend(["stable", "multiplier", "period_multiple", "event", "certified", "branch"].map(String::from));
+    head.extend(["stable", "multiplier", "period_multiple", "event", "certified", "branch", "source"].map(String::from));
     let mut s = head.join(",") + "\n";
     for (b, p) in branches.iter().enumerate().flat_map(|(b, branch)| branch.points.iter().map(move |p| (b, p))) {
         let mut row = vec![format!("{:e}", p.parameter)];
@@ -23,6 +24,7 @@ pub fn to_csv(branches: &[Branch], problem: &PeriodicProblem, labels: &Labels) -
         row.push(p.event.map_or(String::new(), |e| e.name().to_string()));
         row.push(p.certified.to_string());
         row.push(b.to_string());
+        row.push(p.source.name().to_string());
         s.push_str(&row.join(","));
         s.push('\n');
     }
@@ -52,6 +54,7 @@ pub fn events_json(branches: &[Branch], problem: &PeriodicProblem) -> String {
                 "multipliers": p.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
                 "stable": p.stable,
                 "detail": p.detail,
+                "source": p.source.name(),
             })
         })
         .collect();

@@ -13,7 +13,7 @@
 //! period doubling was located with ([`Family::smoothed_monodromy`]).
 use super::corrector::Family;
 use super::events::Node;
-use super::{Branch, BranchPoint, ContinuationSettings, EventKind, Parameter, Walk, family, point, run};
+use super::{Branch, BranchPoint, ContinuationSettings, EventKind, Parameter, Walk, family, point, run_discrete};
 use crate::error::Error;
 use crate::periodic::{PeriodicProblem, PeriodicSolver};
 use nalgebra::DMatrix;
@@ -24,7 +24,8 @@ use nalgebra::DMatrix;
 /// k = 4096: the 2T orbit at 2 % of the amplitude lies 1.2e-4 in Ω past the doubling).
 const FIRST_STEP: f64 = 2e-2;
 
-/// Continues the T branch of `problem` from `from` to `to` ([`run`]), then, at each of its
+/// Continues the T branch of `problem` from `from` to `to` on the grid ([`run_discrete`]: the
+/// switch needs the discrete orbit's active sets), then, at each of its
 /// period doublings that no branch found so far has rejoined, switches to the 2T branch
 /// ([`switch_at`]) and continues it within [from, to]. Returns the branches, the T branch first,
 /// and why a switch failed where one did (the other branches are kept).
@@ -36,7 +37,7 @@ pub fn run_switching(
     settings: &ContinuationSettings,
     on_point: &dyn Fn(f64),
 ) -> Result<(Vec<Branch>, Vec<String>), Error> {
-    let t = run(problem, param, from, to, settings, on_point)?;
+    let t = run_discrete(problem, param, from, to, settings, on_point)?;
     let mut branches = vec![t];
     let doublings: Vec<usize> = (0..branches[0].points.len()).filter(|&i| branches[0].points[i].event == Some(EventKind::PeriodDoubling)).collect();
     // Where a 2T branch ended on the T branch: a doubling there is that branch's other end.

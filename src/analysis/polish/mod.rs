@@ -10,11 +10,13 @@
 //! is verified (clearance ≥ 0 of free rigid contacts and force ≥ 0 of stuck ones between the
 //! events, checked densely and at every local minimum; impulses ≥ 0; a pure impact may not call
 //! for sticking); otherwise the LCP's orbit is kept, with a warning that says why.
+mod continued;
 pub mod events;
 mod orbit;
 mod phase;
 mod verify;
 
+pub use continued::Touch;
 pub use events::{Event, EventKind};
 pub use orbit::{OrbitParts, PolishedOrbit, user_value};
 

@@ -35,7 +35,7 @@ pub struct PolishedOrbit {
     pub(super) period: f64,
     pub(super) events: Vec<Event>,
     /// Contacts closed all period long (no event).
-    always: Vec<usize>,
+    pub(super) always: Vec<usize>,
     /// Event times, increasing, times[0] ∈ [0, T) (a single 0 when there is no event).
     pub(super) times: Vec<f64>,
     /// The phase after each event (phases[e] runs from times[e] to times[e+1]).
@@ -46,9 +46,9 @@ pub struct PolishedOrbit {
     pub(super) after: Vec<DVector<f64>>,
     pub(super) impulses: Vec<f64>,
     gaps: Vec<phase::Harmonics>,
-    iterations: usize,
-    residual: f64,
-    correction: f64,
+    pub(super) iterations: usize,
+    pub(super) residual: f64,
+    pub(super) correction: f64,
     monodromy: DMatrix<f64>,
 }
 
@@ -83,7 +83,7 @@ impl PolishedOrbit {
         OrbitParts { events, always: self.always.clone(), y0: self.y0.iter().copied().collect() }
     }
 
-    fn new(model: &Model, evs: Vec<Event>, always: &[usize]) -> Result<Self, PolishFailure> {
+    pub(super) fn new(model: &Model, evs: Vec<Event>, always: &[usize]) -> Result<Self, PolishFailure> {
         let sets = events::phase_sets(model, &evs, always);
         let mut phases = Vec::new();
         let empty = vec![always.to_vec()];
@@ -122,7 +122,7 @@ impl PolishedOrbit {
         })
     }
 
-    fn gap(&self, i: usize, t: f64, order: u32) -> f64 {
+    pub(super) fn gap(&self, i: usize, t: f64, order: u32) -> f64 {
         let w = self.model.frequency;
         self.gaps[i]
             .iter()
@@ -196,7 +196,7 @@ impl PolishedOrbit {
         Some(Shot { end: y, conditions: g, after, impulses: imp })
     }
 
-    fn residual_of(&self, u: &DVector<f64>) -> Option<DVector<f64>> {
+    pub(super) fn residual_of(&self, u: &DVector<f64>) -> Option<DVector<f64>> {
         let n2 = 2 * self.model.n();
         let y0 = u.rows(0, n2).into_owned();
         let tau: Vec<f64> = u.iter().skip(n2).copied().collect();
@@ -324,12 +324,15 @@ impl PolishedOrbit {
     }
 
     /// The states after the events, the impulses and the monodromy of the orbit at y0 and times.
-    fn finish(&mut self) -> Result<(), PolishFailure> {
+    pub(super) fn finish(&mut self) -> Result<(), PolishFailure> {
         let fail = |w: &str| PolishFailure(w.to_string());
         let shot = self.shoot(&self.y0, &self.times).ok_or_else(|| fail("the converged orbit cannot be flowed"))?;
         self.after = shot.after;
         self.impulses = shot.impulses;
-        self.monodromy = self.stroboscopic().ok_or_else(|| fail("the monodromy could not be formed (an event condition is singular in its time: grazing)"))?;
+        self.monodromy = match self.flow_product() {
+            Some(m) => m,
+            None => self.stroboscopic().ok_or_else(|| fail("the monodromy could not be formed (an event condition is singular in its time: grazing)"))?,
+        };
         Ok(())
     }
 

@@ -170,6 +170,16 @@ impl Phase {
         self.closed.contains(&i)
     }
 
+    /// The phase's fastest rate [rad/s] (the balancing speed, ≥ its ω_max): for sampling.
+    pub fn speed_hint(&self) -> f64 {
+        self.speed
+    }
+
+    /// No contact is stuck: the exponential acts on the whole state [x; v].
+    pub fn all_free(&self) -> bool {
+        self.stuck.is_empty()
+    }
+
     pub fn stuck_contacts(&self) -> impl Iterator<Item = usize> + '_ {
         self.stuck.iter().copied()
     }
