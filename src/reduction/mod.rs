@@ -1,8 +1,10 @@
-//! Model reduction (Craig–Bampton) and modal analysis.
+//! Model reduction (Craig–Bampton, massless boundary) and modal analysis.
 pub mod craig_bampton;
 pub mod eigen;
+mod massless;
 
-pub use craig_bampton::{CraigBamptonOptions, DEFAULT_MODES, Damping, ReducedModel, ReductionError, Timings, craig_bampton, reduce_structure, to_sparse};
+pub use craig_bampton::{CraigBamptonOptions, DEFAULT_MODES, Damping, Method, ReducedModel, ReductionError, Timings, craig_bampton, reduce_structure, to_sparse};
+pub use massless::massless_boundary;
 pub use eigen::{EigenError, LanczosOptions, Modes, dense_modes, lanczos, sparse_modes, symmetric_eigen};
 
 use crate::model::Matrix;
