@@ -221,10 +221,22 @@ fn massless_contact_point_converges_to_the_compliant_orbit() {
     };
     // ω_max over the finite eigenvalues: the mass on k1 (rigid stop open), on k1 plus k2 in series
     // with a compliant stop k_c (closed).
-    let p = PeriodicProblem::new(massless_contact_point(&COMPLIANT, k2, g0, Compliance::Rigid), Discretization { scheme: Scheme::Cds, steps: 64, pairing: None }, outputs.clone(), SolverSettings::default()).unwrap();
+    let p = PeriodicProblem::new(
+        massless_contact_point(&COMPLIANT, k2, g0, Compliance::Rigid),
+        Discretization { scheme: Scheme::Cds, steps: 64, pairing: None },
+        outputs.clone(),
+        SolverSettings::default(),
+    )
+    .unwrap();
     assert!((p.omega_max() - 1.0).abs() < 1e-9, "ω_max = {}", p.omega_max());
     let kc = 30.0;
-    let p = PeriodicProblem::new(massless_contact_point(&COMPLIANT, k2, g0, Compliance::Compliant { stiffness: kc }), Discretization { scheme: Scheme::Cds, steps: 64, pairing: None }, outputs.clone(), SolverSettings::default()).unwrap();
+    let p = PeriodicProblem::new(
+        massless_contact_point(&COMPLIANT, k2, g0, Compliance::Compliant { stiffness: kc }),
+        Discretization { scheme: Scheme::Cds, steps: 64, pairing: None },
+        outputs.clone(),
+        SolverSettings::default(),
+    )
+    .unwrap();
     let series = (1.0 + k2 * kc / (k2 + kc)).sqrt();
     assert!((p.omega_max() - series).abs() < 1e-9 * series, "ω_max = {} vs {series}", p.omega_max());
 
@@ -245,7 +257,13 @@ fn massless_contact_point_converges_to_the_compliant_orbit() {
             // condensation is exact algebra), and so is the condensed step map: its march from any
             // state equals the 1-DOF model's. Galerkin weighs k2 by (1, 4, 1)/6 and has no step map.
             let one_dof = problem(&COMPLIANT, Oscillator::stop(g0, Compliance::Compliant { stiffness: k2 }), scheme, k, None);
-            let two_dof = PeriodicProblem::new(massless_contact_point(&COMPLIANT, k2, g0, Compliance::Rigid), Discretization { scheme, steps: k, pairing: None }, outputs.clone(), SolverSettings::default()).unwrap();
+            let two_dof = PeriodicProblem::new(
+                massless_contact_point(&COMPLIANT, k2, g0, Compliance::Rigid),
+                Discretization { scheme, steps: k, pairing: None },
+                outputs.clone(),
+                SolverSettings::default(),
+            )
+            .unwrap();
             if scheme == Scheme::Galerkin {
                 let why = step_map(&two_dof).unwrap_err();
                 assert!(why.0.contains("massless"), "{why}");

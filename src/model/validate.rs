@@ -77,7 +77,10 @@ fn check_mass(model: &Model) -> Result<(), ModelError> {
     if let Some((i, j, v)) = off {
         return Err(ModelError::new(
             format!("structure.mass[{i}][{j}]"),
-            format!("is {v}, but DOF {} has no mass on its diagonal: a positive semi-definite mass has a zero row and column there", if s.mass.get(i, i) <= 0.0 { i } else { j }),
+            format!(
+                "is {v}, but DOF {} has no mass on its diagonal: a positive semi-definite mass has a zero row and column there",
+                if s.mass.get(i, i) <= 0.0 { i } else { j }
+            ),
         ));
     }
     let massive: Vec<usize> = (0..n).filter(|d| massless.binary_search(d).is_err()).collect();
@@ -94,7 +97,9 @@ fn check_mass(model: &Model) -> Result<(), ModelError> {
     if let Some(&d) = massless.iter().find(|&&d| s.stiffness.get(d, d) == 0.0) {
         return Err(ModelError::new(
             format!("structure.mass[{d}][{d}]"),
-            format!("is 0 and structure.stiffness[{d}][{d}] is 0: DOF {d} carries neither mass nor stiffness, so nothing determines it; give it mass or stiffness, or remove it"),
+            format!(
+                "is 0 and structure.stiffness[{d}][{d}] is 0: DOF {d} carries neither mass nor stiffness, so nothing determines it; give it mass or stiffness, or remove it"
+            ),
         ));
     }
     if !s.stiffness.block(&massless, &massless).is_positive_definite() {

@@ -39,8 +39,8 @@ use super::PeriodicProblem;
 use crate::lcp::{DenseLu, MAX_PAIRS, StepMapData, StepMapLcp, dense_product};
 use crate::model::{Compliance, Model};
 use crate::time::Scheme;
-use faer::linalg::solvers::Solve;
 use faer::Mat;
+use faer::linalg::solvers::Solve;
 
 /// Most DOFs of a model solved by shooting: its march is dense in the state (d = 2n or 3n) and
 /// each Newton iteration forms a d×d Jacobian.
