@@ -276,7 +276,7 @@ fn the_policy_falls_back_after_a_shooting_breakdown() {
             c: vec![1.0; k],
             h: vec![1.0],
             gamma: vec![1.0],
-            compliance: vec![0.0],
+            flexibility: vec![0.0],
             r: vec![1.0; k],
         };
         let sm = StepMapLcp::new(drift).unwrap();

@@ -145,6 +145,15 @@ pub fn march(model: &Model, settings: &MarchSettings) -> Result<MarchResult, Mar
     let start = Instant::now();
     model.validate()?;
     let n = model.n();
+    let massless = model.massless_dofs();
+    if !massless.is_empty() {
+        return Err(MarchError::setting(
+            "structure.mass",
+            format!(
+                "DOFs {massless:?} are massless (a massless boundary, src/formulation.md §4.1): explicit central differences with forward-increment multipliers need (M/h² + C/(2h)) invertible, i.e. mass on every DOF; solve the periodic LCP (cds, bds1, bds2) instead"
+            ),
+        ));
+    }
     let ns = settings.steps_per_period;
     if ns < 2 {
         return Err(MarchError::setting("settings.steps_per_period", format!("is {ns}, must be ≥ 2")));

@@ -196,6 +196,16 @@ impl Model {
             moving_obstacle: self.contacts.iter().any(|c| !c.motion.is_empty()),
         }
     }
+    /// The massless DOFs (sorted): a zero diagonal of M. After [`Model::validate`] their rows
+    /// and columns of M are zero and K holds them (src/formulation.md §4.1).
+    pub fn massless_dofs(&self) -> Vec<usize> {
+        (0..self.n()).filter(|&d| self.structure.mass.get(d, d) <= 0.0).collect()
+    }
+    /// Whether contact `c` acts on a massless DOF: its force is then finite and statically
+    /// transmitted, like a compliant one (same-instant pairing).
+    pub fn contact_is_massless(&self, c: &Contact) -> bool {
+        c.row.iter().all(|&(dof, _)| dof < self.n() && self.structure.mass.get(dof, dof) <= 0.0)
+    }
     /// The highest harmonic of ω in the forcing or in any obstacle motion.
     pub fn highest_harmonic(&self) -> u32 {
         let f = self.forces.iter().map(|f| f.term.harmonic);

@@ -288,7 +288,7 @@ impl PeriodicProblem {
     pub fn pairing_at(&self, i: usize) -> Pairing {
         match (self.contact_pairing(i), self.disc.pairing, self.model.contacts.get(i)) {
             (Some(p), _, _) | (None, Some(p), _) => p,
-            (None, None, c) => self.disc.scheme.default_pairing(c.is_some_and(Contact::is_rigid)),
+            (None, None, c) => self.disc.scheme.default_pairing(c.is_some_and(|c| self.impacts(c))),
         }
     }
 
@@ -297,8 +297,15 @@ impl PeriodicProblem {
     pub fn pairing_of(&self, c: &Contact) -> Pairing {
         match self.model.contacts.iter().position(|x| std::ptr::eq(x, c)) {
             Some(i) => self.pairing_at(i),
-            None => self.disc.pairing.unwrap_or_else(|| self.disc.scheme.default_pairing(c.is_rigid())),
+            None => self.disc.pairing.unwrap_or_else(|| self.disc.scheme.default_pairing(self.impacts(c))),
         }
+    }
+
+    /// A rigid contact on a DOF with mass: its force is an impulse at impacts. On a massless DOF
+    /// (src/formulation.md §4.1) the force is finite and statically transmitted, like a
+    /// compliant one, and same-instant pairing is the consistent one.
+    fn impacts(&self, c: &Contact) -> bool {
+        c.is_rigid() && !self.model.contact_is_massless(c)
     }
 
     /// Warnings about choices that do not converge, said before solving.
@@ -306,13 +313,14 @@ impl PeriodicProblem {
         let mut w: Vec<String> = self.auto_steps.iter().cloned().collect();
         for (i, c) in self.model.contacts.iter().enumerate() {
             let p = self.pairing_of(c);
-            if c.is_rigid() {
+            if self.impacts(c) {
                 if let Some(why) = self.disc.scheme.rigid_contact_warning(p) {
                     w.push(format!("contact[{i}] (rigid, {} with pairing {p}): {why}", self.disc.scheme));
                 }
             } else if p == Pairing::Forward {
+                let kind = if c.is_rigid() { "rigid on a massless DOF" } else { "compliant" };
                 w.push(format!(
-                    "contact[{i}] (compliant): forward pairing makes a compliant force lag one step, so the scheme is first order only; use pairing = \"same\""
+                    "contact[{i}] ({kind}): forward pairing makes its finite force lag one step, so the scheme is first order only; use pairing = \"same\""
                 ));
             }
         }

@@ -1,11 +1,12 @@
-//! The `[reduction]` section: Craig–Bampton reduction of the clamped structure, with the contact
-//! DOFs (and `extra_boundary`) kept physical, and the outputs mapped back through x = Φ q.
+//! The `[reduction]` section: Craig–Bampton or massless-boundary reduction of the clamped
+//! structure, with the contact DOFs (and `extra_boundary`) kept physical, and the outputs mapped
+//! back through x = Φ q.
 use super::contacts::Resolver;
 use super::structure::DampingGiven;
 use super::{BuildError, ReductionSpec};
 use crate::model::{Contact, Force, Harmonic, Model, Structure};
 use crate::periodic::{OutputMap, OutputSelection};
-use crate::reduction::{CraigBamptonOptions, DEFAULT_MODES, Damping, ReducedModel, ReductionError};
+use crate::reduction::{CraigBamptonOptions, DEFAULT_MODES, Damping, Method, ReducedModel, ReductionError};
 
 /// The full (clamped) model's parts that the reduction projects.
 pub(super) struct FullModel<'a> {
@@ -24,9 +25,11 @@ pub(super) fn reduce(
     outputs: &OutputSelection,
     contact_rows: &[Vec<(usize, f64)>],
 ) -> Result<(Model, OutputMap, ReducedModel), BuildError> {
-    if spec.method != "craig-bampton" {
-        return Err(BuildError::field("reduction.method", format!("is \"{}\", expected \"craig-bampton\"", spec.method)));
-    }
+    let method = match spec.method.as_str() {
+        "craig-bampton" => Method::CraigBampton,
+        "massless-boundary" => Method::MasslessBoundary,
+        other => return Err(BuildError::field("reduction.method", format!("is \"{other}\", expected \"craig-bampton\" or \"massless-boundary\""))),
+    };
     let boundary = boundary(spec, full.contacts, resolver)?;
     let damping = match (&full.damping.modal_ratios, full.damping.rayleigh, &full.structure.damping) {
         (Some(z), _, _) => Damping::ModalRatios(z.clone()),
@@ -36,7 +39,7 @@ pub(super) fn reduce(
     };
     let undamped = Structure { mass: full.structure.mass.clone(), stiffness: full.structure.stiffness.clone(), damping: None };
     let opts = CraigBamptonOptions { modes: spec.modes.unwrap_or(DEFAULT_MODES), ..Default::default() };
-    let red = crate::reduction::reduce_structure(&undamped, &boundary, &opts, Some(&damping)).map_err(|e| match e {
+    let red = crate::reduction::reduce_structure(&undamped, method, &boundary, &opts, Some(&damping)).map_err(|e| match e {
         ReductionError::TooManyModes { requested, internal } => BuildError::field(
             "reduction.modes",
             format!("is {requested}, but only {internal} internal DOFs remain besides the {} boundary DOFs", boundary.len()),

@@ -101,9 +101,9 @@ impl std::fmt::Display for DofSpec {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ReductionSpec {
-    /// `"craig-bampton"`.
+    /// `"craig-bampton"` or `"massless-boundary"`.
     pub method: String,
-    /// Fixed-interface modes η (default [`crate::reduction::DEFAULT_MODES`]).
+    /// Fixed-interface (Craig–Bampton) or free-interface (massless boundary) modes η (default [`crate::reduction::DEFAULT_MODES`]).
     pub modes: Option<usize>,
     /// DOFs kept physical besides the contact DOFs.
     #[serde(default)]

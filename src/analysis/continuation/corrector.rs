@@ -117,7 +117,8 @@ impl Family {
         let mut fam = Family { base, path, rho, tolerance: 1e-10, max_iterations: 12, marches: 0, smoothing: 0.0, blocks: 2 };
         // The base as it is for a parameter (its λ may be any value), the path's start for tunings.
         let start = if matches!(path, Path::Tuning { .. }) { fam.problem_at(0.0).ok() } else { Some(fam.base.clone()) };
-        let sized = start.and_then(|p| step_map(&p).ok().map(|sm| sm.state_size() / p.model().n().max(1)));
+        // The state holds the DOFs with mass only (massless ones are condensed in each step).
+        let sized = start.and_then(|p| step_map(&p).ok().map(|sm| sm.state_size() / (p.model().n() - p.model().massless_dofs().len()).max(1)));
         fam.blocks = sized.unwrap_or(2).max(1);
         fam
     }

@@ -32,6 +32,12 @@ pub struct PolishFailure(pub String);
 /// Polishes the orbit of `r` (solved from `problem`).
 pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<PolishedOrbit, PolishFailure> {
     let model = problem.model();
+    let massless = model.massless_dofs();
+    if !massless.is_empty() {
+        return Err(PolishFailure(format!(
+            "DOFs {massless:?} are massless (a massless boundary, src/formulation.md §4.1): the polish's exact flows need every DOF to carry mass; the LCP's orbit is kept"
+        )));
+    }
     if problem.period_multiple() != 1 {
         return Err(PolishFailure(format!(
             "the orbit spans period_multiple = {} forcing periods; the polish fits events over one period T only",

@@ -39,8 +39,9 @@ pub struct StepMapData {
     pub h: Vec<f64>,
     /// Γ, d×m.
     pub gamma: Vec<f64>,
-    /// D: the diagonal added to HΓ (compliances), m.
-    pub compliance: Vec<f64>,
+    /// D: the m×m block added to HΓ, row-major (compliances on its diagonal, and a model's
+    /// static flexibility between contacts, e.g. of condensed massless DOFs).
+    pub flexibility: Vec<f64>,
     /// r_j, k×m.
     pub r: Vec<f64>,
 }
@@ -81,27 +82,27 @@ pub enum StepMapError {
 }
 
 impl StepMapLcp {
-    /// Checks sizes, finiteness and that S = HΓ + diag(compliance) is a P-matrix.
+    /// Checks sizes, finiteness and that S = HΓ + D is a P-matrix.
     pub fn new(data: StepMapData) -> Result<Self, StepMapError> {
-        let StepMapData { k, d, m, phi, carry, c, h, gamma, compliance, r } = data;
+        let StepMapData { k, d, m, phi, carry, c, h, gamma, flexibility, r } = data;
         let size = |what, ok: bool| if ok { Ok(()) } else { Err(StepMapError::Size(what, k, d, m)) };
         size("phi", phi.len() == d * d)?;
         size("carry", carry.iter().all(|&(i, j)| i < d && j < d))?;
         size("c", c.len() == k * d)?;
         size("h", h.len() == m * d)?;
         size("gamma", gamma.len() == d * m)?;
-        size("compliance", compliance.len() == m)?;
+        size("flexibility", flexibility.len() == m * m)?;
         size("r", r.len() == k * m)?;
         if m > MAX_PAIRS {
             return Err(StepMapError::TooManyPairs(m));
         }
-        if !phi.iter().chain(&c).chain(&h).chain(&gamma).chain(&compliance).chain(&r).all(|v| v.is_finite()) {
+        if !phi.iter().chain(&c).chain(&h).chain(&gamma).chain(&flexibility).chain(&r).all(|v| v.is_finite()) {
             return Err(StepMapError::NonFinite);
         }
         let mut s = vec![0.0; m * m];
         for a in 0..m {
             for b in 0..m {
-                s[a * m + b] = (0..d).map(|i| h[a * d + i] * gamma[i * m + b]).sum::<f64>() + if a == b { compliance[a] } else { 0.0 };
+                s[a * m + b] = (0..d).map(|i| h[a * d + i] * gamma[i * m + b]).sum::<f64>() + flexibility[a * m + b];
             }
         }
         check_p_matrix(&s, m)?;
