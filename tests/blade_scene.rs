@@ -520,6 +520,13 @@ fn contacts_by_dofs_take_radial_and_given_normals() {
             assert!((c.gap_at(3.0, t) - expected).abs() < 1e-14, "θ = {theta}: {} vs {expected}", c.gap_at(3.0, t));
         }
     }
+    // The cosine lobes at the same angles: −δ·cos(ω t + L·θ_i), ω = L·Ω.
+    let lobes = text.replace("harmonics = [{ order = 1, amplitude = 0.1, phase = 0.2 }]", "lobes = 3\ndepth = 0.1");
+    let b = build(&lobes);
+    for (c, theta) in b.problem.model().contacts.iter().zip([0.0, std::f64::consts::FRAC_PI_2, std::f64::consts::PI]) {
+        let expected = 0.5 - 0.1 * (3.0 * 0.3 + 3.0 * theta).cos();
+        assert!((c.gap_at(3.0, 0.3) - expected).abs() < 1e-14, "lobes at θ = {theta}: {} vs {expected}", c.gap_at(3.0, 0.3));
+    }
 }
 
 /// The shipped rigid blade scene (coarse, 3 rigid tip contacts) with `method`, `scheme` and

@@ -180,7 +180,10 @@ impl Scene {
                 (None, Source::Blade(blade), Some([x, y, z])) if lobes => {
                     (casing.arc(x, y, blade.params.twist_deg.to_radians() * z / blade.params.length), 0.0)
                 }
-                (None, _, Some(position)) if rotor.is_some() => (0.0, rotor.as_mut().expect("checked").angle(&format!("contact[{}]", p.spec), position)?),
+                (None, _, Some(position)) if rotor.is_some() => {
+                    let angle = rotor.as_mut().expect("checked").angle(&format!("contact[{}]", p.spec), position)?;
+                    (angle * casing.radius, angle)
+                }
                 _ => {
                     let message = format!(
                         "is missing; contact[{}] has no node position, so give the arc position [m] of every contact along the rotation (or each contact's position with casing.axis)",
