@@ -199,6 +199,33 @@ fn shooting_agrees_with_lemke_on_random_multi_contact_models() {
     assert!(by_shooting + 2 >= solved, "only {by_shooting} of {solved} solved by shooting alone");
 }
 
+/// Past the old caps of the step map (64 DOFs, 10 contacts): 70-DOF chains with 12 compliant
+/// stops (stiffness 1–3, the chain's order), under cds/same (S diagonal) and bds1/same (S = B W Bᵀ + D couples all 12: checked
+/// through its symmetric part), at k = 256 (N = 3072). Shooting alone solves them
+/// and agrees with dense Lemke's certified answer to 1e-9. (Rigid stops under cds/forward, or stops
+/// 5–50 times stiffer, on this chain: Newton does not converge and Lemke answers.)
+#[test]
+fn shooting_past_the_old_caps_agrees_with_lemke() {
+    let mut draw = Draw(20261125);
+    for (rigid, scheme, pairing, k) in [(false, Scheme::Cds, Pairing::Same, 256), (false, Scheme::Bds1, Pairing::Same, 256)] {
+        let (n, m) = (70, 12);
+        let mut model = random_chain(&mut draw, n, m, rigid);
+        // Stops of the springs' order (1–3): at 5–50 Newton does not converge with 12 stops.
+        for c in &mut model.contacts {
+            c.compliance = Compliance::Compliant { stiffness: draw.range(1.0, 3.0) };
+        }
+        let outputs = OutputSelection { displacement: vec![0, n - 1], velocity: vec![], acceleration: vec![], contacts: true };
+        let p = PeriodicProblem::new(model, Discretization { scheme, steps: k, pairing: Some(pairing) }, outputs, SolverSettings::default()).unwrap();
+        assert!(step_map(&p).is_ok(), "{:?}", step_map(&p).err());
+        let name = format!("n = {n}, m = {m}, {} {scheme}/{pairing}", if rigid { "rigid" } else { "compliant" });
+        let (r, alone, _) = agree(&name, &p);
+        assert!(alone, "{name}: shooting alone did not solve it: {}", r.lcp.path);
+        let active = r.contacts.iter().filter(|c| c.force.iter().any(|&f| f > 0.0)).count();
+        // Several stops touch (measured: 3 of 12 under cds), so the step LCPs couple pairs.
+        assert!(active >= 2, "{name}: only {active} of {m} contacts are active");
+    }
+}
+
 /// The rigid stop with sticking at k = 65 536 (the size the dense methods refuse): shooting
 /// solves it, certified, and the orbit is the exact one within cds/forward's O(h²) error.
 #[test]

@@ -36,8 +36,8 @@ pub struct ShootingSettings {
     /// then the cheaper way on a small problem. Why: the offset homotopy of a stiff reduced
     /// model near resonance can meet hundreds of kinks, each a Jacobian.
     pub max_work: f64,
-    /// The budget's floor in Newton iterations (a march and a period Jacobian, as measured at the
-    /// first): on a large problem one iteration alone passes `max_work` (≈ 10¹⁰ flops at d = 200,
+    /// The budget's floor in Newton iterations (a march and the costliest period Jacobian formed
+    /// so far): on a large problem one iteration alone passes `max_work` (≈ 10¹⁰ flops at d = 200,
     /// k = 8192), and there is no cheaper fallback.
     pub work_iterations: f64,
 }
@@ -85,7 +85,7 @@ pub struct ShootingSolution {
     pub start: &'static str,
     /// Floating-point operations spent, estimated (marches and Jacobians).
     pub work: f64,
-    /// Of which one Newton iteration: the first march and period Jacobian.
+    /// Of which one Newton iteration at most: a march and the costliest period Jacobian.
     pub work_per_iteration: f64,
 }
 
@@ -102,7 +102,7 @@ struct Newton<'a> {
     jacobians: usize,
     /// Floating-point operations spent, estimated (marches and Jacobians).
     work: f64,
-    /// One march, and one Jacobian as measured at the first (0 before).
+    /// One march, and the costliest Jacobian formed so far (0 before).
     march_work: f64,
     jacobian_work: f64,
     jac: Mat<f64>,
@@ -143,9 +143,7 @@ impl<'a> Newton<'a> {
             self.jacobians += 1;
             // (d+1)×(d+1) products of the runs' powers, 2(d+1)³ flops each.
             let work = products.max(1) as f64 * 2.0 * (self.sm.d as f64 + 1.0).powi(3);
-            if self.jacobian_work == 0.0 {
-                self.jacobian_work = work;
-            }
+            self.jacobian_work = self.jacobian_work.max(work);
             self.work += work;
         }
     }
