@@ -318,3 +318,39 @@ fn the_policy_falls_back_after_a_shooting_breakdown() {
         assert!(sol.info.residual <= 1e-9 * q.iter().fold(1.0f64, |m, v| m.max(v.abs())));
     }
 }
+
+/// A model whose dense step map would cost too much (a 2000-DOF sparse chain: d = 4000, ≈ 1.2e12
+/// flops per Newton iteration at k = 256) gets none: the refusal names the memory and work
+/// figures and the remedy, and comes before the map is built (the test ends in a blink).
+#[test]
+fn a_step_map_past_the_estimates_is_refused_with_its_figures() {
+    use faer::sparse::{SparseColMat, Triplet};
+    let n = 2000;
+    let chain = |diagonal: f64, off: f64| {
+        let mut t = Vec::new();
+        for i in 0..n {
+            t.push(Triplet::new(i, i, diagonal));
+            if i + 1 < n && off != 0.0 {
+                t.push(Triplet::new(i, i + 1, off));
+                t.push(Triplet::new(i + 1, i, off));
+            }
+        }
+        Matrix::Sparse(SparseColMat::try_new_from_triplets(n, n, &t).unwrap())
+    };
+    let structure = Structure { mass: chain(1.0, 0.0), stiffness: chain(2.0, -1.0), damping: None };
+    let contact = Contact { dof: 0, direction: 1.0, gap: 0.5, compliance: Compliance::Rigid, motion: Vec::new() };
+    let model = Model {
+        structure,
+        forces: vec![Force { dof: 0, term: Harmonic { amplitude: 1.0, harmonic: 1, phase: 0.0 } }],
+        contacts: vec![contact],
+        frequency: 1.0,
+    };
+    let outputs = OutputSelection { displacement: vec![0], velocity: vec![], acceleration: vec![], contacts: true };
+    let p =
+        PeriodicProblem::new(model, Discretization { scheme: Scheme::Cds, steps: 256, pairing: Some(Pairing::Forward) }, outputs, SolverSettings::default())
+            .unwrap();
+    let why = step_map(&p).unwrap_err().to_string();
+    for part in ["2000 DOFs", "d = 4000", "GiB", "flops per Newton iteration", "at most 1e12", "Craig–Bampton"] {
+        assert!(why.contains(part), "{part:?} missing from: {why}");
+    }
+}
