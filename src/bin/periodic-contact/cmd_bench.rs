@@ -85,7 +85,7 @@ fn reduced(steps: usize, mut rng: Option<&mut SplitMix>) -> Member {
     for c in 0..32 {
         let gap = pick(&mut rng, 0.1, (0.05, 0.15));
         let amplitude = pick(&mut rng, 0.25, (0.2, 0.3));
-        let phase = pick(&mut rng, 0.2 * c as f64, (0.0, 6.283));
+        let phase = pick(&mut rng, 0.2 * c as f64, (0.0, std::f64::consts::TAU));
         let kc = pick(&mut rng, 2.0, (1.0, 4.0));
         scene += &format!(
             "[[contact]]\ndof = {}\ndirection = {}\ngap = {gap}\nstiffness = {kc}\nmotion = [{{ amplitude = {amplitude}, harmonic = 1, phase = {phase} }}]\n\n",
