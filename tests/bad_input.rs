@@ -364,7 +364,7 @@ fn huge_sizes_are_refused_at_once() {
     refused_quickly(&two, &["discretization.steps", "524300 with 2 contact(s)", "1048600 unknowns", "at most 1048576"]);
     // Fourier collocation has no step map: the dense methods' 32768 is its limit.
     let fourier = with("steps = 64", "steps = 40000").replacen("scheme = \"cds\"", "scheme = \"fourier\"", 1);
-    refused_quickly(&fourier, &["discretization.steps", "40000", "at most 32768", "under fourier", "reduce steps"]);
+    refused_quickly(&fourier, &["discretization.steps", "40000", "at most 32768", "under fourier", "reduce steps", "GiB", "use scheme cds"]);
     // Without contact a fine grid is only FFTs; on a dense model it is one LU per harmonic.
     let n = 100;
     let identity =

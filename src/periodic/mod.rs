@@ -15,7 +15,7 @@ pub use fft::PeriodFft;
 pub use problem::{MAX_DENSE_FLOPS, MAX_LCP_SIZE, MAX_STEPS, MIN_STEPS, PeriodicProblem};
 pub use recovery::render_path as render_lcp_path;
 pub use session::{PeriodicSolver, WarmStart};
-pub use state_space::{MAX_STEP_MAP_DOFS, NoStepMap, step_map};
+pub use state_space::{NoStepMap, SHOOTING_MEMORY_MAX, SHOOTING_WORK_MAX, shooting_memory, shooting_work, step_map};
 pub use tuning::Tuning;
 
 use crate::error::{Error, ErrorKind};

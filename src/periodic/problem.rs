@@ -2,7 +2,7 @@
 //! private: every way in (constructor, updaters) runs the checks, so a `PeriodicProblem` is
 //! always ready to solve.
 use super::{Assembly, OutputMap, OutputSelection, PeriodFft, SolveError, SolverSettings, assembly, lcp_failure, limits, recovery};
-use crate::lcp::{BlockCirculant, DENSE_MAX, LcpMethod, LcpOutcome, LcpSolution, solve_periodic_lcp};
+use crate::lcp::{BlockCirculant, DENSE_MAX, DENSE_MEMORY_MAX, GIB, LcpMethod, LcpOutcome, LcpSolution, dense_memory, solve_periodic_lcp};
 use crate::model::{Contact, Model};
 use crate::response::Response;
 use crate::time::{Discretization, Pairing};
@@ -435,10 +435,12 @@ impl PeriodicProblem {
                     "solver.method: \"shooting\" needs a time-stepping map, and this problem has none: {why}; use \"auto\""
                 )));
             }
-            if q.len() > DENSE_MAX {
+            if dense_memory(q.len()) > DENSE_MEMORY_MAX {
                 return Err(SolveError::Limit(format!(
-                    "discretization.steps: an LCP of {} unknowns is past the {DENSE_MAX} of the dense methods, and shooting does not apply: {why}; reduce steps",
-                    q.len()
+                    "discretization.steps: an LCP of {} unknowns needs ≈ {:.1} GiB in the dense methods (N² numbers, at most {:.0} GiB: N ≤ {DENSE_MAX}), and shooting does not apply: {why}",
+                    q.len(),
+                    dense_memory(q.len()) / GIB,
+                    DENSE_MEMORY_MAX / GIB
                 )));
             }
         }
@@ -474,15 +476,21 @@ fn check_sizes(model: &Model, disc: &Discretization, p: usize) -> Result<(), Sol
         )));
     }
     let m = model.contacts.len();
+    let unknowns = instants.saturating_mul(m);
     // Fourier collocation has no step map: only the dense methods solve it.
-    let most = if disc.scheme == crate::time::Scheme::Fourier { DENSE_MAX } else { MAX_LCP_SIZE };
-    if instants.saturating_mul(m) > most {
+    if disc.scheme == crate::time::Scheme::Fourier && dense_memory(unknowns) > DENSE_MEMORY_MAX {
+        return Err(SolveError::Limit(format!(
+            "discretization.steps: is {k}{} with {m} contact(s), an LCP of {unknowns} unknowns; fourier collocation has no time-stepping map and its dense methods would need ≈ {:.1} GiB (N² numbers; at most {DENSE_MAX} unknowns, {:.0} GiB, under fourier): use scheme cds, galerkin, bds1 or bds2, which shoot in O(k·(d + m)) memory, or reduce steps",
+            if p > 1 { format!(" × period_multiple {p}") } else { String::new() },
+            dense_memory(unknowns) / GIB,
+            DENSE_MEMORY_MAX / GIB
+        )));
+    }
+    if unknowns > MAX_LCP_SIZE {
         let times = if p > 1 { format!(" × period_multiple {p}") } else { String::new() };
         return Err(SolveError::Limit(format!(
-            "discretization.steps: is {k}{times} with {m} contact(s), an LCP of {} unknowns (steps{} × contacts); at most {most} are accepted{}: reduce steps{}",
-            instants.saturating_mul(m),
+            "discretization.steps: is {k}{times} with {m} contact(s), an LCP of {unknowns} unknowns (steps{} × contacts); at most {MAX_LCP_SIZE} are accepted: reduce steps{}",
             if p > 1 { " × period_multiple" } else { "" },
-            if most == DENSE_MAX { " under fourier (no time-stepping map, dense methods only)" } else { "" },
             if p > 1 { " or period_multiple" } else { "" }
         )));
     }

@@ -33,18 +33,37 @@
 //! D = B_b K_bb⁻¹ B_bᵀ added to S = HΓ + D and −B_b K_bb⁻¹ f_b to r_j. Galerkin weighs K over three
 //! instants, (1, 4, 1)/6: a massless DOF then couples the whole period and has no step map.
 //!
-//! Fourier collocation is not a time stepper. The map is dense in d = p·n, so only models of up
-//! to [`MAX_STEP_MAP_DOFS`] DOFs (reduced ones) get one.
+//! Fourier collocation is not a time stepper. The map is dense in d = p·n (reduced models: its
+//! memory is O(d² + k·(d + m)), checked with the LCP's before solving).
 use super::PeriodicProblem;
-use crate::lcp::{DenseLu, MAX_PAIRS, StepMapData, StepMapLcp, dense_product};
+use crate::lcp::{DenseLu, GIB, StepMapData, StepMapLcp, dense_product};
 use crate::model::{Compliance, Model};
 use crate::time::Scheme;
 use faer::Mat;
 use faer::linalg::solvers::Solve;
 
-/// Most DOFs of a model solved by shooting: its march is dense in the state (d = 2n or 3n) and
-/// each Newton iteration forms a d×d Jacobian.
-pub const MAX_STEP_MAP_DOFS: usize = 64;
+/// The most memory the shooting solver may take for a step map ([`shooting_memory`]).
+pub const SHOOTING_MEMORY_MAX: f64 = 4.0 * GIB;
+
+/// The most work one Newton iteration of shooting may cost at the least ([`shooting_work`]):
+/// about a minute on one core.
+pub const SHOOTING_WORK_MAX: f64 = 1e12;
+
+/// Bytes the shooting solver holds for a step map of state size d over k steps with m pairs: the
+/// augmented Φ's powers (log₂ k + 1 of them) and a few more (d+1)² matrices (a run's powers, the
+/// Jacobian, Newton's LU), and the march's k·(d + 3m) (c_j, r_j, z_j and the sets).
+pub fn shooting_memory(k: usize, d: usize, m: usize) -> f64 {
+    let matrices = f64::from(usize::BITS - k.leading_zeros()) + 6.0;
+    8.0 * (matrices * ((d + 1) as f64).powi(2) + k as f64 * (d + 3 * m) as f64)
+}
+
+/// Floating-point operations of one Newton iteration at the least: a march (k·d²) and the
+/// contact-free Jacobian's log₂ k squarings of (d+1)² matrices (each run of one contact set
+/// adds up to 2·log₂ k more).
+pub fn shooting_work(k: usize, d: usize, m: usize) -> f64 {
+    let squarings = f64::from(usize::BITS - k.leading_zeros());
+    k as f64 * ((d * d) as f64 + 2.0 * (d * m) as f64) + squarings * 2.0 * ((d + 1) as f64).powi(3)
+}
 
 /// Why a problem has no step map (the solver then uses the LCP alone).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -74,19 +93,23 @@ pub fn step_map(problem: &PeriodicProblem) -> Result<StepMapLcp, NoStepMap> {
     };
     // p·k steps over p·T for an orbit of p forcing periods (h = T/k either way).
     let (n, m, k) = (model.n(), model.contacts.len(), problem.instants());
-    // Massless DOFs are condensed out of the state.
-    let n_massive = n - model.massless_dofs().len();
-    if n_massive > MAX_STEP_MAP_DOFS {
-        return Err(NoStepMap(format!("the model has {n_massive} DOFs with mass; shooting takes at most {MAX_STEP_MAP_DOFS} (reduce it: Craig–Bampton)")));
-    }
-    if m > MAX_PAIRS {
-        return Err(NoStepMap(format!("{m} contacts; shooting takes at most {MAX_PAIRS}")));
-    }
     let offsets: Vec<usize> = (0..m).map(|c| problem.pairing_at(c).offset()).collect();
     if let Some(c) = offsets.iter().position(|&s| s > lead) {
         return Err(NoStepMap(format!("contact[{c}] is paired forward under {}: its force waits for a later step's gap", disc.scheme)));
     }
     let p = a2.len() - 1;
+    // Massless DOFs are condensed out of the state; the map is dense in the rest.
+    let n = n - model.massless_dofs().len();
+    let d = p * n;
+    // Refuse it before building it when it cannot fit or run.
+    let (bytes, work) = (shooting_memory(k, d, m), shooting_work(k, d, m));
+    if bytes > SHOOTING_MEMORY_MAX || work > SHOOTING_WORK_MAX {
+        return Err(NoStepMap(format!(
+            "shooting on the step map of {n} DOFs with mass (state of d = {d}) over k = {k} steps needs ≈ {:.2} GiB (at most {:.0}) and ≈ {work:.1e} flops per Newton iteration (at most {SHOOTING_WORK_MAX:.0e}); reduce the model (Craig–Bampton) or steps",
+            bytes / GIB,
+            SHOOTING_MEMORY_MAX / GIB
+        )));
+    }
     let h = problem.period() / k as f64;
     let cond = Condensed::new(model, &a0, lead, &offsets)?;
     let (mass, stiffness, damping, n) = (&cond.mass, &cond.stiffness, &cond.damping, cond.massive.len());

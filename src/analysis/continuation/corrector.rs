@@ -62,7 +62,7 @@ pub(super) struct Family {
 #[derive(Clone, Debug)]
 pub(super) struct Solved {
     pub v: Vec<f64>,
-    pub masks: Vec<u32>,
+    pub masks: Vec<u64>,
     pub jacobian: DMatrix<f64>,
     pub monodromy: DMatrix<f64>,
 }
@@ -135,7 +135,7 @@ impl Family {
     }
 
     /// F, its Jacobian and the active sets at v (the march tries `guess` first per step).
-    fn evaluate(&mut self, v: &[f64], guess: &[u32]) -> Option<(Vec<f64>, Solved)> {
+    fn evaluate(&mut self, v: &[f64], guess: &[u64]) -> Option<(Vec<f64>, Solved)> {
         let d = v.len() - 1;
         let lambda = v[d] * self.rho;
         let sm = self.map_at(lambda).ok()?;
@@ -163,7 +163,7 @@ impl Family {
     /// lower the defect is halved (up to 4 times): near a kink of the piecewise-affine map, full
     /// steps can cycle between two pieces, each piece's root lying in the other (met on the 2T
     /// branch of NLvib 03 at k = 4096, where the steps halved down to the smallest).
-    pub fn correct(&mut self, pred: &[f64], normal: &[f64], guess: &[u32]) -> Option<(Solved, usize)> {
+    pub fn correct(&mut self, pred: &[f64], normal: &[f64], guess: &[u64]) -> Option<(Solved, usize)> {
         let n = pred.len();
         let mut v = pred.to_vec();
         let (mut f, mut solved) = self.evaluate(&v, guess)?;
@@ -212,7 +212,7 @@ impl Family {
     }
 
     /// [dF/ds_0 | dF/d(λ/ρ)] at v on the piece of `masks` (the sets imposed, not solved for).
-    fn frozen_jacobian(&mut self, v: &[f64], masks: &[u32]) -> Option<DMatrix<f64>> {
+    fn frozen_jacobian(&mut self, v: &[f64], masks: &[u64]) -> Option<DMatrix<f64>> {
         let d = v.len() - 1;
         let lambda = v[d] * self.rho;
         let j = self.map_at(lambda).ok()?.period_jacobian(masks);
@@ -224,7 +224,7 @@ impl Family {
     }
 
     /// The active sets of the march from the state of v at its λ, `guess` tried first.
-    fn masks_at(&mut self, v: &[f64], guess: &[u32]) -> Option<Vec<u32>> {
+    fn masks_at(&mut self, v: &[f64], guess: &[u64]) -> Option<Vec<u64>> {
         let d = v.len() - 1;
         let sm = self.map_at(v[d] * self.rho).ok()?;
         self.marches += 1;
@@ -309,7 +309,7 @@ impl Family {
 
     /// The orbit at λ with these active sets: the fixed point of their affine piece of P,
     /// s = (I − J_s)⁻¹ P_frozen(0), then corrected at fixed λ.
-    pub fn start(&mut self, lambda: f64, masks: &[u32]) -> Option<Solved> {
+    pub fn start(&mut self, lambda: f64, masks: &[u64]) -> Option<Solved> {
         let sm = self.map_at(lambda).ok()?;
         let d = sm.state_size();
         let b = sm.march_frozen(&vec![0.0; d], masks)?;

@@ -96,7 +96,7 @@ pub struct BranchPoint {
     /// The orbit's initial state s_0 (the step map's state).
     pub state: Vec<f64>,
     /// The active sets of the orbit's steps (bit c: contact c), for a switch of branch here.
-    pub(crate) masks: Vec<u32>,
+    pub(crate) masks: Vec<u64>,
     /// The branch's unit tangent in (s_0, λ/ρ) here, for a switch of branch.
     pub(crate) tangent: Vec<f64>,
     /// What produced the point: the exact orbit, or the discrete walk on the grid.
@@ -258,7 +258,7 @@ fn walk_from(
     solver.reset_warm_start();
     let first = solver.solve().map_err(|e| Error::from(e).context(format!("the start of the continuation at {name} = {from}")))?;
     let (k, m) = (solver.problem().instants(), solver.problem().model().contacts.len());
-    let mut masks = vec![0u32; k];
+    let mut masks = vec![0u64; k];
     for &i in &first.active_set {
         masks[i / m] |= 1 << (i % m);
     }
@@ -352,7 +352,7 @@ impl Walk<'_> {
         let mut turned = false;
         // The parameter of the last steps: a walk that only goes back and forth is in a zigzag.
         let mut recent: Vec<f64> = Vec::new();
-        let mut left: std::collections::VecDeque<Vec<u32>> = std::collections::VecDeque::new();
+        let mut left: std::collections::VecDeque<Vec<u64>> = std::collections::VecDeque::new();
         let mut zigzag = None;
         let stop = loop {
             if points.len() >= settings.max_points {
@@ -563,7 +563,7 @@ fn point(fam: &Family, solver: &mut PeriodicSolver, node: &Node, event: Option<E
 }
 
 /// Indices j·m + c of the active pairs (the LCP's z order), m contacts.
-fn active_set(masks: &[u32], m: usize) -> Vec<usize> {
+fn active_set(masks: &[u64], m: usize) -> Vec<usize> {
     masks.iter().enumerate().flat_map(|(j, mask)| (0..m).filter(move |c| mask >> c & 1 == 1).map(move |c| j * m + c)).collect()
 }
 

@@ -99,7 +99,7 @@ pub fn switch_at(
     let mut w: Vec<f64> = (0..=d).map(|i| if i < d { v[i] } else { 0.0 } - along * t[i]).collect();
     let norm = w.iter().map(|x| x * x).sum::<f64>().sqrt();
     w.iter_mut().for_each(|x| *x /= norm);
-    let masks2: Vec<u32> = pd.masks.iter().chain(&pd.masks).copied().collect();
+    let masks2: Vec<u64> = pd.masks.iter().chain(&pd.masks).copied().collect();
     let (start2, _) = fam2.correct(&star, &w, &masks2).ok_or_else(|| fail("the T orbit does not close as a 2T orbit"))?;
     let mut solver = PeriodicSolver::new(fam2.problem_at(pd.parameter)?);
     let head = Node::new(&mut fam2, start2, w.clone());
@@ -150,7 +150,7 @@ pub(super) struct Rejoin<'a> {
     /// P_T(s) − s at the last point.
     last: Vec<f64>,
     /// The T branch's period doublings (λ, s_0, active sets): where a 2T branch can end.
-    doublings: Vec<(f64, Vec<f64>, Vec<u32>)>,
+    doublings: Vec<(f64, Vec<f64>, Vec<u64>)>,
 }
 
 impl Rejoin<'_> {
@@ -186,7 +186,7 @@ impl Rejoin<'_> {
         };
         let mut star = state.clone();
         star.push(at / rho);
-        let masks2: Vec<u32> = masks.iter().chain(masks).copied().collect();
+        let masks2: Vec<u64> = masks.iter().chain(masks).copied().collect();
         let sec: Vec<f64> = star.iter().zip(&here.solved.v).map(|(b, a)| b - a).collect();
         let len = sec.iter().map(|x| x * x).sum::<f64>().sqrt();
         let tangent: Vec<f64> = sec.iter().map(|x| x / len).collect();

@@ -72,7 +72,7 @@ enum Command {
     /// Benchmark over the class: time, pivots and peak memory per case and k, with random
     /// families (worst case first).
     Bench {
-        /// Cases (comma-separated): rigid-stick, rigid-impact, compliant, chain, blade, or all.
+        /// Cases (comma-separated): rigid-stick, rigid-impact, compliant, chain, blade, reduced, or all.
         #[arg(long, value_delimiter = ',', default_value = "rigid-stick")]
         case: Vec<String>,
         /// LCP sizes k to measure.
