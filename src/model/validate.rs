@@ -95,14 +95,14 @@ impl Model {
         self.validate_frequency()?;
         for (i, f) in self.forces.iter().enumerate() {
             if f.dof >= n {
-                return Err(ModelError::new(format!("force[{i}].dof"), format!("is {}, the model has DOFs 0..{}", f.dof, n - 1)));
+                return Err(ModelError::new(format!("force[{i}].dof"), format!("is {}, the model has DOFs 0 to {} (use one of them)", f.dof, n - 1)));
             }
             check_finite(format!("force[{i}].amplitude"), f.term.amplitude)?;
             check_finite(format!("force[{i}].phase"), f.term.phase)?;
         }
         for (i, c) in self.contacts.iter().enumerate() {
             if c.dof >= n {
-                return Err(ModelError::new(format!("contact[{i}].dof"), format!("is {}, the model has DOFs 0..{}", c.dof, n - 1)));
+                return Err(ModelError::new(format!("contact[{i}].dof"), format!("is {}, the model has DOFs 0 to {} (use one of them)", c.dof, n - 1)));
             }
             if c.direction != 1.0 && c.direction != -1.0 {
                 return Err(ModelError::new(format!("contact[{i}].direction"), format!("is {}, must be +1 or -1", c.direction)));
