@@ -203,7 +203,7 @@ fn massless_contact_point(osc: &Oscillator, k2: f64, gap: f64, contact: Complian
             damping: Some(Matrix::from_rows(&[vec![osc.damping, 0.0], vec![0.0, 0.0]])),
         },
         forces: vec![Force { dof: 0, term: Harmonic { amplitude: osc.force, harmonic: 1, phase: 0.0 } }],
-        contacts: vec![Contact { dof: 1, direction: 1.0, gap, compliance: contact, motion: vec![] }],
+        contacts: vec![Contact::on_dof(1, 1.0, gap, contact)],
         frequency: osc.omega,
     }
 }

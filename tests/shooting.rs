@@ -338,7 +338,7 @@ fn a_step_map_past_the_estimates_is_refused_with_its_figures() {
         Matrix::Sparse(SparseColMat::try_new_from_triplets(n, n, &t).unwrap())
     };
     let structure = Structure { mass: chain(1.0, 0.0), stiffness: chain(2.0, -1.0), damping: None };
-    let contact = Contact { dof: 0, direction: 1.0, gap: 0.5, compliance: Compliance::Rigid, motion: Vec::new() };
+    let contact = Contact::on_dof(0, 1.0, 0.5, Compliance::Rigid);
     let model = Model {
         structure,
         forces: vec![Force { dof: 0, term: Harmonic { amplitude: 1.0, harmonic: 1, phase: 0.0 } }],

@@ -123,7 +123,7 @@ fn check_row(i: usize, row: &[(usize, f64)], n: usize) -> Result<(), ModelError>
     }
     for (e, &(d, c)) in row.iter().enumerate() {
         if d >= n {
-            return Err(ModelError::new(format!("contact[{i}].dof"), format!("is {d}, the model has DOFs 0..{}", n - 1)));
+            return Err(ModelError::new(format!("contact[{i}].dof"), format!("is {d}, the model has DOFs 0 to {} (use one of them)", n - 1)));
         }
         if row[..e].iter().any(|&(o, _)| o == d) {
             return Err(ModelError::new(format!("contact[{i}].normal"), format!("names DOF {d} twice; give each DOF of the normal once")));
@@ -176,7 +176,7 @@ impl Model {
         self.validate_frequency()?;
         for (i, f) in self.forces.iter().enumerate() {
             if f.dof >= n {
-                return Err(ModelError::new(format!("force[{i}].dof"), format!("is {}, the model has DOFs 0..{}", f.dof, n - 1)));
+                return Err(ModelError::new(format!("force[{i}].dof"), format!("is {}, the model has DOFs 0 to {} (use one of them)", f.dof, n - 1)));
             }
             check_finite(format!("force[{i}].amplitude"), f.term.amplitude)?;
             check_finite(format!("force[{i}].phase"), f.term.phase)?;

@@ -554,7 +554,7 @@ fn check_solver(s: &SolverSettings) -> Result<(), SolveError> {
 
 fn check_outputs(outputs: &OutputSelection, n: usize) -> Result<(), SolveError> {
     if let Some(d) = outputs.dofs().into_iter().find(|&d| d >= n) {
-        return Err(SolveError::Invalid(format!("output: DOF {d} does not exist, the model has DOFs 0..{}", n - 1)));
+        return Err(SolveError::Invalid(format!("output: DOF {d} does not exist, the model has DOFs 0 to {}", n - 1)));
     }
     Ok(())
 }

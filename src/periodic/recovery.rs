@@ -1,7 +1,7 @@
 //! Recovery (src/formulation.md §3): X̂_p = X̂lin_p − (Ẑ_p⁻¹Bᵀ) ẑ_p at the output DOFs only, velocities and
 //! accelerations by the symbols σ1, σ2; contact gaps from B X̂_p = B X̂lin_p − Ĝ_p ẑ_p.
 use super::{Assembly, PeriodFft, PeriodicProblem, SolveError};
-use crate::lcp::{AUTO_LEMKE_MAX, LcpMethod, LcpSolution, LcpStep, WarmOutcome};
+use crate::lcp::{AUTO_LEMKE_MAX, LcpMethod, LcpOutcome, LcpSolution, LcpStep, WarmOutcome};
 use crate::response::{ContactResponse, LcpSummary, Response, WarmStartSummary};
 use num_complex::Complex64 as C;
 use std::collections::BTreeMap;
@@ -181,7 +181,12 @@ pub fn render_path(method: LcpMethod, path: &[LcpStep]) -> String {
                 LcpMethod::Pivoting => ("block pivoting", "pivots"),
                 _ => ("dense lexicographic Lemke", "pivots"),
             };
-            format!("{what}, {} {count}, {:.3} s → {}", s.pivots, s.time_s, s.outcome.name())
+            // Shooting counts Newton iterations: its limit is an iteration limit, not a pivot limit.
+            let outcome = match (s.method, s.outcome) {
+                (LcpMethod::Shooting, LcpOutcome::PivotLimit) => "iteration limit",
+                (_, o) => o.name(),
+            };
+            format!("{what}, {} {count}, {:.3} s → {outcome}", s.pivots, s.time_s)
         })
         .collect();
     format!("{head}: {}", steps.join("; fallback: "))

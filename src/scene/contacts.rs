@@ -18,7 +18,7 @@ pub(super) struct Resolver<'a> {
 impl Resolver<'_> {
     fn index(&self, field: &str, d: usize) -> Result<(usize, usize), BuildError> {
         if d >= self.n_user {
-            return Err(BuildError::field(field, format!("is {d}, the model has DOFs 0..{}", self.n_user - 1)));
+            return Err(BuildError::field(field, format!("is {d}, the model has DOFs 0 to {} (use one of them)", self.n_user - 1)));
         }
         match self.dofs.new_index(d) {
             Some(f) => Ok((d, f)),

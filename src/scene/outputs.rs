@@ -59,7 +59,7 @@ pub(super) fn problem(
         let n = model.n();
         for (name, list) in [("displacement", &outputs.displacement), ("velocity", &outputs.velocity), ("acceleration", &outputs.acceleration)] {
             if let Some((i, d)) = list.iter().enumerate().find(|(_, d)| **d >= n) {
-                return Err(BuildError::field(format!("output.{name}[{i}]"), format!("DOF {d} does not exist, the model has DOFs 0..{}", n - 1)));
+                return Err(BuildError::field(format!("output.{name}[{i}]"), format!("DOF {d} does not exist, the model has DOFs 0 to {}", n - 1)));
             }
         }
         return Ok(new(model, disc, outputs, solver)?);

@@ -131,7 +131,13 @@ impl Family {
     /// The step map at λ.
     pub fn map_at(&self, lambda: f64) -> Result<StepMapLcp, Error> {
         let p = self.problem_at(lambda)?;
-        step_map(&p).map_err(|e| Error::input(format!("continuation needs the time-stepping map of a difference scheme: {}", e.0)))
+        step_map(&p).map_err(|e| {
+            Error::input(format!(
+                "continuation needs the time-stepping map of a difference scheme: {}; set [discretization] scheme = \"cds\" \
+                 (or bds1, bds2, galerkin), or trace the scene with `sweep`, which takes every scheme",
+                e.0
+            ))
+        })
     }
 
     /// F, its Jacobian and the active sets at v (the march tries `guess` first per step).

@@ -66,7 +66,7 @@ pub fn events_json(branches: &[Branch], problem: &PeriodicProblem) -> String {
 }
 
 /// PNG of displacement output `i` along the branch: stable runs solid, unstable runs dashed in the
-/// same colour, each event kind as markers of its own without a line; axes named with units.
+/// same colour, each event kind as hollow markers of its own shape without a line; axes named with units.
 #[cfg(feature = "plots")]
 pub fn plot(path: &std::path::Path, branches: &[Branch], problem: &PeriodicProblem, i: usize, labels: &Labels, title: &str) -> Result<(), crate::Error> {
     use crate::plot::{Chart, Legend, Line, Look, Scale, Series, styled_panel_chart};
@@ -98,11 +98,29 @@ pub fn plot(path: &std::path::Path, branches: &[Branch], problem: &PeriodicProbl
         push_run(run, stable, &mut series, &mut looks);
     }
     let kinds = [super::EventKind::Fold, super::EventKind::Grazing, super::EventKind::PeriodDoubling, super::EventKind::NeimarkSacker];
+    // Coincident events (a fold under a period doubling) are drawn side by side: each marker
+    // moves right by 1.2 % of the axis per earlier marker within 1 % of the axes of its place.
+    let extent = |f: &dyn Fn(&(f64, f64)) -> f64| {
+        let v = series.iter().flat_map(|s| s.points.iter()).map(f);
+        let (lo, hi) = v.fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| (l.min(x), h.max(x)));
+        (hi - lo).max(f64::MIN_POSITIVE)
+    };
+    let (dx, dy) = (extent(&|p| p.0), extent(&|p| p.1));
+    let mut placed: Vec<(f64, f64)> = Vec::new();
     for (j, kind) in kinds.into_iter().enumerate() {
-        let pts: Vec<(f64, f64)> = branches.iter().flat_map(|b| b.events()).filter(|p| p.event == Some(kind)).map(|p| (p.parameter, p.amplitude[i])).collect();
+        let events = branches.iter().flat_map(|b| b.events()).filter(|p| p.event == Some(kind));
+        let pts: Vec<(f64, f64)> = events
+            .map(|p| (p.parameter, p.amplitude[i]))
+            .map(|(x, y)| {
+                let near = placed.iter().filter(|q| (q.0 - x).abs() <= 0.01 * dx && (q.1 - y).abs() <= 0.01 * dy).count();
+                (x + 0.012 * dx * near as f64, y)
+            })
+            .collect();
+        placed.extend(branches.iter().flat_map(|b| b.events()).filter(|p| p.event == Some(kind)).map(|p| (p.parameter, p.amplitude[i])));
         if !pts.is_empty() {
             series.push(Series { label: kind.name().into(), points: pts, markers: true });
-            looks.push(Look { colour: branches.len() + j, line: Line::None, marker: Some(j % 3), hollow: false });
+            // Outlines of distinct shapes: coincident events (a fold under a period doubling) stay visible.
+            looks.push(Look { colour: branches.len() + j, line: Line::None, marker: Some(j % 3), hollow: true });
         }
     }
     let (what, quantity) = branches.first().map_or(("parameter", Quantity::Ratio), |b| b.parameter.describe());

@@ -9,15 +9,20 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 #[derive(clap::Args)]
+#[command(after_help = "The scene's scheme must be a difference scheme (cds, bds1, bds2, galerkin): continuation \
+    corrects on its time-stepping map, so fourier scenes are refused (trace them with `sweep`).")]
 pub struct Args {
+    /// The scene (TOML; see the README's "Scene format"): a difference scheme, not fourier.
     pub scene: PathBuf,
     /// The continued parameter: frequency (ω [rad/s]), speed (Ω [rad/s] of the casing; ω =
     /// lobes·Ω), force_scale (× every force of the scene) or gap_offset (added to every contact's
     /// clearance, length unit).
     #[arg(long, default_value = "frequency")]
     pub param: String,
+    /// Where the branch starts (the parameter's value; a cold solve there).
     #[arg(long, allow_negative_numbers = true)]
     pub from: f64,
+    /// Where the branch stops; it may pass folds and turn back on the way.
     #[arg(long, allow_negative_numbers = true)]
     pub to: f64,
     /// Output CSV; the events JSON and the PNG go next to it (same stem).
