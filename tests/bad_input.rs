@@ -209,7 +209,9 @@ const I2: &str = "[[1.0, 0.0], [0.0, 1.0]]";
 fn structural_matrices() {
     refused(&two_dof("[[1.0, 0.5], [0.2, 1.0]]", I2, I2), &["structure.mass", "not symmetric", "0.5", "0.2"]);
     refused(&two_dof("[[1.0, 2.0], [2.0, 1.0]]", I2, I2), &["structure.mass", "not positive definite"]);
-    refused(&two_dof("[[1.0, 0.0], [0.0, 0.0]]", I2, I2), &["structure.mass", "not positive definite"]);
+    // A massless DOF is accepted when K holds it (a massless boundary), refused when nothing does.
+    refused(&two_dof("[[1.0, 0.0], [0.0, 0.0]]", "[[1.0, 0.0], [0.0, 0.0]]", I2), &["structure.mass[1][1]", "neither mass nor stiffness", "remove it"]);
+    refused(&two_dof("[[1.0, 0.5], [0.5, 0.0]]", I2, I2), &["structure.mass[0][1]", "DOF 1 has no mass", "zero row and column"]);
     refused(&with("mass = [[1.0]]", "mass = [[-1.0]]"), &["structure.mass", "not positive definite"]);
     refused(&with("mass = [[1.0]]", "mass = [[0.0]]"), &["structure.mass", "not positive definite"]);
     refused(&two_dof(I2, "[[1.0, 3.0], [1.0, 1.0]]", I2), &["structure.stiffness", "not symmetric"]);

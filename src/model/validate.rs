@@ -65,13 +65,16 @@ fn check_mass(model: &Model) -> Result<(), ModelError> {
     let n = s.n();
     let massless = model.massless_dofs();
     if let Some(&d) = massless.iter().find(|&&d| s.mass.get(d, d) < 0.0) {
-        return Err(ModelError::new(format!("structure.mass[{d}][{d}]"), format!("is {}, a mass must be ≥ 0", s.mass.get(d, d))));
+        return Err(ModelError::new(
+            format!("structure.mass[{d}][{d}]"),
+            format!("is {}: the mass is not positive definite (a mass must be ≥ 0)", s.mass.get(d, d)),
+        ));
     }
     let scale = (0..n).map(|d| s.mass.get(d, d).abs()).fold(0.0f64, f64::max);
     let mut off = None;
     s.mass.for_each(|i, j, v| {
         if off.is_none() && v.abs() > 1e-14 * scale && (massless.binary_search(&i).is_ok() || massless.binary_search(&j).is_ok()) {
-            off = Some((i, j, v));
+            off = Some((i.min(j), i.max(j), v));
         }
     });
     if let Some((i, j, v)) = off {
@@ -79,13 +82,16 @@ fn check_mass(model: &Model) -> Result<(), ModelError> {
             format!("structure.mass[{i}][{j}]"),
             format!(
                 "is {v}, but DOF {} has no mass on its diagonal: a positive semi-definite mass has a zero row and column there",
-                if s.mass.get(i, i) <= 0.0 { i } else { j }
+                if massless.binary_search(&i).is_ok() { i } else { j }
             ),
         ));
     }
     let massive: Vec<usize> = (0..n).filter(|d| massless.binary_search(d).is_err()).collect();
     if massive.is_empty() {
-        return Err(ModelError::new("structure.mass", "is zero: no DOF carries mass, so there is no dynamics to solve (a static problem)"));
+        return Err(ModelError::new(
+            "structure.mass",
+            "is not positive definite: it is zero, no DOF carries mass, so there is no dynamics to solve (a static problem)",
+        ));
     }
     if massless.is_empty() || !s.mass.block(&massive, &massive).is_positive_definite() {
         return Err(ModelError::new(

@@ -237,10 +237,8 @@ impl Condensed {
                 nonzero.len()
             )));
         };
-        if let Some(c) = &s.damping {
-            if let Some(&b) = massless.iter().find(|&&b| (0..n).any(|j| c.get(b, j) != 0.0)) {
-                return Err(NoStepMap(format!("massless DOF {b} carries damping: it is not quasi-static (no step map)")));
-            }
+        if let Some(&b) = s.damping.as_ref().and_then(|c| massless.iter().find(|&&b| (0..n).any(|j| c.get(b, j) != 0.0))) {
+            return Err(NoStepMap(format!("massless DOF {b} carries damping: it is not quasi-static (no step map)")));
         }
         if let Some(c) = (0..m).find(|&c| model.contact_is_massless(&model.contacts[c]) && offsets[c] + star != lead) {
             return Err(NoStepMap(format!(
