@@ -1,7 +1,7 @@
 //! Forces and contacts of a scene: their points (DOF indices or a generator's node names), their
 //! values, and the obstacle motion of an out-of-round casing.
-use super::{BuildError, Casing, DofSpec, Scene, Source};
-use crate::fe::DofMap;
+use super::{BuildError, Casing, DofSpec, NodeSpec, Scene, Source};
+use crate::fe::{DofMap, NodeDofs, NodeMap};
 use crate::model::{Compliance, Contact, Force, Harmonic};
 use crate::time::Pairing;
 
@@ -10,6 +10,8 @@ pub(super) struct Resolver<'a> {
     pub source: &'a Source,
     pub dofs: &'a DofMap,
     pub n_user: usize,
+    /// The node map of a generator or an FE code's output (node → DOF per direction).
+    pub nodes: Option<&'a NodeMap>,
 }
 
 impl Resolver<'_> {
@@ -23,27 +25,46 @@ impl Resolver<'_> {
         }
     }
 
-    fn named(&self, field: &str, node: &str, axis: Option<&str>) -> Result<(usize, usize), BuildError> {
-        let Source::Blade(blade) = self.source else {
-            return Err(BuildError::field(field, format!("is \"{node}\", but node names exist only with structure.generator; give a DOF index")));
+    /// A node's entry in the node map, by number or by a generator's tip name. The node numbers
+    /// are the FE code's (a generator's: index + 1, as in its CalculiX deck).
+    pub fn node(&self, field: &str, node: &NodeSpec) -> Result<(u64, &NodeDofs), BuildError> {
+        let number = match node {
+            NodeSpec::Name(name) => {
+                let Source::Blade(blade) = self.source else {
+                    let remedy = if self.nodes.is_some() { "a node number with axis" } else { "a DOF index" };
+                    return Err(BuildError::field(field, format!("is \"{name}\", but node names exist only with structure.generator; give {remedy}")));
+                };
+                let id = blade
+                    .named_node(name)
+                    .ok_or_else(|| BuildError::field(field, format!("is \"{name}\", expected one of {}", crate::fe::TIP_NODES.join(", "))))?;
+                id as u64 + 1
+            }
+            NodeSpec::Number(n) => *n,
         };
-        let id =
-            blade.named_node(node).ok_or_else(|| BuildError::field(field, format!("is \"{node}\", expected one of {}", crate::fe::TIP_NODES.join(", "))))?;
-        let a = match axis {
-            None | Some("z") => 2,
-            Some("x") => 0,
-            Some("y") => 1,
-            Some(other) => return Err(BuildError::field(field, format!("axis \"{other}\", expected x, y or z"))),
+        let Some(nodes) = self.nodes else {
+            return Err(BuildError::field(field, format!("is {node}, but nodes exist only with structure.generator or structure.calculix; give a DOF index")));
         };
-        let d = blade.dof(id, a).ok_or_else(|| BuildError::field(field, format!("node \"{node}\" is clamped")))?;
+        let dofs = nodes.get(number).ok_or_else(|| BuildError::field(field, format!("node {number} is not in {}: {}", nodes.source, nodes.missing)))?;
+        Ok((number, dofs))
+    }
+
+    fn named(&self, field: &str, node: &NodeSpec, axis: Option<&str>) -> Result<(usize, usize), BuildError> {
+        let (number, _) = self.node(field, node)?;
+        let axis = match (axis, node) {
+            (Some(a), _) => a,
+            (None, NodeSpec::Name(_)) => "z",
+            (None, NodeSpec::Number(n)) => return Err(BuildError::field(field, format!("node {n} needs axis = \"x\", \"y\" or \"z\""))),
+        };
+        let nodes = self.nodes.expect("resolved by node()");
+        let d = crate::fe::axis_index(axis).and_then(|a| nodes.dof(number, a)).map_err(|e| BuildError::field(field, e.to_string()))?;
         self.index(field, d)
     }
 
     /// A force's or contact's point: `dof` or `node` (+ `axis`).
-    fn point(&self, field: &str, dof: Option<usize>, node: Option<&str>, axis: Option<&str>) -> Result<(usize, usize), BuildError> {
+    fn point(&self, field: &str, dof: Option<usize>, node: Option<&NodeSpec>, axis: Option<&str>) -> Result<(usize, usize), BuildError> {
         match (dof, node) {
-            (Some(_), Some(n)) => Err(BuildError::field(field, format!("give either dof or node (\"{n}\"), not both"))),
-            (None, None) => Err(BuildError::field(field, "needs dof = index or node = \"LE\" | \"MC\" | \"TE\"")),
+            (Some(_), Some(n)) => Err(BuildError::field(field, format!("give either dof or node ({n}), not both"))),
+            (None, None) => Err(BuildError::field(field, "needs dof = index, or node = number (or \"LE\" | \"MC\" | \"TE\") with axis")),
             (Some(d), None) => {
                 if let Some(a) = axis {
                     return Err(BuildError::field(format!("{field}.axis"), format!("is \"{a}\", but axis goes with node, not dof")));
@@ -63,9 +84,14 @@ impl Resolver<'_> {
                     Some((n, a)) => (n, Some(a)),
                     None => (s.as_str(), None),
                 };
-                self.named(field, node, axis)
+                let node = node.parse().map_or_else(|_| NodeSpec::Name(node.to_string()), NodeSpec::Number);
+                self.named(field, &node, axis)
             }
-            DofSpec::Invalid(v) => Err(BuildError::field(field, format!("is {v}, expected a DOF index or a node name such as \"LE\" or \"MC:y\""))),
+            DofSpec::Node { node, axis } => self.named(field, node, axis.as_deref()),
+            DofSpec::Invalid(v) => Err(BuildError::field(
+                field,
+                format!("is {v}, expected a DOF index, a node name such as \"LE\" or \"MC:y\", or {{ node = 1234, axis = \"x\" }}"),
+            )),
         }
     }
 
@@ -82,7 +108,7 @@ impl Scene {
         let mut forces = Vec::with_capacity(self.force.len());
         for (i, f) in self.force.iter().enumerate() {
             let field = format!("force[{i}]");
-            let (_, d) = resolver.point(&field, f.dof, f.node.as_deref(), f.axis.as_deref())?;
+            let (_, d) = resolver.point(&field, f.dof, f.node.as_ref(), f.axis.as_deref())?;
             if !f.amplitude.is_finite() {
                 return Err(BuildError::field(format!("{field}.amplitude"), format!("is {}, must be finite", f.amplitude)));
             }
@@ -104,7 +130,7 @@ impl Scene {
         let mut contact_dofs = Vec::with_capacity(self.contact.len());
         for (i, c) in self.contact.iter().enumerate() {
             let field = format!("contact[{i}]");
-            let (u, d) = resolver.point(&field, c.dof, c.node.as_deref(), c.axis.as_deref())?;
+            let (u, d) = resolver.point(&field, c.dof, c.node.as_ref(), c.axis.as_deref())?;
             contact_dofs.push(u);
             contacts.push(Contact {
                 dof: d,
