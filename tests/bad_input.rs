@@ -277,7 +277,7 @@ fn out_of_range_values() {
     refused(&with("frequency = 1.0", "frequency = 0.0"), &["excitation.frequency", "0", "> 0"]);
     refused(&with("frequency = 1.0", "frequency = -2.0"), &["excitation.frequency", "-2"]);
     refused(&with("frequency = 1.0", "frequency = 1e-320"), &["excitation.frequency", "1e-320", "period"]);
-    refused(&with("dof = 0\namplitude", "dof = 7\namplitude"), &["force[0].dof", "7", "0..0"]);
+    refused(&with("dof = 0\namplitude", "dof = 7\namplitude"), &["force[0].dof", "7", "0 to 0"]);
     refused(&with("dof = 0\ndirection", "dof = 3\ndirection"), &["contact[0].dof", "3"]);
     refused(&with("dof = 0\ndirection", "dof = 18446744073709551615\ndirection"), &["dof", "18446744073709551615"]);
     refused(&with("displacement = [0]", "displacement = [0, 5]"), &["output.displacement[1]", "5"]);
@@ -640,4 +640,102 @@ fn bad_casing_profiles() {
     let e = lib_refuses(&text);
     assert!(e.contains("casing.profile") && e.contains("missing.csv") && e.contains("cannot read"), "{e}");
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A 2-DOF CalculiX job (node 7, x and y) in a scratch folder, with `dof`, `sti`, `mas` as given
+/// (`None`: the file is left out). Returns the folder.
+fn calculix_job(dof: Option<&str>, sti: Option<&str>, mas: Option<&str>) -> PathBuf {
+    let dir = scratch();
+    for (ext, text) in [("dof", dof), ("sti", sti), ("mas", mas)] {
+        if let Some(t) = text {
+            std::fs::write(dir.join(format!("job.{ext}")), t).unwrap();
+        }
+    }
+    dir
+}
+
+const JOB_DOF: &str = "7.1\n7.2\n";
+const JOB_STI: &str = "1 1 2.0\n1 2 -1.0\n2 2 2.0\n";
+const JOB_MAS: &str = "1 1 1.0\n2 2 1.0\n";
+
+/// The scene `structure.calculix = "job"` with `contact` in the folder `dir`: the library's
+/// message (which names the scene file) and the CLI's (status 2).
+fn calculix_refused(dir: &std::path::Path, contact: &str, needles: &[&str]) {
+    let text = format!("[structure]\ncalculix = \"job\"\n[excitation]\nfrequency = 1.0\n[[force]]\nnode = 7\naxis = \"x\"\namplitude = 1.0\n{contact}");
+    let scene = dir.join(FILE);
+    std::fs::write(&scene, &text).unwrap();
+    let file = scene.display().to_string();
+    let lib = match Scene::parse(&text, &file).and_then(|s| s.to_problem(&file)) {
+        Ok(_) => panic!("accepted:\n{text}"),
+        Err(e) => e.to_string(),
+    };
+    let o = Command::new(env!("CARGO_BIN_EXE_periodic-contact")).arg("solve").arg(&scene).arg("-o").arg(dir.join("r.json")).output().unwrap();
+    let cli = String::from_utf8_lossy(&o.stderr).to_string();
+    assert_eq!(o.status.code(), Some(2), "exit status; stderr: {cli}");
+    assert!(!dir.join("r.json").exists());
+    for n in needles.iter().chain(&[FILE]) {
+        assert!(lib.contains(n), "library message lacks {n:?}: {lib}");
+        assert!(cli.contains(n), "CLI message lacks {n:?}: {cli}");
+    }
+}
+
+#[test]
+fn calculix_output_that_is_wrong_is_refused_naming_file_line_and_remedy() {
+    let regenerate = "regenerate it with `ccx JOBNAME`";
+    // The good job is accepted, and addresses its DOFs by node and direction.
+    let dir = calculix_job(Some(JOB_DOF), Some(JOB_STI), Some(JOB_MAS));
+    let text = "[structure]\ncalculix = \"job\"\n[excitation]\nfrequency = 1.0\n[[force]]\nnode = 7\naxis = \"y\"\namplitude = 1.0\n[output]\ndisplacement = [\"7:x\", { node = 7, axis = \"y\" }]\n";
+    let file = dir.join(FILE).display().to_string();
+    let p = Scene::parse(text, &file).unwrap().to_problem(&file).unwrap();
+    assert_eq!((p.model().n(), p.model().forces[0].dof), (2, 1));
+    // A node or direction the map does not hold: named, with the remedy.
+    calculix_refused(
+        &dir,
+        "[[contact]]\nnode = 7\naxis = \"z\"\ngap = 1.0\n",
+        &["contact[0].node", "node 7 direction z is not in job.dof", "fixed by *BOUNDARY"],
+    );
+    calculix_refused(&dir, "[[contact]]\nnode = 8\naxis = \"x\"\ngap = 1.0\n", &["node 8 is not in job.dof", "not in the mesh"]);
+    calculix_refused(&dir, "[[contact]]\nnode = 7\ngap = 1.0\n", &["node 7 needs axis"]);
+    // A map whose count does not match the matrices, in both directions.
+    let dir = calculix_job(Some("7.1\n7.2\n7.3\n"), Some(JOB_STI), Some(JOB_MAS));
+    calculix_refused(&dir, "", &["structure.calculix", "job.sti", "has rows up to 2 but", "job.dof lists 3 DOFs", "different runs", regenerate]);
+    let dir = calculix_job(Some("7.1\n"), Some(JOB_STI), Some(JOB_MAS));
+    calculix_refused(&dir, "", &["job.sti:2:", "entry (1, 2) is outside 1..1", regenerate]);
+    // Malformed lines: the file and the line.
+    let dir = calculix_job(Some("7.1\nseven.2\n"), Some(JOB_STI), Some(JOB_MAS));
+    calculix_refused(&dir, "", &["job.dof:2:", "\"seven.2\" is not node.direction", regenerate]);
+    let dir = calculix_job(Some(JOB_DOF), Some("1 1 2.0\n1 2\n2 2 2.0\n"), Some(JOB_MAS));
+    calculix_refused(&dir, "", &["job.sti:2:", "\"1 2\" is not `row column value`"]);
+    let dir = calculix_job(Some(JOB_DOF), Some(JOB_STI), Some("1 1 1.0\n2 2 nan\n"));
+    calculix_refused(&dir, "", &["job.mas:2:", "not finite"]);
+    // A missing file.
+    let dir = calculix_job(Some(JOB_DOF), Some(JOB_STI), None);
+    calculix_refused(&dir, "", &["structure.calculix", "job.mas", "cannot read the file", regenerate]);
+}
+
+#[test]
+fn an_fmu_is_not_packaged_when_a_referenced_file_is_missing() {
+    let dir = scratch();
+    std::fs::write(dir.join("K.mtx"), "%%MatrixMarket matrix coordinate real symmetric\n1 1 1\n1 1 1.0\n").unwrap();
+    let scene = dir.join(FILE);
+    std::fs::write(&scene, "[structure]\nmass = { matrix_market = \"M.mtx\" }\nstiffness = { matrix_market = \"K.mtx\" }\n[excitation]\nfrequency = 1.0\n")
+        .unwrap();
+    let out = dir.join("x.fmu");
+    // Any ELF file stands for the binary: the scene is refused before it is read.
+    let o = Command::new(env!("CARGO_BIN_EXE_periodic-contact"))
+        .arg("fmu")
+        .arg(&scene)
+        .arg("-o")
+        .arg(&out)
+        .arg("--binary")
+        .arg(env!("CARGO_BIN_EXE_periodic-contact"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    for n in [FILE, "structure.mass.matrix_market = \"M.mtx\"", "M.mtx", "create the file or correct the path", "no .fmu was written"] {
+        assert!(err.contains(n), "the message lacks {n:?}: {err}");
+    }
+    let left: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    assert!(!out.exists() && left.len() == 2, "nothing is written: {left:?}");
 }

@@ -859,3 +859,38 @@ fn polish_gives_the_exact_orbit_between_the_instants() {
         s.log.all()
     );
 }
+
+/// Matrix Market files outside the scene's folder (`../M.mtx`) are packaged under
+/// `resources/external/` with the packaged scene rewritten to point there, and the FMU under the
+/// Rust host gives the CLI's displacements to 1e-9 (the files beside the scene are covered by the
+/// front-end matrix, tests/frontends.rs).
+#[test]
+fn matrix_market_files_outside_the_scene_folder_are_packaged_and_read_from_resources() {
+    let dir = scratch("outside_mtx");
+    std::fs::create_dir_all(dir.join("sub")).unwrap();
+    std::fs::write(dir.join("M.mtx"), "%%MatrixMarket matrix coordinate real symmetric\n2 2 3\n1 1 2.0\n2 1 0.3\n2 2 1.0\n").unwrap();
+    std::fs::write(dir.join("K.mtx"), "%%MatrixMarket matrix coordinate real general\n2 2 4\n1 1 5.0\n2 1 -2.0\n1 2 -2.0\n2 2 3.0\n").unwrap();
+    let scene = dir.join("sub/outside.toml");
+    let text = "[structure]\nmass = { matrix_market = \"../M.mtx\" }\nstiffness = { matrix_market = \"../K.mtx\" }\n[damping]\nrayleigh = [0.02, 0.01]\n\
+                [excitation]\nfrequency = 1.3\n[[force]]\ndof = 1\namplitude = 1.0\n[[contact]]\ndof = 0\ngap = 0.2\n\
+                [discretization]\nscheme = \"cds\"\nsteps = 128\n[output]\ndisplacement = [0, 1]\n";
+    std::fs::write(&scene, text).unwrap();
+    let json = cli_solve(&scene);
+    let fmu = Fmu::package_scene("outside", &scene);
+    let resources = fmu.dir.join("unzipped/resources");
+    assert!(resources.join("external/0/M.mtx").is_file() && resources.join("external/1/K.mtx").is_file());
+    let packaged = std::fs::read_to_string(resources.join("scene.toml")).unwrap();
+    assert!(packaged.contains("external/0/M.mtx") && !packaged.contains("../M.mtx"), "{packaged}");
+    let s = fmu.instantiate("outside").expect("instantiated");
+    s.init(0.0);
+    let k = json["steps"].as_u64().unwrap() as usize;
+    let h = json["period"].as_f64().unwrap() / k as f64;
+    let got = run(&s, 0.0, h, k, &["displacement[0]", "displacement[1]"]);
+    for (c, key) in ["0", "1"].iter().enumerate() {
+        let cli = series(&json, "displacement", key);
+        let scale = max_abs(&cli);
+        for (i, row) in got.iter().enumerate() {
+            assert!((row[c] - cli[(i + 1) % k]).abs() <= 1e-9 * scale, "displacement[{key}] at step {i}: FMU {} CLI {}", row[c], cli[(i + 1) % k]);
+        }
+    }
+}

@@ -28,12 +28,13 @@ fn assert_same(scene: &str, front_end: &str, key: &str, got: &[f64], cli: &[f64]
     assert!(worst <= TOL * scale, "{scene}: {front_end} displacement[{key}] differs from the CLI by {worst:e} (peak-to-peak {scale:e})");
 }
 
-/// The C API's displacements for the CLI's keys.
-fn c_api(text: &str, keys: &[String], k: usize) -> Vec<Vec<f64>> {
-    let toml = CString::new(text).unwrap();
+/// The C API's displacements for the CLI's keys (the scene file: its referenced files resolve
+/// relative to it).
+fn c_api(scene: &std::path::Path, keys: &[String], k: usize) -> Vec<Vec<f64>> {
+    let path = CString::new(scene.to_str().unwrap()).unwrap();
     let last_error = || unsafe { CStr::from_ptr(pc_last_error()) }.to_string_lossy().into_owned();
-    let p = unsafe { pc_problem_from_scene_text(toml.as_ptr()) };
-    assert!(!p.is_null(), "pc_problem_from_scene_text: {}", last_error());
+    let p = unsafe { pc_problem_from_scene_file(path.as_ptr()) };
+    assert!(!p.is_null(), "pc_problem_from_scene_file: {}", last_error());
     let r = unsafe { pc_problem_solve(p) };
     assert!(!r.is_null(), "pc_problem_solve: {}", last_error());
     assert_eq!(unsafe { pc_result_steps(r) }, k);
@@ -54,8 +55,8 @@ fn c_api(text: &str, keys: &[String], k: usize) -> Vec<Vec<f64>> {
 }
 
 /// The FMU's displacements after each of k steps of T/k from t = 0: sample j + 1 of the period.
-fn fmu(name: &str, text: &str, keys: &[String], k: usize, period: f64) -> Vec<Vec<f64>> {
-    let fmu = Fmu::package(name, text);
+fn fmu(name: &str, scene: &std::path::Path, keys: &[String], k: usize, period: f64) -> Vec<Vec<f64>> {
+    let fmu = Fmu::package_scene(name, scene);
     let s = fmu.instantiate(name).expect("instantiated");
     s.init(0.0);
     let names: Vec<String> = keys.iter().map(|d| format!("displacement[{d}]")).collect();
@@ -77,17 +78,16 @@ fn fmu(name: &str, text: &str, keys: &[String], k: usize, period: f64) -> Vec<Ve
 fn every_shipped_scene_gives_the_same_displacements_in_the_cli_the_c_api_and_the_fmu() {
     for scene in shipped_scenes() {
         let name = scene.file_stem().unwrap().to_string_lossy().replace('-', "_");
-        let text = std::fs::read_to_string(&scene).unwrap();
-        // The CLI writes its JSON beside the scene: solve a copy in a scratch folder.
-        let copy = scratch(&format!("frontends_{name}")).join(scene.file_name().unwrap());
-        std::fs::write(&copy, &text).unwrap();
+        // The CLI writes its JSON beside the scene: solve a copy (with the files it references) in
+        // a scratch folder.
+        let copy = copy_scene(&scene, &scratch(&format!("frontends_{name}")));
         let json = cli_solve(&copy);
         let k = json["steps"].as_u64().unwrap() as usize;
         let period = json["period"].as_f64().unwrap();
         let keys: Vec<String> = json["displacement"].as_object().unwrap().keys().cloned().collect();
         assert!(!keys.is_empty(), "{name}: no displacement output");
         let cli: Vec<Vec<f64>> = keys.iter().map(|key| series(&json, "displacement", key)).collect();
-        for (front_end, got) in [("C API", c_api(&text, &keys, k)), ("FMU", fmu(&name, &text, &keys, k, period))] {
+        for (front_end, got) in [("C API", c_api(&copy, &keys, k)), ("FMU", fmu(&name, &copy, &keys, k, period))] {
             for ((key, g), c) in keys.iter().zip(&got).zip(&cli) {
                 assert_same(&name, front_end, key, g, c);
             }

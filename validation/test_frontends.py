@@ -6,6 +6,7 @@ and failed in simulate_fmu).
 """
 import json
 import os
+import shutil
 
 import fmpy
 from fmpy.validation import validate_fmu
@@ -29,6 +30,8 @@ def test_fmpy_simulate_matches_the_cli(cli, workdir, scene):
     name = "frontend_" + scene[:-5].replace("-", "_")
     with open(os.path.join(SCENES, scene)) as fh:
         text = fh.read()
+    # The files the scenes reference (Matrix Market, CalculiX) sit in fmu/scenes/data/.
+    shutil.copytree(os.path.join(SCENES, "data"), os.path.join(workdir, "data"), dirs_exist_ok=True)
     result = engine.solve(cli, text, workdir, name)
     with open(result.path) as fh:
         raw = json.load(fh)

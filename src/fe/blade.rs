@@ -221,6 +221,20 @@ impl Blade {
         }
         self.dofs.new_index(3 * node + axis)
     }
+    /// The node map in the numbering of the blade's CalculiX deck (node number = index + 1), with
+    /// each node's DOFs in the model's (clamped) numbering and its position.
+    pub fn node_map(&self) -> super::NodeMap {
+        let mut map = super::NodeMap::new("the blade generator", "it is clamped at the root (z = 0) or beyond the mesh");
+        for (i, x) in self.nodes.iter().enumerate() {
+            map.set_position(i as u64 + 1, *x);
+            for a in 0..3 {
+                if let Some(d) = self.dof(i, a) {
+                    map.insert(i as u64 + 1, a, d);
+                }
+            }
+        }
+        map
+    }
     /// The radial (z) DOF of a named tip node (`LE`, `MC`, `TE`) in the model's numbering:
     /// the contact DOF.
     pub fn node_dof(&self, name: &str) -> Option<usize> {

@@ -40,10 +40,12 @@ use std::path::Path;
 use std::sync::Arc;
 
 mod documentation;
+mod package;
 mod series;
 mod state;
 mod variables;
 
+pub use package::package;
 use series::{Series, Solution};
 pub use state::ContactSnapshot;
 use variables::{Output, Role, Variables, unique};
@@ -538,25 +540,4 @@ fn summary(problem: &PeriodicProblem) -> String {
             problem.discretization().scheme
         )
     }
-}
-
-/// Writes `out` (.fmu) for `scene_path`, with the FMU binary `binary`. Returns the GUID.
-pub fn package(scene_path: &Path, binary: &Path, out: &Path) -> Result<String> {
-    let text = std::fs::read_to_string(scene_path).map_err(|e| Error::io(format!("{}: cannot read the scene: {e}", scene_path.display())))?;
-    let model = ContactModel::from_scene_text(&text, &scene_path.display().to_string())?;
-    model.desc.check().map_err(|e| e.context("internal error, the model description is invalid"))?;
-    let (xml, guid) = crate::fmi::fmi2::xml::render(&model.desc);
-    let so = std::fs::read(binary).map_err(|e| Error::io(format!("{}: cannot read the FMU binary: {e}", binary.display())))?;
-    if !so.starts_with(b"\x7fELF") {
-        return Err(Error::input(format!("{}: is not an ELF shared library", binary.display())));
-    }
-    let platform = crate::fmi::package::platform().ok_or_else(|| Error::input("this platform has no FMI 2.0 platform folder name"))?;
-    let name = scene_path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let entries = vec![
-        crate::fmi::package::Entry { name: format!("binaries/{platform}/{MODEL_IDENTIFIER}.so"), data: so, mode: 0o755 },
-        crate::fmi::package::Entry { name: format!("resources/{SCENE_FILE}"), data: text.into_bytes(), mode: 0o644 },
-        crate::fmi::package::Entry { name: "documentation/index.html".into(), data: model.documentation_html(&name).into_bytes(), mode: 0o644 },
-    ];
-    crate::fmi::package::write_fmu(out, &xml, &entries)?;
-    Ok(guid)
 }

@@ -2,8 +2,8 @@
 //! rows of B (one DOF with a direction, or a unit normal over a node's DOFs: given, or radial
 //! about the rotation axis), their values, and the obstacle motion of an out-of-round casing.
 use super::rotor::Rotor;
-use super::{BuildError, Casing, ContactSpec, DofSpec, NormalSpec, Scene, Source};
-use crate::fe::DofMap;
+use super::{BuildError, Casing, ContactSpec, DofSpec, NodeSpec, NormalSpec, Scene, Source};
+use crate::fe::{DofMap, NodeMap};
 use crate::model::{Compliance, Contact, Force, Harmonic};
 use crate::time::Pairing;
 use std::path::{Path, PathBuf};
@@ -13,6 +13,8 @@ pub(super) struct Resolver<'a> {
     pub source: &'a Source,
     pub dofs: &'a DofMap,
     pub n_user: usize,
+    /// The node map of a generator or an FE code's output (node → DOF per direction).
+    pub nodes: Option<&'a NodeMap>,
 }
 
 impl Resolver<'_> {
@@ -26,27 +28,46 @@ impl Resolver<'_> {
         }
     }
 
-    fn named(&self, field: &str, node: &str, axis: Option<&str>) -> Result<(usize, usize), BuildError> {
-        let Source::Blade(blade) = self.source else {
-            return Err(BuildError::field(field, format!("is \"{node}\", but node names exist only with structure.generator; give a DOF index")));
+    /// A node's entry in the node map, by number or by a generator's tip name. The node numbers
+    /// are the FE code's (a generator's: index + 1, as in its CalculiX deck).
+    pub fn node(&self, field: &str, node: &NodeSpec) -> Result<(u64, &crate::fe::NodeDofs), BuildError> {
+        let number = match node {
+            NodeSpec::Name(name) => {
+                let Source::Blade(blade) = self.source else {
+                    let remedy = if self.nodes.is_some() { "a node number with axis" } else { "a DOF index" };
+                    return Err(BuildError::field(field, format!("is \"{name}\", but node names exist only with structure.generator; give {remedy}")));
+                };
+                let id = blade
+                    .named_node(name)
+                    .ok_or_else(|| BuildError::field(field, format!("is \"{name}\", expected one of {}", crate::fe::TIP_NODES.join(", "))))?;
+                id as u64 + 1
+            }
+            NodeSpec::Number(n) => *n,
         };
-        let id =
-            blade.named_node(node).ok_or_else(|| BuildError::field(field, format!("is \"{node}\", expected one of {}", crate::fe::TIP_NODES.join(", "))))?;
-        let a = match axis {
-            None | Some("z") => 2,
-            Some("x") => 0,
-            Some("y") => 1,
-            Some(other) => return Err(BuildError::field(field, format!("axis \"{other}\", expected x, y or z"))),
+        let Some(nodes) = self.nodes else {
+            return Err(BuildError::field(field, format!("is {node}, but nodes exist only with structure.generator or structure.calculix; give a DOF index")));
         };
-        let d = blade.dof(id, a).ok_or_else(|| BuildError::field(field, format!("node \"{node}\" is clamped")))?;
+        let dofs = nodes.get(number).ok_or_else(|| BuildError::field(field, format!("node {number} is not in {}: {}", nodes.source, nodes.missing)))?;
+        Ok((number, dofs))
+    }
+
+    fn named(&self, field: &str, node: &NodeSpec, axis: Option<&str>) -> Result<(usize, usize), BuildError> {
+        let (number, _) = self.node(field, node)?;
+        let axis = match (axis, node) {
+            (Some(a), _) => a,
+            (None, NodeSpec::Name(_)) => "z",
+            (None, NodeSpec::Number(n)) => return Err(BuildError::field(field, format!("node {n} needs axis = \"x\", \"y\" or \"z\""))),
+        };
+        let nodes = self.nodes.expect("resolved by node()");
+        let d = crate::fe::axis_index(axis).and_then(|a| nodes.dof(number, a)).map_err(|e| BuildError::field(field, e.to_string()))?;
         self.index(field, d)
     }
 
     /// A force's or contact's point: `dof` or `node` (+ `axis`).
-    fn point(&self, field: &str, dof: Option<usize>, node: Option<&str>, axis: Option<&str>) -> Result<(usize, usize), BuildError> {
+    fn point(&self, field: &str, dof: Option<usize>, node: Option<&NodeSpec>, axis: Option<&str>) -> Result<(usize, usize), BuildError> {
         match (dof, node) {
-            (Some(_), Some(n)) => Err(BuildError::field(field, format!("give either dof or node (\"{n}\"), not both"))),
-            (None, None) => Err(BuildError::field(field, "needs dof = index or node = \"LE\" | \"MC\" | \"TE\"")),
+            (Some(_), Some(n)) => Err(BuildError::field(field, format!("give either dof or node ({n}), not both"))),
+            (None, None) => Err(BuildError::field(field, "needs dof = index, or node = number (or \"LE\" | \"MC\" | \"TE\") with axis")),
             (Some(d), None) => {
                 if let Some(a) = axis {
                     return Err(BuildError::field(format!("{field}.axis"), format!("is \"{a}\", but axis goes with node, not dof")));
@@ -66,9 +87,14 @@ impl Resolver<'_> {
                     Some((n, a)) => (n, Some(a)),
                     None => (s.as_str(), None),
                 };
-                self.named(field, node, axis)
+                let node = node.parse().map_or_else(|_| NodeSpec::Name(node.to_string()), NodeSpec::Number);
+                self.named(field, &node, axis)
             }
-            DofSpec::Invalid(v) => Err(BuildError::field(field, format!("is {v}, expected a DOF index or a node name such as \"LE\" or \"MC:y\""))),
+            DofSpec::Node { node, axis } => self.named(field, node, axis.as_deref()),
+            DofSpec::Invalid(v) => Err(BuildError::field(
+                field,
+                format!("is {v}, expected a DOF index, a node name such as \"LE\" or \"MC:y\", or {{ node = 1234, axis = \"x\" }}"),
+            )),
         }
     }
 
@@ -85,7 +111,7 @@ impl Scene {
         let mut forces = Vec::with_capacity(self.force.len());
         for (i, f) in self.force.iter().enumerate() {
             let field = format!("force[{i}]");
-            let (_, d) = resolver.point(&field, f.dof, f.node.as_deref(), f.axis.as_deref())?;
+            let (_, d) = resolver.point(&field, f.dof, f.node.as_ref(), f.axis.as_deref())?;
             if !f.amplitude.is_finite() {
                 return Err(BuildError::field(format!("{field}.amplitude"), format!("is {}, must be finite", f.amplitude)));
             }
@@ -222,7 +248,7 @@ pub(super) struct Placed {
 }
 
 /// A node's x, y, z DOFs as (scene DOF, full DOF) and its coordinates when known.
-struct NodeDofs {
+struct PointDofs {
     dofs: Vec<(usize, usize)>,
     position: Option<[f64; 3]>,
 }
@@ -231,11 +257,11 @@ impl Resolver<'_> {
     /// The one lookup from a node to its DOFs (x, y, z) and coordinates: a generator's named node
     /// (`"LE"`) or node index, or `dofs = [i, j, k]` with `position` in a Matrix Market scene.
     /// A node map of another FE code (node number → DOFs) plugs in here.
-    fn node_dofs(&self, field: &str, node: NodeRef, position: Option<[f64; 3]>) -> Result<NodeDofs, BuildError> {
+    fn node_dofs(&self, field: &str, node: NodeRef, position: Option<[f64; 3]>) -> Result<PointDofs, BuildError> {
         match node {
             NodeRef::Dofs(list) => {
                 let dofs = list.iter().enumerate().map(|(j, &d)| self.index(&format!("{field}.dofs[{j}]"), d)).collect::<Result<_, _>>()?;
-                Ok(NodeDofs { dofs, position })
+                Ok(PointDofs { dofs, position })
             }
             NodeRef::Named(name) => {
                 let Source::Blade(blade) = self.source else {
@@ -249,6 +275,19 @@ impl Resolver<'_> {
                     .ok_or_else(|| BuildError::field(format!("{field}.node"), format!("is \"{name}\", expected one of {}", crate::fe::TIP_NODES.join(", "))))?;
                 self.blade_node(field, blade, id)
             }
+            NodeRef::Number(number) => {
+                let (_, nd) = self.node(&format!("{field}.node"), &NodeSpec::Number(number))?;
+                let dofs = nd
+                    .dofs
+                    .iter()
+                    .enumerate()
+                    .map(|(a, d)| {
+                        d.ok_or_else(|| BuildError::field(format!("{field}.node"), format!("node {number} has no DOF along axis {a} (fixed or absent)")))
+                            .and_then(|d| self.index(field, d))
+                    })
+                    .collect::<Result<_, _>>()?;
+                Ok(PointDofs { dofs, position: nd.position.or(position) })
+            }
             NodeRef::Blade(id) => {
                 let Source::Blade(blade) = self.source else { unreachable!("tip nodes expand only on a blade") };
                 self.blade_node(field, blade, id)
@@ -256,17 +295,19 @@ impl Resolver<'_> {
         }
     }
 
-    fn blade_node(&self, field: &str, blade: &crate::fe::Blade, id: usize) -> Result<NodeDofs, BuildError> {
+    fn blade_node(&self, field: &str, blade: &crate::fe::Blade, id: usize) -> Result<PointDofs, BuildError> {
         let dofs = (0..3)
             .map(|a| blade.dof(id, a).ok_or_else(|| BuildError::field(format!("{field}.node"), "is clamped")).and_then(|d| self.index(field, d)))
             .collect::<Result<_, _>>()?;
-        Ok(NodeDofs { dofs, position: Some(blade.nodes[id]) })
+        Ok(PointDofs { dofs, position: Some(blade.nodes[id]) })
     }
 }
 
 /// A node as a `[[contact]]` names it.
 enum NodeRef<'a> {
     Named(&'a str),
+    /// An FE node number, through the scene's node map (CalculiX `.dof`, the generator).
+    Number(u64),
     Blade(usize),
     Dofs(&'a [usize]),
 }
@@ -278,7 +319,7 @@ fn contact_rows(resolver: &Resolver, field: &str, c: &ContactSpec, rotor: Option
     let along = c.normal.is_some() || c.nodes.is_some() || c.dofs.is_some();
     if !along {
         // One DOF: `dof`, or `node` + `axis`, with `direction`; a blade DOF's node gives the position.
-        let (u, d) = resolver.point(field, c.dof, c.node.as_deref(), c.axis.as_deref())?;
+        let (u, d) = resolver.point(field, c.dof, c.node.as_ref(), c.axis.as_deref())?;
         let s = c.direction.unwrap_or(1) as f64;
         let position = match resolver.source {
             Source::Blade(blade) => Some(blade.nodes[blade.dofs.new_to_old[u] / 3]),
@@ -302,7 +343,8 @@ fn contact_rows(resolver: &Resolver, field: &str, c: &ContactSpec, rotor: Option
                 return Err(BuildError::field(format!("{field}.nodes"), format!("is \"{other}\", expected \"tip\" (every mid-thickness tip node, LE to TE)")));
             }
         },
-        (None, Some(n), None) => vec![NodeRef::Named(n)],
+        (None, Some(NodeSpec::Name(n)), None) => vec![NodeRef::Named(n)],
+        (None, Some(NodeSpec::Number(n)), None) => vec![NodeRef::Number(*n)],
         (None, None, Some(d)) => vec![NodeRef::Dofs(d)],
         _ => return Err(BuildError::field(field, "give one of node, nodes or dofs with a normal")),
     };

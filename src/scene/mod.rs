@@ -8,6 +8,7 @@
 pub mod casing;
 mod contacts;
 mod error;
+mod files;
 mod outputs;
 pub mod profile;
 mod reduce;
@@ -19,10 +20,11 @@ mod units;
 
 pub use casing::Casing;
 pub use error::{BuildError, SceneError};
+pub use files::FileReference;
 pub use settings::{discretization, error_estimate, period_multiple, solver_settings};
 pub use spec::*;
 
-use crate::fe::{Blade, DofMap};
+use crate::fe::{Blade, DofMap, NodeMap};
 use crate::model::{Labels, Model, Structure};
 use crate::periodic::PeriodicProblem;
 use crate::reduction::ReducedModel;
@@ -41,6 +43,9 @@ pub struct SceneModel {
     pub full: Structure,
     /// Scene numbering (the matrices' or the generator's) → full (clamped) numbering.
     pub dofs: DofMap,
+    /// Node number → its DOFs per direction in the scene's numbering (and position when known):
+    /// the blade generator's (node = index + 1) or a CalculiX job's `.dof` map; `None` for matrices.
+    pub nodes: Option<NodeMap>,
     /// The Craig–Bampton reduction, if `[reduction]`.
     pub reduction: Option<ReducedModel>,
     /// The checked casing, if `[casing]`.
@@ -124,13 +129,13 @@ impl Scene {
     fn assemble(&self, dir: &Path) -> Result<SceneModel, BuildError> {
         let t0 = Instant::now();
         // The structure in the scene's numbering, damped on the full model, then clamped.
-        let (source, structure) = self.structure_source(dir)?;
+        let (source, structure, nodes) = self.structure_source(dir)?;
         let t_structure = t0.elapsed().as_secs_f64();
         let n_user = structure.mass.nrows();
         let labels = self.labels(&source)?;
         let (full, damping) = self.damped(structure, dir)?;
-        let (full, dofs) = self.clamp(full)?;
-        let resolver = Resolver { source: &source, dofs: &dofs, n_user };
+        let (full, dofs) = self.clamp(full, &source, nodes.as_ref())?;
+        let resolver = Resolver { source: &source, dofs: &dofs, n_user, nodes: nodes.as_ref() };
 
         // Forces and contacts in the full numbering (user DOF kept for the labels), the casing.
         let forces = self.forces(&resolver)?;
@@ -176,6 +181,7 @@ impl Scene {
             problem,
             full,
             dofs,
+            nodes,
             reduction,
             casing,
             contact_dofs,

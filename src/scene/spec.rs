@@ -43,10 +43,13 @@ pub struct StructureSpec {
     /// A built-in model instead of matrices: `{ kind = "blade", … }` (the rest is a
     /// [`crate::fe::BladeSpec`]).
     pub generator: Option<toml::Table>,
-    /// DOFs removed (clamped), in the numbering of the matrices. Every other DOF index of the
-    /// scene keeps that numbering.
+    /// CalculiX's matrix output instead of matrices: the job name, path relative to the scene
+    /// (`"blade"` reads `blade.sti`, `blade.mas` and the node map `blade.dof`).
+    pub calculix: Option<String>,
+    /// DOFs removed (clamped), in the numbering of the matrices (indices, or nodes as in
+    /// outputs). Every other DOF index of the scene keeps that numbering.
     #[serde(default)]
-    pub fixed: Vec<usize>,
+    pub fixed: Vec<DofSpec>,
 }
 
 /// A structural matrix: dense rows, or a Matrix Market file (path relative to the scene file).
@@ -77,13 +80,18 @@ pub struct DampingSpec {
     pub modal_ratios: Option<Vec<f64>>,
 }
 
-/// A DOF named by index (the matrices' numbering) or by a generator's node name: `"LE"` (its
-/// radial z DOF) or `"LE:x"`, `"LE:y"`, `"LE:z"`.
+/// A DOF named by index (the matrices' numbering), by a generator's node name (`"LE"`, its
+/// radial z DOF, or `"LE:x"`, `"LE:y"`, `"LE:z"`), by an FE node number and direction
+/// (`"1234:x"`), or as a table `{ node = 1234, axis = "x" }`.
 #[derive(Debug, Clone, Deserialize, PartialEq)]
 #[serde(untagged)]
 pub enum DofSpec {
     Index(usize),
     Name(String),
+    Node {
+        node: NodeSpec,
+        axis: Option<String>,
+    },
     /// Anything else, refused with a message naming the field.
     Invalid(toml::Value),
 }
@@ -93,7 +101,27 @@ impl std::fmt::Display for DofSpec {
         match self {
             DofSpec::Index(i) => write!(f, "{i}"),
             DofSpec::Name(n) => write!(f, "\"{n}\""),
+            DofSpec::Node { node, axis: Some(a) } => write!(f, "{{ node = {node}, axis = \"{a}\" }}"),
+            DofSpec::Node { node, axis: None } => write!(f, "{{ node = {node} }}"),
             DofSpec::Invalid(v) => write!(f, "{v}"),
+        }
+    }
+}
+
+/// A node: an FE node number (a CalculiX job's, or the blade generator's: index + 1, the numbering
+/// of its CalculiX deck) or a generator's tip name (`"LE"`, `"MC"`, `"TE"`).
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(untagged)]
+pub enum NodeSpec {
+    Number(u64),
+    Name(String),
+}
+
+impl std::fmt::Display for NodeSpec {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            NodeSpec::Number(n) => write!(f, "{n}"),
+            NodeSpec::Name(n) => write!(f, "\"{n}\""),
         }
     }
 }
@@ -175,9 +203,10 @@ fn yes() -> bool {
 #[serde(deny_unknown_fields)]
 pub struct ForceSpec {
     pub dof: Option<usize>,
-    /// A generator's node instead of `dof`: `"LE"`, `"MC"`, `"TE"`.
-    pub node: Option<String>,
-    /// With `node`: `"x"`, `"y"` or `"z"` (default `"z"`, radial).
+    /// A node instead of `dof`: a generator's `"LE"`, `"MC"`, `"TE"`, or an FE node number.
+    pub node: Option<NodeSpec>,
+    /// With `node`: `"x"`, `"y"` or `"z"` (default `"z"`, radial, for a named node; required
+    /// with a node number).
     pub axis: Option<String>,
     pub amplitude: f64,
     #[serde(default = "one")]
@@ -200,8 +229,8 @@ pub struct HarmonicSpec {
 #[serde(deny_unknown_fields)]
 pub struct ContactSpec {
     pub dof: Option<usize>,
-    /// A generator's node instead of `dof`: `"LE"`, `"MC"`, `"TE"`.
-    pub node: Option<String>,
+    /// A node instead of `dof`: a generator's `"LE"`, `"MC"`, `"TE"`, or an FE node number.
+    pub node: Option<NodeSpec>,
     /// `"tip"`: one contact on every mid-thickness tip node of the generated blade (LE to TE),
     /// each along its radial normal.
     pub nodes: Option<String>,

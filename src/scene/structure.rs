@@ -1,7 +1,8 @@
 //! The structure of a scene: dense rows, Matrix Market files or the blade generator, the damping
 //! defined on the full model, and the clamping (`structure.fixed`).
-use super::{BuildError, MatrixSpec, Scene, Source};
-use crate::fe::{Blade, BladeSpec, DofMap};
+use super::contacts::Resolver;
+use super::{BuildError, DofSpec, MatrixSpec, Scene, Source};
+use crate::fe::{Blade, BladeSpec, DofMap, NodeMap};
 use crate::model::{Matrix, Structure};
 use std::path::Path;
 
@@ -13,22 +14,40 @@ pub(super) struct DampingGiven {
 }
 
 impl Scene {
-    /// Loads or generates the structure (M, K; no damping yet) in the scene's numbering.
-    pub(super) fn structure_source(&self, dir: &Path) -> Result<(Source, Structure), BuildError> {
+    /// Loads or generates the structure (M, K; no damping yet) in the scene's numbering, with the
+    /// node map of a generator or a CalculiX job.
+    pub(super) fn structure_source(&self, dir: &Path) -> Result<(Source, Structure, Option<NodeMap>), BuildError> {
         let s = &self.structure;
+        let given = [s.generator.is_some(), s.mass.is_some() || s.stiffness.is_some(), s.calculix.is_some()];
+        if given.iter().filter(|g| **g).count() > 1 {
+            return Err(BuildError::field("structure", "give one of generator = { … }, calculix = \"job\", or mass and stiffness, not several"));
+        }
+        if let Some(job) = &s.calculix {
+            let model = crate::fe::read_calculix(&dir.join(job)).map_err(|e| BuildError::field("structure.calculix", format!("\"{job}\": {e}")))?;
+            let structure = Structure { mass: Matrix::Sparse(model.mass), stiffness: Matrix::Sparse(model.stiffness), damping: None };
+            return Ok((Source::Files, structure, Some(model.nodes)));
+        }
         match (&s.generator, &s.mass, &s.stiffness) {
-            (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
-                Err(BuildError::field("structure", "give either generator = { … } or mass and stiffness, not both"))
-            }
-            (Some(table), None, None) => generate(table),
+            (Some(table), _, _) => generate(table),
             (None, Some(m), Some(k)) => {
                 let inline = matches!(m, MatrixSpec::Dense(_)) && matches!(k, MatrixSpec::Dense(_));
                 let mass = load_matrix("structure.mass", m, dir)?;
                 let stiffness = load_matrix("structure.stiffness", k, dir)?;
-                Ok((if inline { Source::Inline } else { Source::Files }, Structure { mass, stiffness, damping: None }))
+                Ok((if inline { Source::Inline } else { Source::Files }, Structure { mass, stiffness, damping: None }, None))
             }
-            (None, None, _) => Err(BuildError::field("structure.mass", "is missing (give mass and stiffness, or generator = { kind = \"blade\", … })")),
+            (None, None, _) => {
+                Err(BuildError::field("structure.mass", "is missing (give mass and stiffness, generator = { kind = \"blade\", … } or calculix = \"job\")"))
+            }
             (None, Some(_), None) => Err(BuildError::field("structure.stiffness", "is missing")),
+        }
+    }
+
+    /// The blade of `structure.generator`, if the scene has one (`file` names it in messages).
+    pub fn generator_blade(&self, file: &str) -> Result<Option<Blade>, super::SceneError> {
+        let Some(table) = &self.structure.generator else { return Ok(None) };
+        match generate(table).map_err(|e| super::SceneError::at(file, e))? {
+            (Source::Blade(blade), _, _) => Ok(Some(*blade)),
+            _ => Ok(None),
         }
     }
 
@@ -82,19 +101,28 @@ impl Scene {
         Ok(z.to_vec())
     }
 
-    /// Removes the DOFs of `structure.fixed`; the map goes from the scene's numbering to the
-    /// clamped one.
-    pub(super) fn clamp(&self, full: Structure) -> Result<(Structure, DofMap), BuildError> {
+    /// Removes the DOFs of `structure.fixed` (indices, or nodes through `nodes`); the map goes
+    /// from the scene's numbering to the clamped one.
+    pub(super) fn clamp(&self, full: Structure, source: &Source, nodes: Option<&NodeMap>) -> Result<(Structure, DofMap), BuildError> {
+        let n = full.mass.nrows();
         if self.structure.fixed.is_empty() {
-            let n = full.mass.nrows();
             return Ok((full, DofMap::identity(n)));
         }
-        crate::fe::clamp_structure(&full, &self.structure.fixed).map_err(|e| BuildError::field("structure.fixed", e.to_string()))
+        let identity = DofMap::identity(n);
+        let resolver = Resolver { source, dofs: &identity, n_user: n, nodes };
+        let mut fixed = Vec::with_capacity(self.structure.fixed.len());
+        for (i, d) in self.structure.fixed.iter().enumerate() {
+            fixed.push(match d {
+                DofSpec::Index(d) => *d,
+                other => resolver.output(&format!("structure.fixed[{i}]"), other)?,
+            });
+        }
+        crate::fe::clamp_structure(&full, &fixed).map_err(|e| BuildError::field("structure.fixed", e.to_string()))
     }
 }
 
 /// The blade generator: `structure.generator = { kind = "blade", … }`.
-fn generate(table: &toml::Table) -> Result<(Source, Structure), BuildError> {
+fn generate(table: &toml::Table) -> Result<(Source, Structure, Option<NodeMap>), BuildError> {
     let field = "structure.generator";
     let mut table = table.clone();
     let kind = table.remove("kind");
@@ -109,7 +137,8 @@ fn generate(table: &toml::Table) -> Result<(Source, Structure), BuildError> {
     let params = spec.params().map_err(|e| BuildError::field(field, e.to_string().trim_start_matches("blade generator: ")))?;
     let blade = Blade::generate(&params).map_err(|e| BuildError::field(field, e.to_string()))?;
     let structure = blade.structure();
-    Ok((Source::Blade(Box::new(blade)), structure))
+    let nodes = blade.node_map();
+    Ok((Source::Blade(Box::new(blade)), structure, Some(nodes)))
 }
 
 /// Damping and stiffness must have the size of the mass matrix.

@@ -210,6 +210,22 @@ extern "C" fn sink(ctx: *mut c_void, instance: *const c_char, status: c_int, cat
     });
 }
 
+/// Copies the scene file `scene` and every file it references (at the same relative paths) into
+/// `dir`; returns the copy's path.
+pub fn copy_scene(scene: &Path, dir: &Path) -> PathBuf {
+    let (parsed, from) = periodic_contact::scene::Scene::load(scene).unwrap();
+    for r in parsed.referenced_files() {
+        for f in &r.files {
+            let to = dir.join(f);
+            std::fs::create_dir_all(to.parent().unwrap()).unwrap();
+            std::fs::copy(from.join(f), &to).unwrap_or_else(|e| panic!("{}: {e}", from.join(f).display()));
+        }
+    }
+    let copy = dir.join(scene.file_name().unwrap());
+    std::fs::copy(scene, &copy).unwrap();
+    copy
+}
+
 /// A scratch folder under the system temp dir, unique per process and name.
 pub fn scratch(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("periodic-contact-tests-{}", std::process::id())).join(name);
@@ -323,6 +339,12 @@ impl Fmu {
         let dir = scratch(name);
         let scene = dir.join(format!("{name}.toml"));
         std::fs::write(&scene, scene_text).unwrap();
+        Fmu::package_scene(name, &scene)
+    }
+
+    /// Packages the scene file `scene` (with the files it references) into its folder and loads it.
+    pub fn package_scene(name: &str, scene: &Path) -> Fmu {
+        let (dir, scene) = (scene.parent().unwrap().to_path_buf(), scene.to_path_buf());
         let fmu_file = dir.join(format!("{name}.fmu"));
         let o = Command::new(cli()).arg("fmu").arg(&scene).arg("-o").arg(&fmu_file).arg("--binary").arg(fmu_binary()).output().unwrap();
         assert!(o.status.success(), "periodic-contact fmu: {}", String::from_utf8_lossy(&o.stderr));

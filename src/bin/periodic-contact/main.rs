@@ -2,6 +2,7 @@
 //! Exit status: 0 success, 1 the solver failed (typed outcome printed), 2 bad input.
 mod cmd_bench;
 mod cmd_continue;
+mod cmd_deck;
 mod cmd_fmu;
 mod cmd_lcp;
 mod cmd_modes;
@@ -58,6 +59,14 @@ enum Command {
         /// The FMU binary libPeriodicContact.so (default: $PERIODIC_CONTACT_FMU_BINARY, else next to this executable).
         #[arg(long)]
         binary: Option<PathBuf>,
+    },
+    /// Write the mesh of a scene's blade generator as a CalculiX deck (C3D8 or C3D8I, root
+    /// clamped, *FREQUENCY SOLVER=MATRIXSTORAGE): `ccx JOB` then writes JOB.sti, JOB.mas, JOB.dof.
+    Deck {
+        scene: PathBuf,
+        /// Output .inp file.
+        #[arg(short, long)]
+        output: PathBuf,
     },
     /// First eigenfrequencies of the full model and, with [reduction], of the reduced one.
     Modes {
@@ -156,6 +165,7 @@ fn main() -> ExitCode {
             cmd_solve::run(&scene, &output, overrides, export_lcp.as_deref(), cmd_solve::Refine { estimate: !no_estimate, polish })
         }
         Some(Command::Modes { scene, count }) => cmd_modes::run(&scene, count),
+        Some(Command::Deck { scene, output }) => cmd_deck::run(&scene, &output),
         Some(Command::Sweep(args)) => cmd_sweep::run(&args),
         Some(Command::Continue(args)) => cmd_continue::run(&args),
         Some(Command::Lcp { file, output, method, tolerance }) => cmd_lcp::run(&file, &output, &method, tolerance),

@@ -186,7 +186,7 @@ mod tests {
                 h,
                 gamma,
                 // A large compliance keeps S = HΓ + D positive definite.
-                compliance: vec![10.0; m],
+                flexibility: (0..m * m).map(|i| if i % (m + 1) == 0 { 10.0 } else { 0.0 }).collect(),
                 r: vec![0.0; k * m],
             })
             .unwrap();

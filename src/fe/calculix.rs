@@ -1,0 +1,171 @@
+//! CalculiX's matrix output: `*FREQUENCY, SOLVER=MATRIXSTORAGE` writes, for job `jobname`,
+//! `jobname.sti` (stiffness) and `jobname.mas` (mass) as lines `row column value` (1-based, one
+//! triangle of the symmetric matrix: row ≤ column, verified with ccx 2.20), and `jobname.dof`, one
+//! line `node.direction` per matrix row (`12.1` = node 12, x). DOFs fixed by `*BOUNDARY` are
+//! already removed: the `.dof` map says which remain.
+//!
+//! Every error names the file, the line (1-based) and the remedy.
+use super::nodes::NodeMap;
+use faer::sparse::{SparseColMat, Triplet};
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+
+/// A CalculiX job's matrices and its node map, in the `.dof` order.
+#[derive(Clone, Debug)]
+pub struct CalculixModel {
+    pub mass: SparseColMat<usize, f64>,
+    pub stiffness: SparseColMat<usize, f64>,
+    pub nodes: NodeMap,
+}
+
+/// What is wrong with one of a job's files.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{file}:{line}: {message}")]
+pub struct CalculixError {
+    pub file: String,
+    /// 1-based; 0 when the file cannot be read at all.
+    pub line: usize,
+    pub message: String,
+}
+
+/// The three files of job `stem` (`stem.sti`, `stem.mas`, `stem.dof`).
+pub fn job_files(stem: &Path) -> [PathBuf; 3] {
+    ["sti", "mas", "dof"].map(|ext| {
+        let mut p = stem.as_os_str().to_owned();
+        p.push(".");
+        p.push(ext);
+        PathBuf::from(p)
+    })
+}
+
+const REGENERATE: &str = "regenerate it with `ccx JOBNAME` from a deck with *FREQUENCY, SOLVER=MATRIXSTORAGE";
+
+/// Reads job `stem`: `stem.dof` first (it fixes the order n), then `stem.sti` and `stem.mas`.
+pub fn read_calculix(stem: &Path) -> Result<CalculixModel, CalculixError> {
+    let [sti, mas, dof] = job_files(stem);
+    let nodes = parse_dof(&read(&dof)?, &dof.display().to_string())?;
+    let n = count_dofs(&nodes);
+    let stiffness = parse_matrix(&read(&sti)?, &sti.display().to_string(), n, &dof.display().to_string())?;
+    let mass = parse_matrix(&read(&mas)?, &mas.display().to_string(), n, &dof.display().to_string())?;
+    Ok(CalculixModel { mass, stiffness, nodes })
+}
+
+fn count_dofs(nodes: &NodeMap) -> usize {
+    nodes.iter().map(|(_, d)| d.dofs.iter().flatten().count()).sum()
+}
+
+fn read(path: &Path) -> Result<String, CalculixError> {
+    std::fs::read_to_string(path).map_err(|e| CalculixError {
+        file: path.display().to_string(),
+        line: 0,
+        message: format!("cannot read the file: {e}; {REGENERATE}"),
+    })
+}
+
+/// A `.dof` map: line i (1-based) is matrix row i, `node.direction` with direction 1, 2 or 3.
+pub fn parse_dof(text: &str, file: &str) -> Result<NodeMap, CalculixError> {
+    let name = Path::new(file).file_name().map_or(file.to_string(), |n| n.to_string_lossy().into_owned());
+    let mut map = NodeMap::new(name, "it is fixed by *BOUNDARY or not in the mesh; choose a free node and direction of the deck");
+    let mut row = 0;
+    for (i, line) in text.lines().enumerate() {
+        let err = |message: String| CalculixError { file: file.to_string(), line: i + 1, message };
+        let s = line.trim();
+        if s.is_empty() {
+            continue;
+        }
+        let parsed = s.split_once('.').and_then(|(node, dir)| Some((node.parse::<u64>().ok()?, dir.parse::<usize>().ok()?)));
+        let Some((node, dir)) = parsed else {
+            return Err(err(format!("\"{s}\" is not node.direction (e.g. 12.1 = node 12, x); {REGENERATE}")));
+        };
+        if !(1..=3).contains(&dir) {
+            return Err(err(format!("\"{s}\": direction {dir}, expected 1, 2 or 3 (x, y, z); only displacement DOFs of solid elements are supported")));
+        }
+        if map.insert(node, dir - 1, row).is_some() {
+            return Err(err(format!("\"{s}\": node {node} direction {dir} is listed twice; {REGENERATE}")));
+        }
+        row += 1;
+    }
+    if row == 0 {
+        return Err(CalculixError { file: file.to_string(), line: 0, message: format!("lists no DOF; {REGENERATE}") });
+    }
+    Ok(map)
+}
+
+/// A `.sti` or `.mas` file of order `n` (the `.dof` map's count, from `dof_file`): both triangles
+/// are returned; each pair may be given once, in either triangle.
+pub fn parse_matrix(text: &str, file: &str, n: usize, dof_file: &str) -> Result<SparseColMat<usize, f64>, CalculixError> {
+    let mut triplets = Vec::new();
+    let mut seen = HashSet::new();
+    let mut max_index = 0;
+    for (i, line) in text.lines().enumerate() {
+        let err = |message: String| CalculixError { file: file.to_string(), line: i + 1, message };
+        let words: Vec<&str> = line.split_whitespace().collect();
+        if words.is_empty() {
+            continue;
+        }
+        let entry = match words.as_slice() {
+            [r, c, v] => r.parse::<usize>().ok().zip(c.parse::<usize>().ok()).zip(v.parse::<f64>().ok()),
+            _ => None,
+        };
+        let Some(((r, c), v)) = entry else {
+            return Err(err(format!("\"{}\" is not `row column value` (1-based indices, a number); {REGENERATE}", line.trim())));
+        };
+        if r == 0 || c == 0 || r > n || c > n {
+            return Err(err(format!("entry ({r}, {c}) is outside 1..{n}, the DOFs listed in {dof_file}: the files come from different runs; {REGENERATE}")));
+        }
+        if !v.is_finite() {
+            return Err(err(format!("value {v} is not finite; {REGENERATE}")));
+        }
+        if !seen.insert((r.min(c), r.max(c))) {
+            return Err(err(format!("entry ({r}, {c}) is given twice (a symmetric matrix stores one triangle); {REGENERATE}")));
+        }
+        max_index = max_index.max(r.max(c));
+        triplets.push(Triplet::new(r - 1, c - 1, v));
+        if r != c {
+            triplets.push(Triplet::new(c - 1, r - 1, v));
+        }
+    }
+    if max_index < n {
+        return Err(CalculixError {
+            file: file.to_string(),
+            line: 0,
+            message: format!("has rows up to {max_index} but {dof_file} lists {n} DOFs: the files come from different runs; {REGENERATE}"),
+        });
+    }
+    SparseColMat::try_new_from_triplets(n, n, &triplets).map_err(|e| CalculixError {
+        file: file.to_string(),
+        line: 0,
+        message: format!("cannot build the sparse matrix: {e:?}"),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_job_is_read_with_both_triangles_and_its_node_map() {
+        let nodes = parse_dof("5.1\n5.2\n7.3\n", "j.dof").unwrap();
+        assert_eq!((nodes.dof(5, 1).unwrap(), nodes.dof(7, 2).unwrap()), (1, 2));
+        let e = nodes.dof(7, 0).unwrap_err().to_string();
+        assert_eq!(e, "node 7 direction x is not in j.dof: it is fixed by *BOUNDARY or not in the mesh; choose a free node and direction of the deck");
+        let k = parse_matrix("1 1 2.0\n1 2 -1.0\n2 2 2.0\n2 3 -0.5\n3 3 1.0\n", "j.sti", 3, "j.dof").unwrap();
+        let dense = k.to_dense();
+        assert_eq!((dense[(1, 0)], dense[(0, 1)], dense[(2, 1)], dense[(2, 2)]), (-1.0, -1.0, -0.5, 1.0));
+    }
+
+    #[test]
+    fn bad_lines_are_refused_with_file_and_line() {
+        let e = parse_dof("5.1\nfive.2\n", "j.dof").unwrap_err();
+        assert_eq!((e.line, e.file.as_str()), (2, "j.dof"));
+        assert!(parse_dof("5.1\n5.4\n", "j.dof").unwrap_err().message.contains("direction 4"));
+        assert!(parse_dof("5.1\n5.1\n", "j.dof").unwrap_err().message.contains("twice"));
+        let e = parse_matrix("1 1 2.0\n1 x 1\n", "j.sti", 2, "j.dof").unwrap_err();
+        assert_eq!(e.line, 2);
+        let e = parse_matrix("1 1 2.0\n1 3 1.0\n", "j.sti", 2, "j.dof").unwrap_err();
+        assert!(e.message.contains("outside 1..2"), "{e}");
+        let e = parse_matrix("1 1 2.0\n", "j.sti", 2, "j.dof").unwrap_err();
+        assert!(e.message.contains("lists 2 DOFs"), "{e}");
+        assert!(parse_matrix("1 1 2.0\n2 1 1\n1 2 1\n2 2 1\n", "j.sti", 2, "j.dof").unwrap_err().message.contains("twice"));
+    }
+}
