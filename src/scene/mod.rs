@@ -8,6 +8,7 @@
 pub mod casing;
 mod contacts;
 mod error;
+mod friction;
 mod outputs;
 mod reduce;
 mod settings;
@@ -17,6 +18,7 @@ mod units;
 
 pub use casing::Casing;
 pub use error::{BuildError, SceneError};
+pub use friction::FrictionSpec;
 pub use settings::{discretization, error_estimate, period_multiple, solver_settings};
 pub use spec::*;
 
@@ -130,6 +132,7 @@ impl Scene {
         // Forces and contacts in the full numbering (user DOF kept for the labels), the casing.
         let forces = self.forces(&resolver)?;
         let (mut contacts, contact_dofs) = self.contacts(&resolver)?;
+        let frictions = self.frictions(&resolver)?;
         let pairings = self.contact_pairings()?;
         let casing = self.casing_motion(&mut contacts, &source, &dofs)?;
         let outputs = self.outputs(&resolver, matches!(source, Source::Inline), &contact_dofs, &forces)?;
@@ -140,7 +143,7 @@ impl Scene {
         let (model, map, reduction) = match &self.reduction {
             None => {
                 let map = outputs::clamped_map(&outputs, &dofs, &contact_dofs, !self.structure.fixed.is_empty());
-                (Model { structure: full.clone(), forces, contacts, frequency }, map, None)
+                (Model { structure: full.clone(), forces, contacts, frequency, frictions }, map, None)
             }
             Some(spec) => {
                 let parts = reduce::FullModel { structure: &full, damping: &damping, forces: &forces, contacts: &contacts, frequency };

@@ -57,7 +57,7 @@ pub(super) fn reduce(
         }
     }
     let contacts = full.contacts.iter().map(|c| Contact { dof: red.reduced_dof(c.dof).expect("contacts are boundary DOFs"), ..c.clone() }).collect();
-    let model = Model { structure: red.structure(), forces, contacts, frequency: full.frequency };
+    let model = Model { structure: red.structure(), forces, contacts, frequency: full.frequency, frictions: Vec::new() };
     let rows = outputs.dofs().into_iter().map(|u| (u, row(resolver.dofs.new_index(u).expect("checked")))).collect();
     let map = OutputMap { rows, contact_dofs: contact_dofs.to_vec(), effects: vec!["reduction".into()] };
     Ok((model, map, red))
