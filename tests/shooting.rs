@@ -132,6 +132,7 @@ fn random_chain(draw: &mut Draw, n: usize, m: usize, rigid: bool) -> Model {
         forces: vec![Force { dof: forced, term: Harmonic { amplitude: draw.range(0.5, 2.0), harmonic: 1, phase: 0.0 } }],
         contacts: Vec::new(),
         frequency: omega,
+        frictions: Vec::new(),
     };
     // The contact-free amplitude of each DOF, from a linear solve (no contact).
     let outputs = OutputSelection { displacement: (0..n).collect(), velocity: vec![], acceleration: vec![], contacts: false };

@@ -64,6 +64,9 @@ pub fn step_map(problem: &PeriodicProblem) -> Result<StepMapLcp, NoStepMap> {
     };
     // p·k steps over p·T for an orbit of p forcing periods (h = T/k either way).
     let (n, m, k) = (model.n(), model.contacts.len(), problem.instants());
+    if !model.frictions.is_empty() {
+        return Err(NoStepMap("friction contacts have no step map yet (src/formulation.md §9)".to_string()));
+    }
     if n > MAX_STEP_MAP_DOFS {
         return Err(NoStepMap(format!("the model has {n} DOFs; shooting takes at most {MAX_STEP_MAP_DOFS} (reduce it: Craig–Bampton)")));
     }
