@@ -271,7 +271,7 @@ pub unsafe extern "C" fn pc_problem_add_contact(p: *mut PcProblem, dof: usize, d
         }
         let p = unsafe { problem(p) }?;
         let compliance = if stiffness > 0.0 { Compliance::Compliant { stiffness } } else { Compliance::Rigid };
-        p.edit(|m, _| m.contacts.push(Contact { dof, direction: direction as f64, gap, compliance, motion: vec![] }))?;
+        p.edit(|m, _| m.contacts.push(Contact::on_dof(dof, direction as f64, gap, compliance)))?;
         if let Some(i) = unsafe { index.as_mut() } {
             *i = p.base.model().contacts.len() - 1;
         }

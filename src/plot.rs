@@ -29,6 +29,8 @@ pub enum Line {
     Dashed,
     /// Markers only.
     None,
+    /// A vertical stem from the axis' bottom to each point (spectra), no line between points.
+    Stems,
 }
 
 impl Look {
@@ -98,6 +100,28 @@ fn tick(v: f64, lo: f64, hi: f64) -> String {
     if (1e-2..1e6).contains(&big) { format!("{r}") } else { format!("{r:e}") }
 }
 
+/// The labelled ticks of a log axis over `lo..hi`: every decade (every second, third, … past 12
+/// decades), with 2 and 5 inside when the axis spans three decades or fewer, and 1 … 9 when
+/// fewer than three ticks would remain.
+fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    let (first, last) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+    let decades = (last - first).max(1);
+    let every = (decades as usize).div_ceil(12).max(1);
+    let within = |m: &[f64]| -> Vec<f64> {
+        (first..=last).step_by(every).flat_map(|e| m.iter().map(move |f| f * 10f64.powi(e))).filter(|v| (lo..=hi).contains(v)).collect()
+    };
+    let mut ticks = within(if decades <= 3 { &[1.0, 2.0, 5.0] } else { &[1.0] });
+    if ticks.len() < 3 {
+        ticks = within(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]);
+    }
+    ticks
+}
+
+/// A log axis' tick: "0.01", "200" within 1e-3 … 1e4, else "2e-7".
+fn log_tick(v: f64) -> String {
+    if (1e-3..1e4).contains(&v) { format!("{}", (v * 1e6).round() / 1e6) } else { format!("{v:.0e}") }
+}
+
 fn range(values: impl Iterator<Item = f64>, scale: Scale) -> (f64, f64) {
     let (lo, hi) =
         values.filter(|v| v.is_finite() && (scale == Scale::Linear || *v > 0.0)).fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(v), h.max(v)));
@@ -106,7 +130,10 @@ fn range(values: impl Iterator<Item = f64>, scale: Scale) -> (f64, f64) {
     }
     match scale {
         Scale::Linear => {
-            let pad = 0.05 * (hi - lo).max(hi.abs() * 1e-3).max(1e-12);
+            // A near-constant curve (spread below 1 % of its level) gets ±5 % of its level: its
+            // ticks stay few and short instead of crowding in the round-off.
+            let pad = if hi - lo < 1e-2 * lo.abs().max(hi.abs()) { 0.05 * lo.abs().max(hi.abs()) } else { 0.05 * (hi - lo) };
+            let pad = pad.max(1e-12);
             (lo - pad, hi + pad)
         }
         Scale::Log => (lo / 1.5, hi * 1.5),
@@ -207,7 +234,7 @@ where
             let mut ctx = $ctx;
             {
                 // Log axes: ticks as 1e-3 rather than 0.0009999999.
-                let log_fmt = |v: &f64| format!("{v:.0e}");
+                let log_fmt = |v: &f64| log_tick(*v);
                 let mut mesh = ctx.configure_mesh();
                 mesh.x_desc(chart.x_label).y_desc(chart.y_label);
                 let x_tick = |v: &f64| tick(*v, xs.0, xs.1);
@@ -224,6 +251,7 @@ where
                     Line::Dashed => ctx.draw_series(DashedLineSeries::new(pts.clone(), 8, 5, line)).map_err(|e| err(&e))?,
                     Line::Solid => ctx.draw_series(LineSeries::new(pts.clone(), line)).map_err(|e| err(&e))?,
                     Line::None => ctx.draw_series(LineSeries::new(Vec::new(), line)).map_err(|e| err(&e))?,
+                    Line::Stems => ctx.draw_series(pts.iter().map(|&(x, y)| PathElement::new(vec![(x, ys.0), (x, y)], line))).map_err(|e| err(&e))?,
                 };
                 // Legend: two segments (a gap between them when dashed, none without a line) and the marker.
                 let shape = marker_shape(look.marker.unwrap_or(0));
@@ -264,11 +292,12 @@ where
             labels.draw().map_err(|e| err(&e))?;
         }};
     }
+    let (x_log, y_log) = ((xs.0..xs.1).log_scale().with_key_points(log_ticks(xs.0, xs.1)), (ys.0..ys.1).log_scale().with_key_points(log_ticks(ys.0, ys.1)));
     match (chart.x_scale, chart.y_scale) {
         (Scale::Linear, Scale::Linear) => draw!(builder.build_cartesian_2d(xs.0..xs.1, ys.0..ys.1).map_err(|e| err(&e))?),
-        (Scale::Log, Scale::Log) => draw!(builder.build_cartesian_2d((xs.0..xs.1).log_scale(), (ys.0..ys.1).log_scale()).map_err(|e| err(&e))?),
-        (Scale::Linear, Scale::Log) => draw!(builder.build_cartesian_2d(xs.0..xs.1, (ys.0..ys.1).log_scale()).map_err(|e| err(&e))?),
-        (Scale::Log, Scale::Linear) => draw!(builder.build_cartesian_2d((xs.0..xs.1).log_scale(), ys.0..ys.1).map_err(|e| err(&e))?),
+        (Scale::Log, Scale::Log) => draw!(builder.build_cartesian_2d(x_log, y_log).map_err(|e| err(&e))?),
+        (Scale::Linear, Scale::Log) => draw!(builder.build_cartesian_2d(xs.0..xs.1, y_log).map_err(|e| err(&e))?),
+        (Scale::Log, Scale::Linear) => draw!(builder.build_cartesian_2d(x_log, ys.0..ys.1).map_err(|e| err(&e))?),
     }
     Ok(())
 }
@@ -281,6 +310,15 @@ mod tests {
         assert_eq!([t(2.0, 20.0), t(2000.0, 2700.0), t(0.25, 1.0), t(-1.5, 10.0), t(0.0, 1.0)], ["2", "2000", "0.25", "-1.5", "0"]);
         // Axes in 1e-4 m: every tick a power of ten, zero up to round-off is 0.
         assert_eq!([t(0.00006000000000001, 1e-3), t(1e-3, 1e-3), t(-2.7e-20, 1e-3), t(2.5e6, 3e6)], ["6e-5", "1e-3", "0", "2.5e6"]);
+        // Log ticks: every decade over many, 1-2-5 over few, never fewer than three.
+        assert_eq!(super::log_ticks(1e-9, 2.0), (-9..=0).map(|e| 10f64.powi(e)).collect::<Vec<_>>());
+        let labels = |lo: f64, hi: f64| super::log_ticks(lo, hi).into_iter().map(super::log_tick).collect::<Vec<_>>();
+        assert_eq!(labels(0.15, 3.0), ["0.2", "0.5", "1", "2"]);
+        assert_eq!(labels(2.5e-3, 8.5e-3), ["0.003", "0.004", "0.005", "0.006", "0.007", "0.008"]);
+        assert_eq!([super::log_tick(1e-2), super::log_tick(200.0), super::log_tick(2e-7)], ["0.01", "200", "2e-7"]);
+        // A near-constant curve: ±5 % of its level, not ±5 % of its round-off.
+        let (lo, hi) = super::range([1.0, 1.0 + 2.5e-6].into_iter(), super::Scale::Linear);
+        assert!((lo - 0.95).abs() < 1e-5 && (hi - 1.05).abs() < 1e-5, "{lo} {hi}");
         // Eleven curves: eleven different looks.
         let looks: std::collections::HashSet<String> = (0..11).map(|i| format!("{:?}", super::style(i))).collect();
         assert_eq!(looks.len(), 11);

@@ -4,8 +4,16 @@ use std::collections::BTreeMap;
 
 #[derive(Clone, Debug, Serialize)]
 pub struct ContactResponse {
+    /// The DOF that labels the contact: its normal's largest |coefficient| (the first of equals),
+    /// in the scene's numbering; for a contact on one DOF, that DOF.
     pub dof: usize,
+    /// The sign (+1 or −1) of the normal's coefficient on `dof`.
     pub direction: i32,
+    /// The contact's unit normal, row of B: [DOF, coefficient] pairs in the scene's numbering.
+    pub normal: Vec<(usize, f64)>,
+    /// The normal displacement B_i x at each instant (= gap(t) − clearance): the displacement
+    /// reported for the contact, along its normal, whatever DOFs the normal mixes.
+    pub normal_displacement: Vec<f64>,
     /// Contact stiffness of a compliant contact; null for a rigid one (whose gap never goes
     /// below 0, while a compliant contact's gap is negative when it penetrates).
     pub stiffness: Option<f64>,

@@ -364,7 +364,7 @@ fn huge_sizes_are_refused_at_once() {
     refused_quickly(&two, &["discretization.steps", "524300 with 2 contact(s)", "1048600 unknowns", "at most 1048576"]);
     // Fourier collocation has no step map: the dense methods' 32768 is its limit.
     let fourier = with("steps = 64", "steps = 40000").replacen("scheme = \"cds\"", "scheme = \"fourier\"", 1);
-    refused_quickly(&fourier, &["discretization.steps", "40000", "at most 32768", "under fourier", "reduce steps"]);
+    refused_quickly(&fourier, &["discretization.steps", "40000", "at most 32768", "under fourier", "reduce steps", "GiB", "use scheme cds"]);
     // Without contact a fine grid is only FFTs; on a dense model it is one LU per harmonic.
     let n = 100;
     let identity =
@@ -560,4 +560,82 @@ fn a_solver_failure_writes_nothing_and_exits_1() {
     assert!(err.contains("singular at harmonic 1") && err.contains("add damping"), "{err}");
     assert_eq!(std::fs::read_to_string(dir.join("r.json")).unwrap(), "previous result");
     assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 2, "no temporary file left");
+}
+
+/// A 3-DOF point (x, y, z) for contacts along a normal: an isotropic spring-mass.
+const POINT: &str = "[structure]\nmass = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]\nstiffness = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]\n[excitation]\nfrequency = 1.0\n[[force]]\ndof = 0\namplitude = 1.0\n";
+
+/// Contacts along a normal (issue 23 item 2): a zero, non-finite or mis-sized normal, a radial
+/// normal without an axis or on it, and one-DOF keys mixed in, each refused naming the contact,
+/// the value and the remedy.
+#[test]
+fn bad_contact_normals() {
+    let c = |body: &str| format!("{POINT}[[contact]]\ngap = 0.5\n{body}\n");
+    refused(&c("dofs = [0, 1, 2]\nnormal = [0.0, 0.0, 0.0]"), &["contact[0].normal", "[0.0, 0.0, 0.0]", "nonzero", "e.g. [0, 0, 1]"]);
+    refused(&c("dofs = [0, 1, 2]\nnormal = [1.0, nan, 0.0]"), &["contact[0].normal", "NaN", "finite"]);
+    refused(&c("dofs = [0, 1, 2]\nnormal = [1.0, 1.0]"), &["contact[0].normal", "2 components", "3 DOFs"]);
+    refused(&c("dofs = [0, 1, 2]\nnormal = \"up\""), &["contact[0].normal", "up", "radial"]);
+    refused(&c("dofs = [0, 1, 2]\nnormal = \"radial\""), &["contact[0].normal", "radial", "casing.axis"]);
+    refused(
+        &c(
+            "dofs = [0, 1, 2]\nnormal = \"radial\"\nposition = [0.0, 0.0, 2.0]\n[casing]\naxis = [0.0, 0.0, 1.0]\nradius = 1.0\nharmonics = [{ order = 1, amplitude = 0.1 }]",
+        ),
+        &["contact[0].normal", "on the rotation axis", "normal = [nx, ny, nz]"],
+    );
+    refused(
+        &c("dofs = [0, 1, 2]\nnormal = \"radial\"\n[casing]\naxis = [0.0, 0.0, 1.0]\nradius = 1.0\nharmonics = [{ order = 1, amplitude = 0.1 }]"),
+        &["contact[0].normal", "position = [x, y, z]"],
+    );
+    refused(&c("dofs = [0, 1, 9]\nnormal = [0.0, 0.6, 0.8]"), &["contact[0].dofs[2]", "9"]);
+    refused(&c("dofs = [0, 1, 2]\nnormal = [0.0, 0.6, 0.8]\ndirection = -1"), &["contact[0].direction", "normal"]);
+    refused(&c("dof = 1\nnormal = [0.0, 0.6, 0.8]"), &["contact[0].dof", "normal"]);
+    refused(&c("nodes = \"tip\""), &["contact[0].nodes", "structure.generator"]);
+    // A node on the axis, from the casing's own axis and center.
+    refused(
+        &c(
+            "dofs = [0, 1, 2]\nnormal = \"radial\"\nposition = [1.0, 2.0, 5.0]\n[casing]\naxis = [0.0, 0.0, 2.0]\ncenter = [1.0, 2.0, 0.0]\nradius = 1.0\nharmonics = [{ order = 1, amplitude = 0.1 }]",
+        ),
+        &["on the rotation axis"],
+    );
+}
+
+/// A scene and its casing profile in a scratch folder: the library and the CLI refuse it.
+fn profile_refused(profile: &str, needles: &[&str]) {
+    let dir = scratch();
+    std::fs::write(dir.join("casing.csv"), profile).unwrap();
+    let text = format!(
+        "{POINT}[[contact]]\ndofs = [0, 1, 2]\nnormal = \"radial\"\nposition = [0.0, 1.0, 0.0]\ngap = 0.5\n[casing]\naxis = [0.0, 0.0, 1.0]\nradius = 1.0\nprofile = \"casing.csv\"\n"
+    );
+    let scene = dir.join(FILE);
+    std::fs::write(&scene, &text).unwrap();
+    let f = scene.to_str().unwrap();
+    let lib = match Scene::parse(&text, f).and_then(|s| s.to_problem(f)) {
+        Ok(_) => panic!("accepted profile:\n{profile}"),
+        Err(e) => e.to_string(),
+    };
+    let o = Command::new(env!("CARGO_BIN_EXE_periodic-contact")).arg("solve").arg(&scene).arg("-o").arg(dir.join("r.json")).output().unwrap();
+    let cli = String::from_utf8_lossy(&o.stderr).to_string();
+    assert_eq!(o.status.code(), Some(2), "{cli}");
+    for n in needles.iter().chain(&["casing.profile", "casing.csv"]) {
+        assert!(lib.contains(n), "library message lacks {n:?}: {lib}");
+        assert!(cli.contains(n), "CLI message lacks {n:?}: {cli}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Casing profiles (issue 23 item 3): not periodic, not uniform, unreadable, without the unit of
+/// its angles; each refused naming the file, the line and the remedy. And a good one passes.
+#[test]
+fn bad_casing_profiles() {
+    profile_refused("angle_deg,clearance\n0,0.0\n90,0.1\n180,0.0\n270,-0.1\n360,0.05\n", &["line 6", "not periodic", "make the last value equal the first"]);
+    profile_refused("angle_deg,clearance\n0,0.0\n90,0.1\n200,0.0\n270,-0.1\n", &["line 4", "uniformly spaced", "resample"]);
+    profile_refused("angle_deg,clearance\n10,0.0\n100,0.1\n190,0.0\n280,-0.1\n", &["line 2", "start at 0"]);
+    profile_refused("angle,clearance\n0,0.0\n", &["line 1", "angle_deg,clearance or angle_rad,clearance"]);
+    profile_refused("angle_rad,clearance\n0,0.0\n1.5,zero\n", &["line 3", "two finite numbers"]);
+    profile_refused("angle_rad,clearance\n0,0.0\n", &["at least 3"]);
+    let dir = scratch();
+    let text = format!("{POINT}[[contact]]\ndof = 0\ngap = 0.5\n[casing]\nradius = 1.0\narc = [0.0]\nprofile = \"missing.csv\"\n");
+    let e = lib_refuses(&text);
+    assert!(e.contains("casing.profile") && e.contains("missing.csv") && e.contains("cannot read"), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
 }

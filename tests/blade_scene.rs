@@ -316,3 +316,274 @@ fn bad_scenes_name_the_file_the_field_and_the_value() {
         }
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// Contacts along radial normals and casings of any shape (issue 23 items 2 and 3).
+
+/// A scratch folder for a scene and its casing profile.
+fn casing_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("pc-casing-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The coarse blade (twist 30°) with 16 chord elements, `nodes = "tip"` (17 radial contacts),
+/// stagger 40°, and `casing` as the [casing] body; no reduction (the gaps need none).
+fn tip_scene(casing: &str) -> String {
+    format!(
+        "[structure]\ngenerator = {{ kind = \"blade\", preset = \"coarse\", chord_elements = 16 }}\n[excitation]\nfrequency = 2300.0\n\
+         [casing]\nradius = 0.25\nstagger = 40.0\n{casing}\n[[force]]\nnode = \"MC\"\naxis = \"y\"\namplitude = 1.0\n\
+         [[contact]]\nnodes = \"tip\"\ngap = 3e-5\nstiffness = 1e7\n[discretization]\nscheme = \"bds2\"\nsteps = 1024\n"
+    )
+}
+
+fn write_scene(dir: &Path, text: &str, csv: Option<(&str, String)>) -> SceneModel {
+    if let Some((name, body)) = csv {
+        std::fs::write(dir.join(name), body).unwrap();
+    }
+    let file = dir.join("scene.toml");
+    std::fs::write(&file, text).unwrap();
+    let f = file.to_str().unwrap();
+    Scene::parse(text, f).unwrap().build(f).unwrap()
+}
+
+/// Each tip node's radial normal and angle θ_i, computed here from the blade's geometry: tip node
+/// at chord fraction f has p = x0·u (z = L), x0 = (f − ½)·c_tip, u = (cos τ, sin τ, 0); the axis
+/// runs along e_a = cos γ·u + sin γ·n through (0, 0, L − R); e_θ = −sin γ·u + cos γ·n.
+fn tip_geometry(count: usize) -> Vec<([f64; 3], f64)> {
+    let (tau, gamma, radius, c_tip) = (30f64.to_radians(), 40f64.to_radians(), 0.25, 0.05 * 0.8);
+    let u = [tau.cos(), tau.sin(), 0.0];
+    let nv = [-tau.sin(), tau.cos(), 0.0];
+    let e_a: Vec<f64> = (0..3).map(|i| gamma.cos() * u[i] + gamma.sin() * nv[i]).collect();
+    let e_t: Vec<f64> = (0..3).map(|i| -gamma.sin() * u[i] + gamma.cos() * nv[i]).collect();
+    (0..count)
+        .map(|i| {
+            let x0 = (i as f64 / (count - 1) as f64 - 0.5) * c_tip;
+            let r = [x0 * u[0], x0 * u[1], radius];
+            let along: f64 = (0..3).map(|a| r[a] * e_a[a]).sum();
+            let rp: Vec<f64> = (0..3).map(|a| r[a] - along * e_a[a]).collect();
+            let len = rp.iter().map(|v| v * v).sum::<f64>().sqrt();
+            let theta = (0..3).map(|a| rp[a] * e_t[a]).sum::<f64>().atan2(rp[2]);
+            ([rp[0] / len, rp[1] / len, rp[2] / len], theta)
+        })
+        .collect()
+}
+
+/// Two Gaussian lobes: Δg(θ) = −d·Σ_{c ∈ {0, π}} exp(−wrap(θ − c)²/(2w²)).
+fn two_lobes(theta: f64, depth: f64, width: f64) -> f64 {
+    let wrap = |a: f64| (a + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI;
+    -depth * [0.0, std::f64::consts::PI].iter().map(|c| (-wrap(theta - c).powi(2) / (2.0 * width * width)).exp()).sum::<f64>()
+}
+
+/// `nodes = "tip"` makes one contact per mid-thickness tip node along its radial normal, which
+/// twist and stagger turn off every axis; a sampled two-lobe Gaussian casing gives each contact
+/// gap_i(t) = g0 + Δg(Ω t + θ_i), Δg the Gaussian formula, to round-off: the profile's N = 360
+/// samples resolve the lobes (w = 0.25 rad: the aliasing bound 2Σ_{|k|≥180}|ĝ_k| ~ d·e^{−(180w)²/2}
+/// is far below round-off), and the orders dropped are below 1e-13 of the largest.
+#[test]
+fn tip_contacts_along_radial_normals_rub_two_gaussian_lobes() {
+    let dir = casing_dir("gauss");
+    let (depth, width) = (2e-5, 0.25);
+    let mut csv = String::from("angle_deg,clearance\n");
+    for j in 0..360 {
+        csv.push_str(&format!("{j},{:e}\n", two_lobes((j as f64).to_radians(), depth, width)));
+    }
+    let b = write_scene(&dir, &tip_scene("lobes = 2\nprofile = \"lobes.csv\""), Some(("lobes.csv", csv)));
+    let model = b.problem.model();
+    let geometry = tip_geometry(17);
+    assert_eq!(model.contacts.len(), 17, "every tip node LE..TE");
+    let omega = model.frequency;
+    let speed = omega / 2.0;
+    let mut worst = (0.0f64, 0.0f64);
+    for (i, (c, (normal, theta))) in model.contacts.iter().zip(&geometry).enumerate() {
+        // The generator's DOF of axis a of a node is 3·node + a less the clamped root's 3·count.
+        let row = &b.contact_rows[i];
+        let mut n = [0.0; 3];
+        row.iter().for_each(|&(d, v)| n[d % 3] = v);
+        for a in 0..3 {
+            worst.0 = worst.0.max((n[a] - normal[a]).abs());
+        }
+        if i != 8 {
+            assert_eq!(row.len(), 3, "contact {i} mixes x, y and z: {row:?}");
+            assert!(n[0].abs() > 1e-3 && n[1].abs() > 1e-3, "off-centre normals are off the axes: {row:?}");
+        } else {
+            assert_eq!(row.len(), 1, "MC, on the stacking line, is radial along z: {row:?}");
+        }
+        for j in 0..200 {
+            let t = j as f64 * 2.0 * std::f64::consts::PI / omega / 200.0 * 1.37;
+            let expected = 3e-5 + two_lobes(speed * t + theta, depth, width);
+            worst.1 = worst.1.max((c.gap_at(omega, t) - expected).abs() / depth);
+        }
+    }
+    let terms = c_terms(&b);
+    eprintln!("17 radial tip contacts: |normal − geometry| ≤ {:.1e}, |gap_at − Gaussian| ≤ {:.1e} of the depth, {terms} casing terms", worst.0, worst.1);
+    assert!(worst.0 < 1e-12, "normals: {:.1e}", worst.0);
+    assert!(worst.1 < 1e-10, "gaps: {:.1e}", worst.1);
+    // The referenced files: the profile, for packaging.
+    let scene = Scene::parse(&std::fs::read_to_string(dir.join("scene.toml")).unwrap(), "s").unwrap();
+    assert_eq!(scene.casing_files(&dir), vec![dir.join("lobes.csv")]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+fn c_terms(b: &SceneModel) -> usize {
+    match &b.casing.as_ref().unwrap().shape {
+        periodic_contact::scene::casing::Shape::Series(t) => t.len(),
+        other => panic!("{other:?}"),
+    }
+}
+
+/// A profile sampled (in radians, closing at 2π) from a known Fourier series reproduces its orders,
+/// amplitudes and phases, and equals the same series given as `harmonics`.
+#[test]
+fn a_sampled_profile_reproduces_its_harmonics() {
+    use periodic_contact::scene::casing::Shape;
+    let dir = casing_dir("series");
+    let known = [(0u32, 1e-6, 0.0), (2, 4e-6, 0.3), (4, -1.5e-6, 1.2), (10, 7e-7, -2.0)];
+    let g = |th: f64| known.iter().map(|&(k, a, p)| a * (k as f64 * th + p).cos()).sum::<f64>();
+    for n in [32usize, 64, 256] {
+        let mut csv = String::from("# a known series\nangle_rad,clearance\n");
+        for j in 0..=n {
+            let th = j as f64 * 2.0 * std::f64::consts::PI / n as f64;
+            csv.push_str(&format!("{th:.17e},{:.17e}\n", g(if j == n { 0.0 } else { th })));
+        }
+        let b = write_scene(&dir, &tip_scene("lobes = 2\nprofile = \"p.csv\""), Some(("p.csv", csv)));
+        let Shape::Series(terms) = &b.casing.as_ref().unwrap().shape else { panic!() };
+        assert_eq!(terms.iter().map(|t| t.order).collect::<Vec<_>>(), vec![0, 2, 4, 10], "N = {n}: {terms:?}");
+        for (t, &(_, a, p)) in terms.iter().zip(&known) {
+            // a·cos(kθ + p) = |a|·cos(kθ + p + π) for a < 0.
+            let (ea, ep) = if a < 0.0 { (-a, p + std::f64::consts::PI) } else { (a, p) };
+            let dp = (t.phase - ep + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI;
+            assert!((t.amplitude - ea).abs() < 1e-12 * 4e-6 * n as f64 && (t.order == 0 || dp.abs() < 1e-9), "N = {n}: {t:?} vs {a}, {p}");
+        }
+        // The same series as harmonics gives the same obstacle motion.
+        let h = "lobes = 2\nharmonics = [{ order = 0, amplitude = 1e-6 }, { order = 2, amplitude = 4e-6, phase = 0.3 }, { order = 4, amplitude = -1.5e-6, phase = 1.2 }, { order = 10, amplitude = 7e-7, phase = -2.0 }]";
+        let b2 = build(&tip_scene(h));
+        let omega = b.problem.model().frequency;
+        for (c, c2) in b.problem.model().contacts.iter().zip(&b2.problem.model().contacts) {
+            for j in 0..50 {
+                let t = j as f64 * 1e-4;
+                assert!((c.gap_at(omega, t) - c2.gap_at(omega, t)).abs() < 1e-16, "profile and harmonics agree");
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A radially rubbing blade solves: the 17 radial contacts with the Gaussian casing under
+/// Craig–Bampton, every contact's reported normal displacement is B_i x of its scene row.
+#[test]
+fn radial_tip_contacts_solve_through_the_reduction() {
+    let dir = casing_dir("solve");
+    let mut csv = String::from("angle_deg,clearance\n");
+    for j in 0..=180 {
+        let deg = 2.0 * j as f64;
+        csv.push_str(&format!("{deg},{:e}\n", two_lobes(deg.to_radians(), 4e-5, 0.25)));
+    }
+    let text = tip_scene("lobes = 2\nprofile = \"lobes.csv\"")
+        .replace("[excitation]", "[reduction]\nmethod = \"craig-bampton\"\nmodes = 6\n[damping]\nmodal_ratios = [0.005]\n[excitation]")
+        + "[output]\ndisplacement = [\"LE:x\", \"LE:y\", \"LE:z\", \"MC\"]\n";
+    let text = text.replace("steps = 1024", "steps = 256");
+    let b = write_scene(&dir, &text, Some(("lobes.csv", csv)));
+    let r = b.problem.solve().unwrap();
+    assert!(r.contacts.iter().any(|c| c.force.iter().any(|&f| f > 0.0)), "the lobes touch the tip");
+    let le = &r.contacts[0];
+    let keys: Vec<String> = le.normal.iter().map(|(d, _)| d.to_string()).collect();
+    let e = (0..r.steps)
+        .map(|j| (le.normal_displacement[j] - le.normal.iter().zip(&keys).map(|((_, v), k)| v * r.displacement[k][j]).sum::<f64>()).abs())
+        .fold(0.0, f64::max);
+    let scale = le.normal_displacement.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!(e < 1e-9 * scale, "normal displacement {e:e} vs {scale:e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Matrix Market-style contacts by DOF index: `dofs` + `position` + `normal = "radial"` about
+/// `casing.axis` through `casing.center`, and `dofs` + a given normal (normalised); θ = 0 at the
+/// first positioned contact, growing by the right-hand rule about the axis.
+#[test]
+fn contacts_by_dofs_take_radial_and_given_normals() {
+    let eye: Vec<String> = (0..6).map(|i| format!("[{}]", (0..6).map(|j| if i == j { "1.0" } else { "0.0" }).collect::<Vec<_>>().join(", "))).collect();
+    let text = format!(
+        "[structure]\nmass = [{m}]\nstiffness = [{m}]\n[excitation]\nfrequency = 3.0\n\
+         [casing]\naxis = [0.0, 0.0, 2.0]\ncenter = [1.0, 1.0, 7.0]\nradius = 1.0\nharmonics = [{{ order = 1, amplitude = 0.1, phase = 0.2 }}]\n\
+         [[contact]]\ndofs = [0, 1, 2]\nnormal = \"radial\"\nposition = [3.0, 1.0, 0.0]\ngap = 0.5\n\
+         [[contact]]\ndofs = [3, 4, 5]\nnormal = \"radial\"\nposition = [1.0, 4.0, -2.0]\ngap = 0.5\n\
+         [[contact]]\ndofs = [3, 4, 5]\nnormal = [3.0, 0.0, -4.0]\nposition = [-1.0, 1.0, 0.0]\ngap = 0.5\n",
+        m = eye.join(", ")
+    );
+    let b = build(&text);
+    assert_eq!(b.contact_rows, vec![vec![(0, 1.0)], vec![(4, 1.0)], vec![(3, 0.6), (5, -0.8)]]);
+    // θ = 0, π/2 and π: gap_i(t) = 0.5 + 0.1·cos(Ω t + θ_i + 0.2), Ω = ω (lobes = 1).
+    let model = b.problem.model();
+    for (c, theta) in model.contacts.iter().zip([0.0, std::f64::consts::FRAC_PI_2, std::f64::consts::PI]) {
+        for t in [0.0, 0.3, 1.7] {
+            let expected = 0.5 + 0.1 * (3.0 * t + theta + 0.2).cos();
+            assert!((c.gap_at(3.0, t) - expected).abs() < 1e-14, "θ = {theta}: {} vs {expected}", c.gap_at(3.0, t));
+        }
+    }
+    // The cosine lobes at the same angles: −δ·cos(ω t + L·θ_i), ω = L·Ω.
+    let lobes = text.replace("harmonics = [{ order = 1, amplitude = 0.1, phase = 0.2 }]", "lobes = 3\ndepth = 0.1");
+    let b = build(&lobes);
+    for (c, theta) in b.problem.model().contacts.iter().zip([0.0, std::f64::consts::FRAC_PI_2, std::f64::consts::PI]) {
+        let expected = 0.5 - 0.1 * (3.0 * 0.3 + 3.0 * theta).cos();
+        assert!((c.gap_at(3.0, 0.3) - expected).abs() < 1e-14, "lobes at θ = {theta}: {} vs {expected}", c.gap_at(3.0, 0.3));
+    }
+}
+
+/// The shipped rigid blade scene (coarse, 3 rigid tip contacts) with `method`, `scheme` and
+/// `steps`, the pairing left to its default.
+fn rigid_blade(method: &str, scheme: &str, steps: usize) -> String {
+    let base = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("fmu/scenes/blade-casing-rigid.toml")).unwrap();
+    base.lines()
+        .filter(|l| !l.starts_with("pairing ="))
+        .map(|l| match l {
+            l if l.starts_with("method =") => format!("method = \"{method}\""),
+            l if l.starts_with("scheme =") => format!("scheme = \"{scheme}\""),
+            l if l.starts_with("steps =") => format!("steps = {steps}"),
+            l => l.to_string(),
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+#[test]
+fn massless_boundary_blade_has_the_kept_modes_limit_and_second_order_at_modest_k() {
+    let cb = build(&rigid_blade("craig-bampton", "cds", 1024));
+    let mb = build(&rigid_blade("massless-boundary", "cds", 512));
+    // ω_max: Craig–Bampton's constraint modes against the massless model's highest kept mode,
+    // which is the full model's 20th eigenfrequency (free-interface modes; rigid contacts open).
+    let s = &cb.full;
+    let (periodic_contact::model::Matrix::Sparse(k), periodic_contact::model::Matrix::Sparse(m)) = (&s.stiffness, &s.mass) else { panic!("sparse") };
+    let w20 = sparse_modes(k, m, 20).unwrap().omega[19];
+    let (w_cb, w_mb) = (cb.problem.omega_max(), mb.problem.omega_max());
+    eprintln!("ω_max: Craig–Bampton {w_cb:.4e} rad/s, massless boundary {w_mb:.4e} rad/s (full model's ω_20 = {w20:.4e})");
+    assert!(((w_mb - w20) / w20).abs() < 1e-6, "massless ω_max {w_mb} vs ω_20 {w20}");
+    assert!(w_cb > 3.0 * w_mb);
+    // cds at k = 256 breaks the massless model's limit (ω_max·h ≥ 2), 512 does not; Craig–Bampton needs 1024.
+    let refused =
+        Scene::parse(&rigid_blade("massless-boundary", "cds", 256), "t.toml").unwrap().build("t.toml").err().map(|e| e.to_string()).unwrap_or_default();
+    assert!(refused.contains("stable only"), "{refused}");
+    // Second order on the massless model: cds at k = 512, 1024 against k = 4096 (galerkin, measured
+    // in the README, stalled between 512 and 1024 on this case).
+    let reference = build(&rigid_blade("massless-boundary", "cds", 4096)).problem.solve().unwrap();
+    for scheme in ["cds"] {
+        let e: Vec<f64> = [512usize, 1024]
+            .iter()
+            .map(|&k| {
+                let r = build(&rigid_blade("massless-boundary", scheme, k)).problem.solve().unwrap();
+                assert!(r.warnings.iter().all(|w| !w.contains("converge")), "{scheme}: {:?}", r.warnings);
+                let step = 4096 / k;
+                r.displacement
+                    .iter()
+                    .map(|(key, x)| {
+                        let xr: Vec<f64> = reference.displacement[key].iter().step_by(step).copied().collect();
+                        x.iter().zip(&xr).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max) / Response::peak_to_peak(&reference.displacement[key])
+                    })
+                    .fold(0.0, f64::max)
+            })
+            .collect();
+        let order = (e[0] / e[1]).log2();
+        eprintln!("massless blade, {scheme}: errors {e:?} at k = 512, 1024 against cds k = 4096; observed order {order:.2}");
+        assert!(order > 1.6, "{scheme}: order {order}");
+        assert!(e[1] < 1e-2, "{scheme}: {e:?}");
+    }
+}

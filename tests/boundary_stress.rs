@@ -23,8 +23,7 @@
 //! host (examples/fmu_host.c) with the resident size sampled; valgrind on examples/capi_demo.c
 //! and on the FMU driven by the C host.
 //!
-//! Needs `cargo build --release` (libperiodic_contact.so) and
-//! `cargo build --release -p periodic-contact-fmu` (libPeriodicContact.so). Environment:
+//! Needs `cargo build --release` (libperiodic_contact.so and libPeriodicContact.so). Environment:
 //! `PC_STRESS_STEPS` (default 10⁷) sets the long run's length.
 mod common;
 

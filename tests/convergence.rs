@@ -2,7 +2,7 @@
 //! convergence orders of each scheme, error bounds, impulse per period, persistent contact.
 use periodic_contact::exact::{CompliantStopOrbit, Oscillator, PersistentContact, RigidRegime, RigidStopOrbit};
 use periodic_contact::model::{Compliance, Harmonic};
-use periodic_contact::periodic::{OutputSelection, PeriodicProblem, SolveError, SolverSettings};
+use periodic_contact::periodic::{OutputSelection, PeriodicProblem, SolveError, SolverSettings, step_map};
 use periodic_contact::response::Response;
 use periodic_contact::time::{Discretization, Pairing, Scheme};
 
@@ -142,7 +142,7 @@ fn persistent_contact_follows_the_obstacle_and_the_force_converges() {
     // A constant load of 1 keeps the mass pressed on the obstacle.
     let build = |k: usize| {
         let mut model =
-            osc.model(vec![periodic_contact::model::Contact { dof: 0, direction: 1.0, gap: 0.2, compliance: Compliance::Rigid, motion: motion.clone() }]);
+            osc.model(vec![periodic_contact::model::Contact { row: vec![(0, 1.0)], gap: 0.2, compliance: Compliance::Rigid, motion: motion.clone() }]);
         model.forces.push(periodic_contact::model::Force { dof: 0, term: Harmonic { amplitude: 1.0, harmonic: 0, phase: 0.0 } });
         let outputs = OutputSelection { displacement: vec![0], velocity: vec![], acceleration: vec![], contacts: true };
         PeriodicProblem::new(model, Discretization { scheme: Scheme::Cds, steps: k, pairing: None }, outputs, SolverSettings::default()).unwrap()
@@ -185,6 +185,113 @@ fn cds_forward_equals_the_steady_state_of_explicit_time_marching() {
             let d = (0..k).map(|j| (r.displacement["0"][(j + shift) % k] - m.displacement[j][0]).abs()).fold(0.0, f64::max);
             eprintln!("{name} k={k}: periodic LCP vs marcher steady state {d:.2e} ({} periods, {:.3} s)", m.periods, m.cpu_time_s);
             assert!(d < 1e-9, "{name} k={k}: {d:e}");
+        }
+    }
+}
+
+/// Mass m on spring k1, and through spring k2 a massless contact point against a rigid stop at
+/// g0 (src/formulation.md §4.1). Free: the point follows the mass; in contact it is held at g0,
+/// so the mass sees k1 + k2 with the offset k2·g0: exactly the bilinear oscillator of §6.2 with
+/// k = k1, k_c = k2, whose orbit `CompliantStopOrbit` gives without any time grid.
+fn massless_contact_point(osc: &Oscillator, k2: f64, gap: f64, contact: Compliance) -> periodic_contact::model::Model {
+    use periodic_contact::model::{Contact, Force, Matrix, Model, Structure};
+    let k1 = osc.stiffness;
+    Model {
+        structure: Structure {
+            mass: Matrix::from_rows(&[vec![osc.mass, 0.0], vec![0.0, 0.0]]),
+            stiffness: Matrix::from_rows(&[vec![k1 + k2, -k2], vec![-k2, k2]]),
+            damping: Some(Matrix::from_rows(&[vec![osc.damping, 0.0], vec![0.0, 0.0]])),
+        },
+        forces: vec![Force { dof: 0, term: Harmonic { amplitude: osc.force, harmonic: 1, phase: 0.0 } }],
+        contacts: vec![Contact::on_dof(1, 1.0, gap, contact)],
+        frequency: osc.omega,
+    }
+}
+
+#[test]
+fn massless_contact_point_converges_to_the_compliant_orbit() {
+    use periodic_contact::periodic::LcpMethod;
+    let (k2, g0) = (10.0, 1.0);
+    let exact = CompliantStopOrbit::solve(&COMPLIANT, k2, g0, None).unwrap();
+    let ptp = exact.peak_to_peak();
+    let outputs = OutputSelection { displacement: vec![0, 1], velocity: vec![], acceleration: vec![], contacts: true };
+    let solve = |model, scheme, k, method| {
+        let settings = SolverSettings { method, ..SolverSettings::default() };
+        PeriodicProblem::new(model, Discretization { scheme, steps: k, pairing: None }, outputs.clone(), settings).and_then(|p| p.solve())
+    };
+    // ω_max over the finite eigenvalues: the mass on k1 (rigid stop open), on k1 plus k2 in series
+    // with a compliant stop k_c (closed).
+    let p = PeriodicProblem::new(
+        massless_contact_point(&COMPLIANT, k2, g0, Compliance::Rigid),
+        Discretization { scheme: Scheme::Cds, steps: 64, pairing: None },
+        outputs.clone(),
+        SolverSettings::default(),
+    )
+    .unwrap();
+    assert!((p.omega_max() - 1.0).abs() < 1e-9, "ω_max = {}", p.omega_max());
+    let kc = 30.0;
+    let p = PeriodicProblem::new(
+        massless_contact_point(&COMPLIANT, k2, g0, Compliance::Compliant { stiffness: kc }),
+        Discretization { scheme: Scheme::Cds, steps: 64, pairing: None },
+        outputs.clone(),
+        SolverSettings::default(),
+    )
+    .unwrap();
+    let series = (1.0 + k2 * kc / (k2 + kc)).sqrt();
+    assert!((p.omega_max() - series).abs() < 1e-9 * series, "ω_max = {} vs {series}", p.omega_max());
+
+    for scheme in [Scheme::Cds, Scheme::Galerkin, Scheme::Bds1, Scheme::Bds2] {
+        let ks = [256, 512, 1024];
+        let mut e = Vec::new();
+        for &k in &ks {
+            let r = solve(massless_contact_point(&COMPLIANT, k2, g0, Compliance::Rigid), scheme, k, LcpMethod::Lemke).unwrap();
+            assert_eq!(r.pairing, "same", "a rigid contact on a massless DOF defaults to same pairing");
+            assert!(r.warnings.is_empty(), "{scheme}: {:?}", r.warnings);
+            // The contact force is the spring's, finite: k2·(x_mass − g0) while in contact.
+            let x = &r.displacement["0"];
+            let fmax = r.contacts[0].force.iter().fold(0.0f64, |a, &v| a.max(v));
+            let xmax = x.iter().fold(f64::MIN, |a, &v| a.max(v));
+            assert!((fmax - k2 * (xmax - g0)).abs() < 0.05 * fmax, "{scheme}, k = {k}: force {fmax} vs k2·(x − g0) = {}", k2 * (xmax - g0));
+            e.push(errors(&r, |t| exact.eval(t).0, ptp, exact.impulse_per_period()).0);
+            // For cds and bds the discrete orbit is the 1-DOF compliant stop's to round-off (the
+            // condensation is exact algebra), and so is the condensed step map: its march from any
+            // state equals the 1-DOF model's. Galerkin weighs k2 by (1, 4, 1)/6 and has no step map.
+            let one_dof = problem(&COMPLIANT, Oscillator::stop(g0, Compliance::Compliant { stiffness: k2 }), scheme, k, None);
+            let two_dof = PeriodicProblem::new(
+                massless_contact_point(&COMPLIANT, k2, g0, Compliance::Rigid),
+                Discretization { scheme, steps: k, pairing: None },
+                outputs.clone(),
+                SolverSettings::default(),
+            )
+            .unwrap();
+            if scheme == Scheme::Galerkin {
+                let why = step_map(&two_dof).unwrap_err();
+                assert!(why.0.contains("massless"), "{why}");
+                continue;
+            }
+            let x1 = &one_dof.solve().unwrap().displacement["0"];
+            let d_one = x.iter().zip(x1).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max) / ptp;
+            assert!(d_one < 1e-9, "{scheme}, k = {k}: against the 1-DOF compliant stop {d_one:e}");
+            let (m1, m2) = (step_map(&one_dof).unwrap(), step_map(&two_dof).unwrap());
+            assert_eq!(m1.state_size(), m2.state_size(), "the massless DOF is not in the state");
+            let s0: Vec<f64> = (0..m1.state_size()).map(|i| 0.3 - 0.2 * i as f64).collect();
+            let (e1, _, z1) = m1.march_period(&s0, None).unwrap();
+            let (e2, _, z2) = m2.march_period(&s0, None).unwrap();
+            let gap = e1.iter().zip(&e2).chain(z1.iter().zip(&z2)).map(|(a, b)| (a - b).abs() / (1.0 + a.abs())).fold(0.0, f64::max);
+            assert!(gap < 1e-10, "{scheme}, k = {k}: step maps differ by {gap:e}");
+            // Shooting on it, certified on the stacked LCP (bds: the shooting solver reaches the
+            // cds orbit of this case neither for the 1-DOF model).
+            if scheme != Scheme::Cds {
+                let s = solve(massless_contact_point(&COMPLIANT, k2, g0, Compliance::Rigid), scheme, k, LcpMethod::Shooting).unwrap();
+                let d_shoot = x.iter().zip(&s.displacement["0"]).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max) / ptp;
+                assert!(d_shoot < 1e-9, "{scheme}, k = {k}: shooting {d_shoot:e}");
+            }
+        }
+        let p = fitted_order(&ks, &e);
+        eprintln!("massless contact point, {scheme}: errors {e:?} at k = {ks:?}, fitted order {p:.2}");
+        match scheme.order() {
+            Some(1) => assert!((0.85..1.2).contains(&p), "{scheme}: order {p}"),
+            _ => assert!((1.8..2.4).contains(&p), "{scheme}: order {p}"),
         }
     }
 }

@@ -130,7 +130,7 @@ fn fast_path_agrees_with_lemke_on_the_rigid_stop_reference() {
 fn fast_path_agrees_with_lemke_with_two_contacts() {
     let osc = Oscillator { force: 1.2, ..STICKING };
     let stops =
-        || vec![Oscillator::stop(0.5, Compliance::Rigid), Contact { dof: 0, direction: -1.0, gap: 0.6, compliance: Compliance::Rigid, motion: Vec::new() }];
+        || vec![Oscillator::stop(0.5, Compliance::Rigid), Contact { row: vec![(0, -1.0)], gap: 0.6, compliance: Compliance::Rigid, motion: Vec::new() }];
     for k in [128, 512, 1024] {
         for scheme in [Scheme::Cds, Scheme::Galerkin] {
             let p = osc_problem(&osc, stops(), scheme, k, None);
@@ -195,8 +195,7 @@ fn block_circulant_structure_is_detected_exactly() {
     assert_eq!(found.blocks(), a.blocks());
 
     let osc = Oscillator { force: 1.2, ..STICKING };
-    let stops =
-        vec![Oscillator::stop(0.5, Compliance::Rigid), Contact { dof: 0, direction: -1.0, gap: 0.6, compliance: Compliance::Rigid, motion: Vec::new() }];
+    let stops = vec![Oscillator::stop(0.5, Compliance::Rigid), Contact { row: vec![(0, -1.0)], gap: 0.6, compliance: Compliance::Rigid, motion: Vec::new() }];
     let p = osc_problem(&osc, stops, Scheme::Cds, 32, None);
     let (a2, _) = p.assemble_lcp(&PeriodFft::new(32)).unwrap();
     let d2 = DenseMatrix::from_matrix(&a2);

@@ -1,6 +1,6 @@
 //! Performance figures (ignored by default; they print, they do not assert speed):
 //!
-//!   cargo build --release -p periodic-contact-fmu
+//!   cargo build --release
 //!   cargo test --release --test fmu_bench -- --ignored --nocapture --test-threads 1
 //!
 //! - `fmi2DoStep` throughput over 10⁶ steps of the packaged binary (and with `fmi2GetReal` of

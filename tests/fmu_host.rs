@@ -2,7 +2,7 @@
 //! matches the CLI's JSON at the communication points; misuse gives the documented status and
 //! never a crash; the binary exports exactly the 34 functions and links only the C runtime.
 //!
-//! Needs the FMU binary: `cargo build --release -p periodic-contact-fmu` (the tests fail with
+//! Needs the FMU binary: `cargo build --release` (the tests fail with
 //! that message when it is missing).
 mod common;
 

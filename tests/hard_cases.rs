@@ -175,8 +175,7 @@ fn ten_contacts_with_nearly_dependent_rows() {
 fn a_moving_obstacle_faster_than_the_structure() {
     let osc = oscillator(0.3, 1.0, 0.1);
     let mut model = osc.model(vec![Contact {
-        dof: 0,
-        direction: 1.0,
+        row: vec![(0, 1.0)],
         gap: 0.1,
         compliance: Compliance::Rigid,
         motion: vec![Harmonic { amplitude: 0.05, harmonic: 20, phase: 0.0 }],

@@ -135,17 +135,17 @@ fn check_solve(p: &PeriodicProblem, tally: &Tally) -> Result<(), TestCaseError> 
 fn q_scale(p: &PeriodicProblem) -> f64 {
     let mut model = p.model().clone();
     let contacts = std::mem::take(&mut model.contacts);
-    let dofs: Vec<usize> = contacts.iter().map(|c| c.dof).collect();
+    let dofs: Vec<usize> = contacts.iter().map(|c| c.label_dof()).collect();
     let outputs = OutputSelection { displacement: dofs, velocity: vec![], acceleration: vec![], contacts: false };
     let Ok(free) = PeriodicProblem::new(model, p.discretization(), outputs, p.solver_settings().clone()).and_then(|f| f.solve()) else { return 1.0 };
     let k = free.steps;
     let mut qmax = 1.0f64;
     for c in &contacts {
         let s = p.pairing_of(c).offset();
-        let x = &free.displacement[&c.dof.to_string()];
+        let x = &free.displacement[&c.label_dof().to_string()];
         for j in 0..k {
             let jj = (j + s) % k;
-            qmax = qmax.max((c.gap_at(p.model().frequency, free.time[jj]) - c.direction * x[jj]).abs());
+            qmax = qmax.max((c.gap_at(p.model().frequency, free.time[jj]) - c.row[0].1 * x[jj]).abs());
         }
     }
     qmax
@@ -1225,8 +1225,7 @@ fn build_model(c: &ModelCase) -> Model {
             .contacts
             .iter()
             .map(|cc| Contact {
-                dof: cc.dof,
-                direction: cc.direction,
+                row: vec![(cc.dof, cc.direction)],
                 gap: cc.gap,
                 compliance: cc.stiffness_exp.map_or(Compliance::Rigid, |e| Compliance::Compliant { stiffness: ks * 10f64.powf(e) }),
                 motion: cc.motion.iter().map(|&(a, h, ph)| Harmonic { amplitude: a, harmonic: h, phase: ph }).collect(),

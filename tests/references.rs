@@ -507,7 +507,7 @@ fn march_persistent_contact_with_moving_obstacle() {
     let osc = Oscillator::new(1.0, 0.1, 1.0, 0.5, 1.3);
     let motion = vec![Harmonic { amplitude: -1.0, harmonic: 0, phase: 0.0 }, Harmonic { amplitude: 0.3, harmonic: 1, phase: 0.4 }];
     let p = PersistentContact::solve(&osc, 1.0, 0.0, &motion).unwrap();
-    let contact = Contact { dof: 0, direction: 1.0, gap: 0.0, compliance: Compliance::Rigid, motion };
+    let contact = Contact { row: vec![(0, 1.0)], gap: 0.0, compliance: Compliance::Rigid, motion };
     let model = osc.model(vec![contact]);
     let ns = [50usize, 100, 200, 400];
     let mut errs = Vec::new();
@@ -529,9 +529,9 @@ fn march_persistent_contact_with_moving_obstacle() {
 fn march_two_rigid_contacts_is_complementary() {
     let mut model = chain2();
     model.contacts = vec![
-        Contact { dof: 0, direction: 1.0, gap: 0.05, compliance: Compliance::Rigid, motion: vec![] },
-        Contact { dof: 1, direction: -1.0, gap: 0.4, compliance: Compliance::Rigid, motion: vec![] },
-        Contact { dof: 1, direction: 1.0, gap: 0.5, compliance: Compliance::Compliant { stiffness: 5.0 }, motion: vec![] },
+        Contact { row: vec![(0, 1.0)], gap: 0.05, compliance: Compliance::Rigid, motion: vec![] },
+        Contact { row: vec![(1, -1.0)], gap: 0.4, compliance: Compliance::Rigid, motion: vec![] },
+        Contact { row: vec![(1, 1.0)], gap: 0.5, compliance: Compliance::Compliant { stiffness: 5.0 }, motion: vec![] },
     ];
     let n = 400;
     let r = march(&model, &MarchSettings { steps_per_period: n, tolerance: 1e-10, ..Default::default() }).unwrap();
@@ -634,7 +634,7 @@ fn coexisting_attractors_period_one_orbit_is_real() {
 fn march_mirrored_rigid_stop_direction_minus_one() {
     let (osc, o) = note_rigid();
     let mut model = Oscillator { force: -1.0, ..osc }.model(vec![Oscillator::stop(0.5, Compliance::Rigid)]);
-    model.contacts[0].direction = -1.0;
+    model.contacts[0].row[0].1 = -1.0;
     let n = 800;
     let r = march(&model, &MarchSettings { steps_per_period: n, tolerance: 1e-12, ..Default::default() }).unwrap();
     assert!(r.converged);

@@ -33,7 +33,7 @@ fn chain_model(n: usize, sparse: bool, contacts: Vec<Contact>, frequency: f64) -
 }
 
 fn stop(dof: usize, compliance: Compliance) -> Contact {
-    Contact { dof, direction: 1.0, gap: 0.5, compliance, motion: vec![] }
+    Contact { row: vec![(dof, 1.0)], gap: 0.5, compliance, motion: vec![] }
 }
 
 /// ω_max of the fixed–fixed unit chain: eigenvalues 2 − 2cos(jπ/(n+1)) (analytic), dense and

@@ -150,7 +150,7 @@ fn random_chain(draw: &mut Draw, n: usize, m: usize, rigid: bool) -> Model {
         let reach = x.iter().map(|v| direction * v).fold(f64::MIN, f64::max);
         let gap = reach * draw.range(0.4, 0.9);
         let compliance = if rigid { Compliance::Rigid } else { Compliance::Compliant { stiffness: draw.range(5.0, 50.0) } };
-        model.contacts.push(Contact { dof, direction, gap, compliance, motion: Vec::new() });
+        model.contacts.push(Contact { row: vec![(dof, direction)], gap, compliance, motion: Vec::new() });
     }
     model
 }
@@ -198,6 +198,33 @@ fn shooting_agrees_with_lemke_on_random_multi_contact_models() {
     // Measured: 23 of 24 (the exception, two compliant stops near resonance, needs more than the
     // homotopy's budget). Fewer would mean the fast path regressed.
     assert!(by_shooting + 2 >= solved, "only {by_shooting} of {solved} solved by shooting alone");
+}
+
+/// Past the old caps of the step map (64 DOFs, 10 contacts): 70-DOF chains with 12 compliant
+/// stops (stiffness 1–3, the chain's order), under cds/same (S diagonal) and bds1/same (S = B W Bᵀ + D couples all 12: checked
+/// through its symmetric part), at k = 256 (N = 3072). Shooting alone solves them
+/// and agrees with dense Lemke's certified answer to 1e-9. (Rigid stops under cds/forward, or stops
+/// 5–50 times stiffer, on this chain: Newton does not converge and Lemke answers.)
+#[test]
+fn shooting_past_the_old_caps_agrees_with_lemke() {
+    let mut draw = Draw(20261125);
+    for (rigid, scheme, pairing, k) in [(false, Scheme::Cds, Pairing::Same, 256), (false, Scheme::Bds1, Pairing::Same, 256)] {
+        let (n, m) = (70, 12);
+        let mut model = random_chain(&mut draw, n, m, rigid);
+        // Stops of the springs' order (1–3): at 5–50 Newton does not converge with 12 stops.
+        for c in &mut model.contacts {
+            c.compliance = Compliance::Compliant { stiffness: draw.range(1.0, 3.0) };
+        }
+        let outputs = OutputSelection { displacement: vec![0, n - 1], velocity: vec![], acceleration: vec![], contacts: true };
+        let p = PeriodicProblem::new(model, Discretization { scheme, steps: k, pairing: Some(pairing) }, outputs, SolverSettings::default()).unwrap();
+        assert!(step_map(&p).is_ok(), "{:?}", step_map(&p).err());
+        let name = format!("n = {n}, m = {m}, {} {scheme}/{pairing}", if rigid { "rigid" } else { "compliant" });
+        let (r, alone, _) = agree(&name, &p);
+        assert!(alone, "{name}: shooting alone did not solve it: {}", r.lcp.path);
+        let active = r.contacts.iter().filter(|c| c.force.iter().any(|&f| f > 0.0)).count();
+        // Several stops touch (measured: 3 of 12 under cds), so the step LCPs couple pairs.
+        assert!(active >= 2, "{name}: only {active} of {m} contacts are active");
+    }
 }
 
 /// The rigid stop with sticking at k = 65 536 (the size the dense methods refuse): shooting
@@ -277,7 +304,7 @@ fn the_policy_falls_back_after_a_shooting_breakdown() {
             c: vec![1.0; k],
             h: vec![1.0],
             gamma: vec![1.0],
-            compliance: vec![0.0],
+            flexibility: vec![0.0],
             r: vec![1.0; k],
         };
         let sm = StepMapLcp::new(drift).unwrap();
@@ -290,5 +317,41 @@ fn the_policy_falls_back_after_a_shooting_breakdown() {
         let rendered = periodic_contact::periodic::render_lcp_path(LcpMethod::Auto, &sol.info.path);
         assert!(rendered.contains(&format!("; fallback: {next}")), "{rendered}");
         assert!(sol.info.residual <= 1e-9 * q.iter().fold(1.0f64, |m, v| m.max(v.abs())));
+    }
+}
+
+/// A model whose dense step map would cost too much (a 2000-DOF sparse chain: d = 4000, ≈ 1.2e12
+/// flops per Newton iteration at k = 256) gets none: the refusal names the memory and work
+/// figures and the remedy, and comes before the map is built (the test ends in a blink).
+#[test]
+fn a_step_map_past_the_estimates_is_refused_with_its_figures() {
+    use faer::sparse::{SparseColMat, Triplet};
+    let n = 2000;
+    let chain = |diagonal: f64, off: f64| {
+        let mut t = Vec::new();
+        for i in 0..n {
+            t.push(Triplet::new(i, i, diagonal));
+            if i + 1 < n && off != 0.0 {
+                t.push(Triplet::new(i, i + 1, off));
+                t.push(Triplet::new(i + 1, i, off));
+            }
+        }
+        Matrix::Sparse(SparseColMat::try_new_from_triplets(n, n, &t).unwrap())
+    };
+    let structure = Structure { mass: chain(1.0, 0.0), stiffness: chain(2.0, -1.0), damping: None };
+    let contact = Contact::on_dof(0, 1.0, 0.5, Compliance::Rigid);
+    let model = Model {
+        structure,
+        forces: vec![Force { dof: 0, term: Harmonic { amplitude: 1.0, harmonic: 1, phase: 0.0 } }],
+        contacts: vec![contact],
+        frequency: 1.0,
+    };
+    let outputs = OutputSelection { displacement: vec![0], velocity: vec![], acceleration: vec![], contacts: true };
+    let p =
+        PeriodicProblem::new(model, Discretization { scheme: Scheme::Cds, steps: 256, pairing: Some(Pairing::Forward) }, outputs, SolverSettings::default())
+            .unwrap();
+    let why = step_map(&p).unwrap_err().to_string();
+    for part in ["2000 DOFs", "d = 4000", "GiB", "flops per Newton iteration", "at most 1e12", "Craig–Bampton"] {
+        assert!(why.contains(part), "{part:?} missing from: {why}");
     }
 }

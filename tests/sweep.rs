@@ -243,3 +243,22 @@ fn a_sequential_sweep_stays_on_the_blades_contact_branch_up_to_the_tip() {
     let cold_amp = periodic_contact::response::Response::peak_to_peak(&cold.displacement[&p.outputs().displacement[0].to_string()]) / 2.0;
     assert!(amp[49] > 10.0 * cold_amp, "at 2790 rad/s the branch ({}) lies far above the orbit a cold solve finds ({cold_amp})", amp[49]);
 }
+
+/// `sweep::jumps` finds the one jump of a swept curve, wherever the grid puts it, and nothing on
+/// smooth curves: a resonance peak (steep flanks, 200 points) and the same peak cut at a fold-like
+/// drop at x = 1.9 (the 3-DOF chain's 0.46 → 0.25 m), on grids of 50, 200 and 800 points.
+#[test]
+fn jumps_are_found_where_the_curve_drops_and_nowhere_on_a_smooth_peak() {
+    let peak = |x: f64| 0.1 / ((1.0 - (x / 1.5).powi(2)).powi(2) + (0.05 * x / 1.5).powi(2)).sqrt();
+    for n in [50, 200, 800] {
+        let grid: Vec<f64> = (0..n).map(|i| 1.0 + 1.5 * i as f64 / (n - 1) as f64).collect();
+        let smooth: Vec<(f64, f64)> = grid.iter().map(|&x| (x, peak(x))).collect();
+        assert!(sweep::jumps(&smooth).is_empty(), "n = {n}: {:?}", sweep::jumps(&smooth));
+        let cut: Vec<(f64, f64)> = grid.iter().map(|&x| (x, if x < 1.9 { 0.46 - 0.05 * (1.9 - x) } else { 0.25 - 0.1 * (x - 1.9) })).collect();
+        let found = sweep::jumps(&cut);
+        assert_eq!(found.len(), 1, "n = {n}: {found:?}");
+        let (a, b) = found[0];
+        assert!(a.0 < 1.9 && b.0 >= 1.9 && b.0 - a.0 < 2.0 / n as f64, "n = {n}: jump between {} and {}", a.0, b.0);
+    }
+    assert_eq!(sweep::peak_ratio(0.5, 9.0), 18.0);
+}

@@ -12,10 +12,11 @@ CLI sweep of the same scene. See demo/README.md and demo/runup.py.
     where two orbits coexist, on the contact branch the FMU stays on, checked against time
     integration; the only discontinuity of the output is where the FMU leaves its contact orbit;
   - test_nonlinear_differs_from_linear: the stop bends and caps the resonance (the linear peak is
-    > 1.05x the peak of the contact branch the FMU follows, which lies above 1.3 rad/s), and the figure figures/demo_runup.png is written;
+    > 1.05x the peak of the contact branch the FMU follows, which lies above 1.3 rad/s), and the figure demo_runup.png is written (into
+    harness.report.FIGURES: validation/out/figures unless PC_FIGURES says otherwise);
   - test_hysteresis (issue 13): a run-up and a run-down through the resonance (demo/hysteresis.py)
     each jump once, as the FMU's log says, at the folds of `periodic-contact continue`, and every
-    amplitude in between lies on a stable continued branch; figures/demo_hysteresis.png.
+    amplitude in between lies on a stable continued branch; demo_hysteresis.png (same folder).
 Skipped while the CLI is absent (PC_REQUIRE_BINARIES=1: failed instead).
 """
 import os
@@ -26,6 +27,7 @@ import pytest
 
 from demo import hysteresis, runup
 from harness import engine
+from harness.report import FIGURES
 
 pytestmark = pytest.mark.engine
 
@@ -33,7 +35,7 @@ pytestmark = pytest.mark.engine
 @pytest.fixture(scope="module")
 def demo(cli, workdir):
     t0 = time.perf_counter()
-    r = runup.run_demo(cli, os.path.join(workdir, "demo"))
+    r = runup.run_demo(cli, os.path.join(workdir, "demo"), figure=os.path.join(FIGURES, "demo_runup.png"))
     r.timings["total"] = time.perf_counter() - t0
     print("\n" + runup.summary(r))
     return r
@@ -129,7 +131,7 @@ def test_nonlinear_differs_from_linear(demo):
 
 @pytest.fixture(scope="module")
 def hyst(cli, workdir):
-    h = hysteresis.run_hysteresis(cli, os.path.join(workdir, "hysteresis"))
+    h = hysteresis.run_hysteresis(cli, os.path.join(workdir, "hysteresis"), figure=os.path.join(FIGURES, "demo_hysteresis.png"))
     print("\n" + hysteresis.summary(h))
     return h
 

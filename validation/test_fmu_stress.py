@@ -24,7 +24,7 @@ A "probe" call serializes an FMU state and decodes the machine state and time fr
 (SERIAL_HEADER, format and model versions, GUID, state code, time; src/fmi/state.rs and src/fmi/fmi2/instance.rs) to compare them with the model's.
 
 The process must survive (a crash fails the whole pytest run). Needs the CLI and the FMU binary
-(`cargo build --release && cargo build --release -p periodic-contact-fmu`); skipped without them
+(`cargo build --release`); skipped without them
 unless PC_REQUIRE_BINARIES=1.
 """
 from __future__ import annotations

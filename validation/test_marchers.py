@@ -1,7 +1,7 @@
 """The independent time marchers against the exact references, against each other, and against
 the discrete equations they claim to solve. No engine binaries needed.
 
-Measured numbers are recorded in figures/errors.md (section "marchers")."""
+Measured numbers are recorded in errors.md (harness.report.FIGURES) (section "marchers")."""
 import numpy as np
 import pytest
 

@@ -1,4 +1,4 @@
-"""Figures: one PNG per case in figures/ (runs last: file name). Uses whatever the session
+"""Figures: one PNG per case in harness.report.FIGURES (validation/out/figures; runs last: file name). Uses whatever the session
 produced: the continuous and discrete marchers always, the CLI result and the FMU run when the
 engine tests ran."""
 import os

@@ -30,7 +30,7 @@ pub unsafe extern "C" fn pc_problem_dof_count(p: *const PcProblem) -> usize {
         let Ok(p) = const_problem(p) else { return 0 };
         match p.base.output_map() {
             None => p.base.model().n(),
-            Some(map) => map.rows.keys().chain(&map.contact_dofs).max().map_or(0, |d| d + 1),
+            Some(map) => map.rows.keys().copied().chain(map.contact_rows.iter().flatten().map(|e| e.0)).max().map_or(0, |d| d + 1),
         }
     }))
     .unwrap_or(0)
@@ -46,6 +46,8 @@ pub unsafe extern "C" fn pc_problem_contact_count(p: *const PcProblem) -> usize 
 }
 
 /// Contact `i`'s DOF in the user's numbering and its direction (+1 or −1); either output may be NULL.
+/// For a contact along a normal over several DOFs: the DOF of the normal's largest |coefficient|
+/// and that coefficient's sign.
 ///
 /// # Safety
 /// `p` is NULL or a live problem handle; non-NULL outputs are writable.
@@ -54,15 +56,15 @@ pub unsafe extern "C" fn pc_problem_contact(p: *const PcProblem, i: usize, dof: 
     guarded(|| {
         let p = const_problem(p)?;
         let contacts = &p.base.model().contacts;
-        let c = contacts.get(i).ok_or_else(|| arg(format!("contact {i} does not exist ({} contacts)", contacts.len())))?;
-        let user_dof = p.base.output_map().and_then(|m| m.contact_dofs.get(i).copied()).unwrap_or(c.dof);
+        contacts.get(i).ok_or_else(|| arg(format!("contact {i} does not exist ({} contacts)", contacts.len())))?;
+        let (user_dof, sign) = crate::model::label_of(p.base.user_row(i));
         // SAFETY: NULL or writable, as the caller promises.
         unsafe {
             if let Some(d) = dof.as_mut() {
                 *d = user_dof;
             }
             if let Some(d) = direction.as_mut() {
-                *d = c.direction as c_int;
+                *d = sign as c_int;
             }
         }
         Ok(())

@@ -92,7 +92,7 @@ pub fn linear_response_dense(
     let mut hs: Vec<u32> = Vec::new();
     for (i, f) in forces.iter().enumerate() {
         if f.dof >= n {
-            return Err(ExactError::param(format!("forces[{i}].dof"), format!("is {}, the model has DOFs 0..{}", f.dof, n - 1)));
+            return Err(ExactError::param(format!("forces[{i}].dof"), format!("is {}, the model has DOFs 0 to {} (use one of them)", f.dof, n - 1)));
         }
         if !(f.term.amplitude.is_finite() && f.term.phase.is_finite()) {
             return Err(ExactError::param(format!("forces[{i}]"), format!("amplitude {} and phase {} must be finite", f.term.amplitude, f.term.phase)));

@@ -116,7 +116,7 @@ impl Oscillator {
 
     /// A static stop x ≤ gap on DOF 0 (direction +1).
     pub fn stop(gap: f64, compliance: Compliance) -> Contact {
-        Contact { dof: 0, direction: 1.0, gap, compliance, motion: Vec::new() }
+        Contact::on_dof(0, 1.0, gap, compliance)
     }
 }
 

@@ -226,6 +226,12 @@ impl Blade {
     pub fn node_dof(&self, name: &str) -> Option<usize> {
         self.dof(self.named_node(name)?, 2)
     }
+    /// The mid-thickness tip nodes from LE to TE (chord_elements + 1 of them): the blade-tip
+    /// line a casing rubs, LE, MC and TE among them.
+    pub fn tip_nodes(&self) -> Vec<usize> {
+        let m = &self.params.mesh;
+        (0..=m.chord).map(|ic| self.params.node_index(m.span, ic, m.thickness / 2)).collect()
+    }
     /// The radial DOFs of LE, MC, TE.
     pub fn contact_dofs(&self) -> Vec<usize> {
         TIP_NODES.iter().map(|n| self.node_dof(n).expect("tip nodes exist")).collect()

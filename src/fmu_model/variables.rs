@@ -199,10 +199,9 @@ fn outputs(b: &mut Variables, problem: &PeriodicProblem, labels: &Labels) {
         }
     }
     if shown.contacts {
-        let user_dofs = problem.output_map().map(|m| m.contact_dofs.clone()).filter(|d| d.len() == model.contacts.len());
         let stiffness_unit = format!("{}/{}", labels.units.force(), labels.units.length());
         for (i, c) in model.contacts.iter().enumerate() {
-            let at = format!("contact {i} on {}", name(user_dofs.as_ref().map_or(c.dof, |d| d[i])));
+            let at = contact_place(i, problem.user_row(i), &name);
             let (force, gap) = match c.compliance {
                 Compliance::Rigid => (
                     format!("Compressive force >= 0 of the rigid {at}; > 0 only where the clearance is 0"),
@@ -232,6 +231,18 @@ fn outputs(b: &mut Variables, problem: &PeriodicProblem, labels: &Labels) {
         let kind = Kind::Integer { start: None, min: None, max: None };
         let what = "Event-fitted polish of the last solve: 0 off (parameter polish = false), 1 polished (outputs exact between the instants), 2 fell back to the interpolated samples (the reason is logged as a warning)";
         b.output(Variable::output("polish.status", Discrete, kind, what), Output::PolishStatus);
+    }
+}
+
+/// "contact 2 on MC:y (DOF 7)", or for a normal over several DOFs "contact 2 along 0.6·LE:x
+/// (DOF 3) + 0.8·LE:y (DOF 4)": the gap is gap(t) minus the displacement along that normal.
+fn contact_place(i: usize, row: &[(usize, f64)], name: &dyn Fn(usize) -> String) -> String {
+    match row {
+        [(d, _)] => format!("contact {i} on {}", name(*d)),
+        _ => {
+            let terms: Vec<String> = row.iter().map(|&(d, c)| format!("{c:.6}*{}", name(d))).collect();
+            format!("contact {i} along the normal {}", terms.join(" + "))
+        }
     }
 }
 

@@ -49,9 +49,21 @@ pub fn solve_circulant_lcp(a: &BlockCirculant, q: &[f64], method: LcpMethod, tol
 /// above it).
 pub const LEMKE_AFTER_SHOOTING_MAX: usize = 4096;
 
-/// Above this size no dense method runs (Lemke's B⁻¹ or the pivoting LU of the active block
-/// could need N² numbers, 8 GiB at N = 32768): only shooting, whose memory is O(k·(d² + m)).
+/// The most memory the dense methods may take: Lemke's B⁻¹ or the pivoting LU of the active
+/// block can hold N² numbers ([`dense_memory`]), 8 GiB at N = [`DENSE_MAX`]. Above, only
+/// shooting runs, whose memory is O(d² log k + k·(d + m)).
+pub const DENSE_MEMORY_MAX: f64 = 8.0 * GIB;
+
+/// The largest LCP whose dense methods fit in [`DENSE_MEMORY_MAX`].
 pub const DENSE_MAX: usize = 1 << 15;
+
+/// Bytes in a GiB.
+pub const GIB: f64 = (1u64 << 30) as f64;
+
+/// Bytes the dense methods can need on an LCP of `n` unknowns: N² numbers.
+pub fn dense_memory(n: usize) -> f64 {
+    8.0 * (n as f64).powi(2)
+}
 
 /// The engine's policy for the period's LCP (A block-circulant, q), with the step map of the
 /// scheme when it has one. `auto`: shooting first when there is a step map (certified on (A, q)
@@ -105,7 +117,7 @@ pub fn solve_periodic_lcp(
         sol.info.path.splice(0..0, first.info.path);
         sol
     };
-    let dense_ok = q.len() <= DENSE_MAX;
+    let dense_ok = dense_memory(q.len()) <= DENSE_MEMORY_MAX;
     let blind = || match method {
         LcpMethod::Lemke => lemke(),
         LcpMethod::Pivoting => pivoting(),
@@ -134,8 +146,8 @@ pub fn solve_periodic_lcp(
 fn shooting(a: &BlockCirculant, q: &[f64], sm: &StepMapLcp, tolerance: f64, warm_start: Option<&[usize]>) -> (LcpSolution, Option<Vec<f64>>) {
     let start = Instant::now();
     let m = sm.pairs();
-    let warm: Option<Vec<u32>> = warm_start.map(|set| {
-        let mut masks = vec![0u32; sm.k()];
+    let warm: Option<Vec<u64>> = warm_start.map(|set| {
+        let mut masks = vec![0u64; sm.k()];
         for &i in set.iter().filter(|&&i| i < q.len()) {
             masks[i / m] |= 1 << (i % m);
         }

@@ -145,6 +145,15 @@ pub fn march(model: &Model, settings: &MarchSettings) -> Result<MarchResult, Mar
     let start = Instant::now();
     model.validate()?;
     let n = model.n();
+    let massless = model.massless_dofs();
+    if !massless.is_empty() {
+        return Err(MarchError::setting(
+            "structure.mass",
+            format!(
+                "DOFs {massless:?} are massless (a massless boundary, src/formulation.md §4.1): explicit central differences with forward-increment multipliers need (M/h² + C/(2h)) invertible, i.e. mass on every DOF; solve the periodic LCP (cds, bds1, bds2) instead"
+            ),
+        ));
+    }
     let ns = settings.steps_per_period;
     if ns < 2 {
         return Err(MarchError::setting("settings.steps_per_period", format!("is {ns}, must be ≥ 2")));
@@ -200,19 +209,19 @@ pub fn march(model: &Model, settings: &MarchSettings) -> Result<MarchResult, Mar
     let nc = model.contacts.len();
     let rigid: Vec<usize> = (0..nc).filter(|&i| model.contacts[i].is_rigid()).collect();
     let mr = rigid.len();
-    // Columns s_i Ŵ e_{d_i} and G = B_r Ŵ B_rᵀ.
+    // Columns Ŵ B_iᵀ and G = B_r Ŵ B_rᵀ.
     let cols: Vec<Vec<f64>> = rigid
         .iter()
         .map(|&i| {
             let c = &model.contacts[i];
-            (0..n).map(|r| c.direction * w_hat[(r, c.dof)]).collect()
+            (0..n).map(|r| c.along(|d| w_hat[(r, d)])).collect()
         })
         .collect();
     let mut g = vec![0.0; mr * mr];
     for (a, &i) in rigid.iter().enumerate() {
         let ci = &model.contacts[i];
         for b in 0..mr {
-            g[a * mr + b] = ci.direction * cols[b][ci.dof];
+            g[a * mr + b] = ci.normal_displacement(&cols[b]);
         }
     }
 
@@ -224,9 +233,9 @@ pub fn march(model: &Model, settings: &MarchSettings) -> Result<MarchResult, Mar
     let penalty = |t: f64, x: &[f64], f: &mut [f64], z: &mut [f64]| {
         for (i, c) in model.contacts.iter().enumerate() {
             if let Compliance::Compliant { stiffness } = c.compliance {
-                let zi = stiffness * (c.direction * x[c.dof] - c.gap_at(omega, t)).max(0.0);
+                let zi = stiffness * (c.normal_displacement(x) - c.gap_at(omega, t)).max(0.0);
                 z[i] = zi;
-                f[c.dof] -= c.direction * zi;
+                c.push_back(zi, f);
             }
         }
     };
@@ -276,7 +285,7 @@ pub fn march(model: &Model, settings: &MarchSettings) -> Result<MarchResult, Mar
             if mr > 0 {
                 for (a, &i) in rigid.iter().enumerate() {
                     let c = &model.contacts[i];
-                    q[a] = c.gap_at(omega, t1) - c.direction * x_next[c.dof];
+                    q[a] = c.gap_at(omega, t1) - c.normal_displacement(&x_next);
                 }
                 if q.iter().any(|&v| v < 0.0) {
                     let lam = solve_small_lcp(&g, &q, mr).map_err(|e| MarchError::Step { step: j, period: p + 1, error: e })?;
@@ -300,7 +309,7 @@ pub fn march(model: &Model, settings: &MarchSettings) -> Result<MarchResult, Mar
             }
             for (i, c) in model.contacts.iter().enumerate() {
                 force[j * nc + i] = zbuf[i];
-                clear[j * nc + i] = c.gap_at(omega, t) - c.direction * x_cur[c.dof];
+                clear[j * nc + i] = c.gap_at(omega, t) - c.normal_displacement(&x_cur);
             }
             std::mem::swap(&mut x_prev, &mut x_cur);
             std::mem::swap(&mut x_cur, &mut x_next);

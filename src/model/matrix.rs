@@ -116,3 +116,34 @@ impl Matrix {
         matches!(self, Matrix::Sparse(_))
     }
 }
+
+impl Matrix {
+    /// The block of rows `rows` and columns `cols` (in that order), of the same kind.
+    pub fn block(&self, rows: &[usize], cols: &[usize]) -> Matrix {
+        let map = |idx: &[usize], n: usize| {
+            let mut m = vec![usize::MAX; n];
+            idx.iter().enumerate().for_each(|(new, &old)| m[old] = new);
+            m
+        };
+        let (rm, cm) = (map(rows, self.nrows()), map(cols, self.ncols()));
+        match self {
+            Matrix::Dense(d) => Matrix::Dense(Mat::from_fn(rows.len(), cols.len(), |i, j| d[(rows[i], cols[j])])),
+            Matrix::Sparse(_) => {
+                let mut t = Vec::new();
+                self.for_each(|i, j, v| {
+                    if rm[i] != usize::MAX && cm[j] != usize::MAX {
+                        t.push(faer::sparse::Triplet::new(rm[i], cm[j], v));
+                    }
+                });
+                Matrix::Sparse(SparseColMat::try_new_from_triplets(rows.len(), cols.len(), &t).expect("triplets within the block"))
+            }
+        }
+    }
+    /// Whether a Cholesky factorisation (lower triangle) succeeds: symmetric positive definite.
+    pub fn is_positive_definite(&self) -> bool {
+        match self {
+            Matrix::Dense(m) => m.llt(faer::Side::Lower).is_ok(),
+            Matrix::Sparse(s) => s.sp_cholesky(faer::Side::Lower).is_ok(),
+        }
+    }
+}

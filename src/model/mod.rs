@@ -2,9 +2,11 @@
 //! with m unilateral contacts (src/formulation.md §1).
 //!
 //! Sign conventions (user-facing, the paper's λ = −force, g = −gap):
-//! - contact `i` with direction s ∈ {+1, −1} acts on DOF d: s·x[d] ≤ gap(t);
-//! - its clearance is gap(t) − s·x[d] ≥ 0 and its force z ≥ 0 is compressive: it pushes DOF d
-//!   by −s·z, so row i of B is s·e_dᵀ.
+//! - contact `i` acts along a unit normal n_i over the model's DOFs, row i of B (sparse, its
+//!   [`Contact::row`]): B_i x ≤ gap(t); a contact on one DOF d with direction s ∈ {+1, −1} is
+//!   the one-entry row s·e_dᵀ;
+//! - its clearance is gap(t) − B_i x ≥ 0 and its force z ≥ 0 is compressive: it pushes the
+//!   structure by −B_iᵀ z.
 //!
 //! Units are the user's, as long as they are consistent (e.g. kg, N/m, m, s; or t, N/mm, mm, s);
 //! a scene may name them ([`Units`]), for labels only.
@@ -58,12 +60,13 @@ pub enum Compliance {
     Compliant { stiffness: f64 },
 }
 
-/// A unilateral contact on one DOF against an obstacle at clearance gap(t).
+/// A unilateral contact along a unit normal against an obstacle at clearance gap(t).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Contact {
-    pub dof: usize,
-    /// +1: x[dof] ≤ gap(t); −1: x[dof] ≥ −gap(t).
-    pub direction: f64,
+    /// Row i of B, sparse: (DOF, coefficient) pairs of a unit normal (Σ coefficient² = 1, each
+    /// DOF once). The contact keeps B_i x ≤ gap(t); `[(d, 1.0)]` is x[d] ≤ gap(t) and
+    /// `[(d, -1.0)]` is x[d] ≥ −gap(t).
+    pub row: Vec<(usize, f64)>,
     /// Static clearance.
     pub gap: f64,
     pub compliance: Compliance,
@@ -72,6 +75,36 @@ pub struct Contact {
 }
 
 impl Contact {
+    /// A contact on one DOF: `direction` +1 keeps x[dof] ≤ gap, −1 keeps x[dof] ≥ −gap.
+    pub fn on_dof(dof: usize, direction: f64, gap: f64, compliance: Compliance) -> Contact {
+        Contact { row: vec![(dof, direction)], gap, compliance, motion: Vec::new() }
+    }
+    /// The normal displacement B_i x (for a one-entry row exactly ±x[d]).
+    pub fn normal_displacement(&self, x: &[f64]) -> f64 {
+        self.along(|d| x[d])
+    }
+    /// B_i v for a vector given entry by entry (a column of a matrix, a complex sample, …); a
+    /// one-entry row multiplies its one entry by ±1 alone, bit-identical to the DOF's value.
+    pub fn along<T>(&self, v: impl Fn(usize) -> T) -> T
+    where
+        T: std::ops::Mul<f64, Output = T> + std::iter::Sum<T>,
+    {
+        match self.row.as_slice() {
+            [(d, c)] => v(*d) * *c,
+            row => row.iter().map(|&(d, c)| v(d) * c).sum(),
+        }
+    }
+    /// f −= B_iᵀ z: the compressive force z pushes the structure against its normal.
+    pub fn push_back(&self, z: f64, f: &mut [f64]) {
+        for &(d, c) in &self.row {
+            f[d] -= c * z;
+        }
+    }
+    /// The DOF that labels the contact in outputs: the row's largest |coefficient| (the first
+    /// of equals), so a one-entry row's own DOF.
+    pub fn label_dof(&self) -> usize {
+        label_of(&self.row).0
+    }
     /// The clearance gap(t) of the obstacle, at zero displacement.
     pub fn gap_at(&self, omega: f64, t: f64) -> f64 {
         self.gap + self.motion.iter().map(|h| h.value(omega, t)).sum::<f64>()
@@ -79,6 +112,18 @@ impl Contact {
     pub fn is_rigid(&self) -> bool {
         matches!(self.compliance, Compliance::Rigid)
     }
+}
+
+/// The DOF of a row's largest |coefficient| (the first of equals) and that coefficient's sign
+/// (+1 or −1): a one-entry row's DOF and direction; (0, +1) for an empty row.
+pub fn label_of(row: &[(usize, f64)]) -> (usize, i32) {
+    let mut best: Option<(usize, f64)> = None;
+    for &(d, c) in row {
+        if best.is_none_or(|b| c.abs() > b.1.abs()) {
+            best = Some((d, c));
+        }
+    }
+    best.map_or((0, 1), |(d, c)| (d, if c < 0.0 { -1 } else { 1 }))
 }
 
 /// M, C (optional), K: the structure's n×n matrices.
@@ -157,6 +202,16 @@ impl Model {
             moving_obstacle: self.contacts.iter().any(|c| !c.motion.is_empty()),
             friction: !self.frictions.is_empty(),
         }
+    }
+    /// The massless DOFs (sorted): a zero diagonal of M. After [`Model::validate`] their rows
+    /// and columns of M are zero and K holds them (src/formulation.md §4.1).
+    pub fn massless_dofs(&self) -> Vec<usize> {
+        (0..self.n()).filter(|&d| self.structure.mass.get(d, d) <= 0.0).collect()
+    }
+    /// Whether contact `c` acts on a massless DOF: its force is then finite and statically
+    /// transmitted, like a compliant one (same-instant pairing).
+    pub fn contact_is_massless(&self, c: &Contact) -> bool {
+        c.row.iter().all(|&(dof, _)| dof < self.n() && self.structure.mass.get(dof, dof) <= 0.0)
     }
     /// The highest harmonic of ω in the forcing or in any obstacle motion.
     pub fn highest_harmonic(&self) -> u32 {

@@ -2,9 +2,11 @@
 //! schemes must respect (ω_max·h below a scheme's limit, see `time::Scheme::stability_limit`).
 //!
 //! ω_max² is the largest eigenvalue of the pencil (K + Σ k_c s² e_d e_dᵀ, M): compliant contacts
-//! are counted closed (their stiffness acts on the contact DOF), rigid ones not. M is positive
-//! definite (checked by `Model::validate`: every DOF carries mass, so there are no infinite
-//! eigenvalues to exclude and no static condensation is needed).
+//! are counted closed (their stiffness acts on the contact DOF), rigid ones not. When M is positive
+//! definite there are no infinite eigenvalues. When some DOFs b are massless (a massless boundary,
+//! src/formulation.md §4.1) their eigenvalues are infinite and no scheme resolves them: they are
+//! quasi-static, so ω_max is that of the massive DOFs a after condensing b statically,
+//! the pencil (K_aa − K_ab K_bb⁻¹ K_ba, M_aa), the finite eigenvalues of (K, M).
 use super::{Compliance, Matrix, Model, ModelError};
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
@@ -23,18 +25,26 @@ impl Model {
     /// frequency and of the grid: compute once per structure.
     pub fn omega_max(&self) -> Result<f64, ModelError> {
         let n = self.n();
-        let springs: Vec<(usize, f64)> = self
+        // A compliant contact adds k_c B_iᵀ B_i to K.
+        let springs: Vec<(&[(usize, f64)], f64)> = self
             .contacts
             .iter()
             .filter_map(|c| match c.compliance {
-                Compliance::Compliant { stiffness } => Some((c.dof, stiffness)),
+                Compliance::Compliant { stiffness } => Some((c.row.as_slice(), stiffness)),
                 Compliance::Rigid => None,
             })
             .collect();
-        let lmax = if n <= DENSE_MAX || !self.structure.mass.is_sparse() && n <= 2 * DENSE_MAX {
+        let massless = self.massless_dofs();
+        let lmax = if !massless.is_empty() {
+            self.condensed_largest(&springs, &massless)?
+        } else if n <= DENSE_MAX || !self.structure.mass.is_sparse() && n <= 2 * DENSE_MAX {
             let mut k = self.structure.stiffness.to_dense();
-            for &(d, kc) in &springs {
-                k[(d, d)] += kc;
+            for &(row, kc) in &springs {
+                for &(a, ca) in row {
+                    for &(b, cb) in row {
+                        k[(a, b)] += kc * ca * cb;
+                    }
+                }
             }
             dense_largest(&self.structure.mass.to_dense(), &k)?
         } else {
@@ -42,8 +52,11 @@ impl Model {
             let solve = mass_solver(mass)?;
             let mul_k = |x: &[f64], y: &mut [f64]| {
                 self.structure.stiffness.mul_vec(x, y);
-                for &(d, kc) in &springs {
-                    y[d] += kc * x[d];
+                for &(row, kc) in &springs {
+                    let bx: f64 = row.iter().map(|&(d, c)| c * x[d]).sum();
+                    for &(d, c) in row {
+                        y[d] += kc * c * bx;
+                    }
                 }
             };
             lanczos_largest(n, mul_k, |x: &[f64], y: &mut [f64]| mass.mul_vec(x, y), solve)
@@ -55,6 +68,44 @@ impl Model {
             ));
         }
         Ok(lmax.sqrt())
+    }
+}
+
+impl Model {
+    /// The largest finite eigenvalue with the massless DOFs condensed: Lanczos on the Schur
+    /// complement K̃ = K_aa − K_ab K_bb⁻¹ K_ba (applied, never formed) against M_aa.
+    fn condensed_largest(&self, springs: &[(&[(usize, f64)], f64)], massless: &[usize]) -> Result<f64, ModelError> {
+        let n = self.n();
+        let mut stiffness = self.structure.stiffness.clone();
+        if !springs.is_empty() {
+            let mut t = Vec::new();
+            // k_c B_iᵀ B_i for each compliant contact row.
+            for &(row, kc) in springs {
+                for &(a, ca) in row {
+                    row.iter().for_each(|&(b, cb)| t.push(faer::sparse::Triplet::new(a, b, kc * ca * cb)));
+                }
+            }
+            let s = faer::sparse::SparseColMat::try_new_from_triplets(n, n, &t).expect("contact DOFs are in range");
+            stiffness = stiffness.lincomb(1.0, &Matrix::Sparse(s), 1.0);
+        }
+        let massive: Vec<usize> = (0..n).filter(|d| massless.binary_search(d).is_err()).collect();
+        let (k_aa, k_ab, k_bb) = (stiffness.block(&massive, &massive), stiffness.block(&massive, massless), stiffness.block(massless, massless));
+        let solve_bb = solver(&k_bb, || ModelError::new("structure.stiffness", format!("is not positive definite on the massless DOFs {massless:?}")))?;
+        let mass = self.structure.mass.block(&massive, &massive);
+        let solve_m = mass_solver(&mass)?;
+        let (na, nb) = (massive.len(), massless.len());
+        let mut t = vec![0.0; nb];
+        let mut u = vec![0.0; na];
+        let mul_k = |x: &[f64], y: &mut [f64]| {
+            k_aa.mul_vec(x, y);
+            // y −= K_ab K_bb⁻¹ K_ba x (K_ba = K_abᵀ).
+            t.iter_mut().for_each(|v| *v = 0.0);
+            k_ab.for_each(|i, j, v| t[j] += v * x[i]);
+            solve_bb(&mut t);
+            k_ab.mul_vec(&t, &mut u);
+            y.iter_mut().zip(&u).for_each(|(a, b)| *a -= b);
+        };
+        Ok(lanczos_largest(na, mul_k, |x: &[f64], y: &mut [f64]| mass.mul_vec(x, y), solve_m))
     }
 }
 
@@ -75,7 +126,11 @@ fn dense_largest(mass: &Mat<f64>, stiffness: &Mat<f64>) -> Result<f64, ModelErro
 
 /// x ↦ M⁻¹ x by a Cholesky factorisation of M (dense or sparse).
 fn mass_solver(mass: &Matrix) -> Result<impl Fn(&mut [f64]), ModelError> {
-    let bad = || ModelError::new("structure.mass", "is not positive definite (every DOF must carry mass)");
+    solver(mass, || ModelError::new("structure.mass", "is not positive definite (every DOF must carry mass)"))
+}
+
+/// x ↦ A⁻¹ x by a Cholesky factorisation of A (dense or sparse), `bad()` when it fails.
+fn solver(mass: &Matrix, bad: impl Fn() -> ModelError) -> Result<impl Fn(&mut [f64]), ModelError> {
     enum Factor {
         Dense(faer::linalg::solvers::Llt<f64>),
         Sparse(faer::sparse::linalg::solvers::Llt<usize, f64>),

@@ -53,13 +53,94 @@ fn check_finite(field: String, v: f64) -> Result<(), ModelError> {
     if v.is_finite() { Ok(()) } else { Err(ModelError::new(field, format!("is {v}, must be finite"))) }
 }
 
-/// M positive definite: a Cholesky factorisation that succeeds (dense), or a sparse one.
-fn check_positive_definite(name: &str, a: &Matrix) -> Result<(), ModelError> {
-    let ok = match a {
-        Matrix::Dense(m) => m.llt(faer::Side::Lower).is_ok(),
-        Matrix::Sparse(s) => s.sp_cholesky(faer::Side::Lower).is_ok(),
-    };
-    if ok { Ok(()) } else { Err(ModelError::new(name, "is not positive definite (every DOF must carry mass)")) }
+/// M positive definite, or positive semi-definite with its null space on whole DOFs (a massless
+/// boundary, src/formulation.md §4.1): those DOFs have a zero row and column of M, the rest of M
+/// is positive definite, and K is positive definite on them (they are held statically, so that
+/// σ2 M + σ1 C + K stays invertible).
+fn check_mass(model: &Model) -> Result<(), ModelError> {
+    let s = &model.structure;
+    if s.mass.is_positive_definite() {
+        return Ok(());
+    }
+    let n = s.n();
+    let massless = model.massless_dofs();
+    if let Some(&d) = massless.iter().find(|&&d| s.mass.get(d, d) < 0.0) {
+        return Err(ModelError::new(format!("structure.mass[{d}][{d}]"), format!("is {}, a mass must be ≥ 0", s.mass.get(d, d))));
+    }
+    let scale = (0..n).map(|d| s.mass.get(d, d).abs()).fold(0.0f64, f64::max);
+    let mut off = None;
+    s.mass.for_each(|i, j, v| {
+        if off.is_none() && v.abs() > 1e-14 * scale && (massless.binary_search(&i).is_ok() || massless.binary_search(&j).is_ok()) {
+            off = Some((i, j, v));
+        }
+    });
+    if let Some((i, j, v)) = off {
+        return Err(ModelError::new(
+            format!("structure.mass[{i}][{j}]"),
+            format!(
+                "is {v}, but DOF {} has no mass on its diagonal: a positive semi-definite mass has a zero row and column there",
+                if s.mass.get(i, i) <= 0.0 { i } else { j }
+            ),
+        ));
+    }
+    let massive: Vec<usize> = (0..n).filter(|d| massless.binary_search(d).is_err()).collect();
+    if massive.is_empty() {
+        return Err(ModelError::new("structure.mass", "is zero: no DOF carries mass, so there is no dynamics to solve (a static problem)"));
+    }
+    if massless.is_empty() || !s.mass.block(&massive, &massive).is_positive_definite() {
+        return Err(ModelError::new(
+            "structure.mass",
+            "is not positive definite, and not only on whole massless DOFs: every DOF must carry mass, or be massless with a zero row and column of M \
+             (a massless boundary, src/formulation.md §4.1)",
+        ));
+    }
+    if let Some(&d) = massless.iter().find(|&&d| s.stiffness.get(d, d) == 0.0) {
+        return Err(ModelError::new(
+            format!("structure.mass[{d}][{d}]"),
+            format!(
+                "is 0 and structure.stiffness[{d}][{d}] is 0: DOF {d} carries neither mass nor stiffness, so nothing determines it; give it mass or stiffness, or remove it"
+            ),
+        ));
+    }
+    if !s.stiffness.block(&massless, &massless).is_positive_definite() {
+        return Err(ModelError::new(
+            "structure.stiffness",
+            format!(
+                "is not positive definite on the massless DOFs {massless:?}: they are held by stiffness alone (σ2 M + σ1 C + K must stay invertible); clamp or stiffen them, or give them mass"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Largest |‖n‖ − 1| accepted for a contact normal (the scene normalises; others must too).
+const UNIT_TOL: f64 = 1e-9;
+
+/// Row i of B: DOFs in range, each once, finite coefficients, unit length.
+fn check_row(i: usize, row: &[(usize, f64)], n: usize) -> Result<(), ModelError> {
+    if row.is_empty() {
+        return Err(ModelError::new(format!("contact[{i}].normal"), "is empty; give the contact a DOF (dof = …) or a normal over a node's DOFs"));
+    }
+    for (e, &(d, c)) in row.iter().enumerate() {
+        if d >= n {
+            return Err(ModelError::new(format!("contact[{i}].dof"), format!("is {d}, the model has DOFs 0 to {} (use one of them)", n - 1)));
+        }
+        if row[..e].iter().any(|&(o, _)| o == d) {
+            return Err(ModelError::new(format!("contact[{i}].normal"), format!("names DOF {d} twice; give each DOF of the normal once")));
+        }
+        check_finite(format!("contact[{i}].normal[{e}]"), c)?;
+    }
+    let norm = row.iter().map(|&(_, c)| c * c).sum::<f64>().sqrt();
+    if !((norm - 1.0).abs() <= UNIT_TOL) {
+        let message = if row.len() == 1 {
+            format!("is {}, must be +1 or -1", row[0].1)
+        } else {
+            format!("has length {norm}, must be a unit normal (divide each coefficient by the length)")
+        };
+        let field = if row.len() == 1 { "direction" } else { "normal" };
+        return Err(ModelError::new(format!("contact[{i}].{field}"), message));
+    }
+    Ok(())
 }
 
 impl Model {
@@ -91,22 +172,17 @@ impl Model {
         if let Some(c) = &s.damping {
             check_square("damping", c, n)?;
         }
-        check_positive_definite("structure.mass", &s.mass)?;
+        check_mass(self)?;
         self.validate_frequency()?;
         for (i, f) in self.forces.iter().enumerate() {
             if f.dof >= n {
-                return Err(ModelError::new(format!("force[{i}].dof"), format!("is {}, the model has DOFs 0..{}", f.dof, n - 1)));
+                return Err(ModelError::new(format!("force[{i}].dof"), format!("is {}, the model has DOFs 0 to {} (use one of them)", f.dof, n - 1)));
             }
             check_finite(format!("force[{i}].amplitude"), f.term.amplitude)?;
             check_finite(format!("force[{i}].phase"), f.term.phase)?;
         }
         for (i, c) in self.contacts.iter().enumerate() {
-            if c.dof >= n {
-                return Err(ModelError::new(format!("contact[{i}].dof"), format!("is {}, the model has DOFs 0..{}", c.dof, n - 1)));
-            }
-            if c.direction != 1.0 && c.direction != -1.0 {
-                return Err(ModelError::new(format!("contact[{i}].direction"), format!("is {}, must be +1 or -1", c.direction)));
-            }
+            check_row(i, &c.row, n)?;
             check_finite(format!("contact[{i}].gap"), c.gap)?;
             if c.gap < 0.0 {
                 return Err(ModelError::new(format!("contact[{i}].gap"), format!("is {}, a static clearance must be ≥ 0 (move the reference instead)", c.gap)));

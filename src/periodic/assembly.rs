@@ -203,10 +203,12 @@ pub fn assemble(model: &Model, scheme: Scheme, period: f64, dofs: &[usize], fft:
     let nd = dofs.len();
     let one = |p: usize| -> Result<HarmonicBlock, SolveError> {
         let (s1, s2, w) = (symbols.sigma1[p], symbols.sigma2[p], symbols.weight[p]);
-        // Right-hand sides: Bᵀ (m columns, s_i e_{d_i}) then w_p F̂_p.
+        // Right-hand sides: Bᵀ (m columns, B_iᵀ) then w_p F̂_p.
         let mut rhs = Mat::<C>::zeros(n, m + 1);
         for (i, c) in model.contacts.iter().enumerate() {
-            rhs[(c.dof, i)] = C::from(c.direction);
+            for &(d, v) in &c.row {
+                rhs[(d, i)] = C::from(v);
+            }
         }
         for (d, spec) in &forces {
             rhs[(*d, m)] = spec[p] * w;
@@ -215,9 +217,9 @@ pub fn assemble(model: &Model, scheme: Scheme, period: f64, dofs: &[usize], fft:
         let mut b = HarmonicBlock { g: vec![C::ZERO; m * m], bx: vec![C::ZERO; m], xl: vec![C::ZERO; nd], h: vec![C::ZERO; nd * m] };
         for (a, ca) in model.contacts.iter().enumerate() {
             for j in 0..m {
-                b.g[a * m + j] = y[(ca.dof, j)] * ca.direction;
+                b.g[a * m + j] = ca.along(|d| y[(d, j)]);
             }
-            b.bx[a] = y[(ca.dof, m)] * ca.direction;
+            b.bx[a] = ca.along(|d| y[(d, m)]);
         }
         for (r, &d) in dofs.iter().enumerate() {
             b.xl[r] = y[(d, m)];
@@ -294,7 +296,7 @@ fn assemble_modal(
     let fim = &phil * Mat::<f64>::from_fn(nl, nh, |l, p| (forces[l].1[p] * symbols.weight[p]).im);
     let ure = Mat::<f64>::from_fn(n, nh, |i, p| dre[(i, p)] * fre[(i, p)] - dim[(i, p)] * fim[(i, p)]);
     let uim = Mat::<f64>::from_fn(n, nh, |i, p| dre[(i, p)] * fim[(i, p)] + dim[(i, p)] * fre[(i, p)]);
-    let bphi = Mat::<f64>::from_fn(m, n, |a, i| model.contacts[a].direction * phi[(model.contacts[a].dof, i)]);
+    let bphi = Mat::<f64>::from_fn(m, n, |a, i| model.contacts[a].along(|d| phi[(d, i)]));
     let phio = Mat::<f64>::from_fn(nd, n, |r, i| phi[(dofs[r], i)]);
     let (xre, xim) = (&phio * &ure, &phio * &uim);
     let (bre, bim) = (&bphi * &ure, &bphi * &uim);

@@ -1,7 +1,7 @@
 //! The session's assembly, kept across re-solves (issue 12 item 2).
 //!
 //! The assembly (k/2+1 harmonic solves: Ĝ_p, X̂lin_p, Ẑ_p⁻¹Bᵀ) depends on the frequency, the grid,
-//! the structure, the contacts' DOFs and directions, the recovered DOFs and the forces. It does
+//! the structure, the contacts' rows of B, the recovered DOFs and the forces. It does
 //! not depend on the gaps or the obstacle motions (they enter q only, in `PeriodicProblem::lcp`),
 //! and X̂lin is linear in the forces: a common scale of every force amplitude scales X̂lin and
 //! B X̂lin. So a gap, motion or force-scale change (the FMU's tunables) re-solves without
@@ -37,7 +37,8 @@ fn key(p: &PeriodicProblem) -> (u64, f64) {
         }
     }
     for c in &model.contacts {
-        (c.dof, c.direction.to_bits()).hash(&mut h);
+        c.row.iter().for_each(|&(d, v)| (d, v.to_bits()).hash(&mut h));
+        c.row.len().hash(&mut h);
         if let Compliance::Compliant { stiffness } = c.compliance {
             stiffness.to_bits().hash(&mut h);
         }

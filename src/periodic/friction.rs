@@ -50,7 +50,7 @@ pub(super) fn with_rows(model: &Model) -> Result<Cow<'_, Model>, SolveError> {
         if direction.abs() != 1.0 {
             return Err(SolveError::Invalid(format!("friction[{i}]: the row coefficient is {direction}, this version takes ±1 on one DOF")));
         }
-        rows.contacts.push(Contact { dof, direction, gap: 0.0, compliance: Compliance::Rigid, motion: Vec::new() });
+        rows.contacts.push(Contact::on_dof(dof, direction, 0.0, Compliance::Rigid));
     }
     Ok(Cow::Owned(rows))
 }

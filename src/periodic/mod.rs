@@ -17,7 +17,7 @@ pub use friction::{FRICTION_DENSE_MAX, FrictionGrid, friction_lcp};
 pub use problem::{MAX_DENSE_FLOPS, MAX_LCP_SIZE, MAX_STEPS, MIN_STEPS, PeriodicProblem};
 pub use recovery::render_path as render_lcp_path;
 pub use session::{PeriodicSolver, WarmStart};
-pub use state_space::{MAX_STEP_MAP_DOFS, NoStepMap, step_map};
+pub use state_space::{NoStepMap, SHOOTING_MEMORY_MAX, SHOOTING_WORK_MAX, shooting_memory, shooting_work, step_map};
 pub use tuning::Tuning;
 
 use crate::error::{Error, ErrorKind};
@@ -54,10 +54,18 @@ impl OutputSelection {
 pub struct OutputMap {
     /// For each user DOF that may be output: its (model DOF, coefficient) terms.
     pub rows: std::collections::BTreeMap<usize, Vec<(usize, f64)>>,
-    /// The user's DOF of each contact, in model order (reported as the contact's `dof`).
-    pub contact_dofs: Vec<usize>,
+    /// Each contact's row of B in the user's numbering, in model order (reported as the
+    /// contact's `normal`; its label DOF, the largest |coefficient|, as its `dof`).
+    pub contact_rows: Vec<Vec<(usize, f64)>>,
     /// Effects named in the result besides the model's own (e.g. `reduction`).
     pub effects: Vec<String>,
+}
+
+impl OutputMap {
+    /// Contact `a`'s row of B in the user's numbering, if the map has it.
+    pub fn contact_row(&self, a: usize) -> Option<&[(usize, f64)]> {
+        self.contact_rows.get(a).map(Vec::as_slice)
+    }
 }
 
 /// Solver settings with defaults.

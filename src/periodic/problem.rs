@@ -2,7 +2,7 @@
 //! private: every way in (constructor, updaters) runs the checks, so a `PeriodicProblem` is
 //! always ready to solve.
 use super::{Assembly, OutputMap, OutputSelection, PeriodFft, SolveError, SolverSettings, assembly, lcp_failure, limits, recovery};
-use crate::lcp::{BlockCirculant, DENSE_MAX, LcpMethod, LcpOutcome, LcpSolution, solve_periodic_lcp};
+use crate::lcp::{BlockCirculant, DENSE_MAX, DENSE_MEMORY_MAX, GIB, LcpMethod, LcpOutcome, LcpSolution, dense_memory, solve_periodic_lcp};
 use crate::model::{Contact, Model};
 use crate::response::Response;
 use crate::time::{Discretization, Pairing};
@@ -45,6 +45,11 @@ pub const MAX_LCP_SIZE: usize = 1 << 20;
 pub const MAX_DENSE_FLOPS: f64 = 1e12;
 
 impl PeriodicProblem {
+    /// Contact `a`'s row of B in the user's numbering: the output map's, else the model's own.
+    pub fn user_row(&self, a: usize) -> &[(usize, f64)] {
+        self.output_map().and_then(|m| m.contact_row(a)).unwrap_or(&self.model().contacts[a].row)
+    }
+
     /// Checks everything, the scheme's stability limit included ([`crate::time::Scheme::stability_limit`]).
     pub fn new(model: Model, disc: Discretization, outputs: OutputSelection, solver: SolverSettings) -> Result<Self, SolveError> {
         Self::build(model, disc, outputs, solver, None, None)
@@ -240,8 +245,8 @@ impl PeriodicProblem {
         if let Some((l, _)) = map.rows.iter().find(|(_, r)| r.iter().any(|&(d, c)| d >= n || !c.is_finite())) {
             return Err(SolveError::Invalid(format!("output: the recovery of DOF {l} names a model DOF out of 0..{n} or a non-finite coefficient")));
         }
-        if !map.contact_dofs.is_empty() && map.contact_dofs.len() != self.model.contacts.len() {
-            return Err(SolveError::Invalid(format!("output: {} contact labels for {} contacts", map.contact_dofs.len(), self.model.contacts.len())));
+        if !map.contact_rows.is_empty() && map.contact_rows.len() != self.model.contacts.len() {
+            return Err(SolveError::Invalid(format!("output: {} contact labels for {} contacts", map.contact_rows.len(), self.model.contacts.len())));
         }
         self.outputs = outputs;
         self.output_map = Some(map);
@@ -283,7 +288,7 @@ impl PeriodicProblem {
     pub fn pairing_at(&self, i: usize) -> Pairing {
         match (self.contact_pairing(i), self.disc.pairing, self.model.contacts.get(i)) {
             (Some(p), _, _) | (None, Some(p), _) => p,
-            (None, None, c) => self.disc.scheme.default_pairing(c.is_some_and(Contact::is_rigid)),
+            (None, None, c) => self.disc.scheme.default_pairing(c.is_some_and(|c| self.impacts(c))),
         }
     }
 
@@ -292,8 +297,15 @@ impl PeriodicProblem {
     pub fn pairing_of(&self, c: &Contact) -> Pairing {
         match self.model.contacts.iter().position(|x| std::ptr::eq(x, c)) {
             Some(i) => self.pairing_at(i),
-            None => self.disc.pairing.unwrap_or_else(|| self.disc.scheme.default_pairing(c.is_rigid())),
+            None => self.disc.pairing.unwrap_or_else(|| self.disc.scheme.default_pairing(self.impacts(c))),
         }
+    }
+
+    /// A rigid contact on a DOF with mass: its force is an impulse at impacts. On a massless DOF
+    /// (src/formulation.md §4.1) the force is finite and statically transmitted, like a
+    /// compliant one, and same-instant pairing is the consistent one.
+    fn impacts(&self, c: &Contact) -> bool {
+        c.is_rigid() && !self.model.contact_is_massless(c)
     }
 
     /// Warnings about choices that do not converge, said before solving.
@@ -301,13 +313,14 @@ impl PeriodicProblem {
         let mut w: Vec<String> = self.auto_steps.iter().cloned().collect();
         for (i, c) in self.model.contacts.iter().enumerate() {
             let p = self.pairing_of(c);
-            if c.is_rigid() {
+            if self.impacts(c) {
                 if let Some(why) = self.disc.scheme.rigid_contact_warning(p) {
                     w.push(format!("contact[{i}] (rigid, {} with pairing {p}): {why}", self.disc.scheme));
                 }
             } else if p == Pairing::Forward {
+                let kind = if c.is_rigid() { "rigid on a massless DOF" } else { "compliant" };
                 w.push(format!(
-                    "contact[{i}] (compliant): forward pairing makes a compliant force lag one step, so the scheme is first order only; use pairing = \"same\""
+                    "contact[{i}] ({kind}): forward pairing makes its finite force lag one step, so the scheme is first order only; use pairing = \"same\""
                 ));
             }
         }
@@ -427,10 +440,12 @@ impl PeriodicProblem {
                     "solver.method: \"shooting\" needs a time-stepping map, and this problem has none: {why}; use \"auto\""
                 )));
             }
-            if q.len() > DENSE_MAX {
+            if dense_memory(q.len()) > DENSE_MEMORY_MAX {
                 return Err(SolveError::Limit(format!(
-                    "discretization.steps: an LCP of {} unknowns is past the {DENSE_MAX} of the dense methods, and shooting does not apply: {why}; reduce steps",
-                    q.len()
+                    "discretization.steps: an LCP of {} unknowns needs ≈ {:.1} GiB in the dense methods (N² numbers, at most {:.0} GiB: N ≤ {DENSE_MAX}), and shooting does not apply: {why}",
+                    q.len(),
+                    dense_memory(q.len()) / GIB,
+                    DENSE_MEMORY_MAX / GIB
                 )));
             }
         }
@@ -448,7 +463,7 @@ impl PeriodicProblem {
 
 /// Whether two models have the same ω_max: the same M, K and contact compliances.
 fn same_spectrum(a: &Model, b: &Model) -> bool {
-    let springs = |m: &Model| -> Vec<(usize, crate::model::Compliance)> { m.contacts.iter().map(|c| (c.dof, c.compliance)).collect() };
+    let springs = |m: &Model| -> Vec<(Vec<(usize, f64)>, crate::model::Compliance)> { m.contacts.iter().map(|c| (c.row.clone(), c.compliance)).collect() };
     a.structure.mass == b.structure.mass && a.structure.stiffness == b.structure.stiffness && springs(a) == springs(b)
 }
 
@@ -466,15 +481,21 @@ fn check_sizes(model: &Model, disc: &Discretization, p: usize) -> Result<(), Sol
         )));
     }
     let m = model.contacts.len();
+    let unknowns = instants.saturating_mul(m);
     // Fourier collocation has no step map: only the dense methods solve it.
-    let most = if disc.scheme == crate::time::Scheme::Fourier { DENSE_MAX } else { MAX_LCP_SIZE };
-    if instants.saturating_mul(m) > most {
+    if disc.scheme == crate::time::Scheme::Fourier && dense_memory(unknowns) > DENSE_MEMORY_MAX {
+        return Err(SolveError::Limit(format!(
+            "discretization.steps: is {k}{} with {m} contact(s), an LCP of {unknowns} unknowns; fourier collocation has no time-stepping map and its dense methods would need ≈ {:.1} GiB (N² numbers; at most {DENSE_MAX} unknowns, {:.0} GiB, under fourier): use scheme cds, galerkin, bds1 or bds2, which shoot in O(k·(d + m)) memory, or reduce steps",
+            if p > 1 { format!(" × period_multiple {p}") } else { String::new() },
+            dense_memory(unknowns) / GIB,
+            DENSE_MEMORY_MAX / GIB
+        )));
+    }
+    if unknowns > MAX_LCP_SIZE {
         let times = if p > 1 { format!(" × period_multiple {p}") } else { String::new() };
         return Err(SolveError::Limit(format!(
-            "discretization.steps: is {k}{times} with {m} contact(s), an LCP of {} unknowns (steps{} × contacts); at most {most} are accepted{}: reduce steps{}",
-            instants.saturating_mul(m),
+            "discretization.steps: is {k}{times} with {m} contact(s), an LCP of {unknowns} unknowns (steps{} × contacts); at most {MAX_LCP_SIZE} are accepted: reduce steps{}",
             if p > 1 { " × period_multiple" } else { "" },
-            if most == DENSE_MAX { " under fourier (no time-stepping map, dense methods only)" } else { "" },
             if p > 1 { " or period_multiple" } else { "" }
         )));
     }
@@ -538,7 +559,7 @@ fn check_solver(s: &SolverSettings) -> Result<(), SolveError> {
 
 fn check_outputs(outputs: &OutputSelection, n: usize) -> Result<(), SolveError> {
     if let Some(d) = outputs.dofs().into_iter().find(|&d| d >= n) {
-        return Err(SolveError::Invalid(format!("output: DOF {d} does not exist, the model has DOFs 0..{}", n - 1)));
+        return Err(SolveError::Invalid(format!("output: DOF {d} does not exist, the model has DOFs 0 to {}", n - 1)));
     }
     Ok(())
 }

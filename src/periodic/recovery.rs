@@ -1,7 +1,7 @@
 //! Recovery (src/formulation.md §3): X̂_p = X̂lin_p − (Ẑ_p⁻¹Bᵀ) ẑ_p at the output DOFs only, velocities and
 //! accelerations by the symbols σ1, σ2; contact gaps from B X̂_p = B X̂lin_p − Ĝ_p ẑ_p.
 use super::{Assembly, PeriodFft, PeriodicProblem, SolveError};
-use crate::lcp::{AUTO_LEMKE_MAX, LcpMethod, LcpSolution, LcpStep, WarmOutcome};
+use crate::lcp::{AUTO_LEMKE_MAX, LcpMethod, LcpOutcome, LcpSolution, LcpStep, WarmOutcome};
 use crate::response::{ContactResponse, LcpSummary, Response, WarmStartSummary};
 use num_complex::Complex64 as C;
 use std::collections::BTreeMap;
@@ -91,12 +91,17 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
             let gap: Vec<f64> = time.iter().zip(&bx).map(|(&t, &b)| ca.gap_at(model.frequency, t) - b).collect();
             let force: Vec<f64> = (0..k).map(|j| sol.z[j * m + a]).collect();
             let gap = finite(gap, "contact gap", a)?;
+            let normal_displacement = finite(bx, "contact normal displacement", a)?;
+            let normal = problem.user_row(a).to_vec();
+            let (dof, direction) = crate::model::label_of(&normal);
             // Row j of the LCP pairs force sample j with the gap at t_{j+s} (`PeriodicProblem::lcp`).
             let s = problem.pairing_of(ca).offset();
             let paired_gap = (0..k).map(|j| gap[(j + s) % k]).collect();
             contacts.push(ContactResponse {
-                dof: problem.output_map().as_ref().and_then(|m| m.contact_dofs.get(a).copied()).unwrap_or(ca.dof),
-                direction: ca.direction as i32,
+                dof,
+                direction,
+                normal,
+                normal_displacement,
                 stiffness: match ca.compliance {
                     crate::model::Compliance::Rigid => None,
                     crate::model::Compliance::Compliant { stiffness } => Some(stiffness),
@@ -177,7 +182,12 @@ pub fn render_path(method: LcpMethod, path: &[LcpStep]) -> String {
                 LcpMethod::Pivoting => ("block pivoting", "pivots"),
                 _ => ("dense lexicographic Lemke", "pivots"),
             };
-            format!("{what}, {} {count}, {:.3} s → {}", s.pivots, s.time_s, s.outcome.name())
+            // Shooting counts Newton iterations: its limit is an iteration limit, not a pivot limit.
+            let outcome = match (s.method, s.outcome) {
+                (LcpMethod::Shooting, LcpOutcome::PivotLimit) => "iteration limit",
+                (_, o) => o.name(),
+            };
+            format!("{what}, {} {count}, {:.3} s → {outcome}", s.pivots, s.time_s)
         })
         .collect();
     format!("{head}: {}", steps.join("; fallback: "))

@@ -24,17 +24,46 @@
 //!   one answer per step;
 //! - s > L (bds forward): the force is paired with a later step's gap, not a step map.
 //!
-//! Fourier collocation is not a time stepper. The map is dense in d = p·n, so only models of up
-//! to [`MAX_STEP_MAP_DOFS`] DOFs (reduced ones) get one.
+//! **Massless DOFs** b (a zero row of M and C; src/formulation.md §4.1) have no dynamics of their
+//! own: when K enters the scheme at one instant only (a0 = e_(i*): cds, bds1, bds2), their rows
+//! read K_b· x_(j+L−i*) + B_bᵀ z_j = f_(j,b), so x_b = K_bb⁻¹(f_b − K_ba x_a − B_bᵀ z) at that
+//! instant, and the march advances the massive DOFs a alone, with K̃ = K_aa − K_ab K_bb⁻¹ K_ba,
+//! f̃ = f_a − K_ab K_bb⁻¹ f_b and contact rows B̃ = B_a − B_b K_bb⁻¹ K_ba. A contact on massless
+//! DOFs reads that same instant (pairing offset L − i* = 0: same), with the static flexibility
+//! D = B_b K_bb⁻¹ B_bᵀ added to S = HΓ + D and −B_b K_bb⁻¹ f_b to r_j. Galerkin weighs K over three
+//! instants, (1, 4, 1)/6: a massless DOF then couples the whole period and has no step map.
+//!
+//! Fourier collocation is not a time stepper. The map is dense in d = p·n (reduced models: its
+//! memory is O(d² + k·(d + m)), checked with the LCP's before solving).
 use super::PeriodicProblem;
-use crate::lcp::{DenseLu, MAX_PAIRS, StepMapData, StepMapLcp, dense_product};
+use crate::lcp::{DenseLu, GIB, StepMapData, StepMapLcp, dense_product};
 use crate::model::{Compliance, Model};
 use crate::time::Scheme;
 use faer::Mat;
+use faer::linalg::solvers::Solve;
 
-/// Most DOFs of a model solved by shooting: its march is dense in the state (d = 2n or 3n) and
-/// each Newton iteration forms a d×d Jacobian.
-pub const MAX_STEP_MAP_DOFS: usize = 64;
+/// The most memory the shooting solver may take for a step map ([`shooting_memory`]).
+pub const SHOOTING_MEMORY_MAX: f64 = 4.0 * GIB;
+
+/// The most work one Newton iteration of shooting may cost at the least ([`shooting_work`]):
+/// about a minute on one core.
+pub const SHOOTING_WORK_MAX: f64 = 1e12;
+
+/// Bytes the shooting solver holds for a step map of state size d over k steps with m pairs: the
+/// augmented Φ's powers (log₂ k + 1 of them) and a few more (d+1)² matrices (a run's powers, the
+/// Jacobian, Newton's LU), and the march's k·(d + 3m) (c_j, r_j, z_j and the sets).
+pub fn shooting_memory(k: usize, d: usize, m: usize) -> f64 {
+    let matrices = f64::from(usize::BITS - k.leading_zeros()) + 6.0;
+    8.0 * (matrices * ((d + 1) as f64).powi(2) + k as f64 * (d + 3 * m) as f64)
+}
+
+/// Floating-point operations of one Newton iteration at the least: a march (k·d²) and the
+/// contact-free Jacobian's log₂ k squarings of (d+1)² matrices (each run of one contact set
+/// adds up to 2·log₂ k more).
+pub fn shooting_work(k: usize, d: usize, m: usize) -> f64 {
+    let squarings = f64::from(usize::BITS - k.leading_zeros());
+    k as f64 * ((d * d) as f64 + 2.0 * (d * m) as f64) + squarings * 2.0 * ((d + 1) as f64).powi(3)
+}
 
 /// Why a problem has no step map (the solver then uses the LCP alone).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -67,22 +96,27 @@ pub fn step_map(problem: &PeriodicProblem) -> Result<StepMapLcp, NoStepMap> {
     if !model.frictions.is_empty() {
         return Err(NoStepMap("friction contacts have no step map yet (src/formulation.md §9)".to_string()));
     }
-    if n > MAX_STEP_MAP_DOFS {
-        return Err(NoStepMap(format!("the model has {n} DOFs; shooting takes at most {MAX_STEP_MAP_DOFS} (reduce it: Craig–Bampton)")));
-    }
-    if m > MAX_PAIRS {
-        return Err(NoStepMap(format!("{m} contacts; shooting takes at most {MAX_PAIRS}")));
-    }
     let offsets: Vec<usize> = (0..m).map(|c| problem.pairing_at(c).offset()).collect();
     if let Some(c) = offsets.iter().position(|&s| s > lead) {
         return Err(NoStepMap(format!("contact[{c}] is paired forward under {}: its force waits for a later step's gap", disc.scheme)));
     }
     let p = a2.len() - 1;
+    // Massless DOFs are condensed out of the state; the map is dense in the rest.
+    let n = n - model.massless_dofs().len();
     let d = p * n;
+    // Refuse it before building it when it cannot fit or run.
+    let (bytes, work) = (shooting_memory(k, d, m), shooting_work(k, d, m));
+    if bytes > SHOOTING_MEMORY_MAX || work > SHOOTING_WORK_MAX {
+        return Err(NoStepMap(format!(
+            "shooting on the step map of {n} DOFs with mass (state of d = {d}) over k = {k} steps needs ≈ {:.2} GiB (at most {:.0}) and ≈ {work:.1e} flops per Newton iteration (at most {SHOOTING_WORK_MAX:.0e}); reduce the model (Craig–Bampton) or steps",
+            bytes / GIB,
+            SHOOTING_MEMORY_MAX / GIB
+        )));
+    }
     let h = problem.period() / k as f64;
-    let s = &model.structure;
-    let (mass, stiffness) = (s.mass.to_dense(), s.stiffness.to_dense());
-    let damping = s.damping.as_ref().map(|c| c.to_dense());
+    let cond = Condensed::new(model, &a0, lead, &offsets)?;
+    let (mass, stiffness, damping, n) = (&cond.mass, &cond.stiffness, &cond.damping, cond.massive.len());
+    let d = p * n;
     let combine = |(c2, c1, c0): (f64, f64, f64)| {
         Mat::from_fn(n, n, |r, c| c2 / (h * h) * mass[(r, c)] + c1 / h * damping.as_ref().map_or(0.0, |d| d[(r, c)]) + c0 * stiffness[(r, c)])
     };
@@ -117,7 +151,7 @@ pub fn step_map(problem: &PeriodicProblem) -> Result<StepMapLcp, NoStepMap> {
     }
     let carry: Vec<(usize, usize)> = (0..p).flat_map(|b| (b..p).flat_map(move |i| (0..n).map(move |r| (b * n + r, i * n + r)))).collect();
     // f̄_j at the k instants, then c_j = (W f̄_j, …, W f̄_j).
-    let forces = force_samples(model, k, h);
+    let (forces, gap_shift) = cond.force_samples(model, k, h);
     let galerkin = disc.scheme == Scheme::Galerkin;
     let mut c = vec![0.0; k * d];
     let mut fbar = vec![0.0; n];
@@ -135,28 +169,129 @@ pub fn step_map(problem: &PeriodicProblem) -> Result<StepMapLcp, NoStepMap> {
     }
     let mut hm = vec![0.0; m * d];
     let mut gamma = vec![0.0; d * m];
-    let mut compliance = vec![0.0; m];
+    // D: the static flexibility of the massless DOFs plus each compliant contact's 1/k_c.
+    let mut flexibility = cond.flexibility.clone();
     let mut r = vec![0.0; k * m];
+    let wb = dense_product(&w, &cond.rows.transpose().to_owned());
     for (ci, contact) in model.contacts.iter().enumerate() {
         // Implicit (s = L) reads x_(j+L), y's first block; explicit (s = L − 1) reads
         // x_(j+L−1) = x_(j+L) − ∇x_(j+L), known before the step (Γ's blocks are equal: HΓ = 0).
-        hm[ci * d + contact.dof] = -contact.direction;
-        if offsets[ci] + 1 == lead {
-            hm[ci * d + n + contact.dof] = contact.direction;
+        for col in 0..n {
+            hm[ci * d + col] = -cond.rows[(ci, col)];
+            if offsets[ci] + 1 == lead {
+                hm[ci * d + n + col] = cond.rows[(ci, col)];
+            }
         }
         for row in 0..n {
             for b in 0..p {
-                gamma[(b * n + row) * m + ci] = -w[(row, contact.dof)] * contact.direction;
+                gamma[(b * n + row) * m + ci] = -wb[(row, ci)];
             }
         }
         if let Compliance::Compliant { stiffness } = contact.compliance {
-            compliance[ci] = 1.0 / stiffness;
+            flexibility[ci * m + ci] += 1.0 / stiffness;
         }
         for j in 0..k {
-            r[j * m + ci] = contact.gap_at(model.frequency, ((j + offsets[ci]) % k) as f64 * h);
+            let at = (j + offsets[ci]) % k;
+            r[j * m + ci] = contact.gap_at(model.frequency, at as f64 * h) + gap_shift[at * m + ci];
         }
     }
-    StepMapLcp::new(StepMapData { k, d, m, phi, carry, c, h: hm, gamma, compliance, r }).map_err(|e| NoStepMap(e.to_string()))
+    StepMapLcp::new(StepMapData { k, d, m, phi, carry, c, h: hm, gamma, flexibility, r }).map_err(|e| NoStepMap(e.to_string()))
+}
+
+/// The model the march advances: the massive DOFs, with the massless ones condensed statically
+/// (see the module documentation). Without massless DOFs: the model itself, B̃ = B, D = 0.
+struct Condensed {
+    /// The massive DOFs a (model numbering).
+    massive: Vec<usize>,
+    mass: Mat<f64>,
+    stiffness: Mat<f64>,
+    damping: Option<Mat<f64>>,
+    /// B̃, m × n_a (the model's sign: w = gap − B x).
+    rows: Mat<f64>,
+    /// D = B_b K_bb⁻¹ B_bᵀ, m×m row-major.
+    flexibility: Vec<f64>,
+    /// The massless DOFs b and −K_bb⁻¹ K_ba (n_b × n_a), K_bb⁻¹ (n_b × n_b).
+    massless: Vec<usize>,
+    k_bb_inv: Mat<f64>,
+}
+
+impl Condensed {
+    fn new(model: &Model, a0: &[f64], lead: usize, offsets: &[usize]) -> Result<Condensed, NoStepMap> {
+        let (n, m) = (model.n(), model.contacts.len());
+        let s = &model.structure;
+        let massless = model.massless_dofs();
+        let massive: Vec<usize> = (0..n).filter(|d| massless.binary_search(d).is_err()).collect();
+        let mut full_rows = Mat::zeros(m, n);
+        for (c, contact) in model.contacts.iter().enumerate() {
+            for &(dof, v) in &contact.row {
+                full_rows[(c, dof)] = v;
+            }
+        }
+        let dense = |a: &crate::model::Matrix, r: &[usize], c: &[usize]| a.block(r, c).to_dense();
+        let damping = s.damping.as_ref().map(|c| dense(c, &massive, &massive));
+        if massless.is_empty() {
+            let (mass, stiffness) = (s.mass.to_dense(), s.stiffness.to_dense());
+            return Ok(Condensed { massive, mass, stiffness, damping, rows: full_rows, flexibility: vec![0.0; m * m], massless, k_bb_inv: Mat::zeros(0, 0) });
+        }
+        let nonzero: Vec<usize> = (0..a0.len()).filter(|&i| a0[i] != 0.0).collect();
+        let &[star] = nonzero.as_slice() else {
+            return Err(NoStepMap(format!(
+                "DOFs {massless:?} are massless and the scheme weighs K over {} instants: a massless DOF then couples the whole period (no step map; the periodic LCP solves it)",
+                nonzero.len()
+            )));
+        };
+        if let Some(c) = &s.damping {
+            if let Some(&b) = massless.iter().find(|&&b| (0..n).any(|j| c.get(b, j) != 0.0)) {
+                return Err(NoStepMap(format!("massless DOF {b} carries damping: it is not quasi-static (no step map)")));
+            }
+        }
+        if let Some(c) = (0..m).find(|&c| model.contact_is_massless(&model.contacts[c]) && offsets[c] + star != lead) {
+            return Err(NoStepMap(format!(
+                "contact[{c}] acts on a massless DOF and is paired forward: its gap at the next instant depends on the next force (use pairing = \"same\")"
+            )));
+        }
+        let k_bb = dense(&s.stiffness, &massless, &massless);
+        let llt = k_bb.llt(faer::Side::Lower).map_err(|_| NoStepMap(format!("K is not positive definite on the massless DOFs {massless:?}")))?;
+        let mut k_bb_inv = Mat::<f64>::identity(massless.len(), massless.len());
+        llt.solve_in_place(k_bb_inv.as_mut());
+        let k_ba = dense(&s.stiffness, &massless, &massive);
+        let x_b = -(&k_bb_inv * &k_ba); // x_b = −K_bb⁻¹ K_ba x_a (+ force and contact terms)
+        let stiffness = dense(&s.stiffness, &massive, &massive) + k_ba.transpose() * &x_b;
+        let b_a = Mat::from_fn(m, massive.len(), |c, j| full_rows[(c, massive[j])]);
+        let b_b = Mat::from_fn(m, massless.len(), |c, j| full_rows[(c, massless[j])]);
+        let rows = &b_a + &b_b * &x_b;
+        let dmat = &b_b * &k_bb_inv * b_b.transpose();
+        let flexibility = (0..m * m).map(|e| dmat[(e / m, e % m)]).collect();
+        let mass = dense(&s.mass, &massive, &massive);
+        Ok(Condensed { massive, mass, stiffness, damping, rows, flexibility, massless, k_bb_inv })
+    }
+
+    /// f̃(t_j) on the massive DOFs (k × n_a) and the gap shift −B_b K_bb⁻¹ f_b(t_j) (k × m).
+    fn force_samples(&self, model: &Model, k: usize, h: f64) -> (Vec<f64>, Vec<f64>) {
+        let (n, m, na, nb) = (model.n(), model.contacts.len(), self.massive.len(), self.massless.len());
+        let full = force_samples(model, k, h);
+        let mut f = vec![0.0; k * na];
+        let mut shift = vec![0.0; k * m];
+        for j in 0..k {
+            let row = &full[j * n..(j + 1) * n];
+            for (i, &a) in self.massive.iter().enumerate() {
+                f[j * na + i] = row[a];
+            }
+            if nb == 0 || self.massless.iter().all(|&b| row[b] == 0.0) {
+                continue;
+            }
+            // x_b⁰ = K_bb⁻¹ f_b: the massless DOFs' static share of the load.
+            let xb: Vec<f64> = (0..nb).map(|i| (0..nb).map(|l| self.k_bb_inv[(i, l)] * row[self.massless[l]]).sum()).collect();
+            for (i, &a) in self.massive.iter().enumerate() {
+                f[j * na + i] -= (0..nb).map(|l| model.structure.stiffness.get(a, self.massless[l]) * xb[l]).sum::<f64>();
+            }
+            for (c, contact) in model.contacts.iter().enumerate() {
+                // The massless DOFs' static displacement moves the clearance: −B_b x_b⁰.
+                shift[j * m + c] = -contact.along(|dof| self.massless.binary_search(&dof).map_or(0.0, |l| xb[l]));
+            }
+        }
+        (f, shift)
+    }
 }
 
 /// f(t_j) DOF by DOF (k×n), sampled as the assembly samples them.

@@ -45,6 +45,22 @@ pub enum ReductionError {
     Eigen(#[from] EigenError),
     #[error("damping: {0}")]
     Damping(String),
+    #[error("K is not positive definite: is the structure clamped? ({0})")]
+    Stiffness(String),
+    #[error(
+        "the residual flexibility at the boundary is not positive definite ({0}): the modes kept already span the boundary's static deflections; keep fewer free-interface modes (reduction.modes) or fewer boundary DOFs"
+    )]
+    ResidualFlexibility(String),
+}
+
+/// Which reduction made a [`ReducedModel`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Method {
+    /// Craig–Bampton: q = [x_b; p], fixed-interface modes (src/formulation.md §4).
+    CraigBampton,
+    /// Massless boundary (MacNeal's residual flexibility): q = [u_b; q_modal], free-interface
+    /// modes, the boundary coordinates carry neither mass nor damping (src/formulation.md §4.1).
+    MasslessBoundary,
 }
 
 /// Settings of the reduction.
@@ -94,6 +110,7 @@ pub struct Timings {
 /// A Craig–Bampton reduced model. Reduced coordinates: q = [x_b (in the order of `boundary`); p].
 #[derive(Clone, Debug)]
 pub struct ReducedModel {
+    pub method: Method,
     /// DOF count of the full model.
     pub n_full: usize,
     /// Full-model DOFs kept physical; reduced coordinate i < n_b is full DOF `boundary[i]`.
@@ -104,13 +121,17 @@ pub struct ReducedModel {
     pub stiffness: Mat<f64>,
     /// Reduced damping C_r, if any.
     pub damping: Option<Mat<f64>>,
-    /// Fixed-interface eigenfrequencies ω_r [rad/s] of the modes kept.
+    /// Fixed-interface (Craig–Bampton) or free-interface (massless boundary) eigenfrequencies
+    /// ω_r [rad/s] of the modes kept.
     pub interface_omega: Vec<f64>,
     /// Relative residuals of those modes, ‖K_ii φ − ω² M_ii φ‖ / ‖K_ii φ‖.
     pub interface_residual: Vec<f64>,
     pub timings: Timings,
     /// Φ, n_full × (n_b + η), full numbering.
-    basis: Mat<f64>,
+    pub(super) basis: Mat<f64>,
+    /// Massless boundary only: the free-interface modes at the boundary DOFs Φ_b (n_b × η), to
+    /// rebuild Φ = T_q + Ψ Φ_b for a projected damping matrix.
+    pub(super) modes_at_boundary: Option<Mat<f64>>,
 }
 
 impl ReducedModel {
@@ -158,6 +179,10 @@ impl ReducedModel {
     }
     /// Sets the reduced damping.
     pub fn set_damping(&mut self, damping: &Damping) -> Result<(), ReductionError> {
+        if self.method == Method::MasslessBoundary {
+            self.damping = super::massless::damping(self, damping)?;
+            return Ok(());
+        }
         self.damping = match damping {
             Damping::None => None,
             Damping::Rayleigh { alpha, beta } => Some(Mat::from_fn(self.n(), self.n(), |i, j| alpha * self.mass[(i, j)] + beta * self.stiffness[(i, j)])),
@@ -168,12 +193,7 @@ impl ReducedModel {
                 Some(self.project_matrix(c))
             }
             Damping::ModalRatios(z) => {
-                if z.is_empty() {
-                    return Err(ReductionError::Damping("no modal damping ratio given".into()));
-                }
-                if let Some(bad) = z.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
-                    return Err(ReductionError::Damping(format!("modal damping ratio {bad} is not a finite number ≥ 0")));
-                }
+                check_ratios(z)?;
                 let modes = dense_modes(self.stiffness.as_ref(), self.mass.as_ref(), self.n())?;
                 let n = self.n();
                 let mphi = &self.mass * &modes.shapes;
@@ -197,19 +217,20 @@ impl ReducedModel {
     }
 }
 
-fn symmetric(a: Mat<f64>) -> Mat<f64> {
-    let n = a.nrows();
-    Mat::from_fn(n, n, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]))
+/// Modal damping ratios: at least one, each finite and ≥ 0.
+pub(super) fn check_ratios(z: &[f64]) -> Result<(), ReductionError> {
+    if z.is_empty() {
+        return Err(ReductionError::Damping("no modal damping ratio given".into()));
+    }
+    if let Some(bad) = z.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
+        return Err(ReductionError::Damping(format!("modal damping ratio {bad} is not a finite number ≥ 0")));
+    }
+    Ok(())
 }
 
-/// Reduces (K, M) keeping `boundary` (full-model DOFs, any order, no repeats) physical.
-pub fn craig_bampton(
-    k: &SparseColMat<usize, f64>,
-    m: &SparseColMat<usize, f64>,
-    boundary: &[usize],
-    opts: &CraigBamptonOptions,
-) -> Result<ReducedModel, ReductionError> {
-    let t0 = Instant::now();
+/// The boundary as a mask over the full model's DOFs, checked (in range, no repeats), after
+/// checking that M and K have the same size.
+pub(super) fn boundary_mask(k: &SparseColMat<usize, f64>, m: &SparseColMat<usize, f64>, boundary: &[usize]) -> Result<Vec<bool>, ReductionError> {
     let n = k.nrows();
     if m.nrows() != n || k.ncols() != n || m.ncols() != n {
         return Err(ReductionError::SizeMismatch { m: m.nrows(), k: n });
@@ -224,6 +245,24 @@ pub fn craig_bampton(
         }
         is_b[d] = true;
     }
+    Ok(is_b)
+}
+
+pub(super) fn symmetric(a: Mat<f64>) -> Mat<f64> {
+    let n = a.nrows();
+    Mat::from_fn(n, n, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]))
+}
+
+/// Reduces (K, M) keeping `boundary` (full-model DOFs, any order, no repeats) physical.
+pub fn craig_bampton(
+    k: &SparseColMat<usize, f64>,
+    m: &SparseColMat<usize, f64>,
+    boundary: &[usize],
+    opts: &CraigBamptonOptions,
+) -> Result<ReducedModel, ReductionError> {
+    let t0 = Instant::now();
+    let n = k.nrows();
+    let is_b = boundary_mask(k, m, boundary)?;
     let nb = boundary.len();
     let internal: Vec<usize> = (0..n).filter(|&d| !is_b[d]).collect();
     let ni = internal.len();
@@ -287,7 +326,19 @@ pub fn craig_bampton(
     let stiffness = symmetric(basis.transpose() * sparse_times_dense(k, basis.as_ref()));
     timings.projection = t3.elapsed().as_secs_f64();
     timings.total = t0.elapsed().as_secs_f64();
-    Ok(ReducedModel { n_full: n, boundary: boundary.to_vec(), mass, stiffness, damping: None, interface_omega, interface_residual, timings, basis })
+    Ok(ReducedModel {
+        method: Method::CraigBampton,
+        n_full: n,
+        boundary: boundary.to_vec(),
+        mass,
+        stiffness,
+        damping: None,
+        interface_omega,
+        interface_residual,
+        timings,
+        basis,
+        modes_at_boundary: None,
+    })
 }
 
 /// Converts the engine's matrix to sparse (dense input is scanned for non-zeros).
@@ -308,12 +359,21 @@ pub fn to_sparse(a: &Matrix) -> SparseColMat<usize, f64> {
     }
 }
 
-/// Reduces an engine [`Structure`]. Its damping matrix, if any, is projected (Φᵀ C Φ) unless
-/// `damping` is given, which then replaces it.
-pub fn reduce_structure(s: &Structure, boundary: &[usize], opts: &CraigBamptonOptions, damping: Option<&Damping>) -> Result<ReducedModel, ReductionError> {
+/// Reduces an engine [`Structure`] by `method`. Its damping matrix, if any, is projected
+/// (Φᵀ C Φ) unless `damping` is given, which then replaces it.
+pub fn reduce_structure(
+    s: &Structure,
+    method: Method,
+    boundary: &[usize],
+    opts: &CraigBamptonOptions,
+    damping: Option<&Damping>,
+) -> Result<ReducedModel, ReductionError> {
     let k = to_sparse(&s.stiffness);
     let m = to_sparse(&s.mass);
-    let mut red = craig_bampton(&k, &m, boundary, opts)?;
+    let mut red = match method {
+        Method::CraigBampton => craig_bampton(&k, &m, boundary, opts)?,
+        Method::MasslessBoundary => super::massless::massless_boundary(&k, &m, boundary, opts)?,
+    };
     match (damping, &s.damping) {
         (Some(d), _) => red.set_damping(d)?,
         (None, Some(c)) => red.set_damping(&Damping::Matrix(to_sparse(c)))?,

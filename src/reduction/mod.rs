@@ -1,9 +1,13 @@
-//! Model reduction (Craig–Bampton) and modal analysis.
+//! Model reduction (Craig–Bampton, massless boundary) and modal analysis.
 pub mod craig_bampton;
 pub mod eigen;
+mod massless;
 
-pub use craig_bampton::{CraigBamptonOptions, DEFAULT_MODES, Damping, ReducedModel, ReductionError, Timings, craig_bampton, reduce_structure, to_sparse};
+pub use craig_bampton::{
+    CraigBamptonOptions, DEFAULT_MODES, Damping, Method, ReducedModel, ReductionError, Timings, craig_bampton, reduce_structure, to_sparse,
+};
 pub use eigen::{EigenError, LanczosOptions, Modes, dense_modes, lanczos, sparse_modes, symmetric_eigen};
+pub use massless::massless_boundary;
 
 use crate::model::Matrix;
 use std::f64::consts::PI;

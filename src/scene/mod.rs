@@ -10,7 +10,9 @@ mod contacts;
 mod error;
 mod friction;
 mod outputs;
+pub mod profile;
 mod reduce;
+mod rotor;
 mod settings;
 mod spec;
 mod structure;
@@ -45,8 +47,11 @@ pub struct SceneModel {
     pub reduction: Option<ReducedModel>,
     /// The checked casing, if `[casing]`.
     pub casing: Option<Casing>,
-    /// The scene's DOF of each contact, in contact order.
+    /// The scene's DOF that labels each contact (its normal's largest |coefficient|), in
+    /// contact order.
     pub contact_dofs: Vec<usize>,
+    /// Each contact's row of B (unit normal) in the scene's numbering, in contact order.
+    pub contact_rows: Vec<Vec<(usize, f64)>>,
     /// The scene's units (`[units]`, labels only) and DOF names, for the front ends.
     pub labels: Labels,
     /// Wall times of the set-up [s].
@@ -131,10 +136,16 @@ impl Scene {
 
         // Forces and contacts in the full numbering (user DOF kept for the labels), the casing.
         let forces = self.forces(&resolver)?;
-        let (mut contacts, contact_dofs) = self.contacts(&resolver)?;
+        let casing = self.checked_casing(dir)?;
+        let rotor = self.rotor(casing.as_ref(), &source)?;
+        let mut placed = self.contacts(&resolver, rotor.as_ref())?;
+        self.casing_motion(&mut placed, casing.as_ref(), &source, rotor)?;
+        let spec_pairings = self.contact_pairings()?;
+        let pairings: Vec<_> = placed.iter().map(|p| spec_pairings[p.spec]).collect();
+        let contact_rows: Vec<Vec<(usize, f64)>> = placed.iter().map(|p| p.user_row.clone()).collect();
+        let contact_dofs: Vec<usize> = contact_rows.iter().map(|r| crate::model::label_of(r).0).collect();
+        let contacts: Vec<_> = placed.into_iter().map(|p| p.contact).collect();
         let frictions = self.frictions(&resolver)?;
-        let pairings = self.contact_pairings()?;
-        let casing = self.casing_motion(&mut contacts, &source, &dofs)?;
         let outputs = self.outputs(&resolver, matches!(source, Source::Inline), &contact_dofs, &forces)?;
 
         // The reduction, or the full model.
@@ -142,12 +153,12 @@ impl Scene {
         let frequency = self.excitation.frequency;
         let (model, map, reduction) = match &self.reduction {
             None => {
-                let map = outputs::clamped_map(&outputs, &dofs, &contact_dofs, !self.structure.fixed.is_empty());
+                let map = outputs::clamped_map(&outputs, &dofs, &contact_rows, !self.structure.fixed.is_empty());
                 (Model { structure: full.clone(), forces, contacts, frequency, frictions }, map, None)
             }
             Some(spec) => {
                 let parts = reduce::FullModel { structure: &full, damping: &damping, forces: &forces, contacts: &contacts, frequency };
-                let (model, map, red) = reduce::reduce(spec, parts, &resolver, &outputs, &contact_dofs)?;
+                let (model, map, red) = reduce::reduce(spec, parts, &resolver, &outputs, &contact_rows)?;
                 (model, Some(map), Some(red))
             }
         };
@@ -171,6 +182,7 @@ impl Scene {
             reduction,
             casing,
             contact_dofs,
+            contact_rows,
             labels,
             timings,
             error_estimate: estimate,

@@ -9,7 +9,7 @@ use crate::time::Discretization;
 
 impl Scene {
     /// The outputs in the scene's numbering: `[output]`, or by default every DOF of a small
-    /// inline model, else the contact and loaded DOFs.
+    /// inline model, else the contact (label) and loaded DOFs.
     pub(super) fn outputs(&self, resolver: &Resolver, dense_inline: bool, contact_dofs: &[usize], forces: &[Force]) -> Result<OutputSelection, BuildError> {
         let dofs = resolver.dofs;
         Ok(match &self.output {
@@ -39,10 +39,10 @@ impl Scene {
 
 /// The map of an unreduced model: none when nothing is clamped (the numberings agree), else
 /// each output's scene DOF → its clamped DOF.
-pub(super) fn clamped_map(outputs: &OutputSelection, dofs: &DofMap, contact_dofs: &[usize], clamped: bool) -> Option<OutputMap> {
+pub(super) fn clamped_map(outputs: &OutputSelection, dofs: &DofMap, contact_rows: &[Vec<(usize, f64)>], clamped: bool) -> Option<OutputMap> {
     clamped.then(|| {
         let rows = outputs.dofs().into_iter().map(|u| (u, vec![(dofs.new_index(u).expect("checked"), 1.0)])).collect();
-        OutputMap { rows, contact_dofs: contact_dofs.to_vec(), effects: vec![] }
+        OutputMap { rows, contact_rows: contact_rows.to_vec(), effects: vec![] }
     })
 }
 
@@ -59,7 +59,7 @@ pub(super) fn problem(
         let n = model.n();
         for (name, list) in [("displacement", &outputs.displacement), ("velocity", &outputs.velocity), ("acceleration", &outputs.acceleration)] {
             if let Some((i, d)) = list.iter().enumerate().find(|(_, d)| **d >= n) {
-                return Err(BuildError::field(format!("output.{name}[{i}]"), format!("DOF {d} does not exist, the model has DOFs 0..{}", n - 1)));
+                return Err(BuildError::field(format!("output.{name}[{i}]"), format!("DOF {d} does not exist, the model has DOFs 0 to {}", n - 1)));
             }
         }
         return Ok(new(model, disc, outputs, solver)?);

@@ -1,11 +1,12 @@
-//! The `[reduction]` section: Craig–Bampton reduction of the clamped structure, with the contact
-//! DOFs (and `extra_boundary`) kept physical, and the outputs mapped back through x = Φ q.
+//! The `[reduction]` section: Craig–Bampton or massless-boundary reduction of the clamped
+//! structure, with the contact DOFs (and `extra_boundary`) kept physical, and the outputs mapped
+//! back through x = Φ q.
 use super::contacts::Resolver;
 use super::structure::DampingGiven;
 use super::{BuildError, ReductionSpec};
 use crate::model::{Contact, Force, Harmonic, Model, Structure};
 use crate::periodic::{OutputMap, OutputSelection};
-use crate::reduction::{CraigBamptonOptions, DEFAULT_MODES, Damping, ReducedModel, ReductionError};
+use crate::reduction::{CraigBamptonOptions, DEFAULT_MODES, Damping, Method, ReducedModel, ReductionError};
 
 /// The full (clamped) model's parts that the reduction projects.
 pub(super) struct FullModel<'a> {
@@ -22,11 +23,13 @@ pub(super) fn reduce(
     full: FullModel,
     resolver: &Resolver,
     outputs: &OutputSelection,
-    contact_dofs: &[usize],
+    contact_rows: &[Vec<(usize, f64)>],
 ) -> Result<(Model, OutputMap, ReducedModel), BuildError> {
-    if spec.method != "craig-bampton" {
-        return Err(BuildError::field("reduction.method", format!("is \"{}\", expected \"craig-bampton\"", spec.method)));
-    }
+    let method = match spec.method.as_str() {
+        "craig-bampton" => Method::CraigBampton,
+        "massless-boundary" => Method::MasslessBoundary,
+        other => return Err(BuildError::field("reduction.method", format!("is \"{other}\", expected \"craig-bampton\" or \"massless-boundary\""))),
+    };
     let boundary = boundary(spec, full.contacts, resolver)?;
     let damping = match (&full.damping.modal_ratios, full.damping.rayleigh, &full.structure.damping) {
         (Some(z), _, _) => Damping::ModalRatios(z.clone()),
@@ -36,7 +39,7 @@ pub(super) fn reduce(
     };
     let undamped = Structure { mass: full.structure.mass.clone(), stiffness: full.structure.stiffness.clone(), damping: None };
     let opts = CraigBamptonOptions { modes: spec.modes.unwrap_or(DEFAULT_MODES), ..Default::default() };
-    let red = crate::reduction::reduce_structure(&undamped, &boundary, &opts, Some(&damping)).map_err(|e| match e {
+    let red = crate::reduction::reduce_structure(&undamped, method, &boundary, &opts, Some(&damping)).map_err(|e| match e {
         ReductionError::TooManyModes { requested, internal } => BuildError::field(
             "reduction.modes",
             format!("is {requested}, but only {internal} internal DOFs remain besides the {} boundary DOFs", boundary.len()),
@@ -56,19 +59,24 @@ pub(super) fn reduce(
             forces.push(Force { dof: q, term: Harmonic { amplitude: f.term.amplitude * c, ..f.term.clone() } });
         }
     }
-    let contacts = full.contacts.iter().map(|c| Contact { dof: red.reduced_dof(c.dof).expect("contacts are boundary DOFs"), ..c.clone() }).collect();
+    // Every DOF of a contact's row is a boundary DOF: the row keeps its coefficients.
+    let contacts = full
+        .contacts
+        .iter()
+        .map(|c| Contact { row: c.row.iter().map(|&(d, v)| (red.reduced_dof(d).expect("contacts are boundary DOFs"), v)).collect(), ..c.clone() })
+        .collect();
     let model = Model { structure: red.structure(), forces, contacts, frequency: full.frequency, frictions: Vec::new() };
     let rows = outputs.dofs().into_iter().map(|u| (u, row(resolver.dofs.new_index(u).expect("checked")))).collect();
-    let map = OutputMap { rows, contact_dofs: contact_dofs.to_vec(), effects: vec!["reduction".into()] };
+    let map = OutputMap { rows, contact_rows: contact_rows.to_vec(), effects: vec!["reduction".into()] };
     Ok((model, map, red))
 }
 
 /// The boundary DOFs (full numbering): the contacts', then `extra_boundary`, each once.
 fn boundary(spec: &ReductionSpec, contacts: &[Contact], resolver: &Resolver) -> Result<Vec<usize>, BuildError> {
     let mut boundary: Vec<usize> = Vec::new();
-    for c in contacts {
-        if !boundary.contains(&c.dof) {
-            boundary.push(c.dof);
+    for &(d, _) in contacts.iter().flat_map(|c| &c.row) {
+        if !boundary.contains(&d) {
+            boundary.push(d);
         }
     }
     for (i, e) in spec.extra_boundary.iter().enumerate() {

@@ -104,24 +104,32 @@ impl std::fmt::Display for DofSpec {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ReductionSpec {
-    /// `"craig-bampton"`.
+    /// `"craig-bampton"` or `"massless-boundary"`.
     pub method: String,
-    /// Fixed-interface modes η (default [`crate::reduction::DEFAULT_MODES`]).
+    /// Fixed-interface (Craig–Bampton) or free-interface (massless boundary) modes η (default [`crate::reduction::DEFAULT_MODES`]).
     pub modes: Option<usize>,
     /// DOFs kept physical besides the contact DOFs.
     #[serde(default)]
     pub extra_boundary: Vec<DofSpec>,
 }
 
-/// An out-of-round casing with `lobes` lobes of depth `depth`, turning relative to the blade at
-/// Ω = excitation.frequency / lobes (see [`crate::scene::casing`] for the formula and signs).
+/// An out-of-round casing, turning relative to the blade at Ω = excitation.frequency / lobes
+/// (see [`crate::scene::casing`] for the formulas and signs). Its shape is one of: `depth` (L
+/// cosine lobes), `harmonics` (a Fourier series in the casing's angle) or `profile` (a sampled
+/// clearance change over one turn, from a CSV file).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CasingSpec {
-    /// Number of lobes = engine order EO (≥ 1).
-    pub lobes: u32,
-    /// Depth δ ≥ 0 of the lobes (the clearance varies by ±δ around each contact's `gap`).
-    pub depth: f64,
+    /// Symmetry order L = engine order (≥ 1; default 1 with `harmonics` or `profile`): the
+    /// problem's fundamental is ω = L·Ω, and every order of the shape is a multiple of L.
+    pub lobes: Option<u32>,
+    /// Depth δ ≥ 0 of L cosine lobes (the clearance varies by ±δ around each contact's `gap`).
+    pub depth: Option<f64>,
+    /// Clearance change Σ amplitude·cos(order·θ + phase) in the casing's angle θ [rad].
+    pub harmonics: Option<Vec<CasingHarmonicSpec>>,
+    /// A CSV file (path relative to the scene): header `angle_deg,clearance` or
+    /// `angle_rad,clearance`, then the clearance change at uniformly spaced angles over one turn.
+    pub profile: Option<String>,
     /// Casing radius R [m] (> 0).
     pub radius: f64,
     /// Stagger γ [degrees]: angle between the tip chord and the engine axis (default 0).
@@ -129,12 +137,27 @@ pub struct CasingSpec {
     pub stagger: f64,
     /// Rotation speed Ω [rad/s]; optional, must then equal excitation.frequency / lobes.
     pub speed: Option<f64>,
-    /// Phase φ0 of the lobes at t = 0 [rad] (default 0).
+    /// Phase φ0 of the lobes at t = 0 [rad] (default 0; with `depth` only).
     #[serde(default)]
     pub phase: f64,
     /// Circumferential arc position s [m] of each contact along the direction of rotation;
-    /// default: from the blade generator's node positions.
+    /// default: from the blade generator's node positions or the contacts' `position`.
     pub arc: Option<Vec<f64>>,
+    /// Matrix Market scenes: the rotation axis's direction (rotation by the right-hand rule),
+    /// for `normal = "radial"` and the contacts' angles from their `position`.
+    pub axis: Option<[f64; 3]>,
+    /// A point of the rotation axis (default the origin).
+    pub center: Option<[f64; 3]>,
+}
+
+/// One term of `casing.harmonics`: amplitude·cos(order·θ + phase).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CasingHarmonicSpec {
+    pub order: u32,
+    pub amplitude: f64,
+    #[serde(default)]
+    pub phase: f64,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -145,9 +168,6 @@ pub struct ExcitationSpec {
 }
 
 fn one() -> u32 {
-    1
-}
-fn plus_one() -> i32 {
     1
 }
 fn yes() -> bool {
@@ -185,16 +205,34 @@ pub struct ContactSpec {
     pub dof: Option<usize>,
     /// A generator's node instead of `dof`: `"LE"`, `"MC"`, `"TE"`.
     pub node: Option<String>,
+    /// `"tip"`: one contact on every mid-thickness tip node of the generated blade (LE to TE),
+    /// each along its radial normal.
+    pub nodes: Option<String>,
     /// With `node`: `"x"`, `"y"` or `"z"` (default `"z"`, radial).
     pub axis: Option<String>,
-    #[serde(default = "plus_one")]
-    pub direction: i32,
+    /// A node's DOFs (x, y, z) by index, for a `normal` in Matrix Market scenes.
+    pub dofs: Option<Vec<usize>>,
+    /// The contact's normal over the node's DOFs: `[nx, ny, nz]` (normalised) or `"radial"`.
+    pub normal: Option<NormalSpec>,
+    /// The node's coordinates (Matrix Market scenes), for `normal = "radial"` and the casing.
+    pub position: Option<[f64; 3]>,
+    /// +1 or −1 along a single DOF (default +1).
+    pub direction: Option<i32>,
     pub gap: f64,
     pub stiffness: Option<f64>,
     #[serde(default)]
     pub motion: Vec<HarmonicSpec>,
     /// `"same"` or `"forward"`: this contact's pairing, over `discretization.pairing`.
     pub pairing: Option<String>,
+}
+
+/// A contact normal: components, or a name (`"radial"`); anything else is refused by name.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(untagged)]
+pub enum NormalSpec {
+    Vector(Vec<f64>),
+    Name(String),
+    Invalid(toml::Value),
 }
 
 #[derive(Debug, Clone, Deserialize)]

@@ -19,7 +19,7 @@ pub fn model() -> Model {
             damping: Some(Matrix::from_rows(&[vec![0.1, 0.0], vec![0.0, 0.1]])),
         },
         forces: vec![Force { dof: 0, term: Harmonic { amplitude: 1.0, harmonic: 1, phase: 0.0 } }],
-        contacts: vec![Contact { dof: 1, direction: 1.0, gap: 0.3, compliance: Compliance::Compliant { stiffness: 20.0 }, motion: Vec::new() }],
+        contacts: vec![Contact::on_dof(1, 1.0, 0.3, Compliance::Compliant { stiffness: 20.0 })],
         frequency: 1.2,
         frictions: Vec::new(),
     }

@@ -234,7 +234,7 @@ fn logger_symbol() -> *const c_void {
     *f as *const c_void
 }
 
-/// The FMU binary built by `cargo build --release -p periodic-contact-fmu`.
+/// The FMU binary built by `cargo build --release`.
 pub fn fmu_binary() -> PathBuf {
     let mut roots = Vec::new();
     if let Some(d) = std::env::var_os("CARGO_TARGET_DIR") {
@@ -252,11 +252,7 @@ pub fn fmu_binary() -> PathBuf {
                 let built = std::fs::metadata(&p).and_then(|m| m.modified()).unwrap();
                 let root = Path::new(env!("CARGO_MANIFEST_DIR"));
                 if let Some(newer) = newest_source(&[root.join("src"), root.join("fmu/src")]).filter(|(t, _)| *t > built) {
-                    panic!(
-                        "{} is older than {} (the FMU embeds the engine): rebuild it with\n  cargo build --release -p periodic-contact-fmu",
-                        p.display(),
-                        newer.1.display()
-                    );
+                    panic!("{} is older than {} (the FMU embeds the engine): rebuild it with\n  cargo build --release", p.display(), newer.1.display());
                 }
                 return p;
             }
@@ -264,13 +260,13 @@ pub fn fmu_binary() -> PathBuf {
     }
     panic!(
         "the FMU binary libPeriodicContact.so was not found under {:?} (release, then debug).\n\
-         Build it first with:  cargo build --release -p periodic-contact-fmu",
+         Build it first with:  cargo build --release",
         roots
     );
 }
 
-/// The most recently modified Rust source under `dirs` (the CLI and the C API excepted: the FMU
-/// binary does not contain them).
+/// The most recently modified Rust source under `dirs` (the CLI excepted: the FMU binary does not
+/// contain it).
 fn newest_source(dirs: &[PathBuf]) -> Option<(std::time::SystemTime, PathBuf)> {
     let mut best: Option<(std::time::SystemTime, PathBuf)> = None;
     let mut stack: Vec<PathBuf> = dirs.to_vec();
@@ -282,7 +278,7 @@ fn newest_source(dirs: &[PathBuf]) -> Option<(std::time::SystemTime, PathBuf)> {
                 if !p.ends_with("bin") {
                     stack.push(p);
                 }
-            } else if p.extension().is_some_and(|x| x == "rs") && !p.ends_with("capi.rs") {
+            } else if p.extension().is_some_and(|x| x == "rs") {
                 let t = e.metadata().and_then(|m| m.modified()).unwrap();
                 if best.as_ref().is_none_or(|(b, _)| t > *b) {
                     best = Some((t, p));

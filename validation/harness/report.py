@@ -1,4 +1,4 @@
-"""A registry of measured numbers, written by the tests and dumped to figures/errors.md at the end
+"""A registry of measured numbers, written by the tests and dumped to errors.md in FIGURES at the end
 of the pytest session (conftest.py)."""
 from __future__ import annotations
 
@@ -6,7 +6,10 @@ import datetime
 import os
 from dataclasses import dataclass, field
 
-FIGURES = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "figures")
+VALIDATION = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+# Where the tests write figures and errors.md: validation/out/figures (ignored by git), so that a
+# test run leaves the clone clean. PC_FIGURES=validation/figures regenerates the committed ones.
+FIGURES = os.path.abspath(os.environ.get("PC_FIGURES") or os.path.join(VALIDATION, "out", "figures"))
 
 
 @dataclass

@@ -62,7 +62,7 @@ pub(super) struct Family {
 #[derive(Clone, Debug)]
 pub(super) struct Solved {
     pub v: Vec<f64>,
-    pub masks: Vec<u32>,
+    pub masks: Vec<u64>,
     pub jacobian: DMatrix<f64>,
     pub monodromy: DMatrix<f64>,
 }
@@ -117,7 +117,8 @@ impl Family {
         let mut fam = Family { base, path, rho, tolerance: 1e-10, max_iterations: 12, marches: 0, smoothing: 0.0, blocks: 2 };
         // The base as it is for a parameter (its λ may be any value), the path's start for tunings.
         let start = if matches!(path, Path::Tuning { .. }) { fam.problem_at(0.0).ok() } else { Some(fam.base.clone()) };
-        let sized = start.and_then(|p| step_map(&p).ok().map(|sm| sm.state_size() / p.model().n().max(1)));
+        // The state holds the DOFs with mass only (massless ones are condensed in each step).
+        let sized = start.and_then(|p| step_map(&p).ok().map(|sm| sm.state_size() / (p.model().n() - p.model().massless_dofs().len()).max(1)));
         fam.blocks = sized.unwrap_or(2).max(1);
         fam
     }
@@ -130,11 +131,17 @@ impl Family {
     /// The step map at λ.
     pub fn map_at(&self, lambda: f64) -> Result<StepMapLcp, Error> {
         let p = self.problem_at(lambda)?;
-        step_map(&p).map_err(|e| Error::input(format!("continuation needs the time-stepping map of a difference scheme: {}", e.0)))
+        step_map(&p).map_err(|e| {
+            Error::input(format!(
+                "continuation needs the time-stepping map of a difference scheme: {}; set [discretization] scheme = \"cds\" \
+                 (or bds1, bds2, galerkin), or trace the scene with `sweep`, which takes every scheme",
+                e.0
+            ))
+        })
     }
 
     /// F, its Jacobian and the active sets at v (the march tries `guess` first per step).
-    fn evaluate(&mut self, v: &[f64], guess: &[u32]) -> Option<(Vec<f64>, Solved)> {
+    fn evaluate(&mut self, v: &[f64], guess: &[u64]) -> Option<(Vec<f64>, Solved)> {
         let d = v.len() - 1;
         let lambda = v[d] * self.rho;
         let sm = self.map_at(lambda).ok()?;
@@ -162,7 +169,7 @@ impl Family {
     /// lower the defect is halved (up to 4 times): near a kink of the piecewise-affine map, full
     /// steps can cycle between two pieces, each piece's root lying in the other (met on the 2T
     /// branch of NLvib 03 at k = 4096, where the steps halved down to the smallest).
-    pub fn correct(&mut self, pred: &[f64], normal: &[f64], guess: &[u32]) -> Option<(Solved, usize)> {
+    pub fn correct(&mut self, pred: &[f64], normal: &[f64], guess: &[u64]) -> Option<(Solved, usize)> {
         let n = pred.len();
         let mut v = pred.to_vec();
         let (mut f, mut solved) = self.evaluate(&v, guess)?;
@@ -211,7 +218,7 @@ impl Family {
     }
 
     /// [dF/ds_0 | dF/d(λ/ρ)] at v on the piece of `masks` (the sets imposed, not solved for).
-    fn frozen_jacobian(&mut self, v: &[f64], masks: &[u32]) -> Option<DMatrix<f64>> {
+    fn frozen_jacobian(&mut self, v: &[f64], masks: &[u64]) -> Option<DMatrix<f64>> {
         let d = v.len() - 1;
         let lambda = v[d] * self.rho;
         let j = self.map_at(lambda).ok()?.period_jacobian(masks);
@@ -223,7 +230,7 @@ impl Family {
     }
 
     /// The active sets of the march from the state of v at its λ, `guess` tried first.
-    fn masks_at(&mut self, v: &[f64], guess: &[u32]) -> Option<Vec<u32>> {
+    fn masks_at(&mut self, v: &[f64], guess: &[u64]) -> Option<Vec<u64>> {
         let d = v.len() - 1;
         let sm = self.map_at(v[d] * self.rho).ok()?;
         self.marches += 1;
@@ -308,7 +315,7 @@ impl Family {
 
     /// The orbit at λ with these active sets: the fixed point of their affine piece of P,
     /// s = (I − J_s)⁻¹ P_frozen(0), then corrected at fixed λ.
-    pub fn start(&mut self, lambda: f64, masks: &[u32]) -> Option<Solved> {
+    pub fn start(&mut self, lambda: f64, masks: &[u64]) -> Option<Solved> {
         let sm = self.map_at(lambda).ok()?;
         let d = sm.state_size();
         let b = sm.march_frozen(&vec![0.0; d], masks)?;

@@ -45,8 +45,8 @@ const JUMP_MIN: f64 = 0.02;
 const MAX_STEPS: usize = 200;
 
 /// The active sets as bit masks per step (bit c: contact c).
-fn masks_of(set: &[usize], k: usize, m: usize) -> Vec<u32> {
-    let mut masks = vec![0u32; k];
+fn masks_of(set: &[usize], k: usize, m: usize) -> Vec<u64> {
+    let mut masks = vec![0u64; k];
     for &i in set.iter().filter(|&&i| m > 0 && i < k * m) {
         masks[i / m] |= 1 << (i % m);
     }

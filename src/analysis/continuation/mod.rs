@@ -12,89 +12,28 @@
 //! session ([`PeriodicSolver`]) solves it warm-started from the point's active sets, and its
 //! amplitudes are that certified response's.
 mod corrector;
+mod defences;
 mod events;
+mod exact;
 mod floquet;
 mod follow;
 pub mod output;
+mod parameter;
 mod switch;
 
 pub use events::EventKind;
 pub use floquet::multipliers;
 pub use follow::{Current, Followed, Jump, Resolved, Stability, amplitude, follow, resolve, stability};
+pub use parameter::Parameter;
 pub use switch::{run_switching, switch_at};
 
 use crate::error::Error;
 use crate::periodic::{PeriodicProblem, PeriodicSolver};
 use crate::response::Response;
 use corrector::{Family, Path};
+use defences::{ZIGZAG_BAND, ZIGZAG_STEPS, merge_fold_pairs, zigzag_in};
 use events::Node;
 use num_complex::Complex64;
-
-/// The continued parameter.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Parameter {
-    /// The excitation frequency ω [rad/s] (the period T = 2π/ω; k steps per period).
-    Frequency,
-    /// A factor on every force amplitude of the scene (1: the scene's forces).
-    ForceScale,
-    /// A length added to every contact's static clearance (0: the scene's gaps; negative closes
-    /// them, a preload).
-    GapOffset,
-    /// The casing's rotation speed Ω [rad/s]: the excitation frequency is ω = lobes·Ω (engine
-    /// order; the front end reads `lobes` from the scene's casing).
-    Speed { lobes: u32 },
-}
-
-impl Parameter {
-    /// From its CLI name.
-    pub fn parse(name: &str) -> Result<Parameter, Error> {
-        match name {
-            "frequency" => Ok(Parameter::Frequency),
-            "force_scale" => Ok(Parameter::ForceScale),
-            "gap_offset" => Ok(Parameter::GapOffset),
-            "speed" => Err(Error::input("--param speed: the casing's lobes are needed (ω = lobes·Ω): the scene's [casing] gives them")),
-            other => Err(Error::input(format!("--param: is \"{other}\"; continuation takes frequency, speed, force_scale or gap_offset"))),
-        }
-    }
-    pub fn name(self) -> &'static str {
-        match self {
-            Parameter::Frequency => "frequency",
-            Parameter::ForceScale => "force_scale",
-            Parameter::GapOffset => "gap_offset",
-            Parameter::Speed { .. } => "speed",
-        }
-    }
-    /// What the parameter is, for an axis or a column, with its quantity.
-    pub fn describe(self) -> (&'static str, crate::model::Quantity) {
-        use crate::model::Quantity;
-        match self {
-            Parameter::Frequency => ("excitation frequency ω", Quantity::Frequency),
-            Parameter::ForceScale => ("force scale (× the scene's forces)", Quantity::Ratio),
-            Parameter::GapOffset => ("gap offset (added to every clearance)", Quantity::Length),
-            Parameter::Speed { .. } => ("casing speed Ω (ω = lobes·Ω)", Quantity::Frequency),
-        }
-    }
-    /// Sets the parameter of `problem` (the scene's, unchanged until now) to `value`, checked.
-    fn apply(self, problem: &mut PeriodicProblem, value: f64) -> Result<(), Error> {
-        match self {
-            Parameter::Frequency => problem.set_frequency(value).map_err(Error::from),
-            Parameter::Speed { lobes } => problem.set_frequency(f64::from(lobes) * value).map_err(Error::from),
-            Parameter::ForceScale | Parameter::GapOffset => {
-                if !value.is_finite() {
-                    return Err(Error::input(format!("{}: is {value}, must be finite", self.name())));
-                }
-                let mut model = problem.model().clone();
-                if self == Parameter::ForceScale {
-                    model.forces.iter_mut().for_each(|f| f.term.amplitude *= value);
-                } else {
-                    model.contacts.iter_mut().for_each(|c| c.gap += value);
-                }
-                *problem = problem.with_model(model, problem.discretization())?;
-                Ok(())
-            }
-        }
-    }
-}
 
 /// Settings with defaults. Steps are arclengths in (s_0, λ/|to − from|).
 #[derive(Clone, Debug)]
@@ -114,11 +53,24 @@ pub struct ContinuationSettings {
     /// pairs 3e-5 to 2e-4 apart near the peak, none between the true folds 0.102 apart; the
     /// demo's oscillator at k = 256: wiggles 5e-4 to 6e-3 apart on its unstable branch).
     pub fold_merge: f64,
+    /// Largest arclength step of the exact walk (in y0/y_s, the event times over the period and
+    /// λ/|to − from|): its branch is smooth between grazings, and the tangents' angle limits the
+    /// step where it turns.
+    pub exact_max_step: f64,
 }
 
 impl Default for ContinuationSettings {
     fn default() -> Self {
-        ContinuationSettings { initial_step: 2e-3, min_step: 1e-9, max_step: 2e-2, max_points: 5000, tolerance: 1e-10, smoothing: 5e-3, fold_merge: 1e-2 }
+        ContinuationSettings {
+            initial_step: 2e-3,
+            min_step: 1e-9,
+            max_step: 2e-2,
+            max_points: 5000,
+            tolerance: 1e-10,
+            smoothing: 5e-3,
+            fold_merge: 1e-2,
+            exact_max_step: 0.1,
+        }
     }
 }
 
@@ -146,9 +98,29 @@ pub struct BranchPoint {
     /// The orbit's initial state s_0 (the step map's state).
     pub state: Vec<f64>,
     /// The active sets of the orbit's steps (bit c: contact c), for a switch of branch here.
-    pub(crate) masks: Vec<u32>,
+    pub(crate) masks: Vec<u64>,
     /// The branch's unit tangent in (s_0, λ/ρ) here, for a switch of branch.
     pub(crate) tangent: Vec<f64>,
+    /// What produced the point: the exact orbit, or the discrete walk on the grid.
+    pub source: Source,
+}
+
+/// What produced a point of the branch.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Source {
+    /// The exact hybrid orbit (exact flows between events, event times; [`exact`]).
+    Exact,
+    /// The discrete orbit of the grid's step map (its error is the scheme's at k).
+    Discrete,
+}
+
+impl Source {
+    pub fn name(self) -> &'static str {
+        match self {
+            Source::Exact => "exact",
+            Source::Discrete => "discrete",
+        }
+    }
 }
 
 /// A continued branch.
@@ -178,13 +150,63 @@ impl Branch {
     }
 }
 
-/// Continues the orbit of `problem` at λ = `from` (the session's solve, warm starts as in a
-/// sweep) in the parameter up to λ = `to`, or until the branch leaves [from, to] the other way.
-/// `on_point(λ)` after each point (a progress bar).
+/// Continues the orbit of `problem` at λ = `from` in the parameter up to λ = `to`, or until the
+/// branch leaves [from, to] the other way: the exact orbit's branch where the polish applies
+/// (compliant contacts, one forcing period: [`exact`]), the discrete walk ([`run_discrete`])
+/// where it does not, and from where the exact walk stopped short. Each point says which
+/// ([`BranchPoint::source`]). `on_point(λ)` after each point (a progress bar).
 pub fn run(problem: &PeriodicProblem, param: Parameter, from: f64, to: f64, settings: &ContinuationSettings, on_point: &dyn Fn(f64)) -> Result<Branch, Error> {
+    check_range(from, to)?;
+    let walked = match exact::walk(problem, param, from, to, settings, on_point) {
+        Ok(w) => w,
+        Err(e) => {
+            let mut b = run_discrete(problem, param, from, to, settings, on_point)?;
+            b.stop = format!("{} (discrete walk: {e})", b.stop);
+            return Ok(b);
+        }
+    };
+    let label = "T".to_string();
+    if walked.reached || walked.turned_back {
+        return Ok(Branch { parameter: param, points: walked.points, stop: walked.stop, marches: 0, period_multiple: 1, label });
+    }
+    // The rest of the range by the discrete walk, from where the exact one stopped.
+    let at = walked.points.last().map_or(from, |p| p.parameter);
+    let mut points = walked.points;
+    match run_discrete(problem, param, at, to, settings, on_point) {
+        Ok(rest) => {
+            points.extend(rest.points.into_iter().skip(1));
+            let stop = format!("{}; exact orbit up to {} = {at} ({}), discrete walk from there", rest.stop, param.name(), walked.stop);
+            Ok(Branch { parameter: param, points, stop, marches: rest.marches, period_multiple: 1, label })
+        }
+        Err(e) => Ok(Branch {
+            parameter: param,
+            points,
+            stop: format!("{}; the discrete walk from there failed: {e}", walked.stop),
+            marches: 0,
+            period_multiple: 1,
+            label,
+        }),
+    }
+}
+
+fn check_range(from: f64, to: f64) -> Result<(), Error> {
     if !(from.is_finite() && to.is_finite() && from != to) {
         return Err(Error::input(format!("--from/--to: are {from} and {to}, must be finite and different")));
     }
+    Ok(())
+}
+
+/// The discrete branch: pseudo-arclength on the grid's step map (its kinks, zigzags and fold
+/// chains handled as below), from the session's solve at λ = `from`.
+pub fn run_discrete(
+    problem: &PeriodicProblem,
+    param: Parameter,
+    from: f64,
+    to: f64,
+    settings: &ContinuationSettings,
+    on_point: &dyn Fn(f64),
+) -> Result<Branch, Error> {
+    check_range(from, to)?;
     let rho = (to - from).abs();
     let mut fam = family(problem, param, rho, settings);
     fam.map_at(from)?;
@@ -238,7 +260,7 @@ fn walk_from(
     solver.reset_warm_start();
     let first = solver.solve().map_err(|e| Error::from(e).context(format!("the start of the continuation at {name} = {from}")))?;
     let (k, m) = (solver.problem().instants(), solver.problem().model().contacts.len());
-    let mut masks = vec![0u32; k];
+    let mut masks = vec![0u64; k];
     for &i in &first.active_set {
         masks[i / m] |= 1 << (i % m);
     }
@@ -332,7 +354,7 @@ impl Walk<'_> {
         let mut turned = false;
         // The parameter of the last steps: a walk that only goes back and forth is in a zigzag.
         let mut recent: Vec<f64> = Vec::new();
-        let mut left: std::collections::VecDeque<Vec<u32>> = std::collections::VecDeque::new();
+        let mut left: std::collections::VecDeque<Vec<u64>> = std::collections::VecDeque::new();
         let mut zigzag = None;
         let stop = loop {
             if points.len() >= settings.max_points {
@@ -458,61 +480,6 @@ const CROSS_BELOW: f64 = 1e-4;
 /// Pieces of the map a walk remembers having left.
 const PIECES_REMEMBERED: usize = 64;
 
-/// Steps looked back at for a zigzag, the width of its band (relative to the range) and the
-/// least number of turns in it. The coarse blade at its tip (k = 1024): pieces of 1e-7 m, turns
-/// every 2–3 steps, over 0.15 rad/s of a range of 750.
-const ZIGZAG_STEPS: usize = 24;
-const ZIGZAG_BAND: f64 = 5e-4;
-const ZIGZAG_TURNS: usize = 6;
-
-/// (centre, lowest, highest) of the last [`ZIGZAG_STEPS`] parameters when they stay within
-/// `width` and turn back at least [`ZIGZAG_TURNS`] times.
-fn zigzag_in(recent: &[f64], width: f64) -> Option<(f64, f64, f64)> {
-    let last = recent.get(recent.len().checked_sub(ZIGZAG_STEPS)?..)?;
-    let (lo, hi) = last.iter().fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
-    let turns = last.windows(3).filter(|w| (w[1] - w[0]) * (w[2] - w[1]) < 0.0).count();
-    (hi - lo <= width && turns >= ZIGZAG_TURNS).then_some((0.5 * (lo + hi), lo, hi))
-}
-
-/// Folds in a chain of successive folds each closer than `width` to the last are the discrete
-/// branch's wiggles across its kinks, except one: a chain of odd length turns the branch back
-/// once, at its extreme parameter (the tip of a resonance, whose sides wiggle near it); one of
-/// even length does not turn it.
-fn merge_fold_pairs(points: &mut [BranchPoint], width: f64) {
-    let folds: Vec<usize> = (0..points.len()).filter(|&i| points[i].event == Some(EventKind::Fold)).collect();
-    let mut start = 0;
-    while start < folds.len() {
-        let mut end = start + 1;
-        while end < folds.len() && (points[folds[end]].parameter - points[folds[end - 1]].parameter).abs() < width {
-            end += 1;
-        }
-        // An odd chain turns the branch once, where its parameter is extreme (the largest when it
-        // came in rising) among the certified points the chain spans: the pieces' tangents that
-        // detect folds disagree in sign with the path's own motion near a sharp tip.
-        let (first, last) = (folds[start], folds[end - 1]);
-        let rising = first == 0 || points[first].parameter >= points[first - 1].parameter;
-        let extreme = |range: &mut dyn Iterator<Item = usize>| {
-            range.max_by(|&a, &b| {
-                let o = points[a].parameter.total_cmp(&points[b].parameter);
-                if rising { o } else { o.reverse() }
-            })
-        };
-        let turn = extreme(&mut (first..=last).filter(|&i| points[i].certified)).or_else(|| extreme(&mut folds[start..end].iter().copied()));
-        let detail = turn.map(|t| points[t].detail.clone()).unwrap_or_default();
-        for &i in &folds[start..end] {
-            points[i].event = None;
-            points[i].detail.clear();
-        }
-        if (end - start) % 2 == 1
-            && let Some(t) = turn
-        {
-            points[t].event = Some(EventKind::Fold);
-            points[t].detail = detail;
-        }
-        start = end;
-    }
-}
-
 /// The reported point of a node: multipliers, and the amplitudes of the session's certified solve
 /// warm-started from the node's active sets.
 fn point(fam: &Family, solver: &mut PeriodicSolver, node: &Node, event: Option<EventKind>, detail: String) -> Result<BranchPoint, Error> {
@@ -538,61 +505,16 @@ fn point(fam: &Family, solver: &mut PeriodicSolver, node: &Node, event: Option<E
         state: node.solved.v[..node.solved.v.len() - 1].to_vec(),
         masks: node.solved.masks.clone(),
         tangent: node.tangent.clone(),
+        source: Source::Discrete,
     })
 }
 
 /// Indices j·m + c of the active pairs (the LCP's z order), m contacts.
-fn active_set(masks: &[u32], m: usize) -> Vec<usize> {
+fn active_set(masks: &[u64], m: usize) -> Vec<usize> {
     masks.iter().enumerate().flat_map(|(j, mask)| (0..m).filter(move |c| mask >> c & 1 == 1).map(move |c| j * m + c)).collect()
 }
 
 /// Peak-to-peak/2 of each displacement output.
 fn amplitudes(problem: &PeriodicProblem, r: &Response) -> Vec<f64> {
     problem.outputs().displacement.iter().map(|d| r.displacement.get(&d.to_string()).map_or(0.0, |s| Response::peak_to_peak(s) / 2.0)).collect()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn at(parameter: f64, event: Option<EventKind>) -> BranchPoint {
-        BranchPoint {
-            parameter,
-            amplitude: vec![],
-            multipliers: vec![],
-            max_multiplier: 0.0,
-            stable: true,
-            period_multiple: 1,
-            event,
-            detail: String::new(),
-            certified: true,
-            state: vec![],
-            masks: vec![],
-            tangent: vec![],
-        }
-    }
-
-    #[test]
-    fn a_zigzag_is_a_narrow_band_walked_back_and_forth() {
-        let back_and_forth: Vec<f64> = (0..ZIGZAG_STEPS).map(|i| 10.0 + if i % 2 == 0 { 0.0 } else { 0.01 }).collect();
-        let (centre, lo, hi) = zigzag_in(&back_and_forth, 0.02).unwrap();
-        assert!((centre - 10.005).abs() < 1e-12 && lo == 10.0 && hi == 10.01);
-        assert_eq!(zigzag_in(&back_and_forth, 0.005), None, "wider than the band");
-        assert_eq!(zigzag_in(&back_and_forth[1..], 0.02), None, "too few steps");
-        let slow: Vec<f64> = (0..ZIGZAG_STEPS).map(|i| 10.0 + 1e-4 * i as f64).collect();
-        assert_eq!(zigzag_in(&slow, 0.02), None, "a slow walk is not a zigzag");
-    }
-
-    #[test]
-    fn an_odd_chain_of_folds_is_one_turn_at_its_extreme() {
-        let fold = Some(EventKind::Fold);
-        // Rising to a tip at 2.0 whose folds were detected late (1.99, 1.995, 1.98), then a real
-        // fold far below (1.0), and an even pair of wiggles (1.5, 1.499).
-        let params = [1.9, 1.99, 2.0, 1.995, 1.985, 1.98, 1.5, 1.499, 1.2, 1.0, 1.1];
-        let events = [None, fold, None, fold, None, fold, fold, fold, None, fold, None];
-        let mut points: Vec<BranchPoint> = params.iter().zip(events).map(|(&p, e)| at(p, e)).collect();
-        merge_fold_pairs(&mut points, 0.05);
-        let folds: Vec<f64> = points.iter().filter(|p| p.event == fold).map(|p| p.parameter).collect();
-        assert_eq!(folds, vec![2.0, 1.0]);
-    }
 }

@@ -6,13 +6,14 @@ use crate::periodic::PeriodicProblem;
 /// One row per point of each branch, in order: the parameter (named as given, with its unit),
 /// `amplitude_<dof> [unit]` per displacement output as in `sweep` (over the orbit's period),
 /// `stable`, `multiplier` (largest |μ| of the orbit's own monodromy, over p·T), `period_multiple`,
-/// `event`, `certified`, `branch` (its index: 0 the T branch, then the switched ones).
+/// `event`, `certified`, `branch` (its index: 0 the T branch, then the switched ones), `source`
+/// (`exact`: the exact orbit's branch; `discrete`: the grid's).
 pub fn to_csv(branches: &[Branch], problem: &PeriodicProblem, labels: &Labels) -> String {
     let mm = labels.unit(Quantity::Length);
     let Some(first) = branches.first() else { return String::new() };
     let mut head = vec![format!("{} {}", first.parameter.name(), labels.unit(first.parameter.describe().1))];
     head.extend(problem.outputs().displacement.iter().map(|d| format!("amplitude_{d} {mm}")));
-    head.extend(["stable", "multiplier", "period_multiple", "event", "certified", "branch"].map(String::from));
+    head.extend(["stable", "multiplier", "period_multiple", "event", "certified", "branch", "source"].map(String::from));
     let mut s = head.join(",") + "\n";
     for (b, p) in branches.iter().enumerate().flat_map(|(b, branch)| branch.points.iter().map(move |p| (b, p))) {
         let mut row = vec![format!("{:e}", p.parameter)];
@@ -23,6 +24,7 @@ pub fn to_csv(branches: &[Branch], problem: &PeriodicProblem, labels: &Labels) -
         row.push(p.event.map_or(String::new(), |e| e.name().to_string()));
         row.push(p.certified.to_string());
         row.push(b.to_string());
+        row.push(p.source.name().to_string());
         s.push_str(&row.join(","));
         s.push('\n');
     }
@@ -52,6 +54,7 @@ pub fn events_json(branches: &[Branch], problem: &PeriodicProblem) -> String {
                 "multipliers": p.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
                 "stable": p.stable,
                 "detail": p.detail,
+                "source": p.source.name(),
             })
         })
         .collect();
@@ -63,7 +66,7 @@ pub fn events_json(branches: &[Branch], problem: &PeriodicProblem) -> String {
 }
 
 /// PNG of displacement output `i` along the branch: stable runs solid, unstable runs dashed in the
-/// same colour, each event kind as markers of its own without a line; axes named with units.
+/// same colour, each event kind as hollow markers of its own shape without a line; axes named with units.
 #[cfg(feature = "plots")]
 pub fn plot(path: &std::path::Path, branches: &[Branch], problem: &PeriodicProblem, i: usize, labels: &Labels, title: &str) -> Result<(), crate::Error> {
     use crate::plot::{Chart, Legend, Line, Look, Scale, Series, styled_panel_chart};
@@ -95,11 +98,29 @@ pub fn plot(path: &std::path::Path, branches: &[Branch], problem: &PeriodicProbl
         push_run(run, stable, &mut series, &mut looks);
     }
     let kinds = [super::EventKind::Fold, super::EventKind::Grazing, super::EventKind::PeriodDoubling, super::EventKind::NeimarkSacker];
+    // Coincident events (a fold under a period doubling) are drawn side by side: each marker
+    // moves right by 1.2 % of the axis per earlier marker within 1 % of the axes of its place.
+    let extent = |f: &dyn Fn(&(f64, f64)) -> f64| {
+        let v = series.iter().flat_map(|s| s.points.iter()).map(f);
+        let (lo, hi) = v.fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| (l.min(x), h.max(x)));
+        (hi - lo).max(f64::MIN_POSITIVE)
+    };
+    let (dx, dy) = (extent(&|p| p.0), extent(&|p| p.1));
+    let mut placed: Vec<(f64, f64)> = Vec::new();
     for (j, kind) in kinds.into_iter().enumerate() {
-        let pts: Vec<(f64, f64)> = branches.iter().flat_map(|b| b.events()).filter(|p| p.event == Some(kind)).map(|p| (p.parameter, p.amplitude[i])).collect();
+        let events = branches.iter().flat_map(|b| b.events()).filter(|p| p.event == Some(kind));
+        let pts: Vec<(f64, f64)> = events
+            .map(|p| (p.parameter, p.amplitude[i]))
+            .map(|(x, y)| {
+                let near = placed.iter().filter(|q| (q.0 - x).abs() <= 0.01 * dx && (q.1 - y).abs() <= 0.01 * dy).count();
+                (x + 0.012 * dx * near as f64, y)
+            })
+            .collect();
+        placed.extend(branches.iter().flat_map(|b| b.events()).filter(|p| p.event == Some(kind)).map(|p| (p.parameter, p.amplitude[i])));
         if !pts.is_empty() {
             series.push(Series { label: kind.name().into(), points: pts, markers: true });
-            looks.push(Look { colour: branches.len() + j, line: Line::None, marker: Some(j % 3), hollow: false });
+            // Outlines of distinct shapes: coincident events (a fold under a period doubling) stay visible.
+            looks.push(Look { colour: branches.len() + j, line: Line::None, marker: Some(j % 3), hollow: true });
         }
     }
     let (what, quantity) = branches.first().map_or(("parameter", Quantity::Ratio), |b| b.parameter.describe());

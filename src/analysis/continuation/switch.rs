@@ -13,7 +13,7 @@
 //! period doubling was located with ([`Family::smoothed_monodromy`]).
 use super::corrector::Family;
 use super::events::Node;
-use super::{Branch, BranchPoint, ContinuationSettings, EventKind, Parameter, Walk, family, point, run};
+use super::{Branch, BranchPoint, ContinuationSettings, EventKind, Parameter, Walk, family, point, run_discrete};
 use crate::error::Error;
 use crate::periodic::{PeriodicProblem, PeriodicSolver};
 use nalgebra::DMatrix;
@@ -24,7 +24,8 @@ use nalgebra::DMatrix;
 /// k = 4096: the 2T orbit at 2 % of the amplitude lies 1.2e-4 in Ω past the doubling).
 const FIRST_STEP: f64 = 2e-2;
 
-/// Continues the T branch of `problem` from `from` to `to` ([`run`]), then, at each of its
+/// Continues the T branch of `problem` from `from` to `to` on the grid ([`run_discrete`]: the
+/// switch needs the discrete orbit's active sets), then, at each of its
 /// period doublings that no branch found so far has rejoined, switches to the 2T branch
 /// ([`switch_at`]) and continues it within [from, to]. Returns the branches, the T branch first,
 /// and why a switch failed where one did (the other branches are kept).
@@ -36,7 +37,7 @@ pub fn run_switching(
     settings: &ContinuationSettings,
     on_point: &dyn Fn(f64),
 ) -> Result<(Vec<Branch>, Vec<String>), Error> {
-    let t = run(problem, param, from, to, settings, on_point)?;
+    let t = run_discrete(problem, param, from, to, settings, on_point)?;
     let mut branches = vec![t];
     let doublings: Vec<usize> = (0..branches[0].points.len()).filter(|&i| branches[0].points[i].event == Some(EventKind::PeriodDoubling)).collect();
     // Where a 2T branch ended on the T branch: a doubling there is that branch's other end.
@@ -98,7 +99,7 @@ pub fn switch_at(
     let mut w: Vec<f64> = (0..=d).map(|i| if i < d { v[i] } else { 0.0 } - along * t[i]).collect();
     let norm = w.iter().map(|x| x * x).sum::<f64>().sqrt();
     w.iter_mut().for_each(|x| *x /= norm);
-    let masks2: Vec<u32> = pd.masks.iter().chain(&pd.masks).copied().collect();
+    let masks2: Vec<u64> = pd.masks.iter().chain(&pd.masks).copied().collect();
     let (start2, _) = fam2.correct(&star, &w, &masks2).ok_or_else(|| fail("the T orbit does not close as a 2T orbit"))?;
     let mut solver = PeriodicSolver::new(fam2.problem_at(pd.parameter)?);
     let head = Node::new(&mut fam2, start2, w.clone());
@@ -149,7 +150,7 @@ pub(super) struct Rejoin<'a> {
     /// P_T(s) − s at the last point.
     last: Vec<f64>,
     /// The T branch's period doublings (λ, s_0, active sets): where a 2T branch can end.
-    doublings: Vec<(f64, Vec<f64>, Vec<u32>)>,
+    doublings: Vec<(f64, Vec<f64>, Vec<u64>)>,
 }
 
 impl Rejoin<'_> {
@@ -185,7 +186,7 @@ impl Rejoin<'_> {
         };
         let mut star = state.clone();
         star.push(at / rho);
-        let masks2: Vec<u32> = masks.iter().chain(masks).copied().collect();
+        let masks2: Vec<u64> = masks.iter().chain(masks).copied().collect();
         let sec: Vec<f64> = star.iter().zip(&here.solved.v).map(|(b, a)| b - a).collect();
         let len = sec.iter().map(|x| x * x).sum::<f64>().sqrt();
         let tangent: Vec<f64> = sec.iter().map(|x| x / len).collect();

@@ -10,11 +10,13 @@
 //! is verified (clearance ≥ 0 of free rigid contacts and force ≥ 0 of stuck ones between the
 //! events, checked densely and at every local minimum; impulses ≥ 0; a pure impact may not call
 //! for sticking); otherwise the LCP's orbit is kept, with a warning that says why.
+mod continued;
 pub mod events;
 mod orbit;
 mod phase;
 mod verify;
 
+pub use continued::Touch;
 pub use events::{Event, EventKind};
 pub use orbit::{OrbitParts, PolishedOrbit, user_value};
 
@@ -30,6 +32,12 @@ pub struct PolishFailure(pub String);
 /// Polishes the orbit of `r` (solved from `problem`).
 pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<PolishedOrbit, PolishFailure> {
     let model = problem.model();
+    let massless = model.massless_dofs();
+    if !massless.is_empty() {
+        return Err(PolishFailure(format!(
+            "DOFs {massless:?} are massless (a massless boundary, src/formulation.md §4.1): the polish's exact flows need every DOF to carry mass; the LCP's orbit is kept"
+        )));
+    }
     if problem.period_multiple() != 1 {
         return Err(PolishFailure(format!(
             "the orbit spans period_multiple = {} forcing periods; the polish fits events over one period T only",

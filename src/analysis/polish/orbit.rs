@@ -35,7 +35,7 @@ pub struct PolishedOrbit {
     pub(super) period: f64,
     pub(super) events: Vec<Event>,
     /// Contacts closed all period long (no event).
-    always: Vec<usize>,
+    pub(super) always: Vec<usize>,
     /// Event times, increasing, times[0] ∈ [0, T) (a single 0 when there is no event).
     pub(super) times: Vec<f64>,
     /// The phase after each event (phases[e] runs from times[e] to times[e+1]).
@@ -46,9 +46,9 @@ pub struct PolishedOrbit {
     pub(super) after: Vec<DVector<f64>>,
     pub(super) impulses: Vec<f64>,
     gaps: Vec<phase::Harmonics>,
-    iterations: usize,
-    residual: f64,
-    correction: f64,
+    pub(super) iterations: usize,
+    pub(super) residual: f64,
+    pub(super) correction: f64,
     monodromy: DMatrix<f64>,
 }
 
@@ -83,7 +83,7 @@ impl PolishedOrbit {
         OrbitParts { events, always: self.always.clone(), y0: self.y0.iter().copied().collect() }
     }
 
-    fn new(model: &Model, evs: Vec<Event>, always: &[usize]) -> Result<Self, PolishFailure> {
+    pub(super) fn new(model: &Model, evs: Vec<Event>, always: &[usize]) -> Result<Self, PolishFailure> {
         let sets = events::phase_sets(model, &evs, always);
         let mut phases = Vec::new();
         let empty = vec![always.to_vec()];
@@ -95,7 +95,8 @@ impl PolishedOrbit {
                     .ok_or_else(|| PolishFailure("a phase's operator is singular at a forcing harmonic (undamped resonance)".into()))?,
             );
         }
-        let mut dofs: Vec<usize> = model.contacts.iter().map(|c| c.dof).collect();
+        // Stuck rows must stay orthonormal (phase.rs): contacts on disjoint DOFs.
+        let mut dofs: Vec<usize> = model.contacts.iter().flat_map(|c| c.row.iter().map(|e| e.0)).collect();
         dofs.sort_unstable();
         if dofs.windows(2).any(|w| w[0] == w[1]) {
             return Err(PolishFailure("two contacts act on the same DOF".into()));
@@ -121,7 +122,7 @@ impl PolishedOrbit {
         })
     }
 
-    fn gap(&self, i: usize, t: f64, order: u32) -> f64 {
+    pub(super) fn gap(&self, i: usize, t: f64, order: u32) -> f64 {
         let w = self.model.frequency;
         self.gaps[i]
             .iter()
@@ -129,10 +130,9 @@ impl PolishedOrbit {
             .sum()
     }
 
-    /// Clearance of contact `i` in state `y` at `t`: gap(t) − s·x_d.
+    /// Clearance of contact `i` in state `y` at `t`: gap(t) − B_i x.
     pub(super) fn clearance(&self, i: usize, y: &DVector<f64>, t: f64) -> f64 {
-        let c = &self.model.contacts[i];
-        self.gap(i, t, 0) - c.direction * y[c.dof]
+        self.gap(i, t, 0) - self.model.contacts[i].along(|d| y[d])
     }
 
     /// Plastic impact of contact `i` at `t`, the contacts `stuck` staying on their obstacles:
@@ -144,10 +144,7 @@ impl PolishedOrbit {
             set.push(i);
         }
         let m_inv = phase::dense(&self.model.structure.mass, n).try_inverse()?;
-        let b = DMatrix::from_fn(set.len(), n, |r, d| {
-            let c = &self.model.contacts[set[r]];
-            if c.dof == d { c.direction } else { 0.0 }
-        });
+        let b = DMatrix::from_fn(set.len(), n, |r, d| self.model.contacts[set[r]].row.iter().find(|e| e.0 == d).map_or(0.0, |e| e.1));
         let v = y.rows(n, n).into_owned();
         let rhs = &b * &v - DVector::from_fn(set.len(), |r, _| self.gap(set[r], t, 1));
         let p = (&b * &m_inv * b.transpose()).lu().solve(&rhs)?;
@@ -199,7 +196,7 @@ impl PolishedOrbit {
         Some(Shot { end: y, conditions: g, after, impulses: imp })
     }
 
-    fn residual_of(&self, u: &DVector<f64>) -> Option<DVector<f64>> {
+    pub(super) fn residual_of(&self, u: &DVector<f64>) -> Option<DVector<f64>> {
         let n2 = 2 * self.model.n();
         let y0 = u.rows(0, n2).into_owned();
         let tau: Vec<f64> = u.iter().skip(n2).copied().collect();
@@ -241,7 +238,9 @@ impl PolishedOrbit {
             i if i < 2 * n => 1.0 / rate(i - n),
             i => {
                 let e = self.events[i - 2 * n];
-                let k = s.stiffness.get(self.model.contacts[e.contact].dof, self.model.contacts[e.contact].dof).abs();
+                // n_iᵀ K n_i: the stiffness along the contact's normal.
+                let c = &self.model.contacts[e.contact];
+                let k = c.along(|a| c.along(|b| s.stiffness.get(a, b))).abs();
                 if e.kind == EventKind::Release && k > 0.0 { 1.0 / k } else { 1.0 }
             }
         })
@@ -325,12 +324,15 @@ impl PolishedOrbit {
     }
 
     /// The states after the events, the impulses and the monodromy of the orbit at y0 and times.
-    fn finish(&mut self) -> Result<(), PolishFailure> {
+    pub(super) fn finish(&mut self) -> Result<(), PolishFailure> {
         let fail = |w: &str| PolishFailure(w.to_string());
         let shot = self.shoot(&self.y0, &self.times).ok_or_else(|| fail("the converged orbit cannot be flowed"))?;
         self.after = shot.after;
         self.impulses = shot.impulses;
-        self.monodromy = self.stroboscopic().ok_or_else(|| fail("the monodromy could not be formed (an event condition is singular in its time: grazing)"))?;
+        self.monodromy = match self.flow_product() {
+            Some(m) => m,
+            None => self.stroboscopic().ok_or_else(|| fail("the monodromy could not be formed (an event condition is singular in its time: grazing)"))?,
+        };
         Ok(())
     }
 
@@ -450,11 +452,11 @@ impl PolishedOrbit {
         self.clearance(i, &self.state(tt), tt)
     }
 
-    /// Time derivative of contact `i`'s clearance at `t`: gap'(t) − s·v_d.
+    /// Time derivative of contact `i`'s clearance at `t`: gap'(t) − B_i v.
     pub fn clearance_rate(&self, i: usize, t: f64) -> f64 {
         let (_, tt) = self.locate(t);
-        let c = &self.model.contacts[i];
-        self.gap(i, tt, 1) - c.direction * self.state(tt)[self.model.n() + c.dof]
+        let y = self.state(tt);
+        self.gap(i, tt, 1) - self.model.contacts[i].along(|d| y[self.model.n() + d])
     }
 
     /// Acceleration of every DOF at `t` (between events).

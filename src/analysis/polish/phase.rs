@@ -1,9 +1,11 @@
 //! One linear phase between events, solved exactly: the contacts stuck on their obstacle and the
 //! compliant contacts closed are fixed, so M x'' + C x' + K x = f(t) is linear with harmonic
-//! forcing. The stuck DOFs follow their obstacle, x_c = s·gap(t); the free DOFs obey
-//! M_ff x_f'' + C_ff x_f' + K_ff x_f = f_f − M_fc x_c'' − C_fc x_c' − K_fc x_c, whose flow is the
-//! periodic particular solution plus e^{Aτ} applied to the rest (the matrix exponential of the
-//! first-order form, as in src/formulation.md §6.2 for one DOF).
+//! forcing. The stuck contacts follow their obstacle, B_S x = gap_S(t); with the stuck rows
+//! orthonormal (unit normals on disjoint DOFs) x = B_Sᵀ gap_S(t) + N x_f, N an orthonormal basis
+//! of B_S's null space (the free DOFs' unit vectors when every stuck row is one DOF), and the
+//! free coordinates obey Nᵀ M N x_f'' + Nᵀ C N x_f' + Nᵀ K N x_f = Nᵀ (f − M x_c'' − C x_c' − K x_c),
+//! x_c = B_Sᵀ gap_S, whose flow is the periodic particular solution plus e^{Aτ} applied to the rest
+//! (the matrix exponential of the first-order form, as in src/formulation.md §6.2 for one DOF).
 use crate::model::{Compliance, Model};
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64 as C;
@@ -16,9 +18,11 @@ pub(super) type Harmonics = Vec<(u32, DVector<C>)>;
 pub(super) struct Phase {
     pub n: usize,
     omega: f64,
-    /// Free DOFs and the stuck contacts (DOF, direction, contact index).
-    free: Vec<usize>,
-    stuck: Vec<(usize, f64, usize)>,
+    /// The free coordinates' basis N (n × n_f, orthonormal columns) and the stuck contacts.
+    free: DMatrix<f64>,
+    stuck: Vec<usize>,
+    /// Rows of B of the stuck contacts, dense (|stuck| × n).
+    b_stuck: DMatrix<f64>,
     /// Closed compliant contacts.
     closed: Vec<usize>,
     /// The full-model matrices of this phase (K with the closed compliant springs).
@@ -90,34 +94,43 @@ impl Phase {
         let c = s.damping.as_ref().map_or_else(|| DMatrix::zeros(n, n), |d| dense(d, n));
         let mut k = dense(&s.stiffness, n);
         let mut force = force_harmonics(model);
+        // A closed compliant contact adds k_c B_iᵀ B_i to K and k_c B_iᵀ gap_i(t) to f.
         for &i in closed {
             let ct = &model.contacts[i];
             let Compliance::Compliant { stiffness } = ct.compliance else { continue };
-            k[(ct.dof, ct.dof)] += stiffness;
+            for &(a, ca) in &ct.row {
+                for &(b, cb) in &ct.row {
+                    k[(a, b)] += stiffness * ca * cb;
+                }
+            }
             for (p, g) in gap_harmonics(model, i) {
-                add(&mut force, p, ct.dof, g[0] * stiffness * ct.direction, n);
+                for &(d, cd) in &ct.row {
+                    add(&mut force, p, d, g[0] * stiffness * cd, n);
+                }
             }
         }
-        let stuck: Vec<(usize, f64, usize)> = stuck.iter().map(|&i| (model.contacts[i].dof, model.contacts[i].direction, i)).collect();
         let mut presc: Harmonics = Vec::new();
-        for &(d, dir, i) in &stuck {
+        for &i in stuck {
             for (p, g) in gap_harmonics(model, i) {
-                add(&mut presc, p, d, g[0] * dir, n);
+                for &(d, cd) in &model.contacts[i].row {
+                    add(&mut presc, p, d, g[0] * cd, n);
+                }
             }
         }
-        let free: Vec<usize> = (0..n).filter(|d| !stuck.iter().any(|s| s.0 == *d)).collect();
-        let nf = free.len();
-        let sub = |a: &DMatrix<f64>, r: &[usize], cl: &[usize]| DMatrix::from_fn(r.len(), cl.len(), |i, j| a[(r[i], cl[j])]);
-        let mff_inv = if nf == 0 { DMatrix::zeros(0, 0) } else { sub(&m, &free, &free).try_inverse()? };
+        let b_stuck = DMatrix::from_fn(stuck.len(), n, |r, d| model.contacts[stuck[r]].row.iter().find(|e| e.0 == d).map_or(0.0, |e| e.1));
+        let free = null_basis(model, stuck);
+        let nf = free.ncols();
+        let sub = |a: &DMatrix<f64>| free.transpose() * a * &free;
+        let mff_inv = if nf == 0 { DMatrix::zeros(0, 0) } else { sub(&m).try_inverse()? };
         let mut a = DMatrix::zeros(2 * nf, 2 * nf);
         let mut speed = 1.0;
         if nf > 0 {
-            let mk = -&mff_inv * sub(&k, &free, &free);
+            let mk = -&mff_inv * sub(&k);
             let norm = mk.row_iter().map(|r| r.iter().map(|v| v.abs()).sum::<f64>()).fold(0.0, f64::max);
             speed = if norm > 0.0 && norm.is_finite() { norm.sqrt() } else { 1.0 };
             a.view_mut((0, nf), (nf, nf)).fill_with_identity();
             a.view_mut((nf, 0), (nf, nf)).copy_from(&mk);
-            a.view_mut((nf, nf), (nf, nf)).copy_from(&(-&mff_inv * sub(&c, &free, &free)));
+            a.view_mut((nf, nf), (nf, nf)).copy_from(&(-&mff_inv * sub(&c)));
         }
         // Free forcing per harmonic: f_f − (−(pω)² M_f· + ipω C_f· + K_f·) x_presc.
         let mut ps: Vec<u32> = force.iter().chain(&presc).map(|(p, _)| *p).collect();
@@ -131,7 +144,7 @@ impl Phase {
             let xp = presc.iter().find(|(q, _)| *q == p).map_or_else(|| DVector::zeros(n), |(_, v)| v.clone());
             let dyn_op = m.map(|v| C::new(-w * w * v, 0.0)) + c.map(|v| C::new(0.0, w * v)) + k.map(|v| C::new(v, 0.0));
             let rhs = fp - dyn_op * xp;
-            let g = DVector::from_fn(nf, |i, _| rhs[free[i]]);
+            let g = free.map(|v| C::new(v, 0.0)).transpose() * rhs;
             let acc = mff_inv.map(|v| C::new(v, 0.0)) * g;
             let mut b = DVector::zeros(2 * nf);
             if nf > 0 {
@@ -149,7 +162,7 @@ impl Phase {
             a.view_mut((0, nf), (nf, nf)).scale_mut(speed);
             a.view_mut((nf, 0), (nf, nf)).scale_mut(1.0 / speed);
         }
-        Some(Phase { n, omega, free, stuck, closed: closed.to_vec(), m, c, k, force, presc, a, speed, mff_inv, part })
+        Some(Phase { n, omega, free, stuck: stuck.to_vec(), b_stuck, closed: closed.to_vec(), m, c, k, force, presc, a, speed, mff_inv, part })
     }
 
     /// Whether compliant contact `i` is closed in this phase.
@@ -157,8 +170,18 @@ impl Phase {
         self.closed.contains(&i)
     }
 
+    /// The phase's fastest rate [rad/s] (the balancing speed, ≥ its ω_max): for sampling.
+    pub fn speed_hint(&self) -> f64 {
+        self.speed
+    }
+
+    /// No contact is stuck: the exponential acts on the whole state [x; v].
+    pub fn all_free(&self) -> bool {
+        self.stuck.is_empty()
+    }
+
     pub fn stuck_contacts(&self) -> impl Iterator<Item = usize> + '_ {
-        self.stuck.iter().map(|s| s.2)
+        self.stuck.iter().copied()
     }
 
     /// e^{A τ} of the free state [x_f; v_f], computed as D e^{Â τ} D⁻¹ with D = diag(I, speed·I):
@@ -166,7 +189,7 @@ impl Phase {
     /// (nalgebra's Padé `exp`) then loses about ω_max/ω_ref digits; balanced, ‖Â‖ ≈ ω_max
     /// (Higham, "Functions of Matrices", §10.3; the coarse blade's stall at ω_max = 6.3e5 rad/s).
     pub fn exp(&self, tau: f64) -> DMatrix<f64> {
-        let nf = self.free.len();
+        let nf = self.free.ncols();
         let mut e = (&self.a * tau).exp();
         if nf > 0 {
             e.view_mut((0, nf), (nf, nf)).scale_mut(1.0 / self.speed);
@@ -175,15 +198,19 @@ impl Phase {
         e
     }
 
+    /// [Nᵀ x; Nᵀ v] of the full state [x; v].
     fn free_state(&self, y: &DVector<f64>) -> DVector<f64> {
-        let nf = self.free.len();
-        DVector::from_fn(2 * nf, |i, _| if i < nf { y[self.free[i]] } else { y[self.n + self.free[i - nf]] })
+        let (n, nf) = (self.n, self.free.ncols());
+        let mut out = DVector::zeros(2 * nf);
+        out.rows_mut(0, nf).copy_from(&(self.free.transpose() * y.rows(0, n)));
+        out.rows_mut(nf, nf).copy_from(&(self.free.transpose() * y.rows(n, n)));
+        out
     }
 
     /// The full state [x; v] at `t1`, from the full state `y0` at `t0` (stuck DOFs of `y0` are
     /// ignored: they follow the obstacle); `e` is `self.exp(t1 − t0)`.
     pub fn flow_with(&self, e: &DMatrix<f64>, t0: f64, y0: &DVector<f64>, t1: f64) -> DVector<f64> {
-        let nf2 = 2 * self.free.len();
+        let nf2 = 2 * self.free.ncols();
         let p0 = eval(&self.part, self.omega, t0, 0, nf2);
         let p1 = eval(&self.part, self.omega, t1, 0, nf2);
         let yf = p1 + e * (self.free_state(y0) - p0);
@@ -194,19 +221,14 @@ impl Phase {
         self.flow_with(&self.exp(t1 - t0), t0, y0, t1)
     }
 
+    /// [x_c + N x_f; v_c + N v_f].
     fn assemble(&self, yf: &DVector<f64>, t: f64) -> DVector<f64> {
-        let (n, nf) = (self.n, self.free.len());
+        let (n, nf) = (self.n, self.free.ncols());
         let mut y = DVector::zeros(2 * n);
-        let x = eval(&self.presc, self.omega, t, 0, n);
-        let v = eval(&self.presc, self.omega, t, 1, n);
-        for &(d, _, _) in &self.stuck {
-            y[d] = x[d];
-            y[n + d] = v[d];
-        }
-        for (i, &d) in self.free.iter().enumerate() {
-            y[d] = yf[i];
-            y[n + d] = yf[nf + i];
-        }
+        let x = eval(&self.presc, self.omega, t, 0, n) + &self.free * yf.rows(0, nf);
+        let v = eval(&self.presc, self.omega, t, 1, n) + &self.free * yf.rows(nf, nf);
+        y.rows_mut(0, n).copy_from(&x);
+        y.rows_mut(n, n).copy_from(&v);
         y
     }
 
@@ -214,25 +236,50 @@ impl Phase {
     pub fn acceleration(&self, y: &DVector<f64>, t: f64) -> DVector<f64> {
         let n = self.n;
         let (x, v) = (y.rows(0, n).into_owned(), y.rows(n, n).into_owned());
-        let mut acc = eval(&self.presc, self.omega, t, 2, n);
+        let acc = eval(&self.presc, self.omega, t, 2, n);
         let rhs = eval(&self.force, self.omega, t, 0, n) - &self.c * &v - &self.k * &x - &self.m * &acc;
-        let g = DVector::from_fn(self.free.len(), |i, _| rhs[self.free[i]]);
-        let af = &self.mff_inv * g;
-        for (i, &d) in self.free.iter().enumerate() {
-            acc[d] = af[i];
-        }
-        acc
+        let af = &self.mff_inv * (self.free.transpose() * rhs);
+        acc + &self.free * af
     }
 
     /// Compressive force of each stuck contact (contact index, force) in state `y` at `t`:
-    /// z = s·(f − M a − C v − K x) at its DOF.
+    /// z = B_S (f − M a − C v − K x) (the residual is B_Sᵀ z, and B_S B_Sᵀ = I).
     pub fn stuck_forces(&self, y: &DVector<f64>, t: f64) -> Vec<(usize, f64)> {
         let n = self.n;
         let acc = self.acceleration(y, t);
         let (x, v) = (y.rows(0, n).into_owned(), y.rows(n, n).into_owned());
         let r = eval(&self.force, self.omega, t, 0, n) - &self.m * acc - &self.c * v - &self.k * x;
-        self.stuck.iter().map(|&(d, s, i)| (i, s * r[d])).collect()
+        let z = &self.b_stuck * r;
+        self.stuck.iter().enumerate().map(|(a, &i)| (i, z[a])).collect()
     }
+}
+
+/// An orthonormal basis N of the null space of the stuck rows, whose rows are unit normals on
+/// disjoint DOFs: e_d for every DOF no stuck row touches (ascending, so the free DOFs themselves
+/// when every stuck row is one DOF), then per stuck row over r > 1 DOFs the last r − 1 columns of
+/// the Householder reflection H = I − 2wwᵀ/wᵀw, w = n − σe_1, σ = −sign(n_1): H e_1 = σn, so its
+/// other columns are orthonormal and orthogonal to n (Golub & Van Loan §5.1.2).
+fn null_basis(model: &Model, stuck: &[usize]) -> DMatrix<f64> {
+    let n = model.n();
+    let touched = |d: usize| stuck.iter().any(|&i| model.contacts[i].row.iter().any(|e| e.0 == d));
+    let mut cols: Vec<DVector<f64>> = (0..n).filter(|&d| !touched(d)).map(|d| DVector::from_fn(n, |r, _| if r == d { 1.0 } else { 0.0 })).collect();
+    for &i in stuck {
+        let row = &model.contacts[i].row;
+        if row.len() < 2 {
+            continue;
+        }
+        let sigma = if row[0].1 >= 0.0 { -1.0 } else { 1.0 };
+        let w: Vec<f64> = row.iter().enumerate().map(|(a, e)| if a == 0 { e.1 - sigma } else { e.1 }).collect();
+        let ww: f64 = w.iter().map(|v| v * v).sum();
+        for b in 1..row.len() {
+            let mut col = DVector::zeros(n);
+            for (a, e) in row.iter().enumerate() {
+                col[e.0] = if a == b { 1.0 } else { 0.0 } - 2.0 * w[a] * w[b] / ww;
+            }
+            cols.push(col);
+        }
+    }
+    if cols.is_empty() { DMatrix::zeros(n, 0) } else { DMatrix::from_columns(&cols) }
 }
 
 /// The model's matrix as dense.

@@ -45,8 +45,8 @@ fn minimum(a: f64, b: f64, f: &dyn Fn(f64) -> f64) -> (f64, f64) {
 pub(super) fn check(o: &PolishedOrbit) -> Result<(), PolishFailure> {
     let model = &o.model;
     let ne = o.events.len().max(1);
-    // Scales: the largest displacement of a contact DOF and the largest force met.
-    let xs = o.after.iter().flat_map(|y| model.contacts.iter().map(move |c| y[c.dof].abs())).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
+    // Scales: the largest normal displacement of a contact and the largest force met.
+    let xs = o.after.iter().flat_map(|y| model.contacts.iter().map(move |c| c.along(|d| y[d]).abs())).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
     let loads: f64 = model.forces.iter().map(|f| f.term.amplitude.abs()).sum();
     let fs = o.impulses.iter().fold(loads, |m, p| m.max(p.abs() * model.frequency)).max(f64::MIN_POSITIVE);
     for (e, &p) in o.impulses.iter().enumerate() {

@@ -252,12 +252,9 @@ pub fn to_csv(param: &str, values: &[f64], problem: &PeriodicProblem, points: &[
     s
 }
 
-/// The user's DOF of each contact.
+/// The user's DOF that labels each contact (its normal's largest |coefficient|).
 pub fn contact_labels(problem: &PeriodicProblem) -> Vec<usize> {
-    match problem.output_map() {
-        Some(m) if !m.contact_dofs.is_empty() => m.contact_dofs.clone(),
-        _ => problem.model().contacts.iter().map(|c| c.dof).collect(),
-    }
+    (0..problem.model().contacts.len()).map(|a| crate::model::label_of(problem.user_row(a)).0).collect()
 }
 
 /// The frequency of the largest value of `amplitude(point)` over the solved points, if any.
@@ -282,9 +279,33 @@ pub fn frc_axes(param: &str, d: usize, labels: &Labels) -> (String, String) {
     (x, format!("amplitude of {} {} (peak-to-peak / 2)", labels.dof(d), labels.unit(Quantity::Length)))
 }
 
+/// The jumps of a swept curve, in sweep order: the pairs of neighbouring points between which
+/// the amplitude changes by more than a fifth of its range, five times the median change between
+/// neighbours and three times either neighbouring change (the sweep left a branch at a fold; a
+/// steep or under-resolved peak changes as much on its neighbouring steps, a jump alone).
+pub fn jumps(curve: &[(f64, f64)]) -> Vec<((f64, f64), (f64, f64))> {
+    let steps: Vec<f64> = curve.windows(2).map(|w| (w[1].1 - w[0].1).abs()).collect();
+    let (lo, hi) = curve.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| (l.min(p.1), h.max(p.1)));
+    let mut sorted = steps.clone();
+    sorted.sort_by(f64::total_cmp);
+    let Some(&median) = sorted.get(sorted.len() / 2) else { return Vec::new() };
+    let isolated = |j: usize| {
+        let around = steps.get(j.wrapping_sub(1)).copied().unwrap_or(0.0).max(steps.get(j + 1).copied().unwrap_or(0.0));
+        steps[j] > 3.0 * around
+    };
+    (0..steps.len()).filter(|&j| steps[j] > 0.2 * (hi - lo) && steps[j] > 5.0 * median && isolated(j)).map(|j| (curve[j], curve[j + 1])).collect()
+}
+
+/// The ratio of the larger to the smaller of two peaks (∞ when one is zero): above 10 a linear
+/// amplitude axis squashes the smaller curve, and the CLI suggests `--log-amplitude`.
+pub fn peak_ratio(a: f64, b: f64) -> f64 {
+    a.max(b) / a.min(b)
+}
+
 /// PNG of the frequency-response curve of displacement output `i`: with contact and linear,
-/// labelled with the DOF's name and the scene's units. `swept`: the parameter's name, its
-/// values and the points.
+/// labelled with the DOF's name and the scene's units, each jump of the contact curve drawn as a
+/// dashed vertical segment. `swept`: the parameter's name, its values and the points; `log`: a
+/// log amplitude axis.
 #[cfg(feature = "plots")]
 pub fn plot_frc(
     path: &std::path::Path,
@@ -293,19 +314,31 @@ pub fn plot_frc(
     i: usize,
     labels: &Labels,
     title: &str,
+    log: bool,
 ) -> Result<(), crate::Error> {
-    use crate::plot::{Chart, Scale, Series, line_chart};
+    use crate::plot::{Chart, Legend, Line, Look, Scale, Series, styled_panel_chart};
     let (param, values, points) = swept;
     let d = problem.outputs().displacement[i];
     let pts = |lin: bool| -> Vec<(f64, f64)> {
         values.iter().zip(points).filter(|(_, p)| p.error.is_none()).map(|(v, p)| (*v, if lin { p.linear_amplitude[i] } else { p.amplitude[i] })).collect()
     };
-    let series = [
-        Series { label: "with contact".into(), points: pts(false), markers: false },
+    let contact = pts(false);
+    let found = jumps(&contact);
+    let mut series = vec![
+        Series { label: "with contact".into(), points: contact, markers: false },
         Series { label: "linear (contact-free)".into(), points: pts(true), markers: false },
     ];
+    let mut looks =
+        vec![Look { colour: 0, line: Line::Solid, marker: None, hollow: false }, Look { colour: 1, line: Line::Solid, marker: None, hollow: false }];
+    for (j, (a, b)) in found.iter().enumerate() {
+        let x = 0.5 * (a.0 + b.0);
+        let label = if j == 0 { format!("jump ({} in the sweep)", found.len()) } else { String::new() };
+        series.push(Series { label, points: vec![(x, a.1), (x, b.1)], markers: true });
+        looks.push(Look { colour: 3, line: Line::Dashed, marker: Some(1), hollow: true });
+    }
     let (x_label, y_label) = frc_axes(param, d, labels);
     let title = format!("{title} of {}", labels.dof(d));
-    let chart = Chart { title: &title, x_label: &x_label, y_label: &y_label, x_scale: Scale::Linear, y_scale: Scale::Linear };
-    line_chart(path, &chart, &series, 1000, 650).map_err(crate::Error::from)
+    let y_scale = if log { Scale::Log } else { Scale::Linear };
+    let chart = Chart { title: &title, x_label: &x_label, y_label: &y_label, x_scale: Scale::Linear, y_scale };
+    styled_panel_chart(path, &[(&chart, &series, &looks)], 1, 1000, 650, Legend::Default).map_err(crate::Error::from)
 }

@@ -94,30 +94,37 @@ pub fn to_csv(param: &str, values: &[f64], spectra: &[Spectrum], labels: &Labels
     s
 }
 
-/// PNG of one spectrum, absolute levels in the scene's units on log axes, harmonic 0 (the mean)
-/// included: the displacement outputs in one panel, the contact forces in the other. Levels
-/// below 1e-9 of a panel's largest are round-off and left out.
+/// PNG of one spectrum, absolute levels in the scene's units as stems on a log axis, harmonic 0
+/// (the mean) included: the displacement outputs in one panel, the contact forces in the other.
+/// Levels below 1e-9 of a panel's largest are round-off and left out; several curves in a panel
+/// stand side by side around each harmonic, so that equal levels do not hide each other.
 #[cfg(feature = "plots")]
 pub fn plot(path: &std::path::Path, sp: &Spectrum, labels: &Labels, title: &str) -> Result<(), crate::Error> {
-    use crate::plot::{Chart, Legend, Scale, Series, panel_chart};
-    let series = |curves: Vec<(String, &Vec<f64>)>| -> Vec<Series> {
+    use crate::plot::{Chart, Legend, Line, Look, Scale, Series, styled_panel_chart};
+    let series = |curves: Vec<(String, &Vec<f64>)>| -> (Vec<Series>, Vec<Look>) {
         let floor = 1e-9 * curves.iter().flat_map(|(_, a)| a.iter().copied()).fold(0.0, f64::max);
+        let n = curves.len();
+        let width = 0.5 / sp.period_multiple.max(1) as f64;
         curves
             .into_iter()
-            .map(|(label, a)| {
+            .enumerate()
+            .map(|(c, (label, a))| {
+                let shift = if n > 1 { width * (c as f64 / (n - 1) as f64 - 0.5) } else { 0.0 };
                 let points: Vec<(f64, f64)> =
-                    a.iter().enumerate().filter(|(_, v)| **v > floor).map(|(j, v)| (j as f64 / sp.period_multiple.max(1) as f64, *v)).collect();
+                    a.iter().enumerate().filter(|(_, v)| **v > floor).map(|(j, v)| (j as f64 / sp.period_multiple.max(1) as f64 + shift, *v)).collect();
                 let label = if points.is_empty() { format!("{label} (zero)") } else { label };
-                Series { label, points, markers: true }
+                (Series { label, points, markers: true }, Look { colour: c, line: Line::Stems, marker: Some(0), hollow: false })
             })
-            .collect()
+            .unzip()
     };
     let shown = series(sp.displacement.iter().map(|(d, a)| (labels.dof(*d), a)).collect());
     let forces = series(sp.force.iter().map(|(i, d, a)| (format!("contact {i} at {}", labels.dof(*d)), a)).collect());
     let (y1, y2) = (format!("displacement amplitude {}", labels.unit(Quantity::Length)), format!("contact force amplitude {}", labels.unit(Quantity::Force)));
     let (t1, t2) = (format!("{title}: displacement"), format!("{title}: contact force"));
-    let x_label = "harmonic of ω (0: mean; steps of ω/p for an orbit of p periods)";
-    let c1 = Chart { title: &t1, x_label, y_label: &y1, x_scale: Scale::Linear, y_scale: Scale::Log };
-    let c2 = Chart { title: &t2, x_label, y_label: &y2, x_scale: Scale::Linear, y_scale: Scale::Log };
-    panel_chart(path, &[(&c1, &shown), (&c2, &forces)], 1, 1000, 1100, Legend::UpperRight).map_err(crate::Error::from)
+    let p = sp.period_multiple.max(1);
+    let x_label = if p == 1 { "harmonic of ω (0: mean)".to_string() } else { format!("harmonic of ω (0: mean; steps of ω/{p}, an orbit of {p} periods)") };
+    let c1 = Chart { title: &t1, x_label: &x_label, y_label: &y1, x_scale: Scale::Linear, y_scale: Scale::Log };
+    let c2 = Chart { title: &t2, x_label: &x_label, y_label: &y2, x_scale: Scale::Linear, y_scale: Scale::Log };
+    let panels = [(&c1, shown.0.as_slice(), shown.1.as_slice()), (&c2, forces.0.as_slice(), forces.1.as_slice())];
+    styled_panel_chart(path, &panels, 1, 1000, 1100, Legend::UpperRight).map_err(crate::Error::from)
 }

@@ -52,7 +52,52 @@ fn oscillator(steps: usize, family: Family, rng: Option<&mut SplitMix>) -> Membe
 /// The paper's case: the rigid reduced blade (23 DOFs after Craig–Bampton, 3 tip contacts).
 const BLADE: &str = include_str!("../../../fmu/scenes/blade-casing-rigid.toml");
 
-const CASES: [Case; 5] = [
+/// The size case (issue 23): a 100-DOF spring–mass chain given as dense matrices (the step map
+/// is dense in the state whatever the model, as a Craig–Bampton model's), 32 compliant stops on
+/// DOFs 1, 4, …, 94 from alternating sides, each obstacle moving at the forcing frequency
+/// so that every contact has a contact phase, cds with same pairing (compliant stops: second
+/// order). Contact stiffnesses 1–4, the springs' order: at 5–50 (tests/shooting.rs's draws)
+/// Newton on the period map does not converge with 12 or more stops (measured). Drawn: masses and springs 0.5–2, ω, the gaps, the obstacles' amplitudes and
+/// phases, the contact stiffnesses.
+fn reduced(steps: usize, mut rng: Option<&mut SplitMix>) -> Member {
+    let n = 100;
+    let omega = pick(&mut rng, 0.8, (0.6, 1.0));
+    let masses: Vec<f64> = (0..n).map(|_| pick(&mut rng, 1.0, (0.5, 2.0))).collect();
+    let springs: Vec<f64> = (0..=n).map(|_| pick(&mut rng, 1.0, (0.5, 2.0))).collect();
+    let row = |entry: &dyn Fn(usize) -> f64| format!("[{}]", (0..n).map(|j| format!("{}", entry(j))).collect::<Vec<_>>().join(", "));
+    let mass: Vec<String> = (0..n).map(|i| row(&|j| if i == j { masses[i] } else { 0.0 })).collect();
+    let stiffness: Vec<String> = (0..n)
+        .map(|i| {
+            row(&|j| match j {
+                _ if j == i => springs[i] + springs[i + 1],
+                _ if j == i + 1 => -springs[i + 1],
+                _ if j + 1 == i => -springs[i],
+                _ => 0.0,
+            })
+        })
+        .collect();
+    let mut scene = format!(
+        "[structure]\nmass = [{}]\nstiffness = [{}]\n\n[damping]\nrayleigh = [0.01, 0.02]\n\n[excitation]\nfrequency = {omega}\n\n\
+         [[force]]\ndof = 50\namplitude = 0.5\n\n",
+        mass.join(", "),
+        stiffness.join(", ")
+    );
+    for c in 0..32 {
+        let gap = pick(&mut rng, 0.1, (0.05, 0.15));
+        let amplitude = pick(&mut rng, 0.25, (0.2, 0.3));
+        let phase = pick(&mut rng, 0.2 * c as f64, (0.0, std::f64::consts::TAU));
+        let kc = pick(&mut rng, 2.0, (1.0, 4.0));
+        scene += &format!(
+            "[[contact]]\ndof = {}\ndirection = {}\ngap = {gap}\nstiffness = {kc}\nmotion = [{{ amplitude = {amplitude}, harmonic = 1, phase = {phase} }}]\n\n",
+            1 + 3 * c,
+            if c % 2 == 0 { 1 } else { -1 }
+        );
+    }
+    scene += &format!("[discretization]\nscheme = \"cds\"\nsteps = {steps}\npairing = \"same\"\n\n[output]\ndisplacement = [0, 50, 99]\n");
+    Member { scene, summary: format!("ω={omega:.3}, m̄={:.3}", masses.iter().sum::<f64>() / n as f64) }
+}
+
+const CASES: [Case; 6] = [
     Case {
         name: "rigid-stick",
         about: "rigid 1-DOF stop with sticking (0 < k·g0 < F; src/formulation.md §6.3): m = k = 1, F = 1, cds, forward pairing",
@@ -94,6 +139,11 @@ const CASES: [Case; 5] = [
             let scene = BLADE.replace("steps = \"auto\"", &format!("steps = {steps}")).replace("frequency = 2300.0", &format!("frequency = {omega}"));
             Member { scene, summary: format!("ω={omega:.1} rad/s") }
         },
+    },
+    Case {
+        name: "reduced",
+        about: "100-DOF model (dense matrices), 32 compliant stops (stiffness 1–4) against obstacles moving at ω, cds, same pairing (issue 23's size case: N = 32·k)",
+        member: reduced,
     },
 ];
 

@@ -9,23 +9,30 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 #[derive(clap::Args)]
+#[command(after_help = "The scene's scheme must be a difference scheme (cds, bds1, bds2, galerkin): continuation \
+    corrects on its time-stepping map, so fourier scenes are refused (trace them with `sweep`).")]
 pub struct Args {
+    /// The scene (TOML; see the README's "Scene format"): a difference scheme, not fourier.
     pub scene: PathBuf,
     /// The continued parameter: frequency (ω [rad/s]), speed (Ω [rad/s] of the casing; ω =
     /// lobes·Ω), force_scale (× every force of the scene) or gap_offset (added to every contact's
     /// clearance, length unit).
     #[arg(long, default_value = "frequency")]
     pub param: String,
+    /// Where the branch starts (the parameter's value; a cold solve there).
     #[arg(long, allow_negative_numbers = true)]
     pub from: f64,
+    /// Where the branch stops; it may pass folds and turn back on the way.
     #[arg(long, allow_negative_numbers = true)]
     pub to: f64,
     /// Output CSV; the events JSON and the PNG go next to it (same stem).
     #[arg(short, long, default_value = "branch.csv")]
     pub output: PathBuf,
-    /// Largest arclength step (in the state and the parameter over |to − from|).
-    #[arg(long, default_value_t = 2e-2)]
-    pub max_step: f64,
+    /// Largest arclength step (in the state and the parameter over |to − from|; the exact
+    /// walk's unknowns also hold the event times over the period). Default: 0.1 for the exact
+    /// orbit's branch, 2e-2 for the discrete walk.
+    #[arg(long)]
+    pub max_step: Option<f64>,
     /// At each period doubling of the T branch, switch to the 2T branch and continue it too
     /// (same CSV with a `branch` column, same events JSON and PNG).
     #[arg(long)]
@@ -46,8 +53,8 @@ pub fn run(a: &Args) -> Result<(), Failure> {
     if !(a.from.is_finite() && a.to.is_finite() && a.from > 0.0 && a.to > 0.0 && a.from != a.to) {
         return Err(Failure::input(format!("--from/--to: are {} and {}, must be finite, > 0 and different", a.from, a.to)));
     }
-    if !(a.max_step.is_finite() && a.max_step > 0.0) {
-        return Err(Failure::input(format!("--max-step: is {}, must be finite and > 0", a.max_step)));
+    if let Some(s) = a.max_step.filter(|s| !(s.is_finite() && *s > 0.0)) {
+        return Err(Failure::input(format!("--max-step: is {s}, must be finite and > 0")));
     }
     ensure_writable(&a.output, "--output")?;
     let t_all = Instant::now();
@@ -65,7 +72,11 @@ pub fn run(a: &Args) -> Result<(), Failure> {
         },
         other => Parameter::parse(other).map_err(Failure::from)?,
     };
-    let settings = ContinuationSettings { max_step: a.max_step, ..ContinuationSettings::default() };
+    let defaults = ContinuationSettings::default();
+    let settings = match a.max_step {
+        Some(s) => ContinuationSettings { max_step: s, exact_max_step: s, ..defaults },
+        None => defaults,
+    };
     let bar = if a.quiet { ProgressBar::hidden() } else { ProgressBar::new(1000) };
     bar.set_style(ProgressStyle::with_template("{spinner} continue [{bar:40}] {msg}, {elapsed_precise} elapsed").unwrap().progress_chars("=> "));
     let (from, to) = (a.from, a.to);
@@ -86,9 +97,10 @@ pub fn run(a: &Args) -> Result<(), Failure> {
     eprintln!("continue: {} branch(es) in {:.3} s → {}, {}", branches.len(), t_all.elapsed().as_secs_f64(), a.output.display(), json.display());
     for (i, b) in branches.iter().enumerate() {
         eprintln!(
-            "branch {i} ({}): {} points ({} events), {} marches of the period map; stop: {}",
+            "branch {i} ({}): {} points ({} from the exact orbit, {} events), {} marches of the period map; stop: {}",
             b.label,
             b.points.len(),
+            b.points.iter().filter(|p| p.source == continuation::Source::Exact).count(),
             b.events().count(),
             b.marches,
             b.stop

@@ -23,7 +23,7 @@ fn find_binary(explicit: Option<&Path>) -> Result<PathBuf, Failure> {
         return Ok(beside);
     }
     Err(Failure::input(format!(
-        "the FMU binary {BINARY_FILE} was not found at {}; build it with `cargo build --release -p periodic-contact-fmu` \
+        "the FMU binary {BINARY_FILE} was not found at {}; build it with `cargo build --release` \
          (it lands in target/release/), or name it with --binary PATH or {BINARY_ENV}=PATH",
         beside.display()
     )))

@@ -10,8 +10,10 @@ pub enum StudyCommand {
     /// the error estimates, the polish, time marching and Siconos on the same axes, on the exact
     /// references (rigid stop with sticking and with pure impacts, compliant stop, linear) and a
     /// 2-DOF compliant chain; then the estimates' honesty on random family members. Writes
-    /// DIR/accuracy.csv, estimate.csv, accuracy.md and accuracy.png (about 3 minutes).
+    /// DIR/accuracy.csv, estimate.csv, accuracy.md and accuracy.png (about 2 minutes on 2 cores:
+    /// the k sweep stops at --budget, 120 s by default).
     Accuracy {
+        /// The folder of the outputs (created).
         #[arg(short, long, default_value = "study")]
         output: PathBuf,
         /// k = 32 … 256, no peers, 2 members per family: for tests.
@@ -53,8 +55,10 @@ pub enum StudyCommand {
     /// Pivots and LCP time, cold against warm: a frequency sweep of the rigid stop and re-solves
     /// after a small frequency change. Writes DIR/warmstart.csv, warmstart.md and warmstart.png.
     Warmstart {
+        /// The folder of the outputs (created).
         #[arg(short, long, default_value = "study")]
         output: PathBuf,
+        /// k = 128 and 512, a 5-point sweep, one repeat: for tests.
         #[arg(long)]
         quick: bool,
         /// k values (default 256, 1024, 4096).

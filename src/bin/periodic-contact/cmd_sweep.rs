@@ -10,14 +10,18 @@ use std::time::Instant;
 
 #[derive(clap::Args)]
 pub struct Args {
+    /// The scene (TOML; see the README's "Scene format").
     pub scene: PathBuf,
     /// The swept parameter: frequency (ω [rad/s]) or speed (Ω [rad/s] of the casing; ω = lobes·Ω).
     #[arg(long, default_value = "frequency")]
     pub param: String,
+    /// First value of the swept parameter.
     #[arg(long, allow_negative_numbers = true)]
     pub from: f64,
+    /// Last value (below --from: the sweep runs downwards, warm-started in that direction).
     #[arg(long, allow_negative_numbers = true)]
     pub to: f64,
+    /// Number of equally spaced values, both ends included.
     #[arg(long, default_value_t = 100)]
     pub points: usize,
     /// Output CSV; the PNGs go next to it (same stem).
@@ -53,6 +57,10 @@ pub struct Args {
     /// Time steps per period of the march (a multiple of the LCP's steps; default: stable).
     #[arg(long)]
     pub march_steps: Option<usize>,
+    /// Log amplitude axis in the frequency-response PNGs (suggested when the contact and linear
+    /// peaks differ by more than 10×).
+    #[arg(long)]
+    pub log_amplitude: bool,
     /// No PNG.
     #[arg(long)]
     pub no_plot: bool,
@@ -143,10 +151,11 @@ pub fn run(a: &Args) -> Result<(), Failure> {
     let fallback = points.iter().filter(|p| p.cold_fallback).count();
     let asm: f64 = points.iter().map(|p| p.assembly_s).sum();
     let lcp: f64 = points.iter().map(|p| p.lcp_s).sum();
+    let threads = if a.threads == 0 { rayon::current_num_threads() } else { a.threads };
     eprintln!(
-        "sweep: {} points in {wall:.3} s wall ({} threads, {}): {} solved, {} failed; {} warm-started, {} cold fallbacks; {pivots} pivots; assembly {asm:.3} s + LCP {lcp:.3} s summed over points → {}",
+        "sweep: {} points in {wall:.3} s wall ({threads} thread{}, {}): {} solved, {} failed; {} warm-started, {} cold fallbacks; {pivots} pivots; assembly {asm:.3} s + LCP {lcp:.3} s summed over points → {}",
         points.len(),
-        if a.threads == 0 { rayon::current_num_threads() } else { a.threads },
+        if threads == 1 { "" } else { "s" },
         if a.cold { "cold" } else { "warm-started" },
         points.len() - failed.len(),
         failed.len(),
@@ -167,6 +176,14 @@ pub fn run(a: &Args) -> Result<(), Failure> {
                 li.1,
                 li.0
             );
+            let ratio = sweep::peak_ratio(nl.1, li.1);
+            if ratio > 10.0 && !a.log_amplitude && !a.no_plot {
+                eprintln!("  hint: the peaks differ by {ratio:.0}×: --log-amplitude draws both curves readably");
+            }
+        }
+        let curve: Vec<(f64, f64)> = values.iter().zip(&points).filter(|(_, p)| p.error.is_none()).map(|(v, p)| (*v, p.amplitude[i])).collect();
+        for (x, y) in sweep::jumps(&curve) {
+            eprintln!("  {}: jump between {} = {} and {} (amplitude {:.6e} → {:.6e})", labels.dof(*d), a.param, x.0, y.0, x.1, y.1);
         }
     }
     // The solver path only where a fallback was taken (the progress bar stays clean).
@@ -183,7 +200,8 @@ pub fn run(a: &Args) -> Result<(), Failure> {
         for (i, d) in problem.outputs().displacement.iter().enumerate() {
             // The first output's curve is <csv stem>.png, the others <csv stem>-dof<d>.png.
             let png = if i == 0 { sibling(&a.output, "", "png") } else { sibling(&a.output, &format!("-dof{d}"), "png") };
-            sweep::plot_frc(&png, (&a.param, &values, &points), problem, i, labels, &format!("{stem}: frequency response")).map_err(Failure::from)?;
+            sweep::plot_frc(&png, (&a.param, &values, &points), problem, i, labels, &format!("{stem}: frequency response"), a.log_amplitude)
+                .map_err(Failure::from)?;
             eprintln!("frequency-response curve of {} → {}", labels.dof(*d), png.display());
         }
     }
@@ -202,7 +220,9 @@ pub fn run(a: &Args) -> Result<(), Failure> {
             #[cfg(feature = "plots")]
             if !a.no_plot {
                 let png = sibling(&a.output, &format!("-spectrum-{v}"), "png");
-                let title = format!("spectrum at {} = {v} (ω = {f:.4} {})", a.param, labels.units.name(Quantity::Frequency));
+                let hz = labels.units.name(Quantity::Frequency);
+                let title =
+                    if a.param == "frequency" { format!("spectrum at ω = {v} {hz}") } else { format!("spectrum at {} = {v} (ω = {f:.4} {hz})", a.param) };
                 sweep::spectrum::plot(&png, &sp, labels, &title).map_err(Failure::from)?;
                 eprintln!("spectrum at {} = {v} → {}", a.param, png.display());
             }

@@ -25,6 +25,7 @@ struct Cli {
 enum Command {
     /// Solve a scene and write the periodic response as JSON.
     Solve {
+        /// The scene (TOML; see the README's "Scene format").
         scene: PathBuf,
         /// Output JSON file ("-" for stdout).
         #[arg(short, long, default_value = "result.json")]
@@ -47,8 +48,9 @@ enum Command {
         #[arg(long)]
         period_multiple: Option<i64>,
     },
-    /// Package a scene as an FMI 2.0 co-simulation FMU (needs `cargo build --release -p periodic-contact-fmu`).
+    /// Package a scene as an FMI 2.0 co-simulation FMU (needs `cargo build --release`).
     Fmu {
+        /// The scene (TOML) packaged into the FMU's resources.
         scene: PathBuf,
         /// Output .fmu file.
         #[arg(short, long)]
@@ -59,6 +61,7 @@ enum Command {
     },
     /// First eigenfrequencies of the full model and, with [reduction], of the reduced one.
     Modes {
+        /// The scene (TOML; see the README's "Scene format").
         scene: PathBuf,
         /// How many modes.
         #[arg(long, default_value_t = 10)]
@@ -72,7 +75,7 @@ enum Command {
     /// Benchmark over the class: time, pivots and peak memory per case and k, with random
     /// families (worst case first).
     Bench {
-        /// Cases (comma-separated): rigid-stick, rigid-impact, compliant, chain, blade, or all.
+        /// Cases (comma-separated): rigid-stick, rigid-impact, compliant, chain, blade, reduced, or all.
         #[arg(long, value_delimiter = ',', default_value = "rigid-stick")]
         case: Vec<String>,
         /// LCP sizes k to measure.
@@ -103,7 +106,9 @@ enum Command {
     /// Solve a raw LCP in Siconos' dense .dat format (block-circulant matrices are detected and
     /// solved by the fast path).
     Lcp {
+        /// The LCP: Siconos' dense .dat format (n, M row by row, q).
         file: PathBuf,
+        /// Output JSON file (z, w, status, pivots; "-" for stdout).
         #[arg(short, long, default_value = "-")]
         output: PathBuf,
         /// auto (block-circulant detection, fast path above N = 256), lemke (dense lexicographic
@@ -111,7 +116,7 @@ enum Command {
         #[arg(long, default_value = "auto")]
         method: String,
         /// Certification: ‖min(z, Az+q)‖∞ ≤ tolerance·max(1, ‖q‖∞).
-        #[arg(long, default_value_t = 1e-9)]
+        #[arg(long, default_value = "1e-9")]
         tolerance: f64,
     },
     /// Studies: accuracy against cost, warm starts.

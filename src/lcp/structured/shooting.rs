@@ -9,7 +9,8 @@
 //! takes over: at δ₀ no pair is active on the contact-free orbit, which is then the answer, and δ
 //! is brought to 0 by steps, each solved by Newton from a secant prediction of the previous.
 //! Nothing here is certified on the stacked LCP: the caller does that and falls back.
-use super::step_map::{Contacts, DenseLu, March, PhiPowers, StepMapLcp, march, period_jacobian};
+use super::jacobian::{PhiPowers, period_jacobian};
+use super::step_map::{Contacts, DenseLu, March, StepMapLcp, march};
 use faer::Mat;
 
 /// A defect Newton cannot lower on an unchanged piece is accepted up to this (relative): the
@@ -30,15 +31,20 @@ pub struct ShootingSettings {
     pub max_homotopy_steps: usize,
     /// ‖s − P(s)‖∞ ≤ tolerance · max(‖s‖∞, ‖c‖∞·k) ends Newton.
     pub tolerance: f64,
-    /// Estimated floating-point operations after which shooting gives up (about a second): the
-    /// caller's fallback (dense Lemke) is then the cheaper way. Why: the offset homotopy of a
-    /// stiff reduced model near resonance can meet hundreds of kinks, each a d³ Jacobian.
+    /// Estimated floating-point operations after which shooting gives up (about a second), at
+    /// least `work_iterations` Newton iterations' worth: the caller's fallback (dense Lemke) is
+    /// then the cheaper way on a small problem. Why: the offset homotopy of a stiff reduced
+    /// model near resonance can meet hundreds of kinks, each a Jacobian.
     pub max_work: f64,
+    /// The budget's floor in Newton iterations (a march and the costliest period Jacobian formed
+    /// so far): on a large problem one iteration alone passes `max_work` (≈ 10¹⁰ flops at d = 200,
+    /// k = 8192), and there is no cheaper fallback.
+    pub work_iterations: f64,
 }
 
 impl Default for ShootingSettings {
     fn default() -> Self {
-        ShootingSettings { max_iterations: 30, homotopy_iterations: 8, max_homotopy_steps: 200, tolerance: 1e-13, max_work: 6e9 }
+        ShootingSettings { max_iterations: 30, homotopy_iterations: 8, max_homotopy_steps: 200, tolerance: 1e-13, max_work: 6e9, work_iterations: 40.0 }
     }
 }
 
@@ -62,7 +68,7 @@ pub struct ShootingSolution {
     /// The closed orbit's initial state s_0.
     pub state: Vec<f64>,
     /// The active set of each step (bit c: pair c active) along that orbit.
-    pub masks: Vec<u32>,
+    pub masks: Vec<u64>,
     /// ‖s − P(s)‖∞ at the end.
     pub defect: f64,
     /// Newton iterations (Jacobians formed), homotopy steps included.
@@ -77,6 +83,10 @@ pub struct ShootingSolution {
     pub jacobians: usize,
     /// Where Newton started: "warm" (the given active sets), "free" (the contact-free orbit).
     pub start: &'static str,
+    /// Floating-point operations spent, estimated (marches and Jacobians).
+    pub work: f64,
+    /// Of which one Newton iteration at most: a march and the costliest period Jacobian.
+    pub work_per_iteration: f64,
 }
 
 /// Newton's state between iterations.
@@ -92,9 +102,12 @@ struct Newton<'a> {
     jacobians: usize,
     /// Floating-point operations spent, estimated (marches and Jacobians).
     work: f64,
+    /// One march, and the costliest Jacobian formed so far (0 before).
+    march_work: f64,
+    jacobian_work: f64,
     jac: Mat<f64>,
     /// The active sets `jac` belongs to.
-    jac_masks: Option<Vec<u32>>,
+    jac_masks: Option<Vec<u64>>,
 }
 
 /// An iterate with its march.
@@ -105,14 +118,13 @@ struct Iterate {
 }
 
 impl<'a> Newton<'a> {
-    fn march(&mut self, s: &[f64], shift: f64, guess: &[u32], jacobian: bool) -> Option<Iterate> {
+    fn march(&mut self, s: &[f64], shift: f64, guess: &[u64], jacobian: bool) -> Option<Iterate> {
         // Over budget every march fails, and so does every loop that needs one.
-        if self.work > self.settings.max_work {
+        if self.work > self.budget() {
             return None;
         }
         self.marches += 1;
-        let (k, d, m) = (self.sm.k as f64, self.sm.d as f64, self.sm.m as f64);
-        self.work += k * (d * d + 2.0 * d * m);
+        self.work += self.march_work;
         let m = march(self.sm, s, shift, Contacts::Solve(guess))?;
         self.changes += m.changes;
         if jacobian {
@@ -124,16 +136,21 @@ impl<'a> Newton<'a> {
 
     /// Makes `jac` the Jacobian of the piece of `masks`; P is affine on a piece, so a Jacobian
     /// is formed only when the sets change (Newton's last iterations keep them).
-    fn ensure_jacobian(&mut self, masks: &[u32]) {
+    fn ensure_jacobian(&mut self, masks: &[u64]) {
         if self.jac_masks.as_deref() != Some(masks) {
-            period_jacobian(self.sm, masks, &self.powers, &mut self.jac);
+            let products = period_jacobian(self.sm, masks, &self.powers, &mut self.jac);
             self.jac_masks = Some(masks.to_vec());
             self.jacobians += 1;
-            // Each active step costs a few d×d by d×(d+1) products (the powers of Φ and the
-            // correction).
-            let d = self.sm.d as f64;
-            self.work += masks.iter().filter(|&&m| m != 0).count().max(1) as f64 * 6.0 * d * d * (d + 1.0);
+            // (d+1)×(d+1) products of the runs' powers, 2(d+1)³ flops each.
+            let work = products.max(1) as f64 * 2.0 * (self.sm.d as f64 + 1.0).powi(3);
+            self.jacobian_work = self.jacobian_work.max(work);
+            self.work += work;
         }
+    }
+
+    /// The work allowed: `max_work`, or `work_iterations` Newton iterations when more.
+    fn budget(&self) -> f64 {
+        self.settings.max_work.max(self.settings.work_iterations * (self.march_work + self.jacobian_work))
     }
 
     fn size(&self, it: &Iterate) -> f64 {
@@ -145,7 +162,7 @@ impl<'a> Newton<'a> {
     }
 
     /// Newton from `s` at offset `shift`; Ok: converged iterate, Err: the best iterate met.
-    fn solve(&mut self, s: Vec<f64>, shift: f64, guess: &[u32], max_iterations: usize) -> Result<Iterate, Option<Iterate>> {
+    fn solve(&mut self, s: Vec<f64>, shift: f64, guess: &[u64], max_iterations: usize) -> Result<Iterate, Option<Iterate>> {
         let mut cur = match self.march(&s, shift, guess, true) {
             Some(it) => it,
             None => return Err(None),
@@ -190,7 +207,7 @@ impl<'a> Newton<'a> {
 
 /// Solves a step-map LCP by shooting. `warm`: active sets per step (bit masks) of a neighbouring
 /// answer, e.g. the previous frequency's; Newton then starts from the orbit those sets give.
-pub fn solve_shooting(sm: &StepMapLcp, warm: Option<&[u32]>, settings: &ShootingSettings) -> ShootingSolution {
+pub fn solve_shooting(sm: &StepMapLcp, warm: Option<&[u64]>, settings: &ShootingSettings) -> ShootingSolution {
     let (k, d) = (sm.k, sm.d);
     let scale = sm.c.iter().fold(0.0f64, |a, v| a.max(v.abs())) * k as f64;
     let mut nt = Newton {
@@ -203,6 +220,8 @@ pub fn solve_shooting(sm: &StepMapLcp, warm: Option<&[u32]>, settings: &Shooting
         changes: 0,
         jacobians: 0,
         work: 0.0,
+        march_work: k as f64 * (d as f64 * d as f64 + 2.0 * (d * sm.m) as f64),
+        jacobian_work: 0.0,
         jac: Mat::zeros(d, d + 1),
         jac_masks: None,
     };
@@ -218,6 +237,8 @@ pub fn solve_shooting(sm: &StepMapLcp, warm: Option<&[u32]>, settings: &Shooting
         changes: nt.changes,
         jacobians: nt.jacobians,
         start: if warm.is_some() { "warm" } else { "free" },
+        work: nt.work,
+        work_per_iteration: nt.march_work + nt.jacobian_work,
     };
     let done = |nt: &Newton<'_>, it: Iterate, homotopy_steps, start| ShootingSolution {
         outcome: ShootingOutcome::Converged,
@@ -231,6 +252,8 @@ pub fn solve_shooting(sm: &StepMapLcp, warm: Option<&[u32]>, settings: &Shooting
         changes: nt.changes,
         jacobians: nt.jacobians,
         start,
+        work: nt.work,
+        work_per_iteration: nt.march_work + nt.jacobian_work,
     };
     // The contact-free orbit: the fixed point of the affine map without contact.
     let Some(free) = fixed_point(&mut nt, Contacts::Free) else {
@@ -267,7 +290,7 @@ pub fn solve_shooting(sm: &StepMapLcp, warm: Option<&[u32]>, settings: &Shooting
 struct PathPoint {
     s: Vec<f64>,
     delta: f64,
-    sets: Vec<u32>,
+    sets: Vec<u64>,
 }
 
 /// The unit vector e_i of length n.
@@ -433,6 +456,7 @@ fn fixed_point(nt: &mut Newton<'_>, contacts: Contacts<'_>) -> Option<(Vec<f64>,
     let d = nt.sm.d;
     let zero = vec![0.0; d];
     nt.marches += 1;
+    nt.work += nt.march_work;
     let m0 = march(nt.sm, &zero, 0.0, contacts)?;
     nt.ensure_jacobian(&m0.masks);
     let a = Mat::from_fn(d, d, |i, j| if i == j { 1.0 } else { 0.0 } - nt.jac[(i, j)]);
@@ -441,6 +465,7 @@ fn fixed_point(nt: &mut Newton<'_>, contacts: Contacts<'_>) -> Option<(Vec<f64>,
         return None;
     }
     nt.marches += 1;
+    nt.work += nt.march_work;
     let m = march(nt.sm, &s, 0.0, contacts)?;
     Some((s, m))
 }

@@ -7,7 +7,7 @@
 //! axes; then the estimates' honesty on random members of the exact families
 //! ([`super::honesty`]). Writes `accuracy.csv`, `estimate.csv`, `accuracy.md`, `accuracy.png`.
 //!
-//! Cost caps (so that the whole run stays within about three minutes on 2 cores): the runs go
+//! Cost caps (so that the whole run stays within about 2 minutes on 2 cores): the runs go
 //! level by level (all cases and methods at k = 32, then at 64, …), so that the overall budget
 //! cuts the largest sizes first; a method stops growing k once its next run is predicted (from
 //! the growth of its last two runs) to take longer than `solve_cap_s`, and, for the choices that

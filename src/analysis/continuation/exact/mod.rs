@@ -1,0 +1,366 @@
+//! Continuation of the exact orbit (issue 24): branches that do not depend on the grid.
+//!
+//! The grid LCP and the polish give the first orbit and its event signature; from there the
+//! branch is continued on the exact hybrid orbit ([`family`]: state and event times, exact
+//! flows between events, pseudo-arclength in the parameter; Keller 1977). Stability: the
+//! multipliers of the exact monodromy (the phases' exponentials, identity saltation at compliant
+//! switches). Events between two points are located by bisection on the arc to 1e-12 of the
+//! scaled unknowns: fold (the tangent's parameter component), period doubling (det(I + M)),
+//! Neimark–Sacker (complex multipliers outside the unit circle), grazing (the signature changes).
+//! A grazing is met from either side: a contact's clearance touching zero between its events
+//! (located where the touch's sign flips; a pair of events is inserted there and the new branch
+//! starts with its phase 1e-5 of the period long), or a phase between two events of one contact
+//! shrinking below 1e-6 of the period (steps land on it by quarters; the pair is removed and the
+//! branch goes on in the same direction of the parameter). Compliant contacts only: a rigid one
+//! (impacts, sticking) is the discrete walk's.
+mod family;
+mod signature;
+
+use super::{BranchPoint, ContinuationSettings, EventKind, Parameter, Source, floquet};
+use crate::analysis::polish::{self, EventKind as Switch};
+use crate::error::Error;
+use crate::periodic::{PeriodicProblem, PeriodicSolver};
+use family::{Family, Node, Signature};
+
+/// A phase shorter than this (fraction of the period) and shrinking has vanished: a grazing.
+const VANISH: f64 = 1e-6;
+/// The phase of a pair of events just inserted at a grazing (fraction of the period).
+const NEW_PAIR: f64 = 1e-5;
+/// Bisection stops when the bracket is this short (scaled unknowns).
+const BRACKET: f64 = 1e-12;
+/// Successive tangents at a larger angle than arccos(this) mean a step too long.
+const MIN_COS: f64 = 0.9;
+/// A touch counts as a crossing below −this × the state scale (round-off of the flows).
+const TOUCH_TOL: f64 = 1e-10;
+
+/// One exact walk: its points, why it stopped, and whether it reached `to`.
+pub(super) struct Walked {
+    pub points: Vec<BranchPoint>,
+    pub stop: String,
+    pub reached: bool,
+    /// The branch left the range through `from` (turned back): nothing left to do.
+    pub turned_back: bool,
+}
+
+struct Walk<'a> {
+    problem: &'a PeriodicProblem,
+    fam: Family,
+    points: Vec<BranchPoint>,
+}
+
+/// The branch of the exact orbit from the orbit the session's solve and the polish find at
+/// λ = `from`, towards `to`. An error when no exact orbit can be had at `from`.
+pub(super) fn walk(
+    problem: &PeriodicProblem,
+    param: Parameter,
+    from: f64,
+    to: f64,
+    settings: &ContinuationSettings,
+    on_point: &dyn Fn(f64),
+) -> Result<Walked, Error> {
+    let model = problem.model();
+    if problem.period_multiple() != 1 {
+        return Err(Error::input("the exact continuation follows orbits of one forcing period (period_multiple = 1)"));
+    }
+    if let Some(i) = model.contacts.iter().position(|c| c.is_rigid()) {
+        return Err(Error::input(format!(
+            "contact[{i}] is rigid: the exact continuation takes compliant contacts only (impacts and sticking are the discrete walk's)"
+        )));
+    }
+    let rho = (to - from).abs();
+    let mut start = problem.clone();
+    param.apply(&mut start, from)?;
+    let mut solver = PeriodicSolver::new(start.clone());
+    let r = solver.solve().map_err(|e| Error::from(e).context(format!("the start of the continuation at {} = {from}", param.name())))?;
+    let orbit = polish::polish(&start, &r).map_err(|e| Error::solve(format!("no exact orbit at {} = {from}: {e}", param.name())))?;
+    let ys = orbit.initial_state().iter().fold(0.0f64, |m, y| m.max(y.abs())).max(1e-300);
+    let sig = Signature { events: orbit.events().to_vec(), always: orbit.always_closed().to_vec() };
+    let fam = Family::new(model, param, rho, ys, sig);
+    let d = fam.dim();
+    let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
+    let w0 = fam
+        .correct(&fam.pack(&orbit, from), &e_l, from / rho)
+        .ok_or_else(|| Error::solve(format!("the polished orbit at {} = {from} did not close as a function of the parameter", param.name())))?;
+    let dir = (to - from).signum();
+    let prev: Vec<f64> = e_l.iter().map(|x| x * dir).collect();
+    let here = fam.node(w0, &prev).ok_or_else(|| Error::solve(format!("singular Jacobian at {} = {from}", param.name())))?;
+    let mut walk = Walk { problem, fam, points: Vec::new() };
+    walk.push(&here, None, String::new());
+    on_point(from);
+    Ok(walk.follow(here, from, to, settings, on_point))
+}
+
+impl Walk<'_> {
+    fn push(&mut self, node: &Node, event: Option<EventKind>, detail: String) {
+        let lambda = node.lambda(self.fam.rho);
+        let map = self.problem.output_map();
+        let amplitude = self.problem.outputs().displacement.iter().map(|&d| node.orbit.amplitude(map, d).unwrap_or(f64::NAN)).collect();
+        let max_multiplier = floquet::largest(&node.mu);
+        self.points.push(BranchPoint {
+            parameter: lambda,
+            amplitude,
+            multipliers: node.mu.clone(),
+            max_multiplier,
+            stable: max_multiplier <= 1.0,
+            period_multiple: 1,
+            event,
+            detail,
+            certified: true,
+            state: node.orbit.initial_state().to_vec(),
+            masks: Vec::new(),
+            tangent: node.tangent.clone(),
+            source: Source::Exact,
+        });
+    }
+
+    fn name(&self) -> &'static str {
+        self.points.first().map_or("parameter", |_| "λ")
+    }
+
+    fn follow(mut self, mut here: Node, from: f64, to: f64, settings: &ContinuationSettings, on_point: &dyn Fn(f64)) -> Walked {
+        let rho = self.fam.rho;
+        let dir = (to - from).signum();
+        let mut ds = settings.initial_step;
+        let done = |points: Vec<BranchPoint>, stop: String, reached: bool, turned_back: bool| Walked { points, stop, reached, turned_back };
+        loop {
+            if self.points.len() >= settings.max_points {
+                let stop = format!("{} points (the limit)", settings.max_points);
+                return done(self.points, stop, false, false);
+            }
+            // A phase between two events of one contact shrinking to nothing: a grazing.
+            let shrinking = self.shrinking(&here);
+            if let Some(&(e, len, rate)) = shrinking.iter().find(|s| s.1 < VANISH) {
+                let _ = (len, rate);
+                match self.remove_pair(&here, e) {
+                    Some(next) => {
+                        here = next;
+                        ds = settings.initial_step;
+                        continue;
+                    }
+                    None => {
+                        let stop = format!("a phase of the orbit vanishes at λ = {} and the branch could not go on without it", here.lambda(rho));
+                        return done(self.points, stop, false, false);
+                    }
+                }
+            }
+            // Land on a vanishing phase by quarters.
+            let mut step = ds;
+            for &(_, len, rate) in &shrinking {
+                step = step.min(0.75 * len / rate);
+            }
+            let pred: Vec<f64> = here.w.iter().zip(&here.tangent).map(|(w, t)| w + step * t).collect();
+            let target: f64 = here.tangent.iter().zip(&pred).map(|(t, p)| t * p).sum();
+            let next = self.fam.correct(&pred, &here.tangent, target).and_then(|w| self.fam.node(w, &here.tangent));
+            let next = match next {
+                Some(n) if dot(&n.tangent, &here.tangent) >= MIN_COS || step <= settings.min_step => n,
+                _ => {
+                    ds = step / 2.0;
+                    if ds < settings.min_step {
+                        let stop = format!("no exact orbit at {} = {} with the smallest step", self.name(), here.lambda(rho));
+                        return done(self.points, stop, false, false);
+                    }
+                    continue;
+                }
+            };
+            // A contact's clearance crossed zero between its events: a grazing on the way.
+            let tol = TOUCH_TOL * self.fam.ys;
+            let crossed = |n: &Node| n.touches.iter().any(|t| t.value < -tol);
+            if crossed(&next) && !crossed(&here) {
+                match self.insert_pair(&here, &next, &crossed) {
+                    Some(n) => {
+                        on_point(n.lambda(rho));
+                        here = n;
+                        ds = settings.initial_step;
+                        continue;
+                    }
+                    None => {
+                        let stop = format!("a grazing near λ = {}: the branch with the new contact phase could not be started", here.lambda(rho));
+                        return done(self.points, stop, false, false);
+                    }
+                }
+            }
+            let lambda = next.lambda(rho);
+            let past_to = (lambda - to) * dir > 0.0;
+            let past_from = (lambda - from) * dir < 0.0;
+            let next = if past_to || past_from {
+                let bound = if past_to { to } else { from };
+                let (l0, w0) = (here.lambda(rho), &here.w);
+                let f = (bound - l0) / (lambda - l0);
+                let pred: Vec<f64> = w0.iter().zip(&next.w).map(|(a, b)| a + f * (b - a)).collect();
+                let d = self.fam.dim();
+                let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
+                self.fam.correct(&pred, &e_l, bound / rho).and_then(|w| self.fam.node(w, &here.tangent)).unwrap_or(next)
+            } else {
+                next
+            };
+            for (kind, node, detail) in self.events_between(&here, &next) {
+                self.push(&node, Some(kind), detail);
+            }
+            self.push(&next, None, String::new());
+            on_point(next.lambda(rho));
+            if past_to {
+                return done(self.points, "reached".into(), true, false);
+            }
+            if past_from {
+                let stop = format!("the branch turned back below {from}");
+                return done(self.points, stop, false, true);
+            }
+            here = next;
+            ds = (step * 1.5).min(settings.exact_max_step);
+        }
+    }
+
+    /// Phases between two events of one contact that shrink along the tangent: (phase, length,
+    /// rate of shrinking per unit arclength).
+    fn shrinking(&self, here: &Node) -> Vec<(usize, f64, f64)> {
+        let events = &self.fam.sig.events;
+        let ne = events.len();
+        let n2 = here.w.len() - 1 - ne;
+        (0..ne)
+            .filter(|&e| ne >= 2 && events[e].contact == events[(e + 1) % ne].contact)
+            .filter_map(|e| {
+                let b = (e + 1) % ne;
+                let len = here.w[n2 + b] - here.w[n2 + e] + if b == 0 { 1.0 } else { 0.0 };
+                let rate = here.tangent[n2 + e] - here.tangent[n2 + b];
+                (rate > 0.0).then_some((e, len, rate))
+            })
+            .collect()
+    }
+
+    /// The grazing at `here` where phase `e` has vanished: the point recorded, the pair of
+    /// events removed, and the first point of the branch without it, oriented in the parameter
+    /// as the branch came.
+    fn remove_pair(&mut self, here: &Node, e: usize) -> Option<Node> {
+        let rho = self.fam.rho;
+        let ev = self.fam.sig.events[e];
+        let before = self.fam.ne();
+        let (sig, guess) = signature::remove(&self.fam, &here.orbit, e, here.w[here.w.len() - 1])?;
+        let detail = format!(
+            "contact {}: events per period {before} -> {} (its {} phase vanishes)",
+            ev.contact,
+            sig.events.len(),
+            if ev.kind == Switch::On { "closed" } else { "open" }
+        );
+        self.push(here, Some(EventKind::Grazing), detail);
+        self.fam.sig = sig;
+        let d = self.fam.dim();
+        let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
+        let w = self.fam.correct(&guess, &e_l, here.lambda(rho) / rho)?;
+        let sign = here.tangent[here.tangent.len() - 1].signum();
+        let prev: Vec<f64> = e_l.iter().map(|x| x * if sign == 0.0 { 1.0 } else { sign }).collect();
+        self.fam.node(w, &prev)
+    }
+
+    /// The grazing between `here` and `next` where a contact's clearance first crosses zero
+    /// between its events: located, recorded, the pair of events inserted around the touch, and
+    /// the first point of the branch with its phase [`NEW_PAIR`] long.
+    fn insert_pair(&mut self, here: &Node, next: &Node, crossed: &dyn Fn(&Node) -> bool) -> Option<Node> {
+        let (lo, _) = bisect(&self.fam, here, next, &|n| !crossed(n), true)?;
+        for (kind, node, detail) in self.events_between(here, &lo) {
+            self.push(&node, Some(kind), detail);
+        }
+        let touch = *lo.worst_touch()?;
+        let before = self.fam.ne();
+        let wl = lo.w[lo.w.len() - 1];
+        let (sig, guess, (ia, ib)) = signature::insert(&self.fam, &lo.orbit, &touch, NEW_PAIR, wl);
+        let detail = format!(
+            "contact {}: events per period {before} -> {} (a {} phase begins)",
+            touch.contact,
+            sig.events.len(),
+            if touch.closed { "open" } else { "closed" }
+        );
+        self.push(&lo, Some(EventKind::Grazing), detail);
+        self.fam.sig = sig;
+        let d = self.fam.dim();
+        let n2 = d - 1 - self.fam.ne();
+        let mut normal = vec![0.0; d];
+        normal[n2 + ib] = 1.0;
+        normal[n2 + ia] = -1.0;
+        let wrap = if ib < ia { 1.0 } else { 0.0 };
+        let w1 = self.fam.correct(&guess, &normal, NEW_PAIR - wrap)?;
+        let mut g2 = w1.clone();
+        g2[n2 + ia] -= 0.5 * NEW_PAIR;
+        g2[n2 + ib] += 0.5 * NEW_PAIR;
+        let w2 = self.fam.correct(&g2, &normal, 2.0 * NEW_PAIR - wrap)?;
+        let sec: Vec<f64> = w2.iter().zip(&w1).map(|(a, b)| a - b).collect();
+        let first = self.fam.node(w1, &sec)?;
+        // Multiplier events across the grazing itself (both orbits are the same there).
+        for kind in [EventKind::PeriodDoubling, EventKind::NeimarkSacker] {
+            if side(&lo, kind) != side(&first, kind) {
+                self.push(&first, Some(kind), detail_of(kind, &first));
+            }
+        }
+        Some(first)
+    }
+
+    /// The events between two points of one signature, each located by bisection, in order.
+    fn events_between(&self, a: &Node, b: &Node) -> Vec<(EventKind, Node, String)> {
+        let mut found = Vec::new();
+        for kind in [EventKind::Fold, EventKind::PeriodDoubling, EventKind::NeimarkSacker] {
+            if side(a, kind) == side(b, kind) {
+                continue;
+            }
+            let s = side(a, kind);
+            let node = bisect(&self.fam, a, b, &|n| side(n, kind) == s, false).map_or_else(|| b.clone(), |(_, hi)| hi);
+            let detail = detail_of(kind, &node);
+            found.push((kind, node, detail));
+        }
+        let sec: Vec<f64> = b.w.iter().zip(&a.w).map(|(x, y)| x - y).collect();
+        let coord = |n: &Node| n.w.iter().zip(&a.w).zip(&sec).map(|((x, y), s)| (x - y) * s).sum::<f64>();
+        found.sort_by(|x, y| coord(&x.1).total_cmp(&coord(&y.1)));
+        found
+    }
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// The side of a point for an event's test function.
+fn side(n: &Node, kind: EventKind) -> i64 {
+    match kind {
+        EventKind::Fold => i64::from(n.tangent[n.tangent.len() - 1] > 0.0),
+        EventKind::PeriodDoubling => i64::from(floquet::doubling_sign(&n.mu)),
+        EventKind::NeimarkSacker => floquet::complex_outside(&n.mu) as i64,
+        EventKind::Grazing => 0,
+    }
+}
+
+fn detail_of(kind: EventKind, node: &Node) -> String {
+    match kind {
+        EventKind::NeimarkSacker => {
+            let m = node.mu.iter().find(|m| m.im.abs() > 1e-9 * m.norm()).copied().unwrap_or_default();
+            format!("pair {:.6} ± {:.6}i, |μ| = {:.9}", m.re, m.im.abs(), m.norm())
+        }
+        EventKind::PeriodDoubling => {
+            let m = node.mu.iter().min_by(|x, y| (*x + 1.0).norm().total_cmp(&(*y + 1.0).norm())).copied().unwrap_or_default();
+            format!("multiplier {:.9}", m.re)
+        }
+        _ => String::new(),
+    }
+}
+
+/// Bisection on the arc between `a` (where `same` holds) and `b` (where it does not): each trial
+/// point is the orbit on the hyperplane through the bracket's midpoint normal to its secant.
+/// The last points on either side (with their touches when `touches`).
+fn bisect(fam: &Family, a: &Node, b: &Node, same: &dyn Fn(&Node) -> bool, touches: bool) -> Option<(Node, Node)> {
+    let (mut lo, mut hi) = (a.clone(), b.clone());
+    for _ in 0..80 {
+        let sec: Vec<f64> = hi.w.iter().zip(&lo.w).map(|(x, y)| x - y).collect();
+        let len = sec.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if len <= BRACKET {
+            break;
+        }
+        let normal: Vec<f64> = sec.iter().map(|x| x / len).collect();
+        let pred: Vec<f64> = lo.w.iter().zip(&sec).map(|(x, s)| x + 0.5 * s).collect();
+        let target = dot(&normal, &pred);
+        let w = fam.correct(&pred, &normal, target)?;
+        let node = fam.node_with(w, &lo.tangent, touches)?;
+        if same(&node) {
+            lo = node;
+        } else {
+            hi = node;
+        }
+    }
+    Some((lo, hi))
+}
