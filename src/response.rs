@@ -30,6 +30,30 @@ pub struct ContactResponse {
     pub paired_gap: Vec<f64>,
 }
 
+/// One Coulomb friction contact at the instants (src/formulation.md §9). The force f acts on the
+/// structure as −bᵀf (like a contact force), so it has the sign of the slip: f = μN·sign(v) while
+/// slipping, |f| < μN while stuck, and f·v ≥ 0.
+#[derive(Clone, Debug, Serialize)]
+pub struct FrictionResponse {
+    /// μ.
+    pub coefficient: f64,
+    /// N (constant).
+    pub normal_force: f64,
+    /// k_t of a Jenkins element; null for rigid Coulomb friction.
+    pub stiffness: Option<f64>,
+    /// Friction force f ∈ [−μN, μN] at each instant.
+    pub force: Vec<f64>,
+    /// Slip velocity v at each instant: b ẋ by bds1's backward difference, or the slider's velocity
+    /// b ẋ − ḟ/k_t of a Jenkins element; 0 while stuck.
+    pub slip_velocity: Vec<f64>,
+    /// Whether the contact sticks (|f| < μN) at each instant.
+    pub stuck: Vec<bool>,
+    /// Tangential displacement u = b x at each instant (for force–displacement loops).
+    pub displacement: Vec<f64>,
+    /// Energy dissipated per period, h·Σ f_j v_j = ∮ f v dt ≥ 0.
+    pub dissipated_energy: f64,
+}
+
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct LcpSummary {
     /// k·m; 0 without contact.
@@ -87,6 +111,9 @@ pub struct Response {
     pub velocity: BTreeMap<String, Vec<f64>>,
     pub acceleration: BTreeMap<String, Vec<f64>>,
     pub contacts: Vec<ContactResponse>,
+    /// Coulomb friction contacts, in scene order (absent without `[[friction]]`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub friction: Vec<FrictionResponse>,
     pub lcp: LcpSummary,
     pub warnings: Vec<String>,
     pub timing_s: Timing,

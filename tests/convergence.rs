@@ -205,6 +205,7 @@ fn massless_contact_point(osc: &Oscillator, k2: f64, gap: f64, contact: Complian
         forces: vec![Force { dof: 0, term: Harmonic { amplitude: osc.force, harmonic: 1, phase: 0.0 } }],
         contacts: vec![Contact::on_dof(1, 1.0, gap, contact)],
         frequency: osc.omega,
+        frictions: Vec::new(),
     }
 }
 

@@ -239,6 +239,7 @@ fn planar_pair() -> Model {
             Contact { row: vec![(1, -1.0)], gap: 0.1, compliance: Compliance::Rigid, motion: vec![] },
         ],
         frequency: 1.2,
+        frictions: Vec::new(),
     }
 }
 
@@ -366,6 +367,7 @@ fn a_mass_along_a_normal_is_the_one_dof_rigid_stop() {
             forces: (0..dim).map(|d| Force { dof: d, term: Harmonic { amplitude: osc.force * n[d], harmonic: 1, phase: 0.0 } }).collect(),
             contacts: vec![Contact { row: n.iter().copied().enumerate().collect(), gap: 0.5, compliance: Compliance::Rigid, motion: vec![] }],
             frequency: osc.omega,
+            frictions: Vec::new(),
         };
         let outputs = OutputSelection { displacement: (0..dim).collect(), velocity: vec![], acceleration: vec![], contacts: true };
         let p = PeriodicProblem::new(model, Discretization { scheme: Scheme::Cds, steps: 256, pairing: None }, outputs, SolverSettings::default()).unwrap();

@@ -1232,6 +1232,7 @@ fn build_model(c: &ModelCase) -> Model {
             })
             .collect(),
         frequency: c.omega * scale,
+        frictions: Vec::new(),
     }
 }
 

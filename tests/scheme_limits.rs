@@ -28,6 +28,7 @@ fn chain_model(n: usize, sparse: bool, contacts: Vec<Contact>, frequency: f64) -
         forces: vec![Force { dof: 0, term: Harmonic { amplitude: 1.0, harmonic: 1, phase: 0.0 } }],
         contacts,
         frequency,
+        frictions: Vec::new(),
     }
 }
 

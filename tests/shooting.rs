@@ -132,6 +132,7 @@ fn random_chain(draw: &mut Draw, n: usize, m: usize, rigid: bool) -> Model {
         forces: vec![Force { dof: forced, term: Harmonic { amplitude: draw.range(0.5, 2.0), harmonic: 1, phase: 0.0 } }],
         contacts: Vec::new(),
         frequency: omega,
+        frictions: Vec::new(),
     };
     // The contact-free amplitude of each DOF, from a linear solve (no contact).
     let outputs = OutputSelection { displacement: (0..n).collect(), velocity: vec![], acceleration: vec![], contacts: false };
@@ -344,6 +345,7 @@ fn a_step_map_past_the_estimates_is_refused_with_its_figures() {
         forces: vec![Force { dof: 0, term: Harmonic { amplitude: 1.0, harmonic: 1, phase: 0.0 } }],
         contacts: vec![contact],
         frequency: 1.0,
+        frictions: Vec::new(),
     };
     let outputs = OutputSelection { displacement: vec![0], velocity: vec![], acceleration: vec![], contacts: true };
     let p =

@@ -11,11 +11,13 @@
 //! periodic assembly code, so that they can test it.
 mod compliant;
 mod flow;
+mod friction;
 mod linear;
 mod persistent;
 mod rigid;
 
 pub use compliant::CompliantStopOrbit;
+pub use friction::{FrictionOrbit, FrictionOscillator, den_hartog_amplitude};
 pub use linear::{LinearOrbit, LinearResponse, linear_response_dense};
 pub use persistent::PersistentContact;
 pub use rigid::{RigidRegime, RigidStopOrbit};
@@ -108,6 +110,7 @@ impl Oscillator {
             forces: vec![Force { dof: 0, term: Harmonic { amplitude: self.force, harmonic: 1, phase: 0.0 } }],
             contacts,
             frequency: self.omega,
+            frictions: Vec::new(),
         }
     }
 

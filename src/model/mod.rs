@@ -10,11 +10,13 @@
 //!
 //! Units are the user's, as long as they are consistent (e.g. kg, N/m, m, s; or t, N/mm, mm, s);
 //! a scene may name them ([`Units`]), for labels only.
+mod friction;
 mod matrix;
 mod spectrum;
 pub mod units;
 mod validate;
 
+pub use friction::Friction;
 pub use matrix::Matrix;
 pub use units::{Labels, Quantity, Units};
 pub use validate::ModelError;
@@ -147,6 +149,7 @@ pub struct Effects {
     pub contact: bool,
     pub compliance: bool,
     pub moving_obstacle: bool,
+    pub friction: bool,
 }
 
 impl Effects {
@@ -158,6 +161,7 @@ impl Effects {
             (self.contact, "contact"),
             (self.compliance, "compliance"),
             (self.moving_obstacle, "moving_obstacle"),
+            (self.friction, "friction"),
         ];
         all.iter().filter(|(on, _)| *on).map(|(_, n)| *n).collect()
     }
@@ -169,6 +173,8 @@ pub struct Model {
     pub structure: Structure,
     pub forces: Vec<Force>,
     pub contacts: Vec<Contact>,
+    /// Coulomb friction contacts (src/formulation.md §9); empty: none is assembled.
+    pub frictions: Vec<Friction>,
     /// Fundamental angular frequency ω [rad/s]; the period is T = 2π/ω.
     pub frequency: f64,
 }
@@ -194,6 +200,7 @@ impl Model {
             contact: !self.contacts.is_empty(),
             compliance: self.contacts.iter().any(|c| !c.is_rigid()),
             moving_obstacle: self.contacts.iter().any(|c| !c.motion.is_empty()),
+            friction: !self.frictions.is_empty(),
         }
     }
     /// The massless DOFs (sorted): a zero diagonal of M. After [`Model::validate`] their rows

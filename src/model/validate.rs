@@ -210,6 +210,9 @@ impl Model {
                 check_finite(format!("contact[{i}].motion[{h}].phase"), m.phase)?;
             }
         }
+        for (i, f) in self.frictions.iter().enumerate() {
+            f.check(i, n)?;
+        }
         Ok(())
     }
 }

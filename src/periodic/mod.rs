@@ -2,6 +2,7 @@
 //! recovery of the requested responses (src/formulation.md §2–3).
 mod assembly;
 mod cache;
+mod friction;
 pub mod limits;
 use crate::linalg::fft; // the crate's one FFT plan type, shared with lcp
 mod problem;
@@ -12,6 +13,7 @@ mod tuning;
 
 pub use assembly::Assembly;
 pub use fft::PeriodFft;
+pub use friction::{FRICTION_DENSE_MAX, FrictionGrid, friction_lcp};
 pub use problem::{MAX_DENSE_FLOPS, MAX_LCP_SIZE, MAX_STEPS, MIN_STEPS, PeriodicProblem};
 pub use recovery::render_path as render_lcp_path;
 pub use session::{PeriodicSolver, WarmStart};

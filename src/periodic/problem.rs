@@ -341,12 +341,17 @@ impl PeriodicProblem {
 
     /// The harmonic solves of this problem (Ĝ, X̂lin and Ẑ⁻¹Bᵀ at the recovered DOFs).
     pub(super) fn assemble(&self, fft: &PeriodFft) -> Result<Assembly, SolveError> {
-        assembly::assemble(&self.model, self.disc.scheme, self.period(), &self.recovery_dofs(), fft, self.solver.parallel)
+        // Friction contacts ride as extra rows of B (src/formulation.md §9).
+        let model = super::friction::with_rows(&self.model)?;
+        assembly::assemble(&model, self.disc.scheme, self.period(), &self.recovery_dofs(), fft, self.solver.parallel)
     }
 
     /// Solves with an assembly of this problem (a session's cached one); `t_start`: when the
     /// solve began, for the timings.
     pub(super) fn solve_assembled(&self, asm: &Assembly, fft: &PeriodFft, warm_start: Option<&[usize]>, t_start: Instant) -> Result<Response, SolveError> {
+        if !self.model.frictions.is_empty() {
+            return super::friction::solve(self, asm, fft, t_start);
+        }
         let (a, q) = self.lcp(asm, fft);
         self.check_lcp_finite(&a, &q)?;
         let t_assembly = t_start.elapsed().as_secs_f64();

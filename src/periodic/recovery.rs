@@ -139,6 +139,7 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
         velocity,
         acceleration,
         contacts,
+        friction: Vec::new(),
         lcp: LcpSummary {
             size: k * m,
             status: sol.outcome.name().to_string(),

@@ -9,6 +9,7 @@ pub mod casing;
 mod contacts;
 mod error;
 mod files;
+mod friction;
 mod outputs;
 pub mod profile;
 mod reduce;
@@ -21,6 +22,7 @@ mod units;
 pub use casing::Casing;
 pub use error::{BuildError, SceneError};
 pub use files::FileReference;
+pub use friction::FrictionSpec;
 pub use settings::{discretization, error_estimate, period_multiple, solver_settings};
 pub use spec::*;
 
@@ -148,6 +150,7 @@ impl Scene {
         let contact_rows: Vec<Vec<(usize, f64)>> = placed.iter().map(|p| p.user_row.clone()).collect();
         let contact_dofs: Vec<usize> = contact_rows.iter().map(|r| crate::model::label_of(r).0).collect();
         let contacts: Vec<_> = placed.into_iter().map(|p| p.contact).collect();
+        let frictions = self.frictions(&resolver)?;
         let outputs = self.outputs(&resolver, matches!(source, Source::Inline), &contact_dofs, &forces)?;
 
         // The reduction, or the full model.
@@ -156,7 +159,7 @@ impl Scene {
         let (model, map, reduction) = match &self.reduction {
             None => {
                 let map = outputs::clamped_map(&outputs, &dofs, &contact_rows, !self.structure.fixed.is_empty());
-                (Model { structure: full.clone(), forces, contacts, frequency }, map, None)
+                (Model { structure: full.clone(), forces, contacts, frequency, frictions }, map, None)
             }
             Some(spec) => {
                 let parts = reduce::FullModel { structure: &full, damping: &damping, forces: &forces, contacts: &contacts, frequency };

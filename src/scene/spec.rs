@@ -11,6 +11,9 @@ pub struct Scene {
     pub force: Vec<ForceSpec>,
     #[serde(default)]
     pub contact: Vec<ContactSpec>,
+    /// Coulomb friction contacts (`[[friction]]`, see [`crate::scene::FrictionSpec`]).
+    #[serde(default)]
+    pub friction: Vec<super::FrictionSpec>,
     #[serde(default)]
     pub discretization: DiscretizationSpec,
     pub output: Option<OutputSpec>,

@@ -21,6 +21,7 @@ pub fn model() -> Model {
         forces: vec![Force { dof: 0, term: Harmonic { amplitude: 1.0, harmonic: 1, phase: 0.0 } }],
         contacts: vec![Contact::on_dof(1, 1.0, 0.3, Compliance::Compliant { stiffness: 20.0 })],
         frequency: 1.2,
+        frictions: Vec::new(),
     }
 }
 

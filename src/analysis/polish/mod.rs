@@ -44,6 +44,9 @@ pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<PolishedOrbit, 
             problem.period_multiple()
         )));
     }
+    if !model.frictions.is_empty() {
+        return Err(PolishFailure("the polish does not fit stick and slip events yet: friction contacts (src/formulation.md §9) keep the LCP's orbit".into()));
+    }
     if r.contacts.len() != model.contacts.len() {
         return Err(PolishFailure("the result has no contact outputs ([output] contacts = false): the event sequence cannot be read".into()));
     }

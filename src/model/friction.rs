@@ -1,0 +1,76 @@
+//! Coulomb friction contacts (src/formulation.md §9): one more kind of row of B.
+//!
+//! Sign conventions (the same as a unilateral contact's, whose force z acts as −Bᵀz):
+//! - the row b (a sliding direction over DOFs) gives the tangential displacement u = b x and the
+//!   slip velocity v = b ẋ;
+//! - the friction force f acts on the structure as −bᵀ f, so f has the sign of the slip:
+//!   f = μN·sign(v) while slipping, |f| ≤ μN while stuck (v = 0), and f·v ≥ 0 is the power
+//!   dissipated (the energy per cycle is ∮ f v dt ≥ 0).
+//! - with a tangential stiffness k_t (a Jenkins element: a spring in series with the slider) the
+//!   slider's velocity v − ḟ/k_t takes the place of v.
+use super::ModelError;
+
+/// A Coulomb friction contact under a constant normal load.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Friction {
+    /// The sliding direction as a row of B: (model DOF, coefficient) terms.
+    pub row: Vec<(usize, f64)>,
+    /// Friction coefficient μ ≥ 0.
+    pub coefficient: f64,
+    /// Normal load N ≥ 0 (constant).
+    pub normal_force: f64,
+    /// Tangential stiffness k_t > 0 of a Jenkins element; `None`: rigid Coulomb.
+    pub stiffness: Option<f64>,
+}
+
+impl Friction {
+    /// A friction contact sliding along one DOF.
+    pub fn on_dof(dof: usize, coefficient: f64, normal_force: f64, stiffness: Option<f64>) -> Self {
+        Friction { row: vec![(dof, 1.0)], coefficient, normal_force, stiffness }
+    }
+
+    /// The slip force μN: the largest friction force the contact transmits.
+    pub fn slip_force(&self) -> f64 {
+        self.coefficient * self.normal_force
+    }
+
+    /// Checks friction `i` of a model with `n` DOFs; fields are named as in the scene.
+    pub(super) fn check(&self, i: usize, n: usize) -> Result<(), ModelError> {
+        let field = |f: &str| format!("friction[{i}].{f}");
+        if self.row.is_empty() {
+            return Err(ModelError::new(field("dof"), "is missing: a friction contact needs a sliding direction"));
+        }
+        for &(d, c) in &self.row {
+            if d >= n {
+                return Err(ModelError::new(field("dof"), format!("is {d}, the model has DOFs 0..{}", n - 1)));
+            }
+            if !c.is_finite() {
+                return Err(ModelError::new(field("direction"), format!("has the coefficient {c}, must be finite")));
+            }
+        }
+        if !(self.coefficient.is_finite() && self.coefficient >= 0.0) {
+            return Err(ModelError::new(field("coefficient"), format!("is {}, a friction coefficient μ must be finite and ≥ 0", self.coefficient)));
+        }
+        if !(self.normal_force.is_finite() && self.normal_force >= 0.0) {
+            return Err(ModelError::new(
+                field("normal_force"),
+                format!("is {}, a normal load must be finite and ≥ 0 (compressive); a tensile load cannot hold friction", self.normal_force),
+            ));
+        }
+        if !self.slip_force().is_finite() {
+            return Err(ModelError::new(
+                field("normal_force"),
+                format!("μ·N = {}·{} overflows floating point; rescale the units", self.coefficient, self.normal_force),
+            ));
+        }
+        if let Some(k) = self.stiffness
+            && !(k.is_finite() && k > 0.0 && (1.0 / k).is_finite())
+        {
+            return Err(ModelError::new(
+                field("stiffness"),
+                format!("is {k}, a tangential stiffness must be finite and > 0 (omit it for rigid Coulomb friction)"),
+            ));
+        }
+        Ok(())
+    }
+}

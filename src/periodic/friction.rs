@@ -1,0 +1,280 @@
+//! Coulomb friction rows in the periodic LCP (src/formulation.md §9).
+//!
+//! A friction contact is one more row b of B: the assembly sees it as an extra contact row
+//! ([`with_rows`]), so Ĝ, B X̂lin and Ẑ⁻¹Bᵀ cover the unilateral and the friction rows alike.
+//! At the instants the friction force f ∈ [−μN, μN] and the slip velocity v = D(b x) satisfy
+//! f = μN·sign(v) (v ≠ 0) and |f| ≤ μN (v = 0). With w = −v = A f + b_q, A = D·G (+ D/k_t for a
+//! Jenkins element), the box is mapped to an LCP by z₁ = f + μN ≥ 0 and a slack α ≥ 0
+//! (Siconos' `relay_to_lcp`):
+//!
+//! ```text
+//!   [w₁]   [A   I] [z₁]   [b_q − A·μN]
+//!   [w₂] = [−I  0] [α ] + [   2μN    ],   0 ≤ (z₁, α) ⊥ (w₁, w₂) ≥ 0,
+//! ```
+//!
+//! with the unilateral contacts' rows (gap = A z + q, displacement receptance) in front. zᵀMz =
+//! z₁ᵀAz₁ ≥ 0 for a passive structure: M is positive semi-definite and Lemke ends with a solution
+//! (friction alone). The slip velocity is α − w₁.
+//!
+//! The matrix is dense: N = k·(m_c + 2·m_f) unknowns, at most [`FRICTION_DENSE_MAX`].
+use super::{Assembly, PeriodFft, PeriodicProblem, SolveError, lcp_failure, recovery};
+use crate::lcp::{DenseMatrix, LcpMethod, LcpOutcome, LcpSolution, LcpStep, Lemke, LemkeSettings};
+use crate::model::{Compliance, Contact, Model};
+use crate::response::{FrictionResponse, Response};
+use crate::time::Scheme;
+use num_complex::Complex64 as C;
+use std::borrow::Cow;
+use std::time::Instant;
+
+/// Most unknowns of the dense friction LCP. Why: the matrix and Lemke's basis inverse are two
+/// N×N arrays (2·8·N² bytes: 256 MiB at 4096) and Lemke's pivots cost O(N²) each; a structured
+/// (block-circulant) friction solver is future work.
+pub const FRICTION_DENSE_MAX: usize = 4096;
+
+/// Lemke's pivot budget per unknown on the friction LCP. Why: its matrix is only positive
+/// semi-definite (skew for an undamped structure under cds), and the complementary path can be
+/// longer than the default budget of unilateral contacts allows.
+const FRICTION_PIVOTS_PER_DIM: usize = 200;
+
+/// `model` with one extra contact row per friction contact (after the unilateral contacts), for
+/// the assembly; borrowed unchanged without friction.
+pub(super) fn with_rows(model: &Model) -> Result<Cow<'_, Model>, SolveError> {
+    if model.frictions.is_empty() {
+        return Ok(Cow::Borrowed(model));
+    }
+    let mut rows = model.clone();
+    for (i, f) in model.frictions.iter().enumerate() {
+        let &[(dof, direction)] = f.row.as_slice() else {
+            return Err(SolveError::Invalid(format!("friction[{i}]: a sliding direction over several DOFs is not yet supported; slide along one DOF")));
+        };
+        if direction.abs() != 1.0 {
+            return Err(SolveError::Invalid(format!("friction[{i}]: the row coefficient is {direction}, this version takes ±1 on one DOF")));
+        }
+        rows.contacts.push(Contact::on_dof(dof, direction, 0.0, Compliance::Rigid));
+    }
+    Ok(Cow::Owned(rows))
+}
+
+/// The LCP size with `mc` contacts and `mf` friction contacts over `k` instants, refused above
+/// [`FRICTION_DENSE_MAX`] with the memory it would take.
+pub fn check_size(k: usize, mc: usize, mf: usize) -> Result<usize, SolveError> {
+    let n = k.saturating_mul(mc + 2 * mf);
+    if n > FRICTION_DENSE_MAX {
+        let gib = 2.0 * 8.0 * (n as f64).powi(2) / f64::from(1u32 << 30);
+        return Err(SolveError::Limit(format!(
+            "friction: steps = {k} with {mc} contact(s) and {mf} friction contact(s) make an LCP of {n} unknowns (steps × (contacts + 2 × friction contacts)), solved densely: ≈ {gib:.1} GiB and O(N³) work; at most {FRICTION_DENSE_MAX} unknowns are accepted: reduce discretization.steps to {} or fewer",
+            FRICTION_DENSE_MAX / (mc + 2 * mf)
+        )));
+    }
+    Ok(n)
+}
+
+/// How the friction samples meet the scheme (src/formulation.md §9): f_j and the backward slip
+/// velocity (u_j − u_{j−1})/h at t_j, bds1's own derivative (implicit Euler, Moreau's
+/// time-stepping in the period): first order, and D = σ1 has Re ≥ 0, so A is positive
+/// semi-definite. Measured (tests/friction.rs): it converges at order 1 to Den Hartog's and the
+/// event-driven orbits. The half-step pairing of cds and galerkin (f, v at t_{j+1/2}, the structure
+/// feeling their mean) converged at order 2 but to an orbit 2e-3 off Den Hartog's, and an
+/// undamped cds LCP exhausted Lemke's budget: they are refused until that is understood.
+pub struct FrictionGrid {
+    /// Symbol of the slip velocity from the displacement at the instants, per harmonic.
+    pub velocity: Vec<C>,
+}
+
+impl FrictionGrid {
+    pub fn new(scheme: Scheme, k: usize, period: f64) -> Result<Self, SolveError> {
+        let h = period / k as f64;
+        let nh = k / 2 + 1;
+        let theta = |p: usize| 2.0 * std::f64::consts::PI * p as f64 / k as f64;
+        match scheme {
+            // (1 − z)/h with 1 − cos θ = 2 sin²(θ/2): no cancellation in the low harmonics.
+            Scheme::Bds1 => Ok(FrictionGrid { velocity: (0..nh).map(|p| C::new(2.0 * (theta(p) / 2.0).sin().powi(2), theta(p).sin()) / h).collect() }),
+            other => Err(SolveError::Invalid(format!(
+                "discretization.scheme: is \"{other}\", but friction contacts are solved with bds1 only in this version (first order; src/formulation.md §9); set scheme = \"bds1\""
+            ))),
+        }
+    }
+}
+
+/// Index of unknown (row `a`, instant `j`): contact rows first (time-major), then z₁ of the
+/// friction rows, then their slacks α.
+struct Layout {
+    k: usize,
+    mc: usize,
+    mf: usize,
+}
+
+impl Layout {
+    fn row(&self, a: usize, j: usize) -> usize {
+        if a < self.mc { j * self.mc + a } else { self.k * self.mc + j * self.mf + (a - self.mc) }
+    }
+    fn slack(&self, t: usize, j: usize) -> usize {
+        self.k * (self.mc + self.mf) + j * self.mf + t
+    }
+}
+
+/// The dense LCP (M, q) of contacts and friction rows; `asm` is assembled with [`with_rows`].
+pub fn friction_lcp(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, grid: &FrictionGrid) -> (DenseMatrix, Vec<f64>) {
+    let model = problem.model();
+    let (k, m, nh) = (asm.k, asm.m, asm.k / 2 + 1);
+    let lay = Layout { k, mc: model.contacts.len(), mf: model.frictions.len() };
+    let nn = k * (lay.mc + 2 * lay.mf);
+    let slip: Vec<f64> = model.frictions.iter().map(|f| f.slip_force()).collect();
+    let mut data = vec![0.0; nn * nn];
+    let mut q = vec![0.0; nn];
+    let period = problem.period();
+    let mut spec = vec![C::ZERO; nh];
+    for a in 0..m {
+        // Contact rows pair force j with the gap at t_{j+s} (`PeriodicProblem::lcp`); friction
+        // rows are velocities, w = −v, at the force's own instant.
+        let friction = a >= lay.mc;
+        let s = if friction { 0 } else { problem.pairing_at(a).offset() };
+        let scale = |p: usize| if friction { grid.velocity[p] } else { C::ONE };
+        for (p, v) in spec.iter_mut().enumerate() {
+            *v = asm.bxlin_hat[p * m + a] * scale(p);
+        }
+        let bx = fft.inverse(&spec);
+        for j in 0..k {
+            let jj = (j + s) % k;
+            q[lay.row(a, j)] = if friction { -bx[j] } else { model.contacts[a].gap_at(model.frequency, jj as f64 * period / k as f64) - bx[jj] };
+        }
+        // Columns: the response of row a to each row's force (−G for displacements, −D·G for
+        // velocities, so +G and +D·G in w), a Jenkins element's D/k_t on its own row.
+        for b in 0..m {
+            for (p, v) in spec.iter_mut().enumerate() {
+                *v = asm.g_hat[(p * m + a) * m + b] * scale(p);
+            }
+            let mut ker = fft.inverse(&spec);
+            // Jenkins: the slider's velocity is D(u − f/k_t).
+            if friction
+                && a == b
+                && let Some(kt) = model.frictions[a - lay.mc].stiffness
+            {
+                let d = fft.inverse(&grid.velocity);
+                ker.iter_mut().zip(&d).for_each(|(g, d)| *g += d / kt);
+            }
+            for j in 0..k {
+                let r = lay.row(a, j);
+                for l in 0..k {
+                    let v = ker[(j + s + k - l) % k];
+                    data[r * nn + lay.row(b, l)] += v;
+                    // f = z₁ − μN: the constant part moves to q.
+                    if b >= lay.mc {
+                        q[r] -= v * slip[b - lay.mc];
+                    }
+                }
+            }
+        }
+        if let Some(Contact { compliance: Compliance::Compliant { stiffness }, .. }) = model.contacts.get(a) {
+            (0..k).for_each(|j| data[lay.row(a, j) * nn + lay.row(a, j)] += 1.0 / stiffness);
+        }
+    }
+    for (t, mu_n) in slip.iter().enumerate() {
+        for j in 0..k {
+            let (r, sl) = (lay.row(lay.mc + t, j), lay.slack(t, j));
+            data[r * nn + sl] = 1.0;
+            data[sl * nn + r] = -1.0;
+            q[sl] = 2.0 * mu_n;
+        }
+    }
+    (DenseMatrix::from_row_major(nn, data), q)
+}
+
+/// Solves a problem with friction on `asm` (assembled with [`with_rows`]) by dense Lemke,
+/// certified; recovers the responses and the friction contacts' forces and slip.
+pub(super) fn solve(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, t_start: Instant) -> Result<Response, SolveError> {
+    let model = problem.model();
+    let (k, m) = (asm.k, asm.m);
+    let lay = Layout { k, mc: model.contacts.len(), mf: model.frictions.len() };
+    debug_assert_eq!(m, lay.mc + lay.mf, "assembled with the friction rows");
+    let nn = check_size(k, lay.mc, lay.mf)?;
+    let grid = FrictionGrid::new(problem.discretization().scheme, k, problem.period())?;
+    let (a, q) = friction_lcp(problem, asm, fft, &grid);
+    if let Some(i) = q.iter().chain(a.as_slice()).position(|v| !v.is_finite()) {
+        return Err(SolveError::Invalid(format!(
+            "friction: the LCP holds a non-finite value (entry {i}): loads, gaps, μN or stiffnesses overflow floating point; rescale the units"
+        )));
+    }
+    let t_assembly = t_start.elapsed().as_secs_f64();
+    let t_lcp = Instant::now();
+    let settings = LemkeSettings { certify_tol: problem.solver_settings().tolerance, max_pivots_per_dim: FRICTION_PIVOTS_PER_DIM, ..LemkeSettings::default() };
+    let mut sol = Lemke::new(settings).solve(&a, &q);
+    let lcp_time = t_lcp.elapsed().as_secs_f64();
+    sol.info.path = vec![LcpStep { method: LcpMethod::Lemke, size: nn, pivots: sol.info.pivots, outcome: sol.outcome, time_s: lcp_time }];
+    if sol.outcome != LcpOutcome::Solved {
+        return Err(lcp_failure(sol));
+    }
+    let slip: Vec<f64> = model.frictions.iter().map(|f| f.slip_force()).collect();
+    // The forces in the assembly's row order (j·m + a), friction forces f = z₁ − μN.
+    let mut z = vec![0.0; k * m];
+    let mut forces = vec![Vec::new(); lay.mf];
+    for (t, f) in forces.iter_mut().enumerate() {
+        *f = (0..k).map(|j| sol.z[lay.row(lay.mc + t, j)] - slip[t]).collect();
+    }
+    for j in 0..k {
+        for a in 0..lay.mc {
+            z[j * m + a] = sol.z[lay.row(a, j)];
+        }
+        for (t, f) in forces.iter().enumerate() {
+            z[j * m + lay.mc + t] = f[j];
+        }
+    }
+    let rows = LcpSolution { outcome: sol.outcome, z, w: Vec::new(), info: sol.info.clone() };
+    let t_rec = Instant::now();
+    let mut response = recovery::recover(problem, asm, fft, &rows)?;
+    response.friction = (0..lay.mf).map(|t| friction_response(problem, asm, fft, (&rows.z, &forces[t]), &sol, &lay, t)).collect::<Result<_, _>>()?;
+    response.lcp.size = nn;
+    response.lcp.path = format!(
+        "friction (N = {nn}: contacts and the box LCP of the friction rows, src/formulation.md §9): dense lexicographic Lemke, {} pivots, {lcp_time:.3} s → {}",
+        sol.info.pivots,
+        sol.outcome.name()
+    );
+    // Warm starts are not used by this path: no active set to carry.
+    response.active_set.clear();
+    response.timing_s.assembly = t_assembly;
+    response.timing_s.lcp = lcp_time;
+    response.timing_s.recovery = t_rec.elapsed().as_secs_f64();
+    response.timing_s.total = t_start.elapsed().as_secs_f64();
+    Ok(response)
+}
+
+/// Force, slip velocity, stuck flags, tangential displacement and dissipated energy of friction `t`.
+fn friction_response(
+    problem: &PeriodicProblem,
+    asm: &Assembly,
+    fft: &PeriodFft,
+    (z, force): (&[f64], &[f64]),
+    sol: &LcpSolution,
+    lay: &Layout,
+    t: usize,
+) -> Result<FrictionResponse, SolveError> {
+    let f = &problem.model().frictions[t];
+    let (k, m, nh) = (asm.k, asm.m, asm.k / 2 + 1);
+    let a = lay.mc + t;
+    let mu_n = f.slip_force();
+    let force = force.to_vec();
+    // The relay's velocity v = α − w₁ (src/formulation.md §9).
+    let slip_velocity: Vec<f64> = (0..k).map(|j| sol.z[lay.slack(t, j)] - sol.w[lay.row(a, j)]).collect();
+    // u = b xlin − Σ_b G_ab f_b, by the harmonics.
+    let z_hat: Vec<Vec<C>> = (0..m).map(|b| fft.forward(&(0..k).map(|j| z[j * m + b]).collect::<Vec<_>>())).collect();
+    let u_hat: Vec<C> = (0..nh).map(|p| asm.bxlin_hat[p * m + a] - (0..m).map(|b| asm.g_hat[(p * m + a) * m + b] * z_hat[b][p]).sum::<C>()).collect();
+    let displacement = fft.inverse(&u_hat);
+    // Stuck: strictly inside the box (a slipping force sits on its bound to round-off).
+    let stuck = force.iter().map(|v| v.abs() < mu_n * (1.0 - 1e-9)).collect();
+    let h = problem.period() / k as f64;
+    let dissipated_energy = h * force.iter().zip(&slip_velocity).map(|(f, v)| f * v).sum::<f64>();
+    let all = force.iter().chain(&slip_velocity).chain(&displacement);
+    if !all.clone().all(|v| v.is_finite()) || !dissipated_energy.is_finite() {
+        return Err(SolveError::NonFinite(format!("friction {t}")));
+    }
+    Ok(FrictionResponse {
+        coefficient: f.coefficient,
+        normal_force: f.normal_force,
+        stiffness: f.stiffness,
+        force,
+        slip_velocity,
+        stuck,
+        displacement,
+        dissipated_energy,
+    })
+}
