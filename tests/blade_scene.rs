@@ -291,7 +291,7 @@ fn bad_scenes_name_the_file_the_field_and_the_value() {
         (blade.replace("[\"MC:y\", \"LE\", \"TE\"]", "[\"MC:q\"]"), vec!["output.displacement[0]", "\"q\""]),
         (blade.replace("[\"MC:y\", \"LE\", \"TE\"]", "[99999]"), vec!["output.displacement[0]", "99999"]),
         (blade.replace("node = \"LE\"", "node = \"LE\"\ndof = 3"), vec!["contact[0]", "either dof or node"]),
-        (blade.replace("generator = {", "mass = [[1.0]]\ngenerator = {"), vec!["structure", "not both"]),
+        (blade.replace("generator = {", "mass = [[1.0]]\ngenerator = {"), vec!["structure", "not several"]),
     ];
     for (text, needles) in cases {
         let e = build_err(&text);

@@ -129,6 +129,13 @@ pub(super) fn step_matrix(sm: &StepMapLcp, powers: &PhiPowers, mask: u64) -> Mat
 /// Jacobian depends on the sets alone (dP/ds0 is the discrete monodromy matrix when the orbit
 /// closes). Returns the (d+1)×(d+1) products it formed (the work, with the runs' steps).
 pub(super) fn period_jacobian(sm: &StepMapLcp, masks: &[u64], powers: &PhiPowers, j: &mut Mat<f64>) -> usize {
+    // Small states keep the step-by-step product (k products of d³ are cheap there): the runs'
+    // squaring rounds differently, and the discrete walk's kink tests on NLvib 03 at k = 4096
+    // (tests/continuation.rs, nlvib03_branch_events_amplitudes_stability) lose the branch with it.
+    if sm.d <= STEPWISE_MAX_D {
+        *j = period_jacobian_by_steps(sm, masks);
+        return masks.len();
+    }
     let d = sm.d;
     let mut acc = Mat::<f64>::identity(d + 1, d + 1);
     let mut formed = 0;
@@ -143,8 +150,10 @@ pub(super) fn period_jacobian(sm: &StepMapLcp, masks: &[u64], powers: &PhiPowers
     formed
 }
 
+/// Up to this state size the period Jacobian is formed step by step.
+const STEPWISE_MAX_D: usize = 64;
+
 /// The same Jacobian step by step (k products): the reference of the runs' product.
-#[cfg(test)]
 pub(super) fn period_jacobian_by_steps(sm: &StepMapLcp, masks: &[u64]) -> Mat<f64> {
     let d = sm.d;
     let powers = PhiPowers::new(sm);
