@@ -67,14 +67,7 @@ pub(super) fn between(fam: &mut Family, a: &Node, b: &Node, contacts: usize) -> 
         let node = locate(fam, a, b, kind, c).unwrap_or_else(|| b.clone());
         let detail = match kind {
             EventKind::Grazing => format!("contact {c}: active steps {} -> {}", active_steps(a, c), active_steps(b, c)),
-            EventKind::NeimarkSacker => {
-                let m = node.mu.iter().find(|m| m.im.abs() > 1e-9 * m.norm()).copied().unwrap_or_default();
-                format!("pair {:.6} ± {:.6}i, |μ| = {:.9}", m.re, m.im.abs(), m.norm())
-            }
-            EventKind::PeriodDoubling => {
-                let m = node.mu.iter().min_by(|x, y| (*x + 1.0).norm().total_cmp(&(*y + 1.0).norm())).copied().unwrap_or_default();
-                format!("multiplier {:.9}", m.re)
-            }
+            EventKind::NeimarkSacker | EventKind::PeriodDoubling => floquet::event_detail(kind, &node.mu),
             EventKind::Fold => String::new(),
         };
         found.push((kind, node, detail));

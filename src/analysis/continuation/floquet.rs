@@ -32,3 +32,19 @@ pub fn doubling_sign(mu: &[Complex64]) -> bool {
 pub fn complex_outside(mu: &[Complex64]) -> usize {
     mu.iter().filter(|m| m.im.abs() > 1e-9 * m.norm() && m.norm() > 1.0).count()
 }
+
+/// What an event's multipliers say in its detail: the pair of a Neimark–Sacker, the multiplier
+/// nearest −1 of a period doubling; nothing for the other kinds.
+pub fn event_detail(kind: super::EventKind, mu: &[Complex64]) -> String {
+    match kind {
+        super::EventKind::NeimarkSacker => {
+            let m = mu.iter().find(|m| m.im.abs() > 1e-9 * m.norm()).copied().unwrap_or_default();
+            format!("pair {:.6} ± {:.6}i, |μ| = {:.9}", m.re, m.im.abs(), m.norm())
+        }
+        super::EventKind::PeriodDoubling => {
+            let m = mu.iter().min_by(|x, y| (*x + 1.0).norm().total_cmp(&(*y + 1.0).norm())).copied().unwrap_or_default();
+            format!("multiplier {:.9}", m.re)
+        }
+        _ => String::new(),
+    }
+}

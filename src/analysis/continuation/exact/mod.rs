@@ -327,17 +327,7 @@ fn side(n: &Node, kind: EventKind) -> i64 {
 }
 
 fn detail_of(kind: EventKind, node: &Node) -> String {
-    match kind {
-        EventKind::NeimarkSacker => {
-            let m = node.mu.iter().find(|m| m.im.abs() > 1e-9 * m.norm()).copied().unwrap_or_default();
-            format!("pair {:.6} ± {:.6}i, |μ| = {:.9}", m.re, m.im.abs(), m.norm())
-        }
-        EventKind::PeriodDoubling => {
-            let m = node.mu.iter().min_by(|x, y| (*x + 1.0).norm().total_cmp(&(*y + 1.0).norm())).copied().unwrap_or_default();
-            format!("multiplier {:.9}", m.re)
-        }
-        _ => String::new(),
-    }
+    super::floquet::event_detail(kind, &node.mu)
 }
 
 /// Bisection on the arc between `a` (where `same` holds) and `b` (where it does not): each trial
