@@ -81,17 +81,7 @@ fn nlvib03_exact_branch_is_the_same_at_every_k() {
         // one of our events lies between.
         let (mut disagree, mut worst_amp) = (0, 0.0f64);
         for &(omega, amp, stable) in &ref_points {
-            let best = b
-                .points
-                .windows(2)
-                .filter(|w| (w[0].parameter - omega) * (w[1].parameter - omega) <= 0.0 && w[0].parameter != w[1].parameter)
-                .map(|w| {
-                    let f = (omega - w[0].parameter) / (w[1].parameter - w[0].parameter);
-                    let near = if f < 0.5 { &w[0] } else { &w[1] };
-                    (w[0].amplitude[0] + f * (w[1].amplitude[0] - w[0].amplitude[0]), near)
-                })
-                .min_by(|x, y| (x.0 - amp).abs().total_cmp(&(y.0 - amp).abs()))
-                .unwrap();
+            let best = at_reference(&b.points, omega, amp);
             worst_amp = worst_amp.max((best.0 - amp).abs() / amp);
             let across = ours.iter().any(|(_, e)| (e - omega) * (e - best.1.parameter) <= 0.0);
             if !across && best.1.stable != stable {
@@ -287,17 +277,8 @@ fn nlvib03_branch_events_amplitudes_stability() {
     let mut disagree = 0;
     let near_event = |o: f64| ref_events.iter().any(|(_, e)| (o - e).abs() < 2e-3);
     for &(omega, amp, stable) in &ref_points {
-        let best = b
-            .points
-            .windows(2)
-            .filter(|w| (w[0].parameter - omega) * (w[1].parameter - omega) <= 0.0 && w[0].parameter != w[1].parameter)
-            .map(|w| {
-                let f = (omega - w[0].parameter) / (w[1].parameter - w[0].parameter);
-                let a = w[0].amplitude[0] + f * (w[1].amplitude[0] - w[0].amplitude[0]);
-                (a, if f < 0.5 { w[0].stable } else { w[1].stable })
-            })
-            .min_by(|x, y| (x.0 - amp).abs().total_cmp(&(y.0 - amp).abs()))
-            .unwrap();
+        let (a, near) = at_reference(&b.points, omega, amp);
+        let best = (a, near.stable);
         // Within 1e-5 of a fold our turning point's O(h²) shift may leave Ω off our branch.
         if ref_events.iter().any(|(k, e)| k == "fold" && (omega - e).abs() < 1e-5) {
             continue;
@@ -402,6 +383,20 @@ fn continuation_in_speed_finds_the_events_at_frequency_over_lobes() {
 }
 
 /// A reference branch's points (Ω, amplitude_0, stable).
+/// Where the branch crosses Ω, the crossing whose interpolated amplitude (DOF 0) is nearest the
+/// reference's `amp` (the branch passes most Ω up to three times), with the point nearer in Ω.
+fn at_reference(points: &[continuation::BranchPoint], omega: f64, amp: f64) -> (f64, &continuation::BranchPoint) {
+    points
+        .windows(2)
+        .filter(|w| (w[0].parameter - omega) * (w[1].parameter - omega) <= 0.0 && w[0].parameter != w[1].parameter)
+        .map(|w| {
+            let f = (omega - w[0].parameter) / (w[1].parameter - w[0].parameter);
+            (w[0].amplitude[0] + f * (w[1].amplitude[0] - w[0].amplitude[0]), if f < 0.5 { &w[0] } else { &w[1] })
+        })
+        .min_by(|x, y| (x.0 - amp).abs().total_cmp(&(y.0 - amp).abs()))
+        .expect("the branch crosses every reference Ω")
+}
+
 fn branch_points(b: &Value) -> Vec<RefPoint> {
     b["points"].as_array().unwrap().iter().map(|p| (p["omega"].as_f64().unwrap(), p["amplitude_0"].as_f64().unwrap(), p["stable"].as_bool().unwrap())).collect()
 }
