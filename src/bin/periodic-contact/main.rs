@@ -3,6 +3,7 @@
 mod cmd_bench;
 mod cmd_continue;
 mod cmd_deck;
+mod cmd_export;
 mod cmd_fmu;
 mod cmd_lcp;
 mod cmd_modes;
@@ -65,6 +66,15 @@ enum Command {
     Deck {
         scene: PathBuf,
         /// Output .inp file.
+        #[arg(short, long)]
+        output: PathBuf,
+    },
+    /// Write the model the scene solves (reduced, damped) for an independent reference: M, C, K
+    /// and the contact rows B as Matrix Market, gaps, compliances, forces, ω and outputs in
+    /// DIR/model.json (validation/exact_flow.py reads it).
+    Export {
+        scene: PathBuf,
+        /// Output folder (created).
         #[arg(short, long)]
         output: PathBuf,
     },
@@ -166,6 +176,7 @@ fn main() -> ExitCode {
         }
         Some(Command::Modes { scene, count }) => cmd_modes::run(&scene, count),
         Some(Command::Deck { scene, output }) => cmd_deck::run(&scene, &output),
+        Some(Command::Export { scene, output }) => cmd_export::run(&scene, &output),
         Some(Command::Sweep(args)) => cmd_sweep::run(&args),
         Some(Command::Continue(args)) => cmd_continue::run(&args),
         Some(Command::Lcp { file, output, method, tolerance }) => cmd_lcp::run(&file, &output, &method, tolerance),
