@@ -61,7 +61,7 @@ def main(argv=None):
     ap.add_argument("--kmax", type=int, default=8192)
     ap.add_argument("--methods", default="craig-bampton,massless-boundary")
     ap.add_argument("--schemes", default=",".join(s for s, _ in SCHEMES))
-    ap.add_argument("--polish", action="store_true", help="also the CLI's --polish at the first k of bds2")
+    ap.add_argument("--polish", default=None, help="also the CLI's --polish seeded by SCHEME:K (e.g. bds2:256)")
     ap.add_argument("-o", "--output")
     args = ap.parse_args(argv)
     os.makedirs(args.work, exist_ok=True)
@@ -89,11 +89,13 @@ def main(argv=None):
               f"{flow.stats['topologies']} topologies, Newton {len(orbit.history)} its (last {orbit.history[-1]:.1e}), {t_ref:.1f} s",
               flush=True)
         if args.polish:
-            r, wall, err = solve(args.cli, args.work, variant(base, method, "bds2", 256), f"{method}-polish", ("--polish",))
+            ps, pk = args.polish.split(":")
+            r, wall, err = solve(args.cli, args.work, variant(base, method, ps, int(pk)), f"{method}-polish", ("--polish",))
             e = compare_with_grid(orbit, r) if r else None
             refs[method]["polish"] = {"wall": wall, "error": e, "message": None if r else err[-300:],
                                       "warnings": r["warnings"] if r else None}
-            print(f"  polish (bds2 k = 256): {wall:.1f} s, " + (f"error {e['max_over_orbit']:.2e}" if e else f"failed: {err[-200:]}"), flush=True)
+            print(f"  polish ({args.polish}): {wall:.1f} s, " + (f"error {e['max_over_orbit']:.2e}, {r['polish']['status']}: {r['polish'].get('reason', '')}"
+                                                          if e else f"failed: {err[-200:]}"), flush=True)
         for scheme, expected in SCHEMES:
             if scheme not in args.schemes.split(","):
                 continue
@@ -104,6 +106,9 @@ def main(argv=None):
                 k = 1 << int(np.ceil(np.log2(int(m.group(1)))))
                 r = None
             errs = []
+            if k > args.kmax:
+                print(f"  {scheme:8s} needs k >= {k} (stability), above --kmax {args.kmax}", flush=True)
+                rows.append({"method": method, "scheme": scheme, "k": k, "failed": f"needs k >= {k}, above --kmax"})
             while k <= args.kmax:
                 if r is None:
                     r, wall, err = solve(args.cli, args.work, variant(base, method, scheme, k), f"{method}-{scheme}-{k}")
