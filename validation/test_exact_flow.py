@@ -13,7 +13,7 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import root
 
-from exact_flow import ContactModel, ExactFlow
+from exact_flow import ContactModel, ExactFlow, compare_with_grid
 from marching.exact import compliant_stop
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -139,6 +139,62 @@ def test_exact_flow_transition_equals_expm():
     topo = fl.topology(np.ones(mdl.m, dtype=bool))
     for tau in (0.01, 0.3, 2.0):
         np.testing.assert_allclose(topo.transition(tau), expm(topo.A * tau), rtol=1e-10, atol=1e-11)
+
+
+def _export_and_solve(cli, tmp_path, text, name, schemes_k):
+    """Export the scene, solve it at each (scheme, k): (ContactModel folder, {(scheme, k): result})."""
+    import re
+    scene = tmp_path / f"{name}.toml"
+    scene.write_text(text)
+    folder = tmp_path / f"{name}-model"
+    subprocess.run([cli, "export", str(scene), "-o", str(folder)], check=True, capture_output=True)
+    out = {}
+    for scheme, k in schemes_k:
+        t = re.sub(r'^scheme = "\w+"', f'scheme = "{scheme}"', text, flags=re.M)
+        t = re.sub(r"^steps = \d+", f"steps = {k}", t, flags=re.M)
+        sc = tmp_path / f"{name}-{scheme}-{k}.toml"
+        sc.write_text(t)
+        res = tmp_path / f"{name}-{scheme}-{k}.json"
+        subprocess.run([cli, "solve", str(sc), "--no-estimate", "-o", str(res)], check=True, capture_output=True)
+        out[(scheme, k)] = json.load(open(res))
+    return str(folder), out
+
+
+def _orbit_from(folder, guess):
+    fl = ExactFlow(ContactModel.load(folder))
+    return fl.periodic_orbit(fl.guess_from_forces(guess["time"], np.array([c["force"] for c in guess["contacts"]])))
+
+
+@pytest.mark.engine
+def test_exported_compliant_stop_is_the_closed_form(cli, tmp_path):
+    """`periodic-contact export` of fmu/scenes/compliant-stop.toml, solved by the exact flows from
+    the CLI's cds answer: §6.2's switch times to 1e-10; the CLI's cds error falls at order 2."""
+    text = open(os.path.join(HERE, "..", "fmu", "scenes", "compliant-stop.toml")).read()
+    folder, res = _export_and_solve(cli, tmp_path, text, "stop", [("cds", 256), ("cds", 512)])
+    man = json.load(open(os.path.join(folder, "model.json")))
+    assert man["n"] == 1 and man["m"] == 1 and man["contacts"][0]["stiffness"] == 10.0 and man["omega"] == 1.3
+    orb = _orbit_from(folder, res[("cds", 256)])
+    sw = {kind: t / orb.T for t, _, kind in orb.switches()}
+    assert abs(sw["on"] - 0.9389205916) < 1e-10 and abs(sw["off"] - 0.1343892296) < 1e-10, sw
+    e = [compare_with_grid(orb, res[("cds", k)])["max_over_orbit"] for k in (256, 512)]
+    assert abs(np.log2(e[0] / e[1]) - 2) < 0.3, e
+
+
+@pytest.mark.engine
+def test_massless_blade_cds_within_1e4_of_the_exact_flow(cli, tmp_path):
+    """The compliant two-lobe blade (17 radial tip contacts) reduced with a massless boundary:
+    the CLI's cds answer is within 1e-4 of the peak-to-peak of the grid-free orbit at k = 2048 and
+    converges at order 2 ± 0.3 from k = 1024 (measured 1.6e-4, 4.2e-5: README "Exact-flow reference")."""
+    text = open(os.path.join(HERE, "..", "fmu", "scenes", "blade-two-lobes.toml")).read()
+    text = text.replace('method = "craig-bampton"', 'method = "massless-boundary"').replace('pairing = "same"\n', "")
+    folder, res = _export_and_solve(cli, tmp_path, text, "blade", [("bds2", 256), ("cds", 1024), ("cds", 2048)])
+    man = json.load(open(os.path.join(folder, "model.json")))
+    assert man["m"] == 17 and len(man["massless_dofs"]) > 0
+    orb = _orbit_from(folder, res[("bds2", 256)])
+    assert len(orb.switches()) >= 17 and orb.history[-1] < 1e-12
+    e = [compare_with_grid(orb, res[("cds", k)])["max_over_orbit"] for k in (1024, 2048)]
+    assert e[1] < 1e-4, e
+    assert abs(np.log2(e[0] / e[1]) - 2) < 0.3, e
 
 
 @pytest.mark.skipif(os.environ.get("PC_EXACT_FLOW_BLADE", "") in ("", "0"), reason="opt-in: PC_EXACT_FLOW_BLADE=1 (~5 min)")
