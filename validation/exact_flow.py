@@ -36,7 +36,7 @@ from scipy.linalg import eigh  # noqa: E402
 from scipy.optimize import brentq, minimize_scalar  # noqa: E402
 
 
-def _harmonic_array(terms, H: int, size: int | None = None) -> np.ndarray:
+def _harmonic_array(terms, H: int) -> np.ndarray:
     """Complex amplitudes F_h (h = 0..H) of Σ a cos(h ω t + φ): value(t) = Re Σ F_h e^{i h ω t}."""
     out = np.zeros(H + 1, dtype=complex)
     for h, a, phi in terms:
@@ -231,11 +231,12 @@ class ExactFlow:
         return t
 
     def _grid_step(self, topo: Topology) -> float:
-        # points per the fastest mode's quarter-oscillation, and at least 512 per period
+        # `search_points` samples per oscillation of the fastest mode or harmonic, and at least
+        # 512 per period: a sign change between samples is then a single crossing unless two
+        # switches fall within ~1/8 of the fastest period (grazing), which the search may miss
         fast = np.max(np.abs(topo.lam)) if topo.lam.size else 0.0
-        hmax = self.mdl.H * self.mdl.omega
-        rate = max(fast, hmax, self.mdl.omega)
-        return min(self.mdl.period / 512, (np.pi / 2) / rate / self.search_points * 4)
+        rate = max(fast, self.mdl.H * self.mdl.omega, self.mdl.omega)
+        return min(self.mdl.period / 512, 2 * np.pi / rate / self.search_points)
 
     def run(self, t0: float, y0: np.ndarray, t_end: float, active: np.ndarray | None = None,
             keep: bool = False):
@@ -307,7 +308,6 @@ class ExactFlow:
                         r = brentq(f, a, b, xtol=1e-15 * max(abs(b), self.mdl.period), rtol=4 * np.finfo(float).eps, maxiter=200)
                     if r < best_t:
                         best_t, best_i = r, i
-                # other contacts switching within round-off of the first switch at the same time
                 return best_t, [best_i]
             start = stop
         return t_end, None
