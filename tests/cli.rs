@@ -161,3 +161,35 @@ fn the_exported_lcp_solved_by_dense_lemke_gives_the_solve_forces() {
         assert!(scale > 0.0 && worst <= 1e-9 * scale, "{scene}: forces differ by {worst:e} (scale {scale:e})");
     }
 }
+
+/// `export`: the model of fmu/scenes/compliant-stop.toml, as its file states it (m = 1, c = 0.05,
+/// k = 1, k_c = 10, g0 = 1, F = cos 1.3 t), read back through the Matrix Market reader.
+#[test]
+fn export_writes_the_model_the_scene_states() {
+    let dir = std::env::temp_dir().join(format!("pc-model-export-{}", std::process::id()));
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("fmu/scenes/compliant-stop.toml");
+    let o = cli().arg("export").arg(&scene).arg("-o").arg(&dir).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let entry = |name: &str| {
+        let a = periodic_contact::fe::read_matrix_market(&dir.join(name)).unwrap();
+        (a.nrows(), a.ncols(), a.val().to_vec())
+    };
+    assert_eq!(entry("M.mtx"), (1, 1, vec![1.0]));
+    assert_eq!(entry("K.mtx"), (1, 1, vec![1.0]));
+    assert_eq!(entry("C.mtx"), (1, 1, vec![0.05]));
+    assert_eq!(entry("B.mtx"), (1, 1, vec![1.0]));
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("model.json")).unwrap()).unwrap();
+    assert_eq!((v["n"].as_u64(), v["m"].as_u64(), v["omega"].as_f64()), (Some(1), Some(1), Some(1.3)));
+    let c = &v["contacts"][0];
+    assert_eq!((c["gap_mean"].as_f64(), c["stiffness"].as_f64()), (Some(1.0), Some(10.0)));
+    let f = &v["forces"][0];
+    assert_eq!((f["dof"].as_u64(), f["term"]["harmonic"].as_u64(), f["term"]["cos"].as_f64()), (Some(0), Some(1), Some(1.0)));
+    assert_eq!(v["outputs"][0]["row"], serde_json::json!([[0, 1.0]]));
+    // A scene that cannot be built writes nothing.
+    let bad = dir.join("bad.toml");
+    std::fs::write(&bad, "[structure]\nmass = [[1.0]]\n").unwrap();
+    let o = cli().arg("export").arg(&bad).arg("-o").arg(dir.join("bad")).output().unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(!dir.join("bad").join("model.json").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}

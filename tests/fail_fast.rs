@@ -118,7 +118,8 @@ fn flags(args: &[&str]) -> Vec<String> {
 #[test]
 fn every_flag_is_in_the_readme() {
     let readme = std::fs::read_to_string(repo("README.md")).unwrap();
-    let commands: [&[&str]; 8] = [&["solve"], &["fmu"], &["modes"], &["sweep"], &["bench"], &["lcp"], &["study", "accuracy"], &["study", "warmstart"]];
+    let commands: [&[&str]; 9] =
+        [&["solve"], &["fmu"], &["export"], &["modes"], &["sweep"], &["bench"], &["lcp"], &["study", "accuracy"], &["study", "warmstart"]];
     let mut missing = Vec::new();
     let mut total = 0;
     for c in commands {
