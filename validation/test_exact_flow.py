@@ -200,7 +200,7 @@ def test_massless_blade_cds_within_1e4_of_the_exact_flow(cli, tmp_path):
     assert abs(np.log2(e[0] / e[1]) - 2) < 0.3, e
 
 
-@pytest.mark.skipif(os.environ.get("PC_EXACT_FLOW_BLADE", "") in ("", "0"), reason="opt-in: PC_EXACT_FLOW_BLADE=1 (~5 min)")
+@pytest.mark.skipif(os.environ.get("PC_EXACT_FLOW_BLADE", "") in ("", "0"), reason="opt-in: PC_EXACT_FLOW_BLADE=1 (~3 min)")
 @pytest.mark.engine
 def test_blade_schemes_against_exact_flow(cli, tmp_path):
     """The CLI on the compliant two-lobe blade (fmu/scenes/blade-two-lobes.toml: 17 radial tip
