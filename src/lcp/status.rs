@@ -136,13 +136,13 @@ pub(crate) fn finite_or_zero(mut sol: LcpSolution, q: &[f64]) -> LcpSolution {
     sol
 }
 
-/// Re-certifies a `Solved` answer with w = A z + q summed column by column from A's entries, when
+/// Re-certifies a `Solved` answer with w = A z + q summed directly (`LcpMatrix::direct_mul_add`), when
 /// the round-off of `mul_into` could exceed a hundredth of the certification tolerance.
 ///
 /// Why: the FFT product of a block-circulant A has a normwise error, about
 /// eps·log₂N·max|A|·‖z‖₁, not a componentwise one. On data spanning hundreds of decades that
 /// swamps the small components of w: tests/props.rs found a 9×9 block-circulant LCP "solved" with
-/// w₃ = −2.8e161 when summed exactly. The exact sum costs O(N·nnz(z)) column reads; it runs only
+/// w₃ = −2.8e161 when summed exactly. The exact sum costs O(N·nnz(z)) at most; it runs only
 /// when the bound says the fast product cannot be trusted to the tolerance, and on the rows where
 /// the fast product's w could be wrong about the sign.
 pub(crate) fn recheck_exactly(mut sol: LcpSolution, a: &dyn LcpMatrix, q: &[f64], certify_tol: f64) -> LcpSolution {
