@@ -1364,3 +1364,35 @@ fn regression_pivoting_fft_product_hid_a_violation() {
     let c = LcpCase { class: Class::Magnitudes(-151, 162), n: 9, a, q, circulant: Some((3, 3)), warm_start: None };
     check_lcp_case(&c, &Tally::default()).unwrap();
 }
+
+/// The certification's exact recheck (`LcpMatrix::direct_mul_add`, lag by lag for a
+/// block-circulant A) equals the plain O(k²m²) product `BlockCirculant::mul_into` on random
+/// blocks and a sparse z, on every row and on a selection of rows (the others untouched).
+#[test]
+fn the_direct_block_circulant_product_equals_the_plain_one() {
+    let (k, m) = (37, 5);
+    let mut seed = 3u64;
+    let mut draw = || {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    let mut blocks: Vec<f64> = (0..k * m * m).map(|_| draw()).collect();
+    // A zero block (skipped by the lag loop) among the others.
+    blocks[3 * m * m..4 * m * m].iter_mut().for_each(|v| *v = 0.0);
+    let a = BlockCirculant::new(k, m, blocks);
+    let z: Vec<f64> = (0..k * m).map(|_| draw()).map(|v| if v > 0.1 { v } else { 0.0 }).collect();
+    let mut plain = vec![0.0; k * m];
+    a.mul_into(&z, &mut plain);
+    let rows: Vec<bool> = (0..k * m).map(|i| i % 3 != 1 || i < m).collect();
+    for selection in [vec![true; k * m], rows] {
+        let mut w = vec![7.0; k * m];
+        a.direct_mul_add(&z, &selection, &mut w);
+        for i in 0..k * m {
+            let want = if selection[i] { 7.0 + plain[i] } else { 7.0 };
+            assert!((w[i] - want).abs() <= 1e-13, "row {i}: {} against {want}", w[i]);
+        }
+        let mut by_operator = vec![7.0; k * m];
+        CirculantOperator::new(&a).direct_mul_add(&z, &selection, &mut by_operator);
+        assert_eq!(by_operator, w);
+    }
+}

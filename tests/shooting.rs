@@ -227,6 +227,34 @@ fn shooting_past_the_old_caps_agrees_with_lemke() {
     }
 }
 
+/// The size path at a small size: a 50-DOF chain (state d = 100, so the march's products go to
+/// faer's matrix–vector kernels, and the certification's exact recheck runs lag by lag on the
+/// selected rows) with 8 compliant stops of the springs' order, cds/same, k = 256 (N = 2048):
+/// shooting alone, certified, agrees with dense Lemke to 1e-10.
+#[test]
+fn shooting_with_the_large_state_kernels_agrees_with_lemke_to_1e_10() {
+    let mut draw = Draw(20261126);
+    let (n, m, k) = (50, 8, 256);
+    let mut model = random_chain(&mut draw, n, m, false);
+    for c in &mut model.contacts {
+        c.compliance = Compliance::Compliant { stiffness: draw.range(1.0, 3.0) };
+    }
+    let outputs = OutputSelection { displacement: vec![0, n / 2, n - 1], velocity: vec![], acceleration: vec![], contacts: true };
+    let p = PeriodicProblem::new(model, Discretization { scheme: Scheme::Cds, steps: k, pairing: Some(Pairing::Same) }, outputs, SolverSettings::default())
+        .unwrap();
+    assert_eq!(step_map(&p).unwrap().state_size(), 2 * n);
+    let lemke = with(&p, LcpMethod::Lemke).solve().unwrap();
+    let shot = with(&p, LcpMethod::Shooting).solve().unwrap();
+    let d = difference(&shot, &lemke);
+    let active = shot.contacts.iter().filter(|c| c.force.iter().any(|&f| f > 0.0)).count();
+    eprintln!(
+        "n = {n}, m = {m}, k = {k}: {} Newton iterations, residual {:.1e}, {active} stops active, difference to Lemke {d:.1e}",
+        shot.lcp.pivots, shot.lcp.residual
+    );
+    assert!(active >= 2, "only {active} of {m} stops touch");
+    assert!(d <= 1e-10, "shooting differs from Lemke by {d:.3e}");
+}
+
 /// The rigid stop with sticking at k = 65 536 (the size the dense methods refuse): shooting
 /// solves it, certified, and the orbit is the exact one within cds/forward's O(h²) error.
 #[test]

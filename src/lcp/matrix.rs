@@ -10,6 +10,18 @@ pub trait LcpMatrix: Sync {
     fn mul_into(&self, z: &[f64], out: &mut [f64]);
     /// max |a_ij|, and whether every entry is finite.
     fn max_abs(&self) -> (f64, bool);
+    /// w_i += (A z)_i for the rows i with `rows[i]`, summed directly over the non-zero z_j (no
+    /// FFT): the certification's exact recheck, whose round-off is that of a plain sum. Column by
+    /// column unless a structure does better.
+    fn direct_mul_add(&self, z: &[f64], rows: &[bool], w: &mut [f64]) {
+        let mut col = vec![0.0; self.dim()];
+        for (j, &zj) in z.iter().enumerate() {
+            if zj != 0.0 {
+                self.column_into(j, &mut col);
+                w.iter_mut().zip(&col).zip(rows).filter(|(_, r)| **r).for_each(|((wi, c), _)| *wi += c * zj);
+            }
+        }
+    }
 }
 
 /// A dense n×n matrix stored row-major.
@@ -195,5 +207,40 @@ impl LcpMatrix for BlockCirculant {
     fn max_abs(&self) -> (f64, bool) {
         let finite = self.blocks.iter().all(|v| v.is_finite());
         (self.blocks.iter().fold(0.0f64, |m, v| m.max(v.abs())), finite)
+    }
+    /// Lag by lag: block d (in cache, and transposed once) meets every non-zero z_(l, b), an
+    /// axpy of length m into step l + d, or the selected rows of that step alone. The same
+    /// k·m·nnz(z) multiply-adds at most as column by column, but contiguous (column by column
+    /// read every block with stride m: 70 % of a k = 2048 solve).
+    fn direct_mul_add(&self, z: &[f64], rows: &[bool], w: &mut [f64]) {
+        let (k, m) = (self.k, self.m);
+        let nonzero: Vec<(usize, usize, f64)> = z.iter().enumerate().filter(|(_, v)| **v != 0.0).map(|(j, &v)| (j / m, j % m, v)).collect();
+        // The selected rows of each step (`None`: all of them).
+        let selected: Vec<Option<Vec<usize>>> = (0..k)
+            .map(|j| {
+                let sel: Vec<usize> = (0..m).filter(|&a| rows[j * m + a]).collect();
+                (sel.len() < m).then_some(sel)
+            })
+            .collect();
+        let mut transposed = vec![0.0; m * m];
+        for lag in 0..k {
+            let block = &self.blocks[lag * m * m..(lag + 1) * m * m];
+            if block.iter().all(|&v| v == 0.0) {
+                continue;
+            }
+            for a in 0..m {
+                for b in 0..m {
+                    transposed[b * m + a] = block[a * m + b];
+                }
+            }
+            for &(l, b, v) in &nonzero {
+                let row = (l + lag) % k;
+                let out = &mut w[row * m..(row + 1) * m];
+                match &selected[row] {
+                    None => out.iter_mut().zip(&transposed[b * m..(b + 1) * m]).for_each(|(o, c)| *o += c * v),
+                    Some(sel) => sel.iter().for_each(|&a| out[a] += transposed[b * m + a] * v),
+                }
+            }
+        }
     }
 }

@@ -154,6 +154,7 @@ fn shooting(a: &BlockCirculant, q: &[f64], sm: &StepMapLcp, tolerance: f64, warm
         masks
     });
     let shot = solve_shooting(sm, warm.as_deref(), &ShootingSettings::default());
+    let clock = Instant::now();
     let qmax = q.iter().fold(1.0f64, |acc, v| acc.max(v.abs()));
     let cert = tolerance * qmax;
     let op = CirculantOperator::new(a);
@@ -171,6 +172,9 @@ fn shooting(a: &BlockCirculant, q: &[f64], sm: &StepMapLcp, tolerance: f64, warm
     sol.info.relative_error = cand.relative_error;
     sol.info.pivots = shot.iterations;
     sol = recheck_exactly(sol, &op, q, tolerance);
+    if std::env::var_os("PERIODIC_CONTACT_PROFILE").is_some() {
+        eprintln!("shooting profile: certification on the stacked LCP (N = {}) {:.3} s", q.len(), clock.elapsed().as_secs_f64());
+    }
     sol.info.time_s = start.elapsed().as_secs_f64();
     sol.info.warm = match (warm_start, shot.start) {
         (None, _) => WarmOutcome::NotOffered,

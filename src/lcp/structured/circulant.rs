@@ -102,6 +102,9 @@ impl LcpMatrix for CirculantOperator<'_> {
     fn column_into(&self, j: usize, out: &mut [f64]) {
         self.a.column_into(j, out)
     }
+    fn direct_mul_add(&self, z: &[f64], rows: &[bool], w: &mut [f64]) {
+        self.a.direct_mul_add(z, rows, w)
+    }
     fn mul_into(&self, z: &[f64], out: &mut [f64]) {
         match self.work.try_lock() {
             Ok(mut w) => self.product(z, out, &mut w),

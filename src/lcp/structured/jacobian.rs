@@ -20,7 +20,7 @@ use faer::Mat;
 /// below, plain loops. Why not faer always: its kernels keep thread-local packing buffers that an
 /// FMU unloaded by `dlclose` can never free (valgrind: definitely lost), and the FMU's models
 /// are small.
-const GEMM_MIN: usize = 96;
+pub(super) const GEMM_MIN: usize = 96;
 
 /// a·b.
 pub fn product(a: &Mat<f64>, b: &Mat<f64>) -> Mat<f64> {

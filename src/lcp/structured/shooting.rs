@@ -108,6 +108,9 @@ struct Newton<'a> {
     jac: Mat<f64>,
     /// The active sets `jac` belongs to.
     jac_masks: Option<Vec<u64>>,
+    /// Seconds spent marching and forming Jacobians (printed under `PERIODIC_CONTACT_PROFILE`).
+    march_s: f64,
+    jacobian_s: f64,
 }
 
 /// An iterate with its march.
@@ -125,7 +128,10 @@ impl<'a> Newton<'a> {
         }
         self.marches += 1;
         self.work += self.march_work;
-        let m = march(self.sm, s, shift, Contacts::Solve(guess))?;
+        let clock = std::time::Instant::now();
+        let m = march(self.sm, s, shift, Contacts::Solve(guess));
+        self.march_s += clock.elapsed().as_secs_f64();
+        let m = m?;
         self.changes += m.changes;
         if jacobian {
             self.ensure_jacobian(&m.masks);
@@ -138,7 +144,9 @@ impl<'a> Newton<'a> {
     /// is formed only when the sets change (Newton's last iterations keep them).
     fn ensure_jacobian(&mut self, masks: &[u64]) {
         if self.jac_masks.as_deref() != Some(masks) {
+            let clock = std::time::Instant::now();
             let products = period_jacobian(self.sm, masks, &self.powers, &mut self.jac);
+            self.jacobian_s += clock.elapsed().as_secs_f64();
             self.jac_masks = Some(masks.to_vec());
             self.jacobians += 1;
             // (d+1)×(d+1) products of the runs' powers, 2(d+1)³ flops each.
@@ -224,7 +232,23 @@ pub fn solve_shooting(sm: &StepMapLcp, warm: Option<&[u64]>, settings: &Shooting
         jacobian_work: 0.0,
         jac: Mat::zeros(d, d + 1),
         jac_masks: None,
+        march_s: 0.0,
+        jacobian_s: 0.0,
     };
+    let solution = shoot(&mut nt, warm);
+    if std::env::var_os("PERIODIC_CONTACT_PROFILE").is_some() {
+        eprintln!(
+            "shooting profile: k = {k}, d = {d}, m = {}: {} marches {:.3} s, {} Jacobians {:.3} s, {} iterations, {} homotopy steps",
+            sm.m, nt.marches, nt.march_s, nt.jacobians, nt.jacobian_s, nt.iterations, solution.homotopy_steps
+        );
+    }
+    solution
+}
+
+/// Newton from the warm sets, from the contact-free orbit, then the offset homotopy.
+fn shoot(nt: &mut Newton<'_>, warm: Option<&[u64]>) -> ShootingSolution {
+    let (sm, settings) = (nt.sm, nt.settings);
+    let (k, d) = (sm.k, sm.d);
     let fail = |nt: &Newton<'_>, outcome, best: Option<Iterate>, homotopy_steps| ShootingSolution {
         outcome,
         z: best.as_ref().map_or_else(|| vec![0.0; k * sm.m], |b| b.march.z.clone()),
@@ -256,33 +280,33 @@ pub fn solve_shooting(sm: &StepMapLcp, warm: Option<&[u64]>, settings: &Shooting
         work_per_iteration: nt.march_work + nt.jacobian_work,
     };
     // The contact-free orbit: the fixed point of the affine map without contact.
-    let Some(free) = fixed_point(&mut nt, Contacts::Free) else {
-        return fail(&nt, ShootingOutcome::Breakdown, None, 0);
+    let Some(free) = fixed_point(nt, Contacts::Free) else {
+        return fail(nt, ShootingOutcome::Breakdown, None, 0);
     };
     // 1. Newton from the warm sets' orbit, then from the contact-free orbit.
     if let Some(sets) = warm.filter(|w| w.len() == k)
-        && let Some((s, _)) = fixed_point(&mut nt, Contacts::Frozen(sets))
+        && let Some((s, _)) = fixed_point(nt, Contacts::Frozen(sets))
         && let Ok(it) = nt.solve(s, 0.0, sets, settings.max_iterations)
     {
-        return done(&nt, it, 0, "warm");
+        return done(nt, it, 0, "warm");
     }
     let (s_free, free_march) = free;
     if free_march.min_w >= 0.0 {
         // No pair is active on the contact-free orbit: it is the answer.
         if let Some(it) = nt.march(&s_free, 0.0, &[], false) {
-            return done(&nt, it, 0, "free");
+            return done(nt, it, 0, "free");
         }
     }
     let best = match nt.solve(s_free.clone(), 0.0, &[], settings.max_iterations) {
-        Ok(it) => return done(&nt, it, 0, "free"),
+        Ok(it) => return done(nt, it, 0, "free"),
         Err(best) => best,
     };
     // 2. Homotopy in the offset: δ₀ makes the contact-free orbit feasible; the path (s, δ) is
     // followed by pseudo-arclength down to δ = 0, through its folds (coexisting orbits).
     let delta0 = -free_march.min_w * (1.0 + 1e-6) + f64::MIN_POSITIVE;
-    match follow_offset(&mut nt, s_free, delta0) {
-        Ok((it, steps)) => done(&nt, it, steps, "free"),
-        Err(steps) => fail(&nt, ShootingOutcome::NotConverged, best, steps),
+    match follow_offset(nt, s_free, delta0) {
+        Ok((it, steps)) => done(nt, it, steps, "free"),
+        Err(steps) => fail(nt, ShootingOutcome::NotConverged, best, steps),
     }
 }
 

@@ -11,7 +11,7 @@ pub const MAX_PAIRS: usize = 64;
 const ENUMERATE_MAX: usize = 12;
 
 /// The pairs of a mask, in order, on the stack (this runs at every step of every march).
-fn members(mask: u64, m: usize) -> ([usize; MAX_PAIRS], usize) {
+pub(super) fn members(mask: u64, m: usize) -> ([usize; MAX_PAIRS], usize) {
     let mut act = [0usize; MAX_PAIRS];
     let mut p = 0;
     for i in (0..m).filter(|&i| mask >> i & 1 == 1) {
