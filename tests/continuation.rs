@@ -218,7 +218,7 @@ fn random_compliant_oscillators_give_the_same_exact_branch_at_k_and_2k() {
     assert!(graze <= 1e-8, "a grazing off the closed form by {graze:.1e} (relative)");
 }
 
-/// The whole random family (opt-in: `PC_FAMILY=100 cargo test --release --test continuation --
+/// The whole random family (opt-in: `PC_FAMILY=100 cargo test --release --test suite continuation:: --
 /// --ignored random_family`): the fraction that reaches the end on the exact orbit and the worst
 /// k vs 2k event disagreement.
 #[test]

@@ -3,7 +3,7 @@
 //! displacements at the k instants, to 1e-9 of each output's peak-to-peak amplitude. The reduced
 //! blades are the case that once failed in the C API and the FMU (outputs named in the full
 //! model's numbering). fmpy runs the same matrix in validation/test_frontends.py.
-mod common;
+use crate::common;
 
 use common::host::*;
 use periodic_contact::capi::*;
