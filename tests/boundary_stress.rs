@@ -25,7 +25,7 @@
 //!
 //! Needs `cargo build --release` (libperiodic_contact.so and libPeriodicContact.so). Environment:
 //! `PC_STRESS_STEPS` (default 10⁷) sets the long run's length.
-mod common;
+use crate::common;
 
 use common::host::*;
 use libloading::Library;

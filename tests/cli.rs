@@ -1,30 +1,20 @@
 //! The command-line tool: every shipped scene solves; bad input exits with status 2 and a message
 //! naming the file and the field.
-use std::path::{Path, PathBuf};
+use crate::common::host::{shipped_scenes, shipped_solution};
+use std::path::Path;
 use std::process::Command;
 
 fn cli() -> Command {
     Command::new(env!("CARGO_BIN_EXE_periodic-contact"))
 }
 
-fn scenes() -> Vec<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fmu/scenes");
-    let mut v: Vec<PathBuf> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|e| e == "toml")).collect();
-    v.sort();
-    v
-}
-
 #[test]
 fn every_shipped_scene_solves_from_the_cli() {
-    let tmp = std::env::temp_dir().join(format!("pc-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&tmp).unwrap();
-    let list = scenes();
+    let list = shipped_scenes();
     assert!(list.len() >= 4, "expected the example scenes in fmu/scenes");
+    // Solved once per process, on a copy (tests/frontends.rs compares the same JSON with the C API and the FMU).
     for scene in list {
-        let out = tmp.join(scene.file_stem().unwrap()).with_extension("json");
-        let o = cli().arg("solve").arg(&scene).arg("-o").arg(&out).output().unwrap();
-        assert!(o.status.success(), "{}: {}", scene.display(), String::from_utf8_lossy(&o.stderr));
-        let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+        let (_, v) = shipped_solution(&scene);
         assert_eq!(v["lcp"]["status"], "solved", "{}", scene.display());
         let k = v["steps"].as_u64().unwrap() as usize;
         assert_eq!(v["time"].as_array().unwrap().len(), k);

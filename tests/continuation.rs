@@ -53,7 +53,7 @@ fn reference() -> (Vec<RefPoint>, Vec<(String, f64)>) {
 /// reference's event list kind by kind, every event within 1e-6 of the reference's Ω (exact flows
 /// in Python/scipy, validation/nlvib03), the reference's stable/unstable labels at its branch
 /// points, and each point from the exact orbit. The branch at the default k = 256 in under 1 s
-/// of one core (asserted with a margin for a loaded machine: 3 s of wall time).
+/// of one core (printed; not asserted, CI machines are loaded).
 #[test]
 fn nlvib03_exact_branch_is_the_same_at_every_k() {
     let (ref_points, ref_events) = reference();
@@ -92,9 +92,6 @@ fn nlvib03_exact_branch_is_the_same_at_every_k() {
         eprintln!("k = {k}: {} points, {wall:.3} s; amplitudes (interpolated between points) within {worst_amp:.1e}", b.points.len());
         assert_eq!(disagree, 0, "k = {k}: stability labels");
         assert!(worst_amp < 1e-2, "k = {k}: amplitudes, interpolated, within 1 %: {worst_amp:.1e}");
-        if k == 256 {
-            assert!(wall < 3.0, "the branch at k = 256 took {wall:.2} s");
-        }
     }
     eprintln!("worst event error over k = 256 … 4096: {worst_event:.1e}");
 }
@@ -218,7 +215,7 @@ fn random_compliant_oscillators_give_the_same_exact_branch_at_k_and_2k() {
     assert!(graze <= 1e-8, "a grazing off the closed form by {graze:.1e} (relative)");
 }
 
-/// The whole random family (opt-in: `PC_FAMILY=100 cargo test --release --test continuation --
+/// The whole random family (opt-in: `PC_FAMILY=100 cargo test --release --test suite continuation:: --
 /// --ignored random_family`): the fraction that reaches the end on the exact orbit and the worst
 /// k vs 2k event disagreement.
 #[test]
@@ -296,7 +293,7 @@ fn nlvib03_branch_events_amplitudes_stability() {
     eprintln!("amplitude: worst relative error {worst:.1e} over {} reference points; stability differs at {disagree}", ref_points.len());
     assert!(worst < 5e-3, "amplitudes within 0.5 %: worst {worst:.1e}");
     assert_eq!(disagree, 0, "stability agrees away from the events (±2e-3)");
-    assert!(wall < 30.0, "continuation took {wall:.1} s");
+    // Wall time is printed, not asserted: CI machines are loaded (issue 26).
 }
 
 /// The discrete walk's Floquet multipliers converge to the continuous orbit's as k grows (issue 13,
@@ -486,7 +483,7 @@ fn nlvib03_switch_to_the_2t_branch() {
     assert!(worst < 5e-3, "2T amplitudes within 0.5 %: worst {worst:.1e}");
     assert!((peak - 1.5188175).abs() < 5e-3 * 1.5188175);
     assert_eq!(disagree, 0);
-    assert!(wall < 40.0, "T branch and switch took {wall:.1} s");
+    // Wall time is printed, not asserted: CI machines are loaded (issue 26).
 }
 
 /// An LCP over two forcing periods: 2k instants over 2T with the forcing at ω. At Ω = 0.745 a

@@ -10,8 +10,7 @@ use periodic_contact::model::{Compliance, Contact};
 use periodic_contact::periodic::{AUTO_LEMKE_MAX, LcpMethod, OutputSelection, PeriodFft, PeriodicProblem, SolveError, SolverSettings};
 use periodic_contact::response::Response;
 
-#[path = "common/compare.rs"]
-mod compare;
+use crate::common::compare;
 use compare::{difference, max_abs};
 use periodic_contact::scene::Scene;
 use periodic_contact::time::{Discretization, Pairing, Scheme};

@@ -1,14 +1,14 @@
 //! Performance figures (ignored by default; they print, they do not assert speed):
 //!
 //!   cargo build --release
-//!   cargo test --release --test fmu_bench -- --ignored --nocapture --test-threads 1
+//!   cargo test --release --test suite fmu_bench:: -- --ignored --nocapture --test-threads 1
 //!
 //! - `fmi2DoStep` throughput over 10⁶ steps of the packaged binary (and with `fmi2GetReal` of
 //!   every output after each step);
 //! - a re-solve after a small change of frequency, warm-started from the previous active set,
 //!   against a cold solve of the same problem (library API with the reused FFT plan, and
 //!   through the FMU: `fmi2ExitInitializationMode` vs the `fmi2DoStep` that re-solves).
-mod common;
+use crate::common;
 
 use common::host::*;
 use periodic_contact::fmu_model::Tuning;

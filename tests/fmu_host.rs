@@ -4,7 +4,7 @@
 //!
 //! Needs the FMU binary: `cargo build --release` (the tests fail with
 //! that message when it is missing).
-mod common;
+use crate::common;
 
 use common::host::*;
 use std::collections::BTreeSet;

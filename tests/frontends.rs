@@ -3,22 +3,13 @@
 //! displacements at the k instants, to 1e-9 of each output's peak-to-peak amplitude. The reduced
 //! blades are the case that once failed in the C API and the FMU (outputs named in the full
 //! model's numbering). fmpy runs the same matrix in validation/test_frontends.py.
-mod common;
+use crate::common;
 
 use common::host::*;
 use periodic_contact::capi::*;
 use std::ffi::{CStr, CString};
-use std::path::PathBuf;
 
 const TOL: f64 = 1e-9;
-
-fn shipped_scenes() -> Vec<PathBuf> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fmu/scenes");
-    let mut v: Vec<PathBuf> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|x| x == "toml")).collect();
-    v.sort();
-    assert!(v.len() >= 7, "the shipped scenes are in {}", dir.display());
-    v
-}
 
 fn assert_same(scene: &str, front_end: &str, key: &str, got: &[f64], cli: &[f64]) {
     let (lo, hi) = cli.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &x| (l.min(x), h.max(x)));
@@ -78,16 +69,21 @@ fn fmu(name: &str, scene: &std::path::Path, keys: &[String], k: usize, period: f
 fn every_shipped_scene_gives_the_same_displacements_in_the_cli_the_c_api_and_the_fmu() {
     for scene in shipped_scenes() {
         let name = scene.file_stem().unwrap().to_string_lossy().replace('-', "_");
-        // The CLI writes its JSON beside the scene: solve a copy (with the files it references) in
-        // a scratch folder.
-        let copy = copy_scene(&scene, &scratch(&format!("frontends_{name}")));
-        let json = cli_solve(&copy);
+        // A copy of the scene (with the files it references) in a scratch folder, and its CLI JSON.
+        let (copy, json) = shipped_solution(&scene);
         let k = json["steps"].as_u64().unwrap() as usize;
         let period = json["period"].as_f64().unwrap();
         let keys: Vec<String> = json["displacement"].as_object().unwrap().keys().cloned().collect();
         assert!(!keys.is_empty(), "{name}: no displacement output");
-        let cli: Vec<Vec<f64>> = keys.iter().map(|key| series(&json, "displacement", key)).collect();
-        for (front_end, got) in [("C API", c_api(&copy, &keys, k)), ("FMU", fmu(&name, &copy, &keys, k, period))] {
+        let cli: Vec<Vec<f64>> = keys.iter().map(|key| series(json, "displacement", key)).collect();
+        // The C API and the FMU solve at the same time (independent: the FMU binary has its own engine).
+        let (c, f) = std::thread::scope(|s| {
+            let c = s.spawn(|| c_api(copy, &keys, k));
+            let f = s.spawn(|| fmu(&name, copy, &keys, k, period));
+            let join = |h: std::thread::ScopedJoinHandle<Vec<Vec<f64>>>| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e));
+            (join(c), join(f))
+        });
+        for (front_end, got) in [("C API", c), ("FMU", f)] {
             for ((key, g), c) in keys.iter().zip(&got).zip(&cli) {
                 assert_same(&name, front_end, key, g, c);
             }

@@ -4,9 +4,9 @@
 //! parsed data), never from an earlier run of the solver.
 //!
 //! The ignored test `lemke_block_circulant_timing` prints solve times for n = 1024…4096:
-//! `cargo test --release --test lcp -- --ignored --nocapture`.
+//! `cargo test --release --test suite lcp:: -- --ignored --nocapture`.
 //! The random tests scale with the environment variable `LCP_STRESS` (a multiplier, default 1):
-//! `LCP_STRESS=100 cargo test --release --test lcp` is the long stress run.
+//! `LCP_STRESS=100 cargo test --release --test suite lcp::` is the long stress run.
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 use std::time::Instant;

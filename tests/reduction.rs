@@ -273,7 +273,7 @@ fn reduce_structure_projects_the_structure_damping() {
 }
 
 /// Timings of the reduction on both presets (run with
-/// `cargo test --release --test reduction -- --ignored --nocapture timings`).
+/// `cargo test --release --test suite reduction::timings -- --ignored --nocapture`).
 #[test]
 #[ignore]
 fn timings() {

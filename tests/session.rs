@@ -4,8 +4,7 @@
 use periodic_contact::periodic::{PeriodicProblem, PeriodicSolver, Tuning};
 use periodic_contact::scene::Scene;
 
-#[path = "common/compare.rs"]
-mod compare;
+use crate::common::compare;
 use compare::difference;
 
 const CHAIN: &str = include_str!("../fmu/scenes/chain-3dof-two-stops.toml");

@@ -7,8 +7,7 @@ use periodic_contact::model::{Compliance, Contact, Force, Harmonic, Matrix, Mode
 use periodic_contact::periodic::{LcpMethod, OutputSelection, PeriodicProblem, PeriodicSolver, SolveError, SolverSettings, step_map};
 use periodic_contact::response::Response;
 
-#[path = "common/compare.rs"]
-mod compare;
+use crate::common::compare;
 use compare::{difference, max_abs};
 use periodic_contact::scene::Scene;
 use periodic_contact::time::{Discretization, Pairing, Scheme};

@@ -27,7 +27,7 @@ fn coarse_blade_sweep_of_300_points_shows_the_stiffening_shift_of_the_resonance(
     let wall = t.elapsed().as_secs_f64();
     let warm = points.iter().filter(|x| x.warm_start_used).count();
     eprintln!("coarse blade: set-up {setup:.2} s, 300-point sweep {wall:.2} s wall, {warm} warm-started");
-    assert!(setup + wall < 60.0, "{setup} + {wall} s");
+    // Wall time is printed, not asserted: CI machines are loaded (issue 26).
     assert!(points.iter().all(|x| x.error.is_none()), "every point solves");
     assert!(warm > 250, "warm starts are used: {warm}");
     // Output 0 is the tip flap displacement (MC:y).

@@ -1,5 +1,5 @@
-//! Comparing two responses, for the tests that hold one solver to another (included with
-//! `#[path = "common/compare.rs"] mod compare;`).
+//! Comparing two responses, for the tests that hold one solver to another
+//! (`use crate::common::compare;`).
 use periodic_contact::response::Response;
 
 pub fn max_abs<'a>(v: impl IntoIterator<Item = &'a f64>) -> f64 {

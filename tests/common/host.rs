@@ -317,6 +317,31 @@ pub fn cli_solve(scene: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap()
 }
 
+/// The shipped scenes, fmu/scenes/*.toml, sorted.
+pub fn shipped_scenes() -> Vec<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fmu/scenes");
+    let mut v: Vec<PathBuf> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|x| x == "toml")).collect();
+    v.sort();
+    assert!(v.len() >= 7, "the shipped scenes are in {}", dir.display());
+    v
+}
+
+/// The CLI's solution of the shipped scene `scene`, solved once per process (tests/cli.rs and
+/// tests/frontends.rs share it; the fine blade alone takes minutes): a copy of the scene with the
+/// files it references in a scratch folder (the CLI writes its JSON beside it), and the JSON.
+pub fn shipped_solution(scene: &Path) -> &'static (PathBuf, serde_json::Value) {
+    type Once = OnceLock<(PathBuf, serde_json::Value)>;
+    static SOLVED: OnceLock<Mutex<HashMap<PathBuf, &'static Once>>> = OnceLock::new();
+    // One lock per scene, taken outside the map's lock: different scenes solve concurrently.
+    let once: &'static Once = SOLVED.get_or_init(Default::default).lock().unwrap().entry(scene.to_path_buf()).or_insert_with(|| Box::leak(Box::default()));
+    once.get_or_init(|| {
+        let name = scene.file_stem().unwrap().to_string_lossy().replace('-', "_");
+        let copy = copy_scene(scene, &scratch(&format!("shipped_{name}")));
+        let json = cli_solve(&copy);
+        (copy, json)
+    })
+}
+
 pub fn series(json: &serde_json::Value, field: &str, key: &str) -> Vec<f64> {
     json[field][key].as_array().unwrap_or_else(|| panic!("{field}[{key}] missing")).iter().map(|v| v.as_f64().unwrap()).collect()
 }
