@@ -175,6 +175,8 @@ pub enum Legend {
     Default,
     UpperRight,
     LowerLeft,
+    /// The middle of the plot: inside a hysteresis loop, where no curve runs.
+    Middle,
 }
 
 /// Several charts in one PNG, `columns` per row (each panel as [`line_chart`] draws it).
@@ -287,6 +289,9 @@ where
                 }
                 Legend::LowerLeft => {
                     labels.position(SeriesLabelPosition::LowerLeft);
+                }
+                Legend::Middle => {
+                    labels.position(SeriesLabelPosition::MiddleMiddle);
                 }
             }
             labels.draw().map_err(|e| err(&e))?;
