@@ -158,7 +158,7 @@ def check_examples(text, failures):
 
 
 def markers(text):
-    for m in re.finditer(r"<!--\s*readme-check\s+(\{.*?\})\s*-->", text, re.S):
+    for m in re.finditer(r'<!--\s*readme-check\s+(\{".*?\})\s*-->', text, re.S):
         yield json.loads(m.group(1))
 
 
