@@ -40,8 +40,16 @@ pub struct Files<'a> {
     pub hysteresis: Option<&'a Path>,
 }
 
-/// The checked problem, what to refine, the scene's labels and the scene DOF of each `[[friction]]`.
-fn load(scene: &Path, overrides: Overrides, flags: Refine) -> Result<(PeriodicProblem, Refine, (Labels, Vec<usize>)), Failure> {
+/// A scene loaded for `solve`: the checked problem, what to refine, the scene's labels and the
+/// scene DOF of each `[[friction]]` (for the hysteresis plot).
+struct Loaded {
+    problem: PeriodicProblem,
+    refine: Refine,
+    labels: Labels,
+    friction_dofs: Vec<usize>,
+}
+
+fn load(scene: &Path, overrides: Overrides, flags: Refine) -> Result<Loaded, Failure> {
     let (mut s, dir) = Scene::load(scene).map_err(|e| Failure::input(e.to_string()))?;
     if let Some(f) = overrides.frequency {
         s.set_frequency(f);
@@ -57,7 +65,7 @@ fn load(scene: &Path, overrides: Overrides, flags: Refine) -> Result<(PeriodicPr
     let friction_dofs = s.friction.iter().map(|f| f.dof.unwrap_or(usize::MAX)).collect();
     let built = s.build_in(&scene.display().to_string(), &dir).map_err(|e| Failure::input(e.to_string()))?;
     let refine = Refine { estimate: flags.estimate && built.error_estimate, polish: flags.polish || built.polish };
-    Ok((built.problem, refine, (built.labels, friction_dofs)))
+    Ok(Loaded { problem: built.problem, refine, labels: built.labels, friction_dofs })
 }
 
 /// The error estimate, then the polish (whose estimate replaces it), as `refine` asks.
@@ -106,7 +114,7 @@ pub fn run(scene: &Path, files: Files, overrides: Overrides, flags: Refine) -> R
     if let Some(p) = hysteresis {
         ensure_writable(p, "--hysteresis")?;
     }
-    let (problem, flags, (labels, friction_dofs)) = load(scene, overrides, flags)?;
+    let Loaded { problem, refine: flags, labels, friction_dofs } = load(scene, overrides, flags)?;
     if hysteresis.is_some() && problem.model().frictions.is_empty() {
         return Err(Failure::input(format!(
             "--hysteresis: {} has no [[friction]] contact, so there is no force–displacement loop to draw; add a [[friction]] entry or leave --hysteresis out",
