@@ -175,6 +175,31 @@ pub enum Legend {
     Default,
     UpperRight,
     LowerLeft,
+    /// The middle of the plot: inside a hysteresis loop, where no curve runs.
+    Middle,
+    /// Of the nine places (corners, edge middles, centre), the one whose box covers the fewest
+    /// points of the panel: crowded panels (the accuracy study) keep their curves visible.
+    Emptiest,
+}
+
+/// Where [`Legend::Emptiest`] puts the legend of a panel: `points` in axis fractions (0..1, y up),
+/// a box of `width` × `height` fractions; the first of the least covered places wins.
+fn emptiest_place(points: &[(f64, f64)], width: f64, height: f64) -> SeriesLabelPosition {
+    use SeriesLabelPosition::*;
+    let places = [
+        (UpperRight, 1.0 - width, 1.0 - height),
+        (UpperLeft, 0.0, 1.0 - height),
+        (LowerLeft, 0.0, 0.0),
+        (LowerRight, 1.0 - width, 0.0),
+        (MiddleLeft, 0.0, 0.5 - height / 2.0),
+        (MiddleRight, 1.0 - width, 0.5 - height / 2.0),
+        (UpperMiddle, 0.5 - width / 2.0, 1.0 - height),
+        (LowerMiddle, 0.5 - width / 2.0, 0.0),
+        (MiddleMiddle, 0.5 - width / 2.0, 0.5 - height / 2.0),
+    ];
+    let covered = |x0: f64, y0: f64| points.iter().filter(|(x, y)| (x0..=x0 + width).contains(x) && (y0..=y0 + height).contains(y)).count();
+    let best = places.iter().map(|(_, x0, y0)| covered(*x0, *y0)).min().unwrap_or(0);
+    places.into_iter().find(|(_, x0, y0)| covered(*x0, *y0) == best).map_or(UpperRight, |(p, _, _)| p)
 }
 
 /// Several charts in one PNG, `columns` per row (each panel as [`line_chart`] draws it).
@@ -287,6 +312,25 @@ where
                 }
                 Legend::LowerLeft => {
                     labels.position(SeriesLabelPosition::LowerLeft);
+                }
+                Legend::Middle => {
+                    labels.position(SeriesLabelPosition::MiddleMiddle);
+                }
+                Legend::Emptiest => {
+                    let frac = |v: f64, (lo, hi): (f64, f64), scale: Scale| match scale {
+                        Scale::Linear => (v - lo) / (hi - lo),
+                        Scale::Log => (v.ln() - lo.ln()) / (hi.ln() - lo.ln()),
+                    };
+                    let pts: Vec<(f64, f64)> = series
+                        .iter()
+                        .flat_map(|s| s.points.iter())
+                        .filter(|p| keep(p))
+                        .map(|&(x, y)| (frac(x, xs, chart.x_scale), frac(y, ys, chart.y_scale)))
+                        .collect();
+                    // The legend's size as a fraction of the plot: about 30 % wide, a row per entry.
+                    let entries = series.iter().filter(|s| !s.label.is_empty()).count() as f64;
+                    let (w, h) = area.dim_in_pixel();
+                    labels.position(emptiest_place(&pts, 280.0 / f64::from(w.max(1)), (entries * 17.0 + 14.0) / f64::from(h.max(1))));
                 }
             }
             labels.draw().map_err(|e| err(&e))?;

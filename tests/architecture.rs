@@ -253,3 +253,68 @@ fn collect_text_files(dir: &Path, out: &mut Vec<PathBuf>) {
         }
     }
 }
+
+/// The keys a scene may hold: the fields of every `Deserialize` struct of `src/scene/` (serde's
+/// `rename` honoured), with the struct that holds each.
+fn scene_keys() -> Vec<(String, String)> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/scene");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|e| e == "rs")).collect();
+    files.sort();
+    let mut keys = Vec::new();
+    for file in files {
+        let text = std::fs::read_to_string(&file).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        let mut i = 0;
+        while i < lines.len() {
+            let derives = lines[i].trim_start().starts_with("#[derive(") && lines[i].contains("Deserialize");
+            i += 1;
+            if !derives {
+                continue;
+            }
+            while i < lines.len() && lines[i].trim_start().starts_with("#[") {
+                i += 1;
+            }
+            let Some(name) = lines.get(i).and_then(|l| l.trim_start().strip_prefix("pub struct ").or_else(|| l.trim_start().strip_prefix("struct "))) else {
+                continue;
+            };
+            let name = name.split([' ', '{', '<']).next().unwrap().to_string();
+            let mut rename = None;
+            i += 1;
+            while i < lines.len() && lines[i].trim() != "}" {
+                let l = lines[i].trim();
+                if let Some(r) = l.strip_prefix("#[serde(rename = \"") {
+                    rename = r.split('"').next().map(str::to_string);
+                } else if !l.starts_with("//") && !l.starts_with("#[") && l.contains(':') {
+                    let field = l.trim_start_matches("pub ").trim_start_matches("pub(crate) ").split(':').next().unwrap().trim().to_string();
+                    if field.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_') {
+                        keys.push((name.clone(), rename.take().unwrap_or(field)));
+                    }
+                }
+                i += 1;
+            }
+        }
+    }
+    keys
+}
+
+#[test]
+fn every_scene_key_is_documented_in_the_readmes_scene_format() {
+    let readme = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md")).unwrap();
+    // The scene format: from the units section to the end of the scene-format section.
+    let start = readme.find("\n## Units and sign conventions").expect("README: ## Units and sign conventions");
+    let end = start + readme[start..].find("\n## Blade rubbing").expect("README: the section after ## Scene format");
+    let section = &readme[start..end];
+    let keys = scene_keys();
+    assert!(keys.len() > 40, "parsed {} scene keys from src/scene: the parser of this test is broken", keys.len());
+    let documented = |k: &str| {
+        section.match_indices(k).any(|(i, _)| {
+            let before = section[..i].chars().next_back().unwrap_or(' ');
+            let after = section[i + k.len()..].chars().next().unwrap_or(' ');
+            let word = |c: char| c.is_alphanumeric() || c == '_';
+            let table = before == '[' && after == ']';
+            !word(before) && !word(after) && (table || section[i + k.len()..].starts_with(" =") || before == '`' || before == '.' || after == '`')
+        })
+    };
+    let missing: Vec<String> = keys.iter().filter(|(_, k)| !documented(k)).map(|(s, k)| format!("{s}.{k}")).collect();
+    assert!(missing.is_empty(), "scene keys missing from README.md's scene format (write `key = …` or `key` there): {missing:?}");
+}

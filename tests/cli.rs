@@ -183,3 +183,28 @@ fn export_writes_the_model_the_scene_states() {
     assert!(!dir.join("bad").join("model.json").exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn solve_draws_the_friction_dampers_hysteresis_loop_and_refuses_a_scene_without_friction() {
+    let tmp = std::env::temp_dir().join(format!("pc-hysteresis-{}", std::process::id()));
+    std::fs::create_dir_all(&tmp).unwrap();
+    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("fmu/scenes");
+    let (json, png) = (tmp.join("f.json"), tmp.join("loop.png"));
+    let o =
+        cli().arg("solve").arg(scenes.join("friction-damper.toml")).args(["--no-estimate", "-o"]).arg(&json).arg("--hysteresis").arg(&png).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(std::fs::metadata(&png).unwrap().len() > 10_000, "a PNG");
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let e = v["friction"][0]["dissipated_energy"].as_f64().unwrap();
+    // Masing's bound for the shipped damper (μN = 0.5, k_t = 2): 4·μN·(X − μN/k_t) with X its amplitude.
+    let x = v["friction"][0]["displacement"].as_array().unwrap().iter().map(|u| u.as_f64().unwrap().abs()).fold(0.0, f64::max);
+    assert!((e - 4.0 * 0.5 * (x - 0.25)).abs() < 0.02 * e, "energy {e} against Masing's {}", 4.0 * 0.5 * (x - 0.25));
+    assert!(err.contains("dissipated per cycle"), "{err}");
+    let o =
+        cli().arg("solve").arg(scenes.join("rigid-stop.toml")).arg("-o").arg(tmp.join("r.json")).arg("--hysteresis").arg(tmp.join("no.png")).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("--hysteresis") && err.contains("[[friction]]"), "{err}");
+    assert!(!tmp.join("no.png").exists());
+}

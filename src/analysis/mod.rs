@@ -9,6 +9,7 @@
 //! instants for the front ends.
 pub mod accuracy;
 pub mod continuation;
+pub mod hysteresis;
 pub mod interpolant;
 pub mod polish;
 pub mod sweep;

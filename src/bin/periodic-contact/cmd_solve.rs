@@ -1,7 +1,8 @@
 //! `solve` and the default run.
 use crate::{Failure, ensure_writable, write_output};
-use periodic_contact::analysis::{accuracy, polish};
+use periodic_contact::analysis::{accuracy, hysteresis, polish};
 use periodic_contact::linalg::PeriodFft;
+use periodic_contact::model::Labels;
 use periodic_contact::periodic::PeriodicProblem;
 use periodic_contact::response::Response;
 use periodic_contact::scene::Scene;
@@ -31,7 +32,24 @@ pub struct Overrides {
     pub period_multiple: Option<i64>,
 }
 
-pub fn load(scene: &Path, overrides: Overrides, flags: Refine) -> Result<(PeriodicProblem, Refine), Failure> {
+/// What `solve` writes: the JSON, and on request the LCP and the hysteresis loops.
+#[derive(Clone, Copy, Debug)]
+pub struct Files<'a> {
+    pub output: &'a Path,
+    pub export_lcp: Option<&'a Path>,
+    pub hysteresis: Option<&'a Path>,
+}
+
+/// A scene loaded for `solve`: the checked problem, what to refine, the scene's labels and the
+/// scene DOF of each `[[friction]]` (for the hysteresis plot).
+struct Loaded {
+    problem: PeriodicProblem,
+    refine: Refine,
+    labels: Labels,
+    friction_dofs: Vec<usize>,
+}
+
+fn load(scene: &Path, overrides: Overrides, flags: Refine) -> Result<Loaded, Failure> {
     let (mut s, dir) = Scene::load(scene).map_err(|e| Failure::input(e.to_string()))?;
     if let Some(f) = overrides.frequency {
         s.set_frequency(f);
@@ -44,9 +62,10 @@ pub fn load(scene: &Path, overrides: Overrides, flags: Refine) -> Result<(Period
         }
         s.discretization.period_multiple = Some(p);
     }
+    let friction_dofs = s.friction.iter().map(|f| f.dof.unwrap_or(usize::MAX)).collect();
     let built = s.build_in(&scene.display().to_string(), &dir).map_err(|e| Failure::input(e.to_string()))?;
     let refine = Refine { estimate: flags.estimate && built.error_estimate, polish: flags.polish || built.polish };
-    Ok((built.problem, refine))
+    Ok(Loaded { problem: built.problem, refine, labels: built.labels, friction_dofs })
 }
 
 /// The error estimate, then the polish (whose estimate replaces it), as `refine` asks.
@@ -86,12 +105,22 @@ fn export_lcp(problem: &PeriodicProblem, path: &Path) -> Result<(), Failure> {
     Ok(())
 }
 
-pub fn run(scene: &Path, output: &Path, overrides: Overrides, export: Option<&Path>, flags: Refine) -> Result<(), Failure> {
+pub fn run(scene: &Path, files: Files, overrides: Overrides, flags: Refine) -> Result<(), Failure> {
+    let Files { output, export_lcp: export, hysteresis } = files;
     ensure_writable(output, "--output")?;
     if let Some(p) = export {
         ensure_writable(p, "--export-lcp")?;
     }
-    let (problem, flags) = load(scene, overrides, flags)?;
+    if let Some(p) = hysteresis {
+        ensure_writable(p, "--hysteresis")?;
+    }
+    let Loaded { problem, refine: flags, labels, friction_dofs } = load(scene, overrides, flags)?;
+    if hysteresis.is_some() && problem.model().frictions.is_empty() {
+        return Err(Failure::input(format!(
+            "--hysteresis: {} has no [[friction]] contact, so there is no force–displacement loop to draw; add a [[friction]] entry or leave --hysteresis out",
+            scene.display()
+        )));
+    }
     if let Some(p) = export {
         export_lcp(&problem, p)?;
     }
@@ -100,6 +129,19 @@ pub fn run(scene: &Path, output: &Path, overrides: Overrides, export: Option<&Pa
     refine(&problem, &mut r, flags);
     let json = serde_json::to_string_pretty(&r).map_err(|e| Failure::solver(e.to_string()))?;
     write_output(output, &json)?;
+    if let Some(p) = hysteresis {
+        hysteresis::plot_hysteresis(p, &r.friction, &hysteresis::LoopLabels { dofs: &friction_dofs, labels: &labels })
+            .map_err(|e| Failure::solver(e.to_string()))?;
+        for (i, f) in r.friction.iter().enumerate() {
+            eprintln!(
+                "friction[{i}]: {:.6} {}·{} dissipated per cycle (∮ f du, the loop's area)",
+                f.dissipated_energy,
+                labels.units.force(),
+                labels.units.length()
+            );
+        }
+        eprintln!("hysteresis loop(s) → {}", p.display());
+    }
     eprintln!("solver: {}", r.lcp.path);
     match (r.accuracy.estimate, r.accuracy.relative) {
         (Some(e), Some(rel)) => eprintln!("error estimate: {e:.3e} ({rel:.2e} of the peak-to-peak amplitude), {}", r.accuracy.method),

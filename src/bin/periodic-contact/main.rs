@@ -49,6 +49,11 @@ enum Command {
         /// period_multiple`): the LCP over P periods, `steps` instants per forcing period.
         #[arg(long)]
         period_multiple: Option<i64>,
+        /// Also draw each friction contact's hysteresis loop (friction force against the
+        /// contact's relative displacement, the energy per cycle in the title) to this PNG;
+        /// refused on a scene without `[[friction]]`.
+        #[arg(long, value_name = "PNG")]
+        hysteresis: Option<PathBuf>,
     },
     /// Package a scene as an FMI 2.0 co-simulation FMU (needs `cargo build --release`).
     Fmu {
@@ -170,9 +175,10 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         None => cmd_solve::run_default(),
-        Some(Command::Solve { scene, output, frequency, export_lcp, no_estimate, polish, period_multiple }) => {
+        Some(Command::Solve { scene, output, frequency, export_lcp, no_estimate, polish, period_multiple, hysteresis }) => {
             let overrides = cmd_solve::Overrides { frequency, period_multiple };
-            cmd_solve::run(&scene, &output, overrides, export_lcp.as_deref(), cmd_solve::Refine { estimate: !no_estimate, polish })
+            let files = cmd_solve::Files { output: &output, export_lcp: export_lcp.as_deref(), hysteresis: hysteresis.as_deref() };
+            cmd_solve::run(&scene, files, overrides, cmd_solve::Refine { estimate: !no_estimate, polish })
         }
         Some(Command::Modes { scene, count }) => cmd_modes::run(&scene, count),
         Some(Command::Deck { scene, output }) => cmd_deck::run(&scene, &output),

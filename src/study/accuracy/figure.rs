@@ -112,6 +112,6 @@ impl AccuracyStudy {
         let panels: Vec<(&Chart, &[Series], &[Look])> = charts.iter().zip(&drawn).map(|(c, (s, l))| (c, s.as_slice(), l.as_slice())).collect();
         let cols = panels.len().min(2);
         let rows = panels.len().div_ceil(cols.max(1)) as u32;
-        styled_panel_chart(path, &panels, cols, 1100 * cols as u32, 900 * rows, Legend::UpperRight).map_err(Error::from)
+        styled_panel_chart(path, &panels, cols, 1100 * cols as u32, 900 * rows, Legend::Emptiest).map_err(Error::from)
     }
 }
