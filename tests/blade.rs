@@ -422,7 +422,25 @@ fn calculix_assembles_the_generated_blade_with_our_eigenfrequencies() {
         let deck = dir.join(format!("{kind}.inp"));
         let o = std::process::Command::new(env!("CARGO_BIN_EXE_periodic-contact")).arg("deck").arg(&scene).arg("-o").arg(&deck).output().unwrap();
         assert!(o.status.success(), "periodic-contact deck: {}", String::from_utf8_lossy(&o.stderr));
-        assert_eq!(std::fs::read_to_string(&deck).unwrap(), blade.calculix_deck());
+        let text = std::fs::read_to_string(&deck).unwrap();
+        assert_eq!(text, blade.calculix_deck());
+        // The node set TIP names the mid-thickness tip nodes LE to TE (z = L, y = 0 before twist).
+        let tip: Vec<u64> = text
+            .split("*NSET, NSET=TIP\n")
+            .nth(1)
+            .unwrap()
+            .lines()
+            .take_while(|l| !l.starts_with('*'))
+            .flat_map(|l| l.split(',').filter_map(|v| v.trim().parse().ok()).collect::<Vec<u64>>())
+            .collect();
+        assert_eq!(tip.len(), blade.params.mesh.chord + 1);
+        for n in &tip {
+            let [x, y, z] = blade.nodes[*n as usize - 1];
+            assert!(
+                (z - blade.params.length).abs() < 1e-12 && (x * 30f64.to_radians().sin() - y * 30f64.to_radians().cos()).abs() < 1e-12,
+                "node {n} at {x}, {y}, {z}"
+            );
+        }
         let o = std::process::Command::new("ccx").arg(kind).current_dir(&dir).output().unwrap();
         assert!(o.status.success(), "ccx {kind}: {}", String::from_utf8_lossy(&o.stdout));
         let job = read_calculix(&dir.join(kind)).unwrap();

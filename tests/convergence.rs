@@ -296,3 +296,49 @@ fn massless_contact_point_converges_to_the_compliant_orbit() {
         }
     }
 }
+
+/// Explicit marching of a model with a massless DOF (the massless DOFs condensed statically at
+/// each instant, the rigid contact on it enforced at that instant): its steady state converges
+/// at second order to the exact orbit of the equivalent bilinear oscillator (no time grid), and
+/// is the periodic cds LCP's orbit at the same k to the march's tolerance (the same recurrence,
+/// reached by marching instead of by one LCP). The stable step counts the closed contact:
+/// ω_max = √((k1 + k2)/m), not the open √(k1/m).
+#[test]
+fn massless_contact_point_marches_to_the_exact_orbit_at_second_order() {
+    use periodic_contact::marching::{MarchSettings, march, stable_omega_max};
+    let (k2, g0) = (10.0, 1.0);
+    let model = massless_contact_point(&COMPLIANT, k2, g0, Compliance::Rigid);
+    let w = stable_omega_max(&model).unwrap();
+    assert!((w - 11f64.sqrt()).abs() < 1e-5, "ω_max for marching {w} vs √11");
+    let exact = CompliantStopOrbit::solve(&COMPLIANT, k2, g0, None).unwrap();
+    let ptp = exact.peak_to_peak();
+    let ks = [128, 256, 512];
+    let mut e = Vec::new();
+    for &k in &ks {
+        let m = march(&model, &MarchSettings { steps_per_period: k, tolerance: 1e-12, max_periods: 5000, ..Default::default() }).unwrap();
+        assert!(m.converged, "k = {k}: no steady state in {} periods", m.periods);
+        let err = m.time.iter().zip(&m.displacement).map(|(&t, x)| (x[0] - exact.eval(t).0).abs()).fold(0.0, f64::max) / ptp;
+        let outputs = OutputSelection { displacement: vec![0, 1], velocity: vec![], acceleration: vec![], contacts: true };
+        let r = PeriodicProblem::new(model.clone(), Discretization { scheme: Scheme::Cds, steps: k, pairing: None }, outputs, SolverSettings::default())
+            .unwrap()
+            .solve()
+            .unwrap();
+        let d = (0..k)
+            .map(|j| (r.displacement["0"][j] - m.displacement[j][0]).abs().max((r.displacement["1"][j] - m.displacement[j][1]).abs()))
+            .fold(0.0, f64::max);
+        // The force is finite and the contact point is held at the stop while it acts.
+        for (x, f) in m.displacement.iter().zip(&m.contact_force) {
+            assert!(f[0] >= 0.0 && (f[0] == 0.0 || (x[1] - g0).abs() < 1e-12), "force {} at x = {}", f[0], x[1]);
+        }
+        eprintln!("massless march k = {k}: error {err:.3e} of ptp vs exact, {d:.2e} vs the cds LCP, {} periods", m.periods);
+        assert!(d < 1e-9 * ptp, "k = {k}: march vs LCP {d:e}");
+        e.push(err);
+    }
+    let order = fitted_order(&ks, &e);
+    assert!(order > 1.8, "observed order {order:.2}: {e:?}");
+    // Below the closed contact's limit the march is refused, naming the steps needed.
+    let period = 2.0 * std::f64::consts::PI / COMPLIANT.omega;
+    let few = (period * w / 2.0).floor() as usize - 1;
+    let err = march(&model, &MarchSettings { steps_per_period: few, ..Default::default() }).unwrap_err().to_string();
+    assert!(err.contains("contacts closed") && err.contains("steps per period"), "{err}");
+}

@@ -262,3 +262,31 @@ fn jumps_are_found_where_the_curve_drops_and_nowhere_on_a_smooth_peak() {
     }
     assert_eq!(sweep::peak_ratio(0.5, 9.0), 18.0);
 }
+
+/// `SweepSettings::estimate` gives every point the estimate of a standalone solve
+/// (`accuracy::estimate`, a cold second solve) although its second grid is warm-started along
+/// the sweep: below the fold the orbits are unique, so both agree to round-off.
+#[test]
+fn sweep_estimates_every_point_as_a_standalone_solve_does() {
+    // bds2 at k = 256 (compliant contacts: second order, no stability limit) keeps it quick.
+    let mut p = problem();
+    p.set_discretization(periodic_contact::time::Discretization { scheme: periodic_contact::time::Scheme::Bds2, steps: 256, pairing: None }).unwrap();
+    let freqs = sweep::linspace(2200.0, 2300.0, 4);
+    let settings = SweepSettings { threads: 1, chunks_per_thread: 1, estimate: true, ..Default::default() };
+    let points = sweep::run(&p, &freqs, &settings, &|| {}).unwrap();
+    for x in &points {
+        let mut q = p.clone();
+        q.set_parallel(false);
+        let mut solver = periodic_contact::periodic::PeriodicSolver::new(q);
+        solver.update_frequency(x.frequency).unwrap();
+        let r = solver.solve().unwrap();
+        let alone = periodic_contact::analysis::accuracy::estimate(solver.problem(), &r);
+        let (e, a) = (x.estimate_relative.unwrap(), alone.relative.unwrap());
+        eprintln!("ω = {}: sweep estimate {e:.3e}, standalone {a:.3e} ({})", x.frequency, x.estimate_method);
+        assert!(e > 0.0 && (e - a).abs() <= 1e-6 * a, "ω = {}: {e} vs {a}", x.frequency);
+        assert_eq!(x.estimate_method, alone.method);
+    }
+    // Without the setting no estimate is made.
+    let plain = sweep::run(&p, &freqs[..1], &SweepSettings { estimate: false, ..settings }, &|| {}).unwrap();
+    assert!(plain[0].estimate_relative.is_none() && plain[0].estimate_method.is_empty());
+}

@@ -86,6 +86,13 @@ fn longest_run(force: &[f64]) -> usize {
 /// is odd or too small, the scheme does not converge for this contact, or the second solve is
 /// refused or fails.
 pub fn estimate(problem: &PeriodicProblem, r: &Response) -> Accuracy {
+    estimate_with(problem, r, &mut |second| second.solve())
+}
+
+/// [`estimate`] with the second solve made by `solve_second` (given the problem at k/2 or 2k):
+/// a sweep passes a warm-started session of its own, so that the estimate of every point costs
+/// a warm solve instead of a cold one.
+pub fn estimate_with(problem: &PeriodicProblem, r: &Response, solve_second: &mut dyn FnMut(&PeriodicProblem) -> Result<Response, SolveError>) -> Accuracy {
     let none = |why: String| Accuracy { estimate: None, relative: None, method: format!("none: {why}") };
     let disc = problem.discretization();
     let k = disc.steps;
@@ -111,7 +118,7 @@ pub fn estimate(problem: &PeriodicProblem, r: &Response) -> Accuracy {
     if let Err(e) = second.set_discretization(Discretization { steps: other, ..disc }) {
         return none(format!("the second solve at {note} is refused: {e}"));
     }
-    let rs = match second.solve() {
+    let rs = match solve_second(&second) {
         Ok(rs) => rs,
         Err(e) => return none(format!("the second solve at {note} failed: {}", short(&e))),
     };

@@ -17,15 +17,20 @@
 //! (forward increment), and its impulse is λ_n·h. On a contact DOF carrying mass this is a
 //! perfectly plastic impact (restitution 0).
 //!
+//! A model with massless DOFs (a massless boundary) is marched with those DOFs condensed
+//! statically at each instant (`massless.rs`).
+//!
 //! Stability: h < 2/ω_max, with ω_max² the largest eigenvalue of (K + Σ k_c e_d e_dᵀ, M)
 //! (compliant contacts closed). The viscous term C(x_{n+1} − x_{n−1})/(2h) does not lower this
 //! bound for a 1-DOF or proportionally damped system.
+mod massless;
 mod small_lcp;
 
 use crate::error::ErrorKind;
 use crate::model::{Compliance, Model, ModelError};
 use faer::Mat;
 use faer::linalg::solvers::{DenseSolveCore, Solve};
+pub use massless::stable_omega_max;
 pub use small_lcp::StepLcpError;
 use small_lcp::solve_small_lcp;
 use std::time::Instant;
@@ -145,15 +150,6 @@ pub fn march(model: &Model, settings: &MarchSettings) -> Result<MarchResult, Mar
     let start = Instant::now();
     model.validate()?;
     let n = model.n();
-    let massless = model.massless_dofs();
-    if !massless.is_empty() {
-        return Err(MarchError::setting(
-            "structure.mass",
-            format!(
-                "DOFs {massless:?} are massless (a massless boundary, src/formulation.md §4.1): explicit central differences with forward-increment multipliers need (M/h² + C/(2h)) invertible, i.e. mass on every DOF; solve the periodic LCP (cds, bds1, bds2) instead"
-            ),
-        ));
-    }
     let ns = settings.steps_per_period;
     if ns < 2 {
         return Err(MarchError::setting("settings.steps_per_period", format!("is {ns}, must be ≥ 2")));
@@ -173,6 +169,10 @@ pub fn march(model: &Model, settings: &MarchSettings) -> Result<MarchResult, Mar
                 return Err(MarchError::setting(format!("{name}[{i}]"), format!("is {}, must be finite", v[i])));
             }
         }
+    }
+    let massless = model.massless_dofs();
+    if !massless.is_empty() {
+        return massless::march_massless(model, settings, &massless, start);
     }
     let period = model.period();
     let h = period / ns as f64;
@@ -316,13 +316,7 @@ pub fn march(model: &Model, settings: &MarchSettings) -> Result<MarchResult, Mar
         }
         periods = p + 1;
         if p >= 1 {
-            let mut ptp = 0.0f64;
-            for i in 0..n {
-                let (lo, hi) = (0..ns).map(|j| disp[j * n + i]).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
-                ptp = ptp.max(hi - lo);
-            }
-            let diff = disp.iter().zip(&disp_prev).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
-            defect = if ptp > 0.0 { diff / ptp } else { diff };
+            defect = period_defect(&disp, &disp_prev, n, ns);
             history.push(defect);
             if defect < settings.tolerance && periods >= settings.min_periods.max(2) {
                 converged = true;
@@ -334,16 +328,44 @@ pub fn march(model: &Model, settings: &MarchSettings) -> Result<MarchResult, Mar
     // After a converged break `disp` holds the last period; otherwise the final swap moved it
     // to `disp_prev`.
     let last = if converged { &disp } else { &disp_prev };
+    Ok(result(Samples { disp: last, vel: &vel, force: &force, clear: &clear, n, m: nc, ns, h }, periods, omega_max, start, converged, defect, history))
+}
+
+/// ‖x(period p) − x(period p−1)‖∞ / peak-to-peak over the DOFs (`n` per sample, `ns` samples).
+fn period_defect(disp: &[f64], disp_prev: &[f64], n: usize, ns: usize) -> f64 {
+    let mut ptp = 0.0f64;
+    for i in 0..n {
+        let (lo, hi) = (0..ns).map(|j| disp[j * n + i]).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+        ptp = ptp.max(hi - lo);
+    }
+    let diff = disp.iter().zip(disp_prev).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+    if ptp > 0.0 { diff / ptp } else { diff }
+}
+
+/// The last period's samples, row-major: `n` DOFs and `m` contacts per sample, `ns` samples.
+struct Samples<'a> {
+    disp: &'a [f64],
+    vel: &'a [f64],
+    force: &'a [f64],
+    clear: &'a [f64],
+    n: usize,
+    m: usize,
+    ns: usize,
+    h: f64,
+}
+
+fn result(s: Samples, periods: usize, omega_max: f64, start: Instant, converged: bool, defect: f64, defect_history: Vec<f64>) -> MarchResult {
+    let (ns, h) = (s.ns, s.h);
     let rows = |buf: &[f64], w: usize| -> Vec<Vec<f64>> { (0..ns).map(|j| buf[j * w..(j + 1) * w].to_vec()).collect() };
-    let contact_force = rows(&force, nc);
+    let contact_force = rows(s.force, s.m);
     let contact_impulse = contact_force.iter().map(|r| r.iter().map(|v| v * h).collect()).collect();
-    Ok(MarchResult {
+    MarchResult {
         time: (0..ns).map(|j| j as f64 * h).collect(),
-        displacement: rows(last, n),
-        velocity: rows(&vel, n),
+        displacement: rows(s.disp, s.n),
+        velocity: rows(s.vel, s.n),
         contact_force,
         contact_impulse,
-        clearance: rows(&clear, nc),
+        clearance: rows(s.clear, s.m),
         periods,
         steps_per_period: ns,
         step: h,
@@ -351,6 +373,6 @@ pub fn march(model: &Model, settings: &MarchSettings) -> Result<MarchResult, Mar
         cpu_time_s: start.elapsed().as_secs_f64(),
         converged,
         defect,
-        defect_history: history,
-    })
+        defect_history,
+    }
 }

@@ -73,7 +73,7 @@ pub const STEP_GRAIN: usize = 128;
 /// Smallest steps per period, multiple of [`STEP_GRAIN`], at `margin` × the stability limit of
 /// the model (compliant contacts closed) at frequency ω.
 pub fn stable_steps(problem: &PeriodicProblem, frequency: f64, margin: f64) -> Result<usize, Error> {
-    let wmax = problem.model().omega_max().map_err(|e| Error::solve(format!("the stability limit of time marching: {e}")))?;
+    let wmax = crate::marching::stable_omega_max(problem.model()).map_err(|e| Error::solve(format!("the stability limit of time marching: {e}")))?;
     let period = 2.0 * std::f64::consts::PI / frequency;
     let n_min = (margin * period * wmax / 2.0).ceil() as usize;
     Ok(n_min.div_ceil(STEP_GRAIN).max(1) * STEP_GRAIN)

@@ -16,9 +16,9 @@
 pub mod marching;
 pub mod spectrum;
 
-use crate::analysis::continuation;
+use crate::analysis::{accuracy, continuation};
 use crate::model::{Labels, Quantity};
-use crate::periodic::{PeriodicProblem, PeriodicSolver, Tuning, WarmStart};
+use crate::periodic::{PeriodicProblem, PeriodicSolver, SolveError, Tuning, WarmStart};
 use crate::response::Response;
 use rayon::prelude::*;
 use std::time::Instant;
@@ -32,11 +32,14 @@ pub struct SweepSettings {
     pub threads: usize,
     /// Contiguous chunks per thread (more balance the load, fewer keep more warm starts).
     pub chunks_per_thread: usize,
+    /// Estimate every point's error ([`crate::analysis::accuracy`]): a second, warm-started
+    /// sweep at k/2 (or 2k where k/2 breaks the scheme's limit) beside the first.
+    pub estimate: bool,
 }
 
 impl Default for SweepSettings {
     fn default() -> Self {
-        SweepSettings { warm_start: true, threads: 0, chunks_per_thread: 4 }
+        SweepSettings { warm_start: true, threads: 0, chunks_per_thread: 4, estimate: false }
     }
 }
 
@@ -66,6 +69,10 @@ pub struct SweepPoint {
     /// Assembly and LCP times of the final solve [s].
     pub assembly_s: f64,
     pub lcp_s: f64,
+    /// The error estimate relative to the peak-to-peak amplitude (`SweepSettings::estimate`),
+    /// and how it was made or why there is none.
+    pub estimate_relative: Option<f64>,
+    pub estimate_method: String,
     /// The failure, if the point could not be solved.
     pub error: Option<String>,
     /// The LCP methods that ran and the fallbacks taken (`lcp.path` of the JSON).
@@ -92,6 +99,8 @@ impl SweepPoint {
             time_s: 0.0,
             assembly_s: r.timing_s.assembly,
             lcp_s: r.timing_s.lcp,
+            estimate_relative: None,
+            estimate_method: String::new(),
             error: None,
             lcp_path: r.lcp.path.clone(),
             active_set: r.active_set.clone(),
@@ -147,6 +156,8 @@ pub fn run(template: &PeriodicProblem, frequencies: &[f64], settings: &SweepSett
             .par_iter()
             .map(|&(lo, hi)| {
                 let mut solver = session.clone();
+                // The second grid of the error estimates, warm-started along the chunk too.
+                let mut second: Option<PeriodicSolver> = None;
                 let mut out = Vec::with_capacity(hi - lo);
                 let mut last: Option<(f64, Response)> = None;
                 for &f in &frequencies[lo..hi] {
@@ -167,6 +178,10 @@ pub fn run(template: &PeriodicProblem, frequencies: &[f64], settings: &SweepSett
                     };
                     point.warm_start_used = r.is_ok() && solver.last_start() == WarmStart::Used;
                     point.cold_fallback = solver.last_start() == WarmStart::ColdFallback;
+                    if let (Ok(r), true) = (&r, settings.estimate) {
+                        let a = accuracy::estimate_with(solver.problem(), r, &mut |p| second_solve(&mut second, p, settings.warm_start));
+                        (point.estimate_relative, point.estimate_method) = (a.relative, a.method);
+                    }
                     point.time_s = t.elapsed().as_secs_f64();
                     match r {
                         Ok(r) => last = Some((f, r)),
@@ -184,6 +199,18 @@ pub fn run(template: &PeriodicProblem, frequencies: &[f64], settings: &SweepSett
             .collect()
     });
     Ok(results.into_iter().flatten().collect())
+}
+
+/// The second solve of a point's error estimate, in the chunk's session for that grid (made on
+/// the first point, or again when the grid changes).
+fn second_solve(session: &mut Option<PeriodicSolver>, problem: &PeriodicProblem, warm: bool) -> Result<Response, SolveError> {
+    let steps = problem.discretization().steps;
+    let solver = match session {
+        Some(s) if s.problem().discretization().steps == steps => s,
+        _ => session.insert(PeriodicSolver::new(problem.clone()).with_warm_starts(warm)),
+    };
+    solver.update_frequency(problem.model().frequency)?;
+    solver.solve()
 }
 
 /// The CSV of a sweep: the parameter, amplitude per displacement output (nonlinear, then
@@ -223,6 +250,10 @@ pub fn to_csv(param: &str, values: &[f64], problem: &PeriodicProblem, points: &[
     head.extend(contact_dofs.iter().enumerate().map(|(i, d)| format!("max_force_c{i}_dof{d} {kn}")));
     head.extend(contact_dofs.iter().enumerate().map(|(i, d)| format!("contact_fraction_c{i}_dof{d}")));
     head.extend(["lcp_size", "pivots", "warm_start_used", "cold_fallback", "time_s", "status"].map(String::from));
+    let estimated = points.iter().any(|p| !p.estimate_method.is_empty());
+    if estimated {
+        head.push("error_estimate_relative".into());
+    }
     s.push_str(&head.join(","));
     s.push('\n');
     for (v, p) in values.iter().zip(points) {
@@ -246,6 +277,9 @@ pub fn to_csv(param: &str, values: &[f64], problem: &PeriodicProblem, points: &[
             None => "solved".to_string(),
             Some(e) => format!("\"{}\"", e.replace('"', "'")),
         });
+        if estimated {
+            row.push(num(p.estimate_relative.as_ref()));
+        }
         s.push_str(&row.join(","));
         s.push('\n');
     }

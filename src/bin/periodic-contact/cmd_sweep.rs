@@ -57,6 +57,10 @@ pub struct Args {
     /// Time steps per period of the march (a multiple of the LCP's steps; default: stable).
     #[arg(long)]
     pub march_steps: Option<usize>,
+    /// Estimate every point's error (a second, warm-started solve at k/2 per point; the CSV's
+    /// last column, relative to the peak-to-peak amplitude; the worst is printed).
+    #[arg(long)]
+    pub estimate: bool,
     /// Log amplitude axis in the frequency-response PNGs (suggested when the contact and linear
     /// peaks differ by more than 10×).
     #[arg(long)]
@@ -123,9 +127,13 @@ pub fn run(a: &Args) -> Result<(), Failure> {
     let problem = &problem;
     match &built.reduction {
         Some(r) => eprintln!(
-            "{file}: {} DOFs reduced to {} (Craig–Bampton, {} boundary + {} modes) in {:.3} s; set-up {:.3} s",
+            "{file}: {} DOFs reduced to {} ({}, {} boundary + {} modes) in {:.3} s; set-up {:.3} s",
             built.full.n(),
             r.n(),
+            match r.method {
+                periodic_contact::reduction::Method::CraigBampton => "Craig–Bampton",
+                periodic_contact::reduction::Method::MasslessBoundary => "massless boundary",
+            },
             r.n_boundary(),
             r.n_modes(),
             built.timings.reduction,
@@ -133,7 +141,7 @@ pub fn run(a: &Args) -> Result<(), Failure> {
         ),
         None => eprintln!("{file}: {} DOFs, set-up {:.3} s", built.full.n(), built.timings.total),
     }
-    let settings = SweepSettings { warm_start: !a.cold, threads: a.threads, chunks_per_thread: a.chunks_per_thread };
+    let settings = SweepSettings { warm_start: !a.cold, threads: a.threads, chunks_per_thread: a.chunks_per_thread, estimate: a.estimate };
     let bar = if a.quiet { ProgressBar::hidden() } else { ProgressBar::new(a.points as u64) };
     bar.set_style(
         ProgressStyle::with_template("{spinner} sweep [{bar:40}] {pos}/{len} points, {elapsed_precise} elapsed, ETA {eta}").unwrap().progress_chars("=> "),
@@ -163,6 +171,20 @@ pub fn run(a: &Args) -> Result<(), Failure> {
         fallback,
         a.output.display()
     );
+    if a.estimate {
+        let worst = points
+            .iter()
+            .filter(|p| p.error.is_none())
+            .max_by(|x, y| x.estimate_relative.unwrap_or(f64::INFINITY).total_cmp(&y.estimate_relative.unwrap_or(f64::INFINITY)));
+        if let Some(w) = worst {
+            let none = points.iter().filter(|p| p.error.is_none() && p.estimate_relative.is_none()).count();
+            let e = w.estimate_relative.map_or("none".to_string(), |e| format!("{e:.2e}"));
+            eprintln!(
+                "  error estimates: worst {e} of the peak-to-peak amplitude at ω = {} ({}); {none} points without an estimate",
+                w.frequency, w.estimate_method
+            );
+        }
+    }
     for (i, d) in problem.outputs().displacement.iter().enumerate() {
         let nl = sweep::peak(&points, |p| p.amplitude[i]);
         let li = sweep::peak(&points, |p| p.linear_amplitude[i]);
