@@ -32,7 +32,9 @@ def test_fmpy_simulate_matches_the_cli(cli, workdir, scene):
         text = fh.read()
     # The files the scenes reference (Matrix Market, CalculiX) sit in fmu/scenes/data/.
     shutil.copytree(os.path.join(SCENES, "data"), os.path.join(workdir, "data"), dirs_exist_ok=True)
-    result = engine.solve(cli, text, workdir, name)
+    # The orbit is compared, not the error estimate (tested in test_cli.py and tests/): its
+    # second solve at 2k costs the fine blade 80 s of dense Lemke.
+    result = engine.solve(cli, text, workdir, name, ("--no-estimate",))
     with open(result.path) as fh:
         raw = json.load(fh)
     k, period = raw["steps"], raw["period"]

@@ -133,7 +133,7 @@ def parse_result(raw: dict, path: str = "", wall_s: float = 0.0) -> EngineResult
                         warnings=list(raw.get("warnings") or []), timing=timing, problems=problems)
 
 
-def solve(cli: str, scene_text: str, workdir: str, name: str) -> EngineResult:
+def solve(cli: str, scene_text: str, workdir: str, name: str, extra: tuple = ()) -> EngineResult:
     os.makedirs(workdir, exist_ok=True)
     scene = os.path.join(workdir, f"{name}.toml")
     out = os.path.join(workdir, f"{name}.json")
@@ -141,7 +141,7 @@ def solve(cli: str, scene_text: str, workdir: str, name: str) -> EngineResult:
         fh.write(scene_text)
     if os.path.exists(out):
         os.remove(out)
-    _, wall = _run([cli, "solve", scene, "-o", out], f"periodic-contact solve {name}")
+    _, wall = _run([cli, "solve", scene, "-o", out, *extra], f"periodic-contact solve {name}")
     with open(out) as fh:
         raw = json.load(fh)
     return parse_result(raw, out, wall)
