@@ -295,6 +295,16 @@ pub fn run(settings: &AccuracySettings, progress: &mut dyn FnMut(&Row)) -> Resul
                             polished = Some(polish_point(&row, &problem, &r, reference, settings));
                         }
                     }
+                    // The table keeps its shape: a method that would be polished gets its polished
+                    // row even when its periodic row was skipped or failed (a loaded machine spends
+                    // the budget sooner), saying why.
+                    let polished = polished.or_else(|| {
+                        (settings.polish && converges && case.has_contact()).then(|| {
+                            let mut p = Row::new(case, label.clone(), Kind::Polished, k, converges);
+                            p.status = format!("skipped: no periodic solution to polish ({})", row.status);
+                            p
+                        })
+                    });
                     progress(&row);
                     rows.push(row);
                     if let Some(p) = polished {
