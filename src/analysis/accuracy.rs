@@ -8,7 +8,7 @@
 //! k/2 breaks the scheme's stability limit (the coarse blade under cds at k = 1024), the second
 //! solve is at 2k instead: dearer (twice the unknowns), but the only one that is honest there.
 use crate::model::Compliance;
-use crate::periodic::{PeriodicProblem, SolveError};
+use crate::periodic::{PeriodicProblem, PeriodicSolver, SolveError};
 use crate::response::{Accuracy, Response};
 use crate::time::{Discretization, Pairing, Scheme};
 
@@ -86,7 +86,32 @@ fn longest_run(force: &[f64]) -> usize {
 /// is odd or too small, the scheme does not converge for this contact, or the second solve is
 /// refused or fails.
 pub fn estimate(problem: &PeriodicProblem, r: &Response) -> Accuracy {
-    estimate_with(problem, r, &mut |second| second.solve())
+    let instants = problem.instants();
+    estimate_with(problem, r, &mut |second| {
+        // Warm-started from the first answer's active set on the second grid: Newton on the
+        // period map then starts on the right pieces, where a cold start's offset homotopy
+        // fails on stiff blades (the fine blade's 2k solve fell back to minutes of dense Lemke).
+        let mut session = PeriodicSolver::new(second.clone());
+        session.set_warm_start(&resampled_active_set(&r.active_set, r.lcp.size / instants.max(1), instants, second.instants()));
+        session.solve()
+    })
+}
+
+/// An active set (indices j·m + c of instant j, row c) of a grid of `from` instants, on a grid of
+/// `to` = 2·from or from/2 instants over the same period: instant j of k is instants 2j and
+/// 2j + 1 of 2k; instant j of k/2 is instant 2j of k.
+fn resampled_active_set(active: &[usize], rows: usize, from: usize, to: usize) -> Vec<usize> {
+    if rows == 0 {
+        return Vec::new();
+    }
+    let split = |i: usize| (i / rows, i % rows);
+    if to == 2 * from {
+        active.iter().map(|&i| split(i)).flat_map(|(j, c)| [(2 * j) * rows + c, (2 * j + 1) * rows + c]).collect()
+    } else if 2 * to == from {
+        active.iter().map(|&i| split(i)).filter(|(j, _)| j % 2 == 0).map(|(j, c)| (j / 2) * rows + c).collect()
+    } else {
+        Vec::new()
+    }
 }
 
 /// [`estimate`] with the second solve made by `solve_second` (given the problem at k/2 or 2k):
@@ -142,4 +167,20 @@ pub fn estimate_with(problem: &PeriodicProblem, r: &Response, solve_second: &mut
 fn short(e: &SolveError) -> String {
     let s = e.to_string();
     s.split(':').next().unwrap_or(&s).to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::resampled_active_set;
+
+    #[test]
+    fn an_active_set_moves_to_the_doubled_and_the_halved_grid() {
+        // 2 rows, 4 instants: row 1 active at instants 1 and 2, row 0 at instant 3.
+        let active = [3, 5, 6];
+        assert_eq!(resampled_active_set(&active, 2, 4, 8), vec![5, 7, 9, 11, 12, 14]);
+        // Halved: only the even instants survive (instant 2 → 1).
+        assert_eq!(resampled_active_set(&active, 2, 4, 2), vec![3]);
+        assert!(resampled_active_set(&active, 2, 4, 3).is_empty());
+        assert!(resampled_active_set(&active, 0, 4, 8).is_empty());
+    }
 }
