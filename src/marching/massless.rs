@@ -11,7 +11,7 @@
 //! force is finite, as in the periodic LCP's step map. Stable for h < 2/ω_max with ω_max of the
 //! condensed pencil with the contacts closed ([`stable_omega_max`]).
 use super::small_lcp::solve_small_lcp;
-use super::{MarchError, MarchResult, MarchSettings, period_defect};
+use super::{MarchError, MarchResult, MarchSettings};
 use crate::model::{Compliance, Model, ModelError};
 use faer::Mat;
 use faer::linalg::solvers::{DenseSolveCore, Solve};
@@ -126,9 +126,7 @@ pub(super) fn march_massless(model: &Model, settings: &MarchSettings, massless: 
         x_prev[a] = x_cur[a] - h * v0[a] + 0.5 * h * h * acc0[(i, 0)];
     }
     let mut x_next = vec![0.0; n];
-    let (mut disp, mut disp_prev, mut vel) = (vec![0.0; ns * n], vec![0.0; ns * n], vec![0.0; ns * n]);
-    let (mut force, mut clear) = (vec![0.0; ns * m], vec![0.0; ns * m]);
-    let (mut defect, mut history, mut converged, mut periods) = (f64::INFINITY, Vec::new(), false, 0);
+    let mut rec = super::Recorder::new(n, m, ns, h);
     for p in 0..settings.max_periods {
         for j in 0..ns {
             let t = j as f64 * h;
@@ -138,40 +136,19 @@ pub(super) fn march_massless(model: &Model, settings: &MarchSettings, massless: 
                 v += (0..nb).map(|k| ab[(i, k)] * x_cur[ib[k]]).sum::<f64>();
                 x_next[a] = v;
             }
-            for (i, c) in model.contacts.iter().enumerate() {
-                force[j * m + i] = lam[i];
-                clear[j * m + i] = c.gap_at(omega, t) - c.normal_displacement(&x_cur);
-            }
+            rec.contacts(j, model, t, &lam, &x_cur);
             condense((j + 1) as f64 * h, &mut x_next, &mut lam).map_err(|e| step_error(j, p + 1, e))?;
             if x_next.iter().any(|v| !v.is_finite()) {
                 return Err(MarchError::Diverged { step: j, period: p + 1 });
             }
-            for i in 0..n {
-                disp[j * n + i] = x_cur[i];
-                vel[j * n + i] = (x_next[i] - x_prev[i]) / (2.0 * h);
-            }
+            rec.state(j, &x_prev, &x_cur, &x_next);
             std::mem::swap(&mut x_prev, &mut x_cur);
             std::mem::swap(&mut x_cur, &mut x_next);
         }
-        periods = p + 1;
-        if p >= 1 {
-            defect = period_defect(&disp, &disp_prev, n, ns);
-            history.push(defect);
-            if defect < settings.tolerance && periods >= settings.min_periods.max(2) {
-                converged = true;
-                break;
-            }
+        if rec.end_period(p, settings) {
+            break;
         }
-        std::mem::swap(&mut disp, &mut disp_prev);
     }
-    let last = if converged { &disp } else { &disp_prev };
-    Ok(super::result(
-        super::Samples { disp: last, vel: &vel, force: &force, clear: &clear, n, m, ns, h },
-        periods,
-        omega_max,
-        start,
-        converged,
-        defect,
-        history,
-    ))
+    Ok(rec.finish(omega_max, start))
 }
+

@@ -253,16 +253,8 @@ pub fn march(model: &Model, settings: &MarchSettings) -> Result<MarchResult, Mar
     let mut x_cur = x0;
     let mut x_next = vec![0.0; n];
 
-    let mut disp = vec![0.0; ns * n];
-    let mut disp_prev = vec![0.0; ns * n];
-    let mut vel = vec![0.0; ns * n];
-    let mut force = vec![0.0; ns * nc];
-    let mut clear = vec![0.0; ns * nc];
+    let mut rec = Recorder::new(n, nc, ns, h);
     let mut q = vec![0.0; mr];
-    let mut defect = f64::INFINITY;
-    let mut history = Vec::new();
-    let mut converged = false;
-    let mut periods = 0;
     for p in 0..settings.max_periods {
         for j in 0..ns {
             let t = j as f64 * h;
@@ -302,33 +294,97 @@ pub fn march(model: &Model, settings: &MarchSettings) -> Result<MarchResult, Mar
             if x_next.iter().any(|v| !v.is_finite()) {
                 return Err(MarchError::Diverged { step: j, period: p + 1 });
             }
-            // Record sample j.
-            for i in 0..n {
-                disp[j * n + i] = x_cur[i];
-                vel[j * n + i] = (x_next[i] - x_prev[i]) / (2.0 * h);
-            }
-            for (i, c) in model.contacts.iter().enumerate() {
-                force[j * nc + i] = zbuf[i];
-                clear[j * nc + i] = c.gap_at(omega, t) - c.normal_displacement(&x_cur);
-            }
+            rec.contacts(j, model, t, &zbuf, &x_cur);
+            rec.state(j, &x_prev, &x_cur, &x_next);
             std::mem::swap(&mut x_prev, &mut x_cur);
             std::mem::swap(&mut x_cur, &mut x_next);
         }
-        periods = p + 1;
+        if rec.end_period(p, settings) {
+            break;
+        }
+    }
+    Ok(rec.finish(omega_max, start))
+}
+
+/// The samples of the period being marched and of the one before, and the convergence test on
+/// them: the bookkeeping both marchers (this one and `massless`) share.
+struct Recorder {
+    n: usize,
+    m: usize,
+    ns: usize,
+    h: f64,
+    disp: Vec<f64>,
+    disp_prev: Vec<f64>,
+    vel: Vec<f64>,
+    force: Vec<f64>,
+    clear: Vec<f64>,
+    defect: f64,
+    history: Vec<f64>,
+    converged: bool,
+    periods: usize,
+}
+
+impl Recorder {
+    /// `n` DOFs and `m` contacts per sample, `ns` samples of step `h` per period.
+    fn new(n: usize, m: usize, ns: usize, h: f64) -> Self {
+        let zeros = |len| vec![0.0; len];
+        Recorder {
+            n,
+            m,
+            ns,
+            h,
+            disp: zeros(ns * n),
+            disp_prev: zeros(ns * n),
+            vel: zeros(ns * n),
+            force: zeros(ns * m),
+            clear: zeros(ns * m),
+            defect: f64::INFINITY,
+            history: Vec::new(),
+            converged: false,
+            periods: 0,
+        }
+    }
+
+    /// Sample j's contact forces and clearances (of x at t_j).
+    fn contacts(&mut self, j: usize, model: &Model, t: f64, forces: &[f64], x: &[f64]) {
+        for (i, c) in model.contacts.iter().enumerate() {
+            self.force[j * self.m + i] = forces[i];
+            self.clear[j * self.m + i] = c.gap_at(model.frequency, t) - c.normal_displacement(x);
+        }
+    }
+
+    /// Sample j's displacement x_j and central velocity (x_{j+1} − x_{j−1})/(2h).
+    fn state(&mut self, j: usize, x_prev: &[f64], x_cur: &[f64], x_next: &[f64]) {
+        let n = self.n;
+        self.disp[j * n..(j + 1) * n].copy_from_slice(x_cur);
+        for i in 0..n {
+            self.vel[j * n + i] = (x_next[i] - x_prev[i]) / (2.0 * self.h);
+        }
+    }
+
+    /// After period p (0-based): true when the march has converged and stops.
+    fn end_period(&mut self, p: usize, settings: &MarchSettings) -> bool {
+        self.periods = p + 1;
         if p >= 1 {
-            defect = period_defect(&disp, &disp_prev, n, ns);
-            history.push(defect);
-            if defect < settings.tolerance && periods >= settings.min_periods.max(2) {
-                converged = true;
-                break;
+            self.defect = period_defect(&self.disp, &self.disp_prev, self.n, self.ns);
+            self.history.push(self.defect);
+            if self.defect < settings.tolerance && self.periods >= settings.min_periods.max(2) {
+                self.converged = true;
+                return true;
             }
         }
-        std::mem::swap(&mut disp, &mut disp_prev);
+        std::mem::swap(&mut self.disp, &mut self.disp_prev);
+        false
     }
-    // After a converged break `disp` holds the last period; otherwise the final swap moved it
-    // to `disp_prev`.
-    let last = if converged { &disp } else { &disp_prev };
-    Ok(result(Samples { disp: last, vel: &vel, force: &force, clear: &clear, n, m: nc, ns, h }, periods, omega_max, start, converged, defect, history))
+
+    fn finish(mut self, omega_max: f64, start: Instant) -> MarchResult {
+        // After a converged break `disp` holds the last period; otherwise the final swap moved
+        // it to `disp_prev`.
+        let history = std::mem::take(&mut self.history);
+        let last = if self.converged { &self.disp } else { &self.disp_prev };
+        let samples = Samples { disp: last, vel: &self.vel, force: &self.force, clear: &self.clear, n: self.n, m: self.m, ns: self.ns, h: self.h };
+        result(samples, self.periods, omega_max, start, self.converged, self.defect, history)
+    }
 }
 
 /// ‖x(period p) − x(period p−1)‖∞ / peak-to-peak over the DOFs (`n` per sample, `ns` samples).
