@@ -5,7 +5,8 @@ peak-to-peak amplitude.
 - test_coarse_calculix_blade_fmu (default run, ccx needed, skipped with the reason without it):
   the generator's coarse blade written as a deck by `periodic-contact deck` (24 x 8 x 2 C3D8I,
   5 400 DOFs), assembled by `ccx`, massless-boundary reduction, rigid radial contacts on the 9 tip
-  nodes, the two-lobe Gaussian casing of examples/real-blade/blade.toml, cds k = 512. The whole
+  nodes, the two-lobe Gaussian casing of examples/real-blade/blade.toml, cds k = 512, block
+  pivoting. The whole
   chain deck -> ccx -> CLI -> FMU -> fmpy + libcosim.
 - test_real_blade_fmu (opt-in: PC_REAL_BLADE_FMU=1, about a minute): examples/real-blade/blade.toml
   itself (66 480 DOFs, 2 x 65 MB of matrices, generated into examples/real-blade/job/ by deck + ccx
@@ -169,6 +170,8 @@ def test_coarse_calculix_blade_fmu(cli, workdir):
             f"[excitation]\nfrequency = {_whole_ns_frequency(2300.0, k)!r}\n"
             f"[casing]\nlobes = 2\nradius = {casing['radius']!r}\naxis = {casing['axis']!r}\ncenter = {casing['center']!r}\nharmonics = [\n{harmonics}\n]\n"
             f'{contacts}[discretization]\nscheme = "cds"\nsteps = {k}\npairing = "same"\n'
+            # Block pivoting solves this LCP in 9 pivots: 0.3 s CPU per solve against 0.9 s for auto's shooting.
+            '[solver]\nmethod = "pivoting"\n'
             f'[output]\ndisplacement = ["{tip[0]}:z", "{tip[len(tip) // 2]}:y", "{tip[-1]}:z"]\n'
         )
     figures = _fmu_equals_cli(cli, scene, "coarse_blade", timed=False)
