@@ -739,3 +739,113 @@ fn an_fmu_is_not_packaged_when_a_referenced_file_is_missing() {
     let left: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     assert!(!out.exists() && left.len() == 2, "nothing is written: {left:?}");
 }
+
+// ---------------------------------------------------------------------------------------------
+// Issue 23's bad input through every front end.
+
+/// The scene `dir/bad.toml` is refused by every front end, each message containing every needle
+/// and the scene's name: the library, `periodic-contact solve` (status 2, no result),
+/// `periodic-contact fmu` (status 2, no `.fmu` and no temporary file: nothing packaged half) and
+/// the C API (`pc_problem_from_scene_file` returns NULL, `pc_last_error` says why). The folder
+/// holds the same files afterwards.
+#[track_caller]
+fn refused_by_every_front_end(dir: &std::path::Path, needles: &[&str]) {
+    use periodic_contact::capi::{pc_last_error, pc_problem_from_scene_file};
+    let listing = || {
+        let mut l: Vec<String> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        l.sort();
+        l
+    };
+    let before = listing();
+    let scene = dir.join(FILE);
+    let file = scene.display().to_string();
+    let text = std::fs::read_to_string(&scene).unwrap();
+    let lib = match Scene::parse(&text, &file).and_then(|s| s.to_problem(&file)) {
+        Ok(_) => panic!("the library accepted:\n{text}"),
+        Err(e) => e.to_string(),
+    };
+    let cli = |args: &[&std::ffi::OsStr]| {
+        let o = Command::new(env!("CARGO_BIN_EXE_periodic-contact")).args(args).output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr).to_string();
+        assert_eq!(o.status.code(), Some(2), "{args:?}: exit status; stderr: {err}");
+        assert!(!err.contains("panicked"), "a panic: {err}");
+        err
+    };
+    let (json, fmu) = (dir.join("r.json"), dir.join("x.fmu"));
+    let solve = cli(&["solve".as_ref(), scene.as_os_str(), "-o".as_ref(), json.as_os_str()]);
+    // Any ELF file stands for the FMU binary: the scene is checked before the binary is read.
+    let binary = std::path::Path::new(env!("CARGO_BIN_EXE_periodic-contact"));
+    let packaged = cli(&["fmu".as_ref(), scene.as_os_str(), "-o".as_ref(), fmu.as_os_str(), "--binary".as_ref(), binary.as_os_str()]);
+    let path = std::ffi::CString::new(file.as_str()).unwrap();
+    let p = unsafe { pc_problem_from_scene_file(path.as_ptr()) };
+    assert!(p.is_null(), "the C API accepted:\n{text}");
+    let capi = unsafe { std::ffi::CStr::from_ptr(pc_last_error()) }.to_string_lossy().into_owned();
+    assert_eq!(listing(), before, "nothing is written: no result, no .fmu, no temporary file");
+    for (front_end, message) in [("library", &lib), ("solve", &solve), ("fmu", &packaged), ("C API", &capi)] {
+        for n in needles.iter().chain(&[FILE]) {
+            assert!(message.contains(n), "the {front_end}'s message lacks {n:?}: {message}");
+        }
+    }
+}
+
+/// A scratch folder holding `bad.toml` = `scene` and the `files` (name, text).
+fn scene_folder(scene: &str, files: &[(&str, &str)]) -> PathBuf {
+    let dir = scratch();
+    std::fs::write(dir.join(FILE), scene).unwrap();
+    for (name, text) in files {
+        std::fs::write(dir.join(name), text).unwrap();
+    }
+    dir
+}
+
+/// Issue 23's four bad inputs, each through the library, the CLI's solve, the FMU packaging and
+/// the C API, naming the file, the line where the input has lines, the value and the remedy: a
+/// wrong `.dof` map, a normal of zero length, a casing profile that is not periodic, and a mass
+/// semi-definite on a contact DOF (in a Matrix Market file).
+#[test]
+fn issue_23_bad_input_is_refused_by_every_front_end_and_nothing_is_packaged() {
+    let calculix = "[structure]\ncalculix = \"job\"\n[excitation]\nfrequency = 1.0\n[[force]]\nnode = 7\naxis = \"x\"\namplitude = 1.0\n[[contact]]\nnode = 7\naxis = \"x\"\ngap = 1.0\n";
+    let job = |dof: &'static str| [("job.dof", dof), ("job.sti", JOB_STI), ("job.mas", JOB_MAS)];
+    let regenerate = "regenerate it with `ccx JOBNAME`";
+    refused_by_every_front_end(&scene_folder(calculix, &job("7.1\nseven.2\n")), &["job.dof:2:", "\"seven.2\" is not node.direction", regenerate]);
+    refused_by_every_front_end(&scene_folder(calculix, &job("7.1\n7.2\n7.3\n")), &["job.dof lists 3 DOFs", "has rows up to 2", regenerate]);
+    refused_by_every_front_end(
+        &scene_folder(&calculix.replace("axis = \"x\"\ngap", "axis = \"z\"\ngap"), &job(JOB_DOF)),
+        &["contact[0].node", "node 7 direction z is not in job.dof"],
+    );
+    // A normal of zero length.
+    let normal = format!("{POINT}[[contact]]\ngap = 0.5\ndofs = [0, 1, 2]\nnormal = [0.0, 0.0, 0.0]\n");
+    refused_by_every_front_end(&scene_folder(&normal, &[]), &["contact[0].normal", "[0.0, 0.0, 0.0]", "nonzero", "e.g. [0, 0, 1]"]);
+    // A casing profile that does not close the turn.
+    let casing = format!(
+        "{POINT}[[contact]]\ndofs = [0, 1, 2]\nnormal = \"radial\"\nposition = [0.0, 1.0, 0.0]\ngap = 0.5\n[casing]\naxis = [0.0, 0.0, 1.0]\nradius = 1.0\nprofile = \"casing.csv\"\n"
+    );
+    let profile = "angle_deg,clearance\n0,0.0\n90,0.1\n180,0.0\n270,-0.1\n360,0.05\n";
+    refused_by_every_front_end(
+        &scene_folder(&casing, &[("casing.csv", profile)]),
+        &["casing.profile", "casing.csv", "line 6", "not periodic", "make the last value equal the first"],
+    );
+    // A mass semi-definite on the contact's DOF: massless there and not held by K, or singular
+    // along a combination of DOFs.
+    let matrices = "[structure]\nmass = { matrix_market = \"M.mtx\" }\nstiffness = { matrix_market = \"K.mtx\" }\n[excitation]\nfrequency = 1.0\n[[force]]\ndof = 0\namplitude = 1.0\n[[contact]]\ndof = 1\ngap = 0.5\n";
+    let mtx = |entries: &[(usize, usize, f64)]| {
+        let lines: String = entries.iter().map(|(i, j, v)| format!("{i} {j} {v}\n")).collect();
+        format!("%%MatrixMarket matrix coordinate real symmetric\n2 2 {}\n{lines}", entries.len())
+    };
+    let (k_held, k_free) = (mtx(&[(1, 1, 2.0), (2, 1, -1.0), (2, 2, 2.0)]), mtx(&[(1, 1, 2.0)]));
+    let massless = mtx(&[(1, 1, 1.0)]);
+    refused_by_every_front_end(
+        &scene_folder(matrices, &[("M.mtx", &massless), ("K.mtx", &k_free)]),
+        &["structure.mass[1][1] (read from M.mtx", "contact[0] acts on DOF 1", "neither mass nor stiffness", "give it mass or stiffness"],
+    );
+    let singular = mtx(&[(1, 1, 1.0), (2, 1, 1.0), (2, 2, 1.0)]);
+    refused_by_every_front_end(
+        &scene_folder(matrices, &[("M.mtx", &singular), ("K.mtx", &k_held)]),
+        &["structure.mass (read from M.mtx", "not positive definite (eigenvalue", "along DOFs [0, 1]; contact[0] acts on DOF 1", "correct the mass matrix"],
+    );
+    // The well-posed semi-definite mass (massless contact DOF held by K: a massless boundary) is
+    // accepted.
+    let dir = scene_folder(matrices, &[("M.mtx", &massless), ("K.mtx", &k_held)]);
+    let file = dir.join(FILE).display().to_string();
+    Scene::parse(matrices, &file).unwrap().to_problem(&file).unwrap();
+}

@@ -96,15 +96,19 @@ fn check_mass(model: &Model) -> Result<(), ModelError> {
     if massless.is_empty() || !s.mass.block(&massive, &massive).is_positive_definite() {
         return Err(ModelError::new(
             "structure.mass",
-            "is not positive definite, and not only on whole massless DOFs: every DOF must carry mass, or be massless with a zero row and column of M \
-             (a massless boundary, src/formulation.md §4.1)",
+            format!(
+                "is not positive definite{}, and not only on whole massless DOFs: every DOF must carry mass, or be massless with a zero row and column of M \
+                 (a massless boundary, src/formulation.md §4.1); correct the mass matrix, or reduce the model ([reduction])",
+                null_direction(model)
+            ),
         ));
     }
     if let Some(&d) = massless.iter().find(|&&d| s.stiffness.get(d, d) == 0.0) {
         return Err(ModelError::new(
             format!("structure.mass[{d}][{d}]"),
             format!(
-                "is 0 and structure.stiffness[{d}][{d}] is 0: DOF {d} carries neither mass nor stiffness, so nothing determines it; give it mass or stiffness, or remove it"
+                "is 0 and structure.stiffness[{d}][{d}] is 0: DOF {d}{} carries neither mass nor stiffness, so nothing determines it; give it mass or stiffness, or remove it",
+                contacts_on(model, &[d]).map(|c| format!(" ({c})")).unwrap_or_default()
             ),
         ));
     }
@@ -117,6 +121,37 @@ fn check_mass(model: &Model) -> Result<(), ModelError> {
         ));
     }
     Ok(())
+}
+
+/// Largest model size whose singular mass is diagnosed (a dense eigendecomposition).
+const DIAGNOSED_DOFS: usize = 600;
+
+/// Where a singular M has no mass, for its message: " (eigenvalue λ along DOFs […]; contact[i]
+/// acts on DOF d)" from the eigenvector of M's smallest eigenvalue, or "" past
+/// [`DIAGNOSED_DOFS`].
+fn null_direction(model: &Model) -> String {
+    let n = model.n();
+    if n > DIAGNOSED_DOFS {
+        return String::new();
+    }
+    let Ok(eig) = model.structure.mass.to_dense().self_adjoint_eigen(faer::Side::Lower) else { return String::new() };
+    let (values, vectors) = (eig.S().column_vector(), eig.U());
+    // Eigenvalues come in ascending order: column 0 is the direction without mass.
+    let largest = (0..n).map(|i| vectors[(i, 0)].abs()).fold(0.0, f64::max);
+    let dofs: Vec<usize> = (0..n).filter(|&i| vectors[(i, 0)].abs() >= 0.1 * largest).collect();
+    let contacts = contacts_on(model, &dofs).map(|c| format!("; {c}")).unwrap_or_default();
+    format!(" (eigenvalue {:e} along DOFs {dofs:?}{contacts})", values[0])
+}
+
+/// "contact[i] acts on DOF d, …" for every contact whose row touches one of `dofs`.
+fn contacts_on(model: &Model, dofs: &[usize]) -> Option<String> {
+    let named: Vec<String> = model
+        .contacts
+        .iter()
+        .enumerate()
+        .flat_map(|(i, c)| c.row.iter().filter(|(d, _)| dofs.contains(d)).map(move |(d, _)| format!("contact[{i}] acts on DOF {d}")))
+        .collect();
+    (!named.is_empty()).then(|| named.join(", "))
 }
 
 /// Largest |‖n‖ − 1| accepted for a contact normal (the scene normalises; others must too).

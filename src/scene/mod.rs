@@ -168,7 +168,7 @@ impl Scene {
             }
         };
         let t_reduction = if reduction.is_some() { t_red.elapsed().as_secs_f64() } else { 0.0 };
-        model.validate()?;
+        model.validate().map_err(|e| self.name_matrix_file(e))?;
 
         let (disc, auto) = discretization(&self.discretization)?;
         let solver = solver_settings(self.solver.as_ref())?;

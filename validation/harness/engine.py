@@ -250,16 +250,18 @@ def simulate_fmpy(fmu: str, output_dofs, m: int, period: float, periods: int, st
                   values={lab: np.asarray(res[n], dtype=float) for lab, n in names.items()}, wall_s=wall)
 
 
-def simulate_libcosim(fmu: str, output_dofs, m: int, period: float, periods: int, steps_per_period: int) -> FmuRun:
+def simulate_libcosim(fmu: str, output_dofs, m: int, period: float, periods: int, steps_per_period: int,
+                      names: dict[str, str] | None = None) -> FmuRun:
     """The same run through libcosimpy (FMI Library loader, stepping on a worker thread). libcosim
     time is integer nanoseconds, so the step is rounded to 1 ns; outputs are returned at the
-    communication points it reports (libcosimpy drops the step-0 sample)."""
+    communication points it reports (libcosimpy drops the step-0 sample). `names` (our label: FMI
+    name) replaces the contract's outputs of `output_dofs` and `m`."""
     from libcosimpy.CosimEnums import CosimVariableType
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimObserver import CosimObserver
     from libcosimpy.CosimSlave import CosimLocalSlave
 
-    names = fmu_output_names(output_dofs, m)
+    names = names or fmu_output_names(output_dofs, m)
     step_ns = int(round(period / steps_per_period * 1e9))
     n_steps = periods * steps_per_period
     t0 = time.perf_counter()
