@@ -223,6 +223,21 @@ impl Walk<'_> {
                     continue;
                 }
             };
+            // Past an end of the range: the point at the end, before a grazing beyond it is looked for.
+            let lambda = next.lambda(rho);
+            let past_to = (lambda - to) * dir > 0.0;
+            let past_from = (lambda - from) * dir < 0.0;
+            let next = if past_to || past_from {
+                let bound = if past_to { to } else { from };
+                let (l0, w0) = (here.lambda(rho), &here.w);
+                let f = (bound - l0) / (lambda - l0);
+                let pred: Vec<f64> = w0.iter().zip(&next.w).map(|(a, b)| a + f * (b - a)).collect();
+                let d = self.fam.dim();
+                let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
+                self.fam.correct(&pred, &e_l, bound / rho).and_then(|w| self.fam.node(w, &here.tangent)).unwrap_or(next)
+            } else {
+                next
+            };
             // A contact's clearance crossed zero between its events: a grazing on the way.
             let tol = TOUCH_TOL * self.fam.ys;
             let crossed = |n: &Node| n.touches.iter().any(|t| t.value < -tol);
@@ -245,20 +260,6 @@ impl Walk<'_> {
                     }
                 }
             }
-            let lambda = next.lambda(rho);
-            let past_to = (lambda - to) * dir > 0.0;
-            let past_from = (lambda - from) * dir < 0.0;
-            let next = if past_to || past_from {
-                let bound = if past_to { to } else { from };
-                let (l0, w0) = (here.lambda(rho), &here.w);
-                let f = (bound - l0) / (lambda - l0);
-                let pred: Vec<f64> = w0.iter().zip(&next.w).map(|(a, b)| a + f * (b - a)).collect();
-                let d = self.fam.dim();
-                let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
-                self.fam.correct(&pred, &e_l, bound / rho).and_then(|w| self.fam.node(w, &here.tangent)).unwrap_or(next)
-            } else {
-                next
-            };
             for (kind, node, detail) in self.events_between(&here, &next) {
                 if self.stop_at_fold && kind == EventKind::Fold {
                     self.fold = Some(node.lambda(rho));
