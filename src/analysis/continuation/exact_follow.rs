@@ -23,14 +23,14 @@ const MAX_DOFS: usize = 8;
 /// The one knob that changed from `a` to `b`, as the continued parameter: (parameter, its values
 /// at `a` and `b`, the tuning whose problem the exact family varies: that knob at its neutral value,
 /// as [`Parameter`] scales the scene's forces and offsets its gaps). `Err(why)` otherwise.
-fn knob(a: &Tuning, b: &Tuning) -> Result<(Parameter, f64, f64, Tuning), String> {
+fn knob(a: &Tuning, b: &Tuning) -> Result<(Parameter, f64, f64, Tuning), &'static str> {
     let changed = [a.frequency != b.frequency, a.force_scale != b.force_scale, a.gap_offset != b.gap_offset, a.motion_scale != b.motion_scale];
     match changed {
         [true, false, false, false] => Ok((Parameter::Frequency, a.frequency, b.frequency, *a)),
         [false, true, false, false] => Ok((Parameter::ForceScale, a.force_scale, b.force_scale, Tuning { force_scale: 1.0, ..*a })),
         [false, false, true, false] => Ok((Parameter::GapOffset, a.gap_offset, b.gap_offset, Tuning { gap_offset: 0.0, ..*a })),
-        [false, false, false, true] => Err("the obstacle-motion scale is not a parameter of the exact walk".into()),
-        _ => Err("more than one knob changed at once (the exact walk continues in one)".into()),
+        [false, false, false, true] => Err("the obstacle-motion scale is not a parameter of the exact walk"),
+        _ => Err("more than one knob changed at once (the exact walk continues in one)"),
     }
 }
 
@@ -53,27 +53,27 @@ fn far(a: f64, b: f64) -> bool {
     (a - b).abs() > JUMP_MIN * a.abs().max(b.abs())
 }
 
-/// The re-solve of `session` (already set to `tuning`) from `c` on the exact branch: `Ok(Err(why))`
-/// when the exact walk does not apply here (the caller follows the discrete branch, saying why).
-pub(super) fn resolve(
-    session: &mut PeriodicSolver,
-    base: &PeriodicProblem,
-    disc: Discretization,
-    tuning: Tuning,
-    c: &Current<'_>,
-) -> Result<Result<Resolved, String>, Error> {
+/// A re-solve on the exact branch, or why not.
+pub(super) enum Outcome {
+    Followed(Box<Resolved>),
+    /// The exact walk does not apply here: the caller follows the discrete branch, saying why.
+    Discrete(String),
+}
+
+/// The re-solve of `session` (already set to `tuning`) from `c` on the exact branch.
+pub(super) fn resolve(session: &mut PeriodicSolver, base: &PeriodicProblem, disc: Discretization, tuning: Tuning, c: &Current<'_>) -> Result<Outcome, Error> {
     if let (true, Some(o)) = (c.tuning == tuning, c.orbit) {
-        return Ok(Ok(on_branch(session, c, o.clone())?));
+        return Ok(Outcome::Followed(Box::new(on_branch(session, c, o.clone())?)));
     }
     let n = base.model().n();
     if n > MAX_DOFS {
-        return Ok(Err(format!(
+        return Ok(Outcome::Discrete(format!(
             "the model has {n} DOFs; the exact walk's finite-difference Jacobian costs 2n + events + 1 shooting runs a step, and the re-solves take it up to {MAX_DOFS} DOFs"
         )));
     }
     let (param, from, to, neutral) = match knob(&c.tuning, &tuning) {
         Ok(k) => k,
-        Err(why) => return Ok(Err(why)),
+        Err(why) => return Ok(Outcome::Discrete(why.into())),
     };
     let family = neutral.apply(base, disc)?;
     // The current exact orbit: the front end's, or the polish of the current grid orbit.
@@ -91,18 +91,18 @@ pub(super) fn resolve(
                     derived = o;
                     &derived
                 }
-                Err(e) => return Ok(Err(format!("no exact orbit at the current values: {e}"))),
+                Err(e) => return Ok(Outcome::Discrete(format!("no exact orbit at the current values: {e}"))),
             }
         }
     };
     let stepped = match exact::step(&family, param, from, to, orbit) {
         Ok(s) => s,
-        Err(e) => return Ok(Err(e.message().to_string())),
+        Err(e) => return Ok(Outcome::Discrete(e.message().to_string())),
     };
     match stepped {
-        Stepped::Stopped(why) => Ok(Err(format!("the exact walk stopped: {why}"))),
-        Stepped::Reached(end) => Ok(Ok(on_branch(session, c, end)?)),
-        Stepped::Fold(at) => Ok(Ok(jump(session, c, param, at)?)),
+        Stepped::Stopped(why) => Ok(Outcome::Discrete(format!("the exact walk stopped: {why}"))),
+        Stepped::Reached(end) => Ok(Outcome::Followed(Box::new(on_branch(session, c, *end)?))),
+        Stepped::Fold(at) => Ok(Outcome::Followed(Box::new(jump(session, c, param, at)?))),
     }
 }
 

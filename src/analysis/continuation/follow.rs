@@ -10,6 +10,7 @@
 //! one (λ from 0 to 1, [`Family`]): through the wiggles, and, when the path turns back for good
 //! (a fold: the branch ends), the caller is told so and solves for the orbit that exists.
 use super::corrector::{Family, Path, Solved};
+use super::exact_follow::Outcome;
 use super::{ContinuationSettings, Parameter, active_set, floquet};
 use crate::analysis::polish::PolishedOrbit;
 use crate::error::Error;
@@ -271,8 +272,8 @@ pub fn resolve(
     };
     let exact = match c.exact {
         true => match super::exact_follow::resolve(session, base, disc, tuning, &c)? {
-            Ok(resolved) => return Ok(resolved),
-            Err(why) => Some(why),
+            Outcome::Followed(resolved) => return Ok(*resolved),
+            Outcome::Discrete(why) => Some(why),
         },
         false => None,
     };

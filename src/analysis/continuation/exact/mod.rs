@@ -110,7 +110,7 @@ fn begin<'a>(problem: &'a PeriodicProblem, param: Parameter, from: f64, to: f64,
 #[derive(Clone, Debug)]
 pub(super) enum Stepped {
     /// The branch reaches `to`: its exact orbit there.
-    Reached(PolishedOrbit),
+    Reached(Box<PolishedOrbit>),
     /// The branch turns back before `to`: the fold's parameter (located by bisection on the arc,
     /// or at a grazing after which the new branch turns back).
     Fold(f64),
@@ -133,7 +133,7 @@ pub(super) fn step(problem: &PeriodicProblem, param: Parameter, from: f64, to: f
     let walked = walk.follow_to(here, from, to, &settings, &|_| {});
     Ok(match walked {
         (_, Some(at), _) => Stepped::Fold(at),
-        (_, None, Some(end)) => Stepped::Reached(end),
+        (_, None, Some(end)) => Stepped::Reached(Box::new(end)),
         (w, None, None) => Stepped::Stopped(w.stop),
     })
 }
