@@ -67,7 +67,7 @@ fn time_marching_brackets_the_coarse_blades_resonance_tip() {
     let mut r = session.solve().unwrap();
     for omega in (1..=24).map(|i| 2300.0 + 20.0 * i as f64).chain([BELOW]) {
         let next = Tuning { frequency: omega, ..tuning };
-        let current = continuation::Current { tuning, disc, active_set: &r.active_set, amplitude: continuation::amplitude(&r) };
+        let current = continuation::Current { tuning, disc, active_set: &r.active_set, amplitude: continuation::amplitude(&r), orbit: None, exact: true };
         let resolved = continuation::resolve(&mut session, &p, disc, next, Some(current)).unwrap();
         assert!(resolved.jump.is_none(), "no fold below the tip: {:?} at {}", resolved.jump, next.frequency);
         r = resolved.response;

@@ -1,5 +1,5 @@
-//! Branches through the C API (issue 13 item 6): re-solves continue the orbit along its branch,
-//! jump where it ends at a fold, and report the orbit's Floquet stability. References: the
+//! Branches through the C API (issue 13 item 6, issue 24 item 4): re-solves continue the orbit
+//! along its exact branch, jump where it ends at a fold, and report the orbit's Floquet stability. References: the
 //! damped linear oscillator's multipliers e^{−cT/2m} (a contact-free orbit), its grazing
 //! frequency |1 − ω² + icω| = F/gap (where the contact-free branch of a run-down ends), and the
 //! contact-free amplitude after the run-up's jump.
@@ -28,14 +28,22 @@ struct Step {
     to: f64,
     stable: bool,
     multiplier: f64,
+    /// Half the peak-to-peak of displacement 0 over the k instants.
+    amplitude: f64,
 }
 
-/// Solves at each frequency in turn on one problem handle.
-fn ramp(omegas: &[f64]) -> Vec<Step> {
-    let text = CString::new(DEMO).unwrap();
+/// The demo's scene on k instants.
+fn demo(k: usize) -> String {
+    DEMO.replace("steps = 256", &format!("steps = {k}"))
+}
+
+/// Solves `scene` at each frequency in turn on one problem handle.
+fn ramp_scene(scene: &str, omegas: &[f64]) -> Vec<Step> {
+    let text = CString::new(scene).unwrap();
     unsafe {
         let p = pc_problem_from_scene_text(text.as_ptr());
         assert!(!p.is_null());
+        assert_eq!(pc_problem_set_stability(p, 1), PC_OK);
         let steps = omegas
             .iter()
             .map(|&w| {
@@ -47,13 +55,30 @@ fn ramp(omegas: &[f64]) -> Vec<Step> {
                 let (mut computed, mut stable, mut mu) = (0, 0, 0.0);
                 assert_eq!(pc_result_stability(r, &mut computed, &mut stable, &mut mu, std::ptr::null_mut()), PC_OK);
                 assert_eq!(computed, 1, "stability at {w}");
+                let k = pc_result_steps(r);
+                let mut x = vec![0.0; k];
+                assert_eq!(pc_result_displacement(r, 0, x.as_mut_ptr(), k), PC_OK);
+                let amplitude = (x.iter().fold(f64::MIN, |a, &b| a.max(b)) - x.iter().fold(f64::MAX, |a, &b| a.min(b))) / 2.0;
                 pc_result_free(r);
-                Step { jumped: jumped == 1, fold, from, to, stable: stable == 1, multiplier: mu }
+                Step { jumped: jumped == 1, fold, from, to, stable: stable == 1, multiplier: mu, amplitude }
             })
             .collect();
         pc_problem_free(p);
         steps
     }
+}
+
+fn ramp(omegas: &[f64]) -> Vec<Step> {
+    ramp_scene(DEMO, omegas)
+}
+
+/// From `a` to `b` by `coarse`, then from `b` to `c` by `fine` (each end included once).
+fn path(a: f64, b: f64, c: f64, coarse: f64, fine: f64) -> Vec<f64> {
+    let leg = |x: f64, y: f64, h: f64| {
+        let n = ((y - x).abs() / h).ceil() as usize;
+        (0..n).map(move |i| x + (y - x) * i as f64 / n as f64)
+    };
+    leg(a, b, coarse).chain(leg(b, c, fine)).chain([c]).collect()
 }
 
 #[test]
@@ -64,40 +89,73 @@ fn a_contact_free_orbit_has_the_multipliers_of_its_damping() {
     assert!(s[0].stable);
 }
 
+/// Issue 24 (Must show): at k = 256, 512 and 1024 the run-up and the run-down follow the exact
+/// branch and jump at the first step past its fold, which they report within 1e-4 (relative) of
+/// the continuation's fold; the run-down's fold is next to the analytic grazing of the
+/// contact-free orbit, |1 − ω² + icω| = F/gap. Ramps: 0.01 rad/s steps, 1e-4 rad/s near the folds.
 #[test]
 fn a_run_up_and_a_run_down_jump_once_at_their_folds() {
-    let n = 900;
-    let up: Vec<f64> = (0..=n).map(|i| 1.0 + 0.45 * i as f64 / n as f64).collect();
-    let down: Vec<f64> = up.iter().rev().copied().collect();
-    let dw = 0.45 / n as f64;
-
-    // The run-up stays on the contact branch up to its fold, then falls to the contact-free orbit.
-    let s = ramp(&up);
-    let jumps: Vec<usize> = (0..s.len()).filter(|&i| s[i].jumped).collect();
-    assert_eq!(jumps.len(), 1, "run-up jumps at {:?}", jumps.iter().map(|&i| up[i]).collect::<Vec<_>>());
-    let j = &s[jumps[0]];
-    // The fold of the continued branch (periodic-contact continue): the contact branch's largest
-    // frequency (the branch goes on through the unstable orbits and the contact-free ones to 1.45).
-    let p = Scene::parse(DEMO, "demo").unwrap().to_problem("demo").unwrap();
-    let b = continuation::run(&p, Parameter::Frequency, 1.0, 1.45, &ContinuationSettings::default(), &|_| {}).unwrap();
-    let fold = b.points.iter().filter(|q| q.amplitude[0] > 2.0).map(|q| q.parameter).fold(0.0, f64::max);
-    let located = b.events().filter(|q| q.event == Some(continuation::EventKind::Fold)).map(|q| q.parameter).fold(0.0, f64::max);
-    assert!((located - fold).abs() <= 1e-4 * fold, "the fold event at {located} vs the resonance tip {fold}");
-    // Within the width that tells a fold from a wiggle of the discrete branch (1e-3 relative) and a step.
-    assert!((j.fold - fold).abs() <= 1e-3 * fold + dw, "run-up jump at {} vs the continuation's fold {fold}", j.fold);
-    assert!(j.from > 2.5 && (j.to - linear(up[jumps[0]])).abs() <= 1e-3 * j.to, "amplitudes {} -> {} (linear {})", j.from, j.to, linear(up[jumps[0]]));
-    assert!(s[..jumps[0]].iter().all(|x| x.stable), "the followed branch is stable");
-
-    // The run-down stays on the contact-free orbit down to its grazing, then jumps up.
-    let s = ramp(&down);
-    let jumps: Vec<usize> = (0..s.len()).filter(|&i| s[i].jumped).collect();
-    assert_eq!(jumps.len(), 1, "run-down jumps at {:?}", jumps.iter().map(|&i| down[i]).collect::<Vec<_>>());
-    let j = &s[jumps[0]];
     // |1 − ω² + icω| = F/gap: ω² = (1.9975 + √0.15000625)/2.
     let grazing = ((1.9975 + 0.150_006_25f64.sqrt()) / 2.0).sqrt();
-    assert!((j.fold - grazing).abs() <= 1e-3 * grazing + dw, "run-down jump at {} vs grazing {grazing}", j.fold);
-    assert!((j.from - 1.0).abs() < 0.01 && j.to > 1.2, "amplitudes {} -> {}", j.from, j.to);
-    assert!(s.iter().all(|x| x.stable), "both branches of the run-down are stable");
+    let fine = 1e-4;
+    for k in [256, 512, 1024] {
+        let scene = demo(k);
+        let p = Scene::parse(&scene, "demo").unwrap().to_problem("demo").unwrap();
+        let b = continuation::run(&p, Parameter::Frequency, 1.0, 1.45, &ContinuationSettings::default(), &|_| {}).unwrap();
+        let folds: Vec<f64> = b.events().filter(|q| q.event == Some(continuation::EventKind::Fold)).map(|q| q.parameter).collect();
+        let (tip, lower) = (folds.iter().fold(0.0f64, |a, &f| a.max(f)), folds.iter().fold(f64::MAX, |a, &f| a.min(f)));
+        assert!((lower - grazing).abs() <= 1e-4 * grazing, "k = {k}: the lower fold {lower} vs grazing {grazing}");
+
+        // The run-up stays on the contact branch up to its tip, then falls to the contact-free orbit.
+        let up = path(1.0, 1.365, 1.375, 0.01, fine);
+        let s = ramp_scene(&scene, &up);
+        let jumps: Vec<usize> = (0..s.len()).filter(|&i| s[i].jumped).collect();
+        assert_eq!(jumps.len(), 1, "k = {k}: run-up jumps at {:?}", jumps.iter().map(|&i| up[i]).collect::<Vec<_>>());
+        let (i, j) = (jumps[0], &s[jumps[0]]);
+        assert!((j.fold - tip).abs() <= 1e-4 * tip, "k = {k}: run-up jump at {} vs the continuation's fold {tip}", j.fold);
+        assert!(up[i - 1] <= tip && tip <= up[i], "k = {k}: the jump at {} is not the first step past the fold {tip}", up[i]);
+        assert!(j.from > 2.5 && (j.to - linear(up[i])).abs() <= 1e-3 * j.to, "k = {k}: amplitudes {} -> {} (linear {})", j.from, j.to, linear(up[i]));
+        assert!(s[..i].iter().all(|x| x.stable), "k = {k}: the followed branch is stable");
+
+        // The run-down stays on the contact-free orbit down to its grazing, then jumps up.
+        let down = path(1.45, 1.095, 1.085, 0.01, fine);
+        let s = ramp_scene(&scene, &down);
+        let jumps: Vec<usize> = (0..s.len()).filter(|&i| s[i].jumped).collect();
+        assert_eq!(jumps.len(), 1, "k = {k}: run-down jumps at {:?}", jumps.iter().map(|&i| down[i]).collect::<Vec<_>>());
+        let (i, j) = (jumps[0], &s[jumps[0]]);
+        assert!((j.fold - lower).abs() <= 1e-4 * lower, "k = {k}: run-down jump at {} vs the continuation's fold {lower}", j.fold);
+        assert!(down[i] <= lower && lower <= down[i - 1], "k = {k}: the jump at {} is not the first step past the fold {lower}", down[i]);
+        assert!((j.from - 1.0).abs() < 0.01 && j.to > 1.2, "k = {k}: amplitudes {} -> {}", j.from, j.to);
+        assert!(s.iter().all(|x| x.stable), "k = {k}: both branches of the run-down are stable");
+    }
+}
+
+/// Issue 24: NLvib 03's slow run-up from 0.64 to 0.72 rad/s (C API, 0.001 rad/s steps) stays on
+/// the upper branch at k = 256 and 512, where the discrete follow fell to the lower one (0.348).
+/// Reference: the exact-flow shooting of validation/nlvib03 (reference.json, `checks`: the upper
+/// orbit at 0.72, A0 = 1.284995). Tolerance: the grid's O(h²) error, 1e-3 (measured 4.1e-4 at
+/// k = 256).
+#[test]
+fn nlvib03_slow_run_up_stays_on_the_upper_branch() {
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/validation/nlvib03/reference.json")).unwrap();
+    let reference: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let upper = reference["checks"]["stable_reached"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|c| c["omega"].as_f64() == Some(0.72))
+        .map(|c| c["amplitude_0"].as_f64().unwrap())
+        .fold(0.0f64, f64::max);
+    assert!(upper > 1.0, "the reference's upper orbit at 0.72: {upper}");
+    let scene = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/validation/nlvib03/nlvib03.toml")).unwrap();
+    let omegas: Vec<f64> = (0..=80).map(|i| 0.64 + 0.08 * i as f64 / 80.0).collect();
+    for k in [256, 512] {
+        let scene = scene.replace("steps = 4096", &format!("steps = {k}")) + "\n[output]\ndisplacement = [0, 1]\n";
+        let s = ramp_scene(&scene, &omegas);
+        let end = s.last().unwrap().amplitude;
+        assert!(s.iter().all(|x| !x.jumped), "k = {k}: jumps at {:?}", s.iter().filter(|x| x.jumped).map(|x| x.fold).collect::<Vec<_>>());
+        assert!((end - upper).abs() <= 1e-3 * upper, "k = {k}: the run-up ends at amplitude {end}, the upper orbit's is {upper}");
+    }
 }
 
 /// One continuation walks the demo's whole S-curve, 1.0 → 1.45: up the stable contact branch,

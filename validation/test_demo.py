@@ -129,10 +129,17 @@ def test_nonlinear_differs_from_linear(demo):
     assert demo.timings["total"] < 120, demo.timings
 
 
-@pytest.fixture(scope="module")
-def hyst(cli, workdir):
-    h = hysteresis.run_hysteresis(cli, os.path.join(workdir, "hysteresis"), figure=os.path.join(FIGURES, "demo_hysteresis.png"))
-    print("\n" + hysteresis.summary(h))
+# The grids of test_hysteresis: k = 256 (the demo's) by default; PC_HYSTERESIS_K="256,512,1024"
+# adds the finer ones (issue 24, Must show; ~1 min each on 2 cores).
+HYSTERESIS_K = [int(k) for k in os.environ.get("PC_HYSTERESIS_K", str(runup.STEPS)).split(",")]
+
+
+@pytest.fixture(scope="module", params=HYSTERESIS_K, ids=lambda k: f"k{k}")
+def hyst(cli, workdir, request):
+    k = request.param
+    figure = os.path.join(FIGURES, "demo_hysteresis.png") if k == runup.STEPS else ""
+    h = hysteresis.run_hysteresis(cli, os.path.join(workdir, f"hysteresis_k{k}"), figure=figure, steps=k)
+    print(f"\nk = {k}\n" + hysteresis.summary(h))
     return h
 
 
@@ -140,16 +147,16 @@ def test_hysteresis(hyst):
     """Run-up 0.9 -> 1.6 rad/s and run-down 1.6 -> 0.9 in libcosim, FrequencyRamp driving our
     frequency_in. References: `periodic-contact continue` up and down (the stable and unstable
     branches, their folds). Tolerances:
-      - a jump: 1e-3 of the fold's frequency (the retreat that tells a fold from a wiggle of the
-        discrete branch, the FMU's criterion) plus one ramp step;
+      - a jump (issue 24: the FMU follows the exact branch and locates its fold on the exact
+        orbit): the fold it logs within 1e-4 (relative) of the continuation's, and the jump at the
+        first step past it;
       - an amplitude: the sampling bound of the communication and CLI grids plus the linear
         interpolation bound of the continued branch (hysteresis.envelope, on_stable_branch)."""
     for name, run, fold in (("up", hyst.up, hyst.fold_upper), ("down", hyst.down, hyst.fold_lower)):
-        step = float(np.max(np.abs(np.diff(run.w_in[1:]))))
         assert len(run.jumps) == 1, f"run-{name}: {len(run.jumps)} jumps in the FMU log: {run.jumps}"
         _, w_fold, w_before, w_after, a_before, a_after = run.jumps[0]
-        assert abs(w_fold - fold) <= 1e-3 * fold + step, f"run-{name} jumps at {w_fold}, the continuation's fold is {fold}"
-        assert min(w_before, w_after) - step <= w_fold <= max(w_before, w_after) + step
+        assert abs(w_fold - fold) <= 1e-4 * fold, f"run-{name} jumps at {w_fold}, the continuation's fold is {fold}"
+        assert min(w_before, w_after) <= fold <= max(w_before, w_after), f"run-{name}: the jump from {w_before} to {w_after} is not the step past the fold {fold}"
         if name == "up":
             assert a_before > 2.5 and a_after < 0.3, (a_before, a_after)   # contact branch -> contact-free
         else:
@@ -165,5 +172,6 @@ def test_hysteresis(hyst):
         assert np.all(np.isfinite(m)) and m.min() > 0
         over = run.w_in[1:][m > 1.0]
         assert np.all(np.abs(over - fold) <= 1e-3 * fold), f"run-{name}: unstable orbits reported at {over}"
-    assert os.path.getsize(hyst.figure) > 10000
-    assert os.path.getmtime(hyst.figure) > time.time() - 600
+    if hyst.figure:
+        assert os.path.getsize(hyst.figure) > 10000
+        assert os.path.getmtime(hyst.figure) > time.time() - 600

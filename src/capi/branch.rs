@@ -4,6 +4,7 @@
 //! stability.
 use super::{PcProblem, PcResult, arg, guarded, problem, result, solver_error, to_cstring};
 use crate::analysis::continuation::{self, Current, Jump, Stability};
+use crate::analysis::polish::PolishedOrbit;
 use crate::periodic::{PeriodicSolver, Tuning};
 use crate::response::Response;
 use crate::time::Discretization;
@@ -16,6 +17,8 @@ pub(super) struct BranchState {
     pub stability: bool,
     /// The last orbit: its values, grid, active set and amplitude.
     last: Option<(Tuning, Discretization, Vec<usize>, f64)>,
+    /// Its exact orbit on the followed branch, when the branch was followed exactly.
+    orbit: Option<PolishedOrbit>,
     /// Jumps since the problem was made.
     jumps: usize,
 }
@@ -36,14 +39,18 @@ pub(super) fn solve(p: &mut PcProblem) -> Result<(Response, BranchResult), (c_in
     let problem = p.tuning.apply(&p.base, disc).map_err(solver_error)?;
     let session = p.session.get_or_insert_with(|| PeriodicSolver::new(problem));
     let state = &mut p.branch;
-    let current = state.last.as_ref().map(|(t, d, set, a)| Current { tuning: *t, disc: *d, active_set: set, amplitude: *a });
+    let orbit = state.orbit.as_ref();
+    let current = state.last.as_ref().map(|(t, d, set, a)| Current { tuning: *t, disc: *d, active_set: set, amplitude: *a, orbit, exact: true });
     let resolved = continuation::resolve(session, &p.base, disc, p.tuning, current).map_err(|e| (super::PC_ERROR_SOLVER, e.to_string()))?;
     let r = resolved.response;
     state.jumps += usize::from(resolved.jump.is_some());
     state.last = Some((p.tuning, disc, r.active_set.clone(), continuation::amplitude(&r)));
-    let (stability, why) = match state.stability {
-        false => (None, "not requested (pc_problem_set_stability, [output] stability)".to_string()),
-        true => match continuation::stability(session.problem(), &r.active_set) {
+    state.orbit = resolved.orbit;
+    // The exact orbit's multipliers where the branch was followed exactly, else the discrete ones.
+    let (stability, why) = match (state.stability, resolved.stability) {
+        (false, _) => (None, "not requested (pc_problem_set_stability, [output] stability)".to_string()),
+        (true, Some(exact)) => (Some(exact), String::new()),
+        (true, None) => match continuation::stability(session.problem(), &r.active_set) {
             Ok(s) => (Some(s), String::new()),
             Err(why) => (None, why),
         },

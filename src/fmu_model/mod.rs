@@ -23,9 +23,10 @@
 //!
 //!   `fmi2GetRealOutputDerivatives` (order 1) is the exact time derivative of the interpolant:
 //!   for `displacement[d]` it is the velocity.
+use crate::analysis::accuracy;
 use crate::analysis::continuation::{self, Current, Jump};
 use crate::analysis::interpolant::{fill_powers, locate};
-use crate::analysis::{accuracy, polish};
+use crate::analysis::polish::{self, PolishedOrbit};
 use crate::error::{Error, Result};
 use crate::fmi::state::{StateReader, StateWriter};
 use crate::fmi::{CoSimModel, DefaultExperiment, EventLog, ModelDescription};
@@ -111,6 +112,13 @@ pub struct ContactModel {
     /// Each solve also computes the orbit's Floquet stability (`[output] stability`).
     stability: bool,
     solution: Option<Arc<Solution>>,
+    /// The exact orbit on the branch the re-solves follow, with the configuration and active set
+    /// of the solution it belongs to (after a state restore to another solution, the exact walk
+    /// starts again from the polish of the grid orbit).
+    branch: Option<(Config, Vec<usize>, PolishedOrbit)>,
+    /// Why the last re-solve followed the discrete branch, not the exact one; the log says it once.
+    discrete_why: Option<String>,
+    said_discrete: bool,
     /// τ(t) = t + phase_offset (mod T): keeps the phase continuous across frequency changes.
     phase_offset: f64,
     initialized: bool,
@@ -181,6 +189,9 @@ impl ContactModel {
             stability,
             base,
             solution: None,
+            branch: None,
+            discrete_why: None,
+            said_discrete: false,
             phase_offset: 0.0,
             initialized: false,
             start_time: 0.0,
@@ -205,18 +216,24 @@ impl ContactModel {
         let disc = Discretization { scheme: cfg.scheme, steps: cfg.steps, pairing: self.base.discretization().pairing };
         // The current orbit is the current solution's (which an FMU-state restore may have changed).
         let current = self.solution.as_deref().filter(|s| s.k == cfg.steps && s.config.scheme == cfg.scheme);
-        let current = current.map(|s| Current { tuning: s.config.tuning, disc, active_set: &s.active_set, amplitude: s.amplitude });
+        let orbit = |s: &Solution| self.branch.as_ref().filter(|b| b.0 == s.config && b.1 == s.active_set).map(|b| &b.2);
+        let current =
+            current.map(|s| Current { tuning: s.config.tuning, disc, active_set: &s.active_set, amplitude: s.amplitude, orbit: orbit(s), exact: true });
         let jumps = self.solution.as_ref().map_or(0, |s| s.jumps);
         let resolved = continuation::resolve(&mut self.session, &self.base, disc, cfg.tuning, current)?;
+        self.discrete_why = resolved.exact;
+        self.branch = resolved.orbit.map(|o| (cfg, resolved.response.active_set.clone(), o));
         let mut r = resolved.response;
         if self.estimate {
             r.accuracy = accuracy::estimate(self.session.problem(), &r);
         }
-        let stability = match self.stability {
-            true => {
+        // The exact orbit's multipliers where the branch was followed exactly, else the discrete ones.
+        let stability = match (self.stability, resolved.stability) {
+            (true, Some(exact)) => Some(exact),
+            (true, None) => {
                 Some(continuation::stability(self.session.problem(), &r.active_set).map_err(|why| Error::solve(format!("the stability of the orbit: {why}")))?)
             }
-            false => None,
+            (false, _) => None,
         };
         let jumps = jumps + u32::from(resolved.jump.is_some());
         let orbit = if cfg.polish { polish::apply(self.session.problem(), &mut r).map(Arc::new) } else { None };
@@ -472,6 +489,10 @@ impl CoSimModel for ContactModel {
                     "jump at t = {t}: the branch ended at a fold (frequency {:.9} rad/s) between frequency {old:.9} and {:.9}; amplitude {:.6e} -> {:.6e} (jump {})",
                     j.fold.frequency, cfg.tuning.frequency, j.from_amplitude, j.to_amplitude, sol.jumps
                 ));
+            }
+            if let (Some(why), false) = (self.discrete_why.take(), self.said_discrete) {
+                self.said_discrete = true;
+                log.event(&format!("the re-solves follow the discrete branch of the grid, not the exact orbit's: {why}"));
             }
             log.event(&format!("re-solved at t = {t} for {:?}: {} pivots, residual {:.3e}", cfg.tuning, sol.pivots, sol.residual));
             self.install(sol, t);

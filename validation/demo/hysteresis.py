@@ -45,8 +45,9 @@ JUMP = re.compile(r"jump at t = ([0-9.eE+-]+): the branch ended at a fold \(freq
                   r"between frequency ([0-9.eE+-]+) and ([0-9.eE+-]+); amplitude ([0-9.eE+-]+) -> ([0-9.eE+-]+)")
 
 
-def scene_text(omega: float) -> str:
-    return runup.scene_text(omega).replace("velocity = [0]", "velocity = [0]\nstability = true")
+def scene_text(omega: float, steps: int = runup.STEPS) -> str:
+    text = runup.scene_text(omega).replace("velocity = [0]", "velocity = [0]\nstability = true")
+    return text.replace(f"steps = {runup.STEPS}", f"steps = {steps}")
 
 
 @dataclass
@@ -203,13 +204,15 @@ class Hysteresis:
     timings: dict
 
 
-def run_hysteresis(cli: str, workdir: str, figure: str = FIGURE) -> Hysteresis:
+def run_hysteresis(cli: str, workdir: str, figure: str = FIGURE, steps: int = runup.STEPS) -> Hysteresis:
+    """The run-up, the run-down and both continuations of the demo's scene on `steps` instants."""
     tm = {}
     os.makedirs(workdir, exist_ok=True)
     t0 = time.perf_counter()
-    pc = engine.build_fmu(cli, scene_text(W_LOW), workdir, "demo_oscillator_stop_stability")
+    name = "demo_oscillator_stop_stability" + ("" if steps == runup.STEPS else f"_k{steps}")
+    pc = engine.build_fmu(cli, scene_text(W_LOW, steps), workdir, name)
     ramp = build_ramp.build(os.path.join(workdir, "FrequencyRamp.fmu"))
-    scene = os.path.join(workdir, "demo_oscillator_stop_stability.toml")
+    scene = os.path.join(workdir, f"{name}.toml")
     up_b = continue_branch(cli, scene, W_LOW, W_HIGH, os.path.join(workdir, "branch_up.csv"))
     down_b = continue_branch(cli, scene, W_HIGH, W_LOW, os.path.join(workdir, "branch_down.csv"))
     tm["continuation"] = time.perf_counter() - t0

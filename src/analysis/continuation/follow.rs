@@ -10,7 +10,9 @@
 //! one (λ from 0 to 1, [`Family`]): through the wiggles, and, when the path turns back for good
 //! (a fold: the branch ends), the caller is told so and solves for the orbit that exists.
 use super::corrector::{Family, Path, Solved};
+use super::exact_follow::Outcome;
 use super::{ContinuationSettings, Parameter, active_set, floquet};
+use crate::analysis::polish::PolishedOrbit;
 use crate::error::Error;
 use crate::periodic::{PeriodicProblem, PeriodicSolver, Tuning};
 use crate::response::Response;
@@ -39,7 +41,7 @@ const RETREAT: f64 = 1e-3;
 /// A fold is reported as a jump when the amplitude changes by more than this (relative): on the
 /// demo's oscillator (cds, k = 256) the orbit found past a discrete fold next to the true one
 /// differed by 6e-4, the jumps at the folds by 33 % and 92 %.
-const JUMP_MIN: f64 = 0.02;
+pub(super) const JUMP_MIN: f64 = 0.02;
 
 /// Most arclength steps of one follow.
 const MAX_STEPS: usize = 200;
@@ -209,6 +211,12 @@ pub struct Current<'a> {
     pub active_set: &'a [usize],
     /// Its [`amplitude`].
     pub amplitude: f64,
+    /// Its exact orbit on the followed branch ([`Resolved::orbit`] of the last re-solve), when
+    /// the front end kept it; without it the exact walk starts from the polish of the grid orbit.
+    pub orbit: Option<&'a PolishedOrbit>,
+    /// Follow the exact branch where the scene has one (the FMU, the C API); `false`: the
+    /// discrete branch only (`sweep`'s branch check).
+    pub exact: bool,
 }
 
 /// A jump off a branch that ended at a fold between the old and the new tuning.
@@ -228,6 +236,13 @@ pub struct Resolved {
     pub jump: Option<Jump>,
     /// Why the branch was not followed (the solve was warm-started from the active set only).
     pub not_followed: Option<String>,
+    /// The exact orbit on the followed branch at the new values (the next [`Current::orbit`]).
+    pub orbit: Option<PolishedOrbit>,
+    /// The stability of that exact orbit (the multipliers of its exact monodromy).
+    pub stability: Option<Stability>,
+    /// Why the exact branch was not followed (the discrete branch was, as [`follow`]); `None`
+    /// when it was, or when there was nothing to follow.
+    pub exact: Option<String>,
 }
 
 /// Half the largest peak-to-peak of the displacement series of `r` (the recovered DOFs), or of
@@ -253,7 +268,14 @@ pub fn resolve(
     let current = current.filter(|c| c.disc == disc && !base.model().contacts.is_empty());
     let Some(c) = current else {
         session.reset_warm_start();
-        return Ok(Resolved { response: session.solve()?, jump: None, not_followed: None });
+        return Ok(Resolved { response: session.solve()?, jump: None, not_followed: None, orbit: None, stability: None, exact: None });
+    };
+    let exact = match c.exact {
+        true => match super::exact_follow::resolve(session, base, disc, tuning, &c)? {
+            Outcome::Followed(resolved) => return Ok(*resolved),
+            Outcome::Discrete(why) => Some(why),
+        },
+        false => None,
     };
     let (start, fold, not_followed) = match follow(base, disc, c.tuning, tuning, c.active_set) {
         Followed::Reached(set) => (set, None, None),
@@ -269,5 +291,5 @@ pub fn resolve(
     // Near a true fold the discrete branch can end in a kink and go on in a neighbouring piece
     // (NLvib-like wiggles): the orbit the solver finds is then next to the old one, no jump.
     let jump = jump.filter(|j| (j.to_amplitude - j.from_amplitude).abs() > JUMP_MIN * j.from_amplitude.max(j.to_amplitude));
-    Ok(Resolved { response, jump, not_followed })
+    Ok(Resolved { response, jump, not_followed, orbit: None, stability: None, exact })
 }

@@ -15,6 +15,7 @@ mod corrector;
 mod defences;
 mod events;
 mod exact;
+mod exact_follow;
 mod floquet;
 mod follow;
 pub mod output;

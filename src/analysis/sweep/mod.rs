@@ -230,7 +230,7 @@ fn left_the_branch(before: &Response, now: &Response) -> bool {
 fn follow_from(solver: &mut PeriodicSolver, base: &PeriodicProblem, f0: f64, before: &Response, f: f64) -> Result<Response, crate::Error> {
     let disc = solver.problem().discretization();
     let tuning = Tuning { frequency: f0, ..Tuning::of(base) };
-    let current = continuation::Current { tuning, disc, active_set: &before.active_set, amplitude: continuation::amplitude(before) };
+    let current = continuation::Current { tuning, disc, active_set: &before.active_set, amplitude: continuation::amplitude(before), orbit: None, exact: false };
     continuation::resolve(solver, base, disc, Tuning { frequency: f, ..tuning }, Some(current)).map(|r| r.response)
 }
 

@@ -17,7 +17,7 @@ mod family;
 mod signature;
 
 use super::{BranchPoint, ContinuationSettings, EventKind, Parameter, Source, floquet};
-use crate::analysis::polish::{self, EventKind as Switch};
+use crate::analysis::polish::{self, EventKind as Switch, PolishedOrbit};
 use crate::error::Error;
 use crate::periodic::{PeriodicProblem, PeriodicSolver};
 use family::{Family, Node, Signature};
@@ -46,6 +46,25 @@ struct Walk<'a> {
     problem: &'a PeriodicProblem,
     fam: Family,
     points: Vec<BranchPoint>,
+    /// A front end's step ([`step`]): stop at the first fold, where its branch ends.
+    stop_at_fold: bool,
+    /// The fold the walk stopped at (its λ), when `stop_at_fold`.
+    fold: Option<f64>,
+    /// The exact orbit where the walk reached `to`.
+    end: Option<PolishedOrbit>,
+}
+
+/// The scenes the exact walk takes: compliant contacts, orbits of one forcing period.
+fn check(problem: &PeriodicProblem) -> Result<(), Error> {
+    if problem.period_multiple() != 1 {
+        return Err(Error::input("the exact continuation follows orbits of one forcing period (period_multiple = 1)"));
+    }
+    if let Some(i) = problem.model().contacts.iter().position(|c| c.is_rigid()) {
+        return Err(Error::input(format!(
+            "contact[{i}] is rigid: the exact continuation takes compliant contacts only (impacts and sticking are the discrete walk's)"
+        )));
+    }
+    Ok(())
 }
 
 /// The branch of the exact orbit from the orbit the session's solve and the polish find at
@@ -58,36 +77,65 @@ pub(super) fn walk(
     settings: &ContinuationSettings,
     on_point: &dyn Fn(f64),
 ) -> Result<Walked, Error> {
-    let model = problem.model();
-    if problem.period_multiple() != 1 {
-        return Err(Error::input("the exact continuation follows orbits of one forcing period (period_multiple = 1)"));
-    }
-    if let Some(i) = model.contacts.iter().position(|c| c.is_rigid()) {
-        return Err(Error::input(format!(
-            "contact[{i}] is rigid: the exact continuation takes compliant contacts only (impacts and sticking are the discrete walk's)"
-        )));
-    }
-    let rho = (to - from).abs();
+    check(problem)?;
     let mut start = problem.clone();
     param.apply(&mut start, from)?;
     let mut solver = PeriodicSolver::new(start.clone());
     let r = solver.solve().map_err(|e| Error::from(e).context(format!("the start of the continuation at {} = {from}", param.name())))?;
     let orbit = polish::polish(&start, &r).map_err(|e| Error::solve(format!("no exact orbit at {} = {from}: {e}", param.name())))?;
+    let (mut walk, here) = begin(problem, param, from, to, (to - from).abs(), &orbit)?;
+    walk.push(&here, None, String::new());
+    on_point(from);
+    Ok(walk.follow(here, from, to, settings, on_point))
+}
+
+/// The walk's first point: `orbit` (at λ = `from`) closed as a function of the parameter, its
+/// tangent towards `to`; λ scaled by `rho` in the unknowns.
+fn begin<'a>(problem: &'a PeriodicProblem, param: Parameter, from: f64, to: f64, rho: f64, orbit: &PolishedOrbit) -> Result<(Walk<'a>, Node), Error> {
     let ys = orbit.initial_state().iter().fold(0.0f64, |m, y| m.max(y.abs())).max(1e-300);
     let sig = Signature { events: orbit.events().to_vec(), always: orbit.always_closed().to_vec() };
-    let fam = Family::new(model, param, rho, ys, sig);
+    let fam = Family::new(problem.model(), param, rho, ys, sig);
     let d = fam.dim();
     let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
     let w0 = fam
-        .correct(&fam.pack(&orbit, from), &e_l, from / rho)
+        .correct(&fam.pack(orbit, from), &e_l, from / rho)
         .ok_or_else(|| Error::solve(format!("the polished orbit at {} = {from} did not close as a function of the parameter", param.name())))?;
     let dir = (to - from).signum();
     let prev: Vec<f64> = e_l.iter().map(|x| x * dir).collect();
     let here = fam.node(w0, &prev).ok_or_else(|| Error::solve(format!("singular Jacobian at {} = {from}", param.name())))?;
-    let mut walk = Walk { problem, fam, points: Vec::new() };
-    walk.push(&here, None, String::new());
-    on_point(from);
-    Ok(walk.follow(here, from, to, settings, on_point))
+    Ok((Walk { problem, fam, points: Vec::new(), stop_at_fold: false, fold: None, end: None }, here))
+}
+
+/// Where a front end's step along the exact branch ends ([`step`]).
+#[derive(Clone, Debug)]
+pub(super) enum Stepped {
+    /// The branch reaches `to`: its exact orbit there.
+    Reached(Box<PolishedOrbit>),
+    /// The branch turns back before `to`: the fold's parameter (located by bisection on the arc,
+    /// or at a grazing after which the new branch turns back).
+    Fold(f64),
+    /// The walk stopped short (why).
+    Stopped(String),
+}
+
+/// A front end's re-solve as a step of the exact walk (issue 24 item 4): from `orbit`, the exact
+/// orbit at λ = `from` of `problem` (whose parameter the family sets), along its branch to λ =
+/// `to`, stopping at the first fold. λ is scaled by its own size (not by |to − from|), so that a
+/// small change of the knob is a short arclength: one step or a few.
+pub(super) fn step(problem: &PeriodicProblem, param: Parameter, from: f64, to: f64, orbit: &PolishedOrbit) -> Result<Stepped, Error> {
+    check(problem)?;
+    let rho = from.abs().max(to.abs()).max((to - from).abs());
+    let defaults = ContinuationSettings::default();
+    let reach = 1.2 * (to - from).abs() / rho;
+    let settings = ContinuationSettings { initial_step: reach.min(defaults.exact_max_step), min_step: 1e-6 * reach, max_points: 400, ..defaults };
+    let (mut walk, here) = begin(problem, param, from, to, rho, orbit)?;
+    walk.stop_at_fold = true;
+    let walked = walk.follow_to(here, from, to, &settings, &|_| {});
+    Ok(match walked {
+        (_, Some(at), _) => Stepped::Fold(at),
+        (_, None, Some(end)) => Stepped::Reached(Box::new(end)),
+        (w, None, None) => Stepped::Stopped(w.stop),
+    })
 }
 
 impl Walk<'_> {
@@ -117,15 +165,28 @@ impl Walk<'_> {
         self.points.first().map_or("parameter", |_| "λ")
     }
 
-    fn follow(mut self, mut here: Node, from: f64, to: f64, settings: &ContinuationSettings, on_point: &dyn Fn(f64)) -> Walked {
+    fn follow(self, here: Node, from: f64, to: f64, settings: &ContinuationSettings, on_point: &dyn Fn(f64)) -> Walked {
+        self.follow_to(here, from, to, settings, on_point).0
+    }
+
+    /// [`Self::follow`], with the fold it stopped at (when `stop_at_fold`) and the exact orbit
+    /// where it reached `to`.
+    fn follow_to(
+        mut self,
+        mut here: Node,
+        from: f64,
+        to: f64,
+        settings: &ContinuationSettings,
+        on_point: &dyn Fn(f64),
+    ) -> (Walked, Option<f64>, Option<PolishedOrbit>) {
+        let done = |w: Walk, stop: String, reached: bool, turned_back: bool| (Walked { points: w.points, stop, reached, turned_back }, w.fold, w.end);
         let rho = self.fam.rho;
         let dir = (to - from).signum();
         let mut ds = settings.initial_step;
-        let done = |points: Vec<BranchPoint>, stop: String, reached: bool, turned_back: bool| Walked { points, stop, reached, turned_back };
         loop {
             if self.points.len() >= settings.max_points {
                 let stop = format!("{} points (the limit)", settings.max_points);
-                return done(self.points, stop, false, false);
+                return done(self, stop, false, false);
             }
             // A phase between two events of one contact shrinking to nothing: a grazing.
             let shrinking = self.shrinking(&here);
@@ -139,7 +200,7 @@ impl Walk<'_> {
                     }
                     None => {
                         let stop = format!("a phase of the orbit vanishes at λ = {} and the branch could not go on without it", here.lambda(rho));
-                        return done(self.points, stop, false, false);
+                        return done(self, stop, false, false);
                     }
                 }
             }
@@ -157,28 +218,12 @@ impl Walk<'_> {
                     ds = step / 2.0;
                     if ds < settings.min_step {
                         let stop = format!("no exact orbit at {} = {} with the smallest step", self.name(), here.lambda(rho));
-                        return done(self.points, stop, false, false);
+                        return done(self, stop, false, false);
                     }
                     continue;
                 }
             };
-            // A contact's clearance crossed zero between its events: a grazing on the way.
-            let tol = TOUCH_TOL * self.fam.ys;
-            let crossed = |n: &Node| n.touches.iter().any(|t| t.value < -tol);
-            if crossed(&next) && !crossed(&here) {
-                match self.insert_pair(&here, &next, &crossed) {
-                    Some(n) => {
-                        on_point(n.lambda(rho));
-                        here = n;
-                        ds = settings.initial_step;
-                        continue;
-                    }
-                    None => {
-                        let stop = format!("a grazing near λ = {}: the branch with the new contact phase could not be started", here.lambda(rho));
-                        return done(self.points, stop, false, false);
-                    }
-                }
-            }
+            // Past an end of the range: the point at the end, before a grazing beyond it is looked for.
             let lambda = next.lambda(rho);
             let past_to = (lambda - to) * dir > 0.0;
             let past_from = (lambda - from) * dir < 0.0;
@@ -193,17 +238,44 @@ impl Walk<'_> {
             } else {
                 next
             };
+            // A contact's clearance crossed zero between its events: a grazing on the way.
+            let tol = TOUCH_TOL * self.fam.ys;
+            let crossed = |n: &Node| n.touches.iter().any(|t| t.value < -tol);
+            if crossed(&next) && !crossed(&here) {
+                match self.insert_pair(&here, &next, &crossed) {
+                    Some(n) => {
+                        on_point(n.lambda(rho));
+                        // The branch with the new phase turns back: the old one ended at the grazing.
+                        if self.stop_at_fold && n.tangent[n.tangent.len() - 1] * dir < 0.0 {
+                            self.fold = Some(n.lambda(rho));
+                            return done(self, "a fold at a grazing".into(), false, false);
+                        }
+                        here = n;
+                        ds = settings.initial_step;
+                        continue;
+                    }
+                    None => {
+                        let stop = format!("a grazing near λ = {}: the branch with the new contact phase could not be started", here.lambda(rho));
+                        return done(self, stop, false, false);
+                    }
+                }
+            }
             for (kind, node, detail) in self.events_between(&here, &next) {
+                if self.stop_at_fold && kind == EventKind::Fold {
+                    self.fold = Some(node.lambda(rho));
+                    return done(self, "a fold".into(), false, false);
+                }
                 self.push(&node, Some(kind), detail);
             }
             self.push(&next, None, String::new());
             on_point(next.lambda(rho));
             if past_to {
-                return done(self.points, "reached".into(), true, false);
+                self.end = Some(next.orbit);
+                return done(self, "reached".into(), true, false);
             }
             if past_from {
                 let stop = format!("the branch turned back below {from}");
-                return done(self.points, stop, false, true);
+                return done(self, stop, false, true);
             }
             here = next;
             ds = (step * 1.5).min(settings.exact_max_step);

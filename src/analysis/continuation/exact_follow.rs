@@ -1,0 +1,159 @@
+//! The front ends' re-solve on the exact branch (issue 24 item 4): where the scene has an exact
+//! orbit (compliant contacts, one forcing period, a polish that succeeds), a change of one knob is
+//! a step of the exact walk ([`exact::step`], the walk `continue` uses) from the current exact
+//! orbit. The branch reaches the new value: the grid LCP is solved on it (warm-started from the
+//! current active set, then from the exact orbit's) and the exact orbit goes on. The branch folds
+//! on the way (the fold located on the exact orbit): the response jumps to the orbit the grid LCP
+//! finds without the old branch, polished. Elsewhere [`super::resolve`] falls back to the discrete
+//! follow ([`super::follow`]).
+use super::exact::{self, Stepped};
+use super::follow::{Current, JUMP_MIN, Jump, Resolved, Stability, amplitude};
+use super::{Parameter, floquet};
+use crate::analysis::polish::{self, PolishedOrbit};
+use crate::error::Error;
+use crate::periodic::{PeriodicProblem, PeriodicSolver, Tuning};
+use crate::response::Response;
+use crate::time::Discretization;
+
+/// The largest model whose re-solves follow the exact branch: a step costs a few finite-difference
+/// Jacobians of 2n + events + 1 shooting runs each (measured 3 ms a re-solve on the 1-DOF demo at
+/// k = 256, C API); the coarse blade (23 DOFs) keeps the discrete follow.
+const MAX_DOFS: usize = 8;
+
+/// The one knob that changed from `a` to `b`, as the continued parameter: (parameter, its values
+/// at `a` and `b`, the tuning whose problem the exact family varies: that knob at its neutral value,
+/// as [`Parameter`] scales the scene's forces and offsets its gaps). `Err(why)` otherwise.
+fn knob(a: &Tuning, b: &Tuning) -> Result<(Parameter, f64, f64, Tuning), &'static str> {
+    let changed = [a.frequency != b.frequency, a.force_scale != b.force_scale, a.gap_offset != b.gap_offset, a.motion_scale != b.motion_scale];
+    match changed {
+        [true, false, false, false] => Ok((Parameter::Frequency, a.frequency, b.frequency, *a)),
+        [false, true, false, false] => Ok((Parameter::ForceScale, a.force_scale, b.force_scale, Tuning { force_scale: 1.0, ..*a })),
+        [false, false, true, false] => Ok((Parameter::GapOffset, a.gap_offset, b.gap_offset, Tuning { gap_offset: 0.0, ..*a })),
+        [false, false, false, true] => Err("the obstacle-motion scale is not a parameter of the exact walk"),
+        _ => Err("more than one knob changed at once (the exact walk continues in one)"),
+    }
+}
+
+/// The stability of an exact orbit: the multipliers of its exact monodromy.
+pub(super) fn exact_stability(orbit: &PolishedOrbit) -> Stability {
+    let multipliers = floquet::multipliers(orbit.monodromy());
+    let largest = floquet::largest(&multipliers);
+    Stability { stable: largest <= 1.0, largest, multipliers }
+}
+
+/// The active set (the LCP's z indices, step-major) of the grid response `r`'s contact phases:
+/// the instants whose paired clearance is negative.
+fn active_set_of(r: &Response) -> Vec<usize> {
+    let m = r.contacts.len();
+    let k = r.contacts.first().map_or(0, |c| c.paired_gap.len());
+    (0..k).flat_map(|j| (0..m).filter(move |&i| r.contacts[i].paired_gap[j] < 0.0).map(move |i| j * m + i)).collect()
+}
+
+fn far(a: f64, b: f64) -> bool {
+    (a - b).abs() > JUMP_MIN * a.abs().max(b.abs())
+}
+
+/// A re-solve on the exact branch, or why not.
+pub(super) enum Outcome {
+    Followed(Box<Resolved>),
+    /// The exact walk does not apply here: the caller follows the discrete branch, saying why.
+    Discrete(String),
+}
+
+/// The re-solve of `session` (already set to `tuning`) from `c` on the exact branch.
+pub(super) fn resolve(session: &mut PeriodicSolver, base: &PeriodicProblem, disc: Discretization, tuning: Tuning, c: &Current<'_>) -> Result<Outcome, Error> {
+    if let (true, Some(o)) = (c.tuning == tuning, c.orbit) {
+        return Ok(Outcome::Followed(Box::new(on_branch(session, c, o.clone())?)));
+    }
+    let n = base.model().n();
+    if n > MAX_DOFS {
+        return Ok(Outcome::Discrete(format!(
+            "the model has {n} DOFs; the exact walk's finite-difference Jacobian costs 2n + events + 1 shooting runs a step, and the re-solves take it up to {MAX_DOFS} DOFs"
+        )));
+    }
+    let (param, from, to, neutral) = match knob(&c.tuning, &tuning) {
+        Ok(k) => k,
+        Err(why) => return Ok(Outcome::Discrete(why.into())),
+    };
+    let family = neutral.apply(base, disc)?;
+    // The current exact orbit: the front end's, or the polish of the current grid orbit.
+    let derived;
+    let orbit = match c.orbit {
+        Some(o) => o,
+        None => {
+            let here = c.tuning.apply(base, disc)?;
+            session.update_problem(here.clone());
+            session.set_warm_start(c.active_set);
+            let r = session.solve()?;
+            session.update_problem(tuning.apply(base, disc)?);
+            match polish::polish(&here, &r) {
+                Ok(o) => {
+                    derived = o;
+                    &derived
+                }
+                Err(e) => return Ok(Outcome::Discrete(format!("no exact orbit at the current values: {e}"))),
+            }
+        }
+    };
+    let stepped = match exact::step(&family, param, from, to, orbit) {
+        Ok(s) => s,
+        Err(e) => return Ok(Outcome::Discrete(e.message().to_string())),
+    };
+    match stepped {
+        Stepped::Stopped(why) => Ok(Outcome::Discrete(format!("the exact walk stopped: {why}"))),
+        Stepped::Reached(end) => Ok(Outcome::Followed(Box::new(on_branch(session, c, *end)?))),
+        Stepped::Fold(at) => Ok(Outcome::Followed(Box::new(jump(session, c, param, at)?))),
+    }
+}
+
+/// The branch reached the new values with the exact orbit `end`: the grid orbit on it.
+fn on_branch(session: &mut PeriodicSolver, c: &Current<'_>, end: PolishedOrbit) -> Result<Resolved, Error> {
+    session.set_warm_start(c.active_set);
+    let r = session.solve()?;
+    let mut exact = r.clone();
+    end.write(session.problem(), &mut exact);
+    let target = amplitude(&exact);
+    let mut response = r;
+    if far(amplitude(&response), target) {
+        // The grid's orbit of this branch has another active set here: start from the exact one's.
+        session.set_warm_start(&active_set_of(&exact));
+        response = session.solve()?;
+    }
+    if far(amplitude(&response), target) {
+        // No grid orbit on the branch here (the discrete branch folds before the exact one): the
+        // answer is the exact orbit at the instants.
+        exact.active_set = active_set_of(&exact);
+        exact.warnings.push(format!(
+            "the grid LCP has no orbit on the followed branch here (its discrete fold comes first; amplitude {:.6e} vs the exact orbit's {target:.6e}): the series are the exact orbit's at the instants",
+            amplitude(&response)
+        ));
+        session.set_warm_start(&exact.active_set);
+        response = exact;
+    }
+    let stability = Some(exact_stability(&end));
+    Ok(Resolved { response, jump: None, not_followed: None, orbit: Some(end), stability, exact: None })
+}
+
+/// The branch folded at parameter `at` on the way: the orbit the grid LCP finds without the old
+/// branch (cold, then contact-free), polished for the next step.
+fn jump(session: &mut PeriodicSolver, c: &Current<'_>, param: Parameter, at: f64) -> Result<Resolved, Error> {
+    session.reset_warm_start();
+    let mut response = session.solve()?;
+    if !far(amplitude(&response), c.amplitude) {
+        session.set_warm_start(&[]);
+        let free = session.solve()?;
+        if far(amplitude(&free), c.amplitude) {
+            response = free;
+        }
+    }
+    let orbit = polish::polish(session.problem(), &response).ok();
+    let stability = orbit.as_ref().map(exact_stability);
+    let mut fold = c.tuning;
+    match param {
+        Parameter::Frequency | Parameter::Speed { .. } => fold.frequency = at,
+        Parameter::ForceScale => fold.force_scale = at,
+        Parameter::GapOffset => fold.gap_offset = at,
+    }
+    let jump = Jump { fold, from_amplitude: c.amplitude, to_amplitude: amplitude(&response) };
+    Ok(Resolved { response, jump: Some(jump), not_followed: None, orbit, stability, exact: None })
+}
