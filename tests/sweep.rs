@@ -291,31 +291,50 @@ fn sweep_estimates_every_point_as_a_standalone_solve_does() {
     assert!(plain[0].estimate_relative.is_none() && plain[0].estimate_method.is_empty());
 }
 
-/// A sweep over an LCP above the dense fallback's quick size (N = 2 × 2560 = 5120 > 4096) is
-/// guarded: shooting, ω sub-steps, never the dense fallback, and its error estimates start from
-/// the point's own active set carried to k/2. Every point is solved and estimated, and the
-/// middle point equals dense lexicographic Lemke on the same LCP (the independent reference).
-#[test]
-fn a_guarded_sweep_over_a_large_lcp_equals_dense_lemke() {
-    use periodic_contact::periodic::{LcpMethod, PeriodicSolver};
+/// The chain with its two rigid stops at k = 2560: N = 5120, above the dense fallback's quick
+/// size (4096), so its sweeps are guarded.
+fn large_chain() -> PeriodicProblem {
     let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("fmu/scenes/chain-3dof-two-stops.toml"))
         .unwrap()
         .replace("steps = 256", "steps = 2560");
-    let p = Scene::parse(&text, "chain").unwrap().to_problem("chain").unwrap();
+    Scene::parse(&text, "chain").unwrap().to_problem("chain").unwrap()
+}
+
+/// The guarded sweep of `large_chain` over 5 points with estimates.
+fn guarded_sweep() -> (Vec<f64>, Vec<sweep::SweepPoint>) {
     let freqs = sweep::linspace(0.5, 0.7, 5);
     let settings = SweepSettings { threads: 1, chunks_per_thread: 1, estimate: true, ..Default::default() };
     let t = Instant::now();
-    let points = sweep::run(&p, &freqs, &settings, &|_| {}).unwrap();
+    let points = sweep::run(&large_chain(), &freqs, &settings, &|_| {}).unwrap();
     eprintln!("guarded sweep, 5 points at N = 5120 with estimates: {:.2} s", t.elapsed().as_secs_f64());
+    (freqs, points)
+}
+
+/// A sweep over an LCP above the dense fallback's quick size is guarded: shooting (ω sub-steps
+/// where it misses), never the dense fallback, and its error estimates start from the point's
+/// own active set carried to k/2. Every point is solved and estimated, by shooting alone.
+#[test]
+fn a_guarded_sweep_solves_and_estimates_every_point_by_shooting() {
+    let (_, points) = guarded_sweep();
     for x in &points {
         eprintln!("ω = {}: {} ({} sub-steps), estimate {:?}, {:?}", x.frequency, sweep::solver_label(&x.lcp_path), x.substeps, x.estimate_relative, x.error);
         assert!(x.error.is_none() && x.estimate_relative.is_some(), "ω = {}: {:?} {}", x.frequency, x.error, x.estimate_method);
         assert_eq!(sweep::solver_label(&x.lcp_path), "shooting", "no dense fallback in a guarded sweep");
     }
     assert!(points.iter().any(|x| x.max_force.iter().any(|&f| f > 0.0)), "the stops are hit");
-    let mut lemke = p.clone();
+}
+
+/// The guarded sweep's middle point equals dense lexicographic Lemke on the same LCP (the
+/// independent reference). Opt-in (dense Lemke at N = 5120: about 100 s at load 10):
+/// `cargo test --release --test suite sweep::a_guarded_sweep_equals_dense_lemke -- --ignored`.
+#[test]
+#[ignore]
+fn a_guarded_sweep_equals_dense_lemke() {
+    use periodic_contact::periodic::{LcpMethod, PeriodicSolver, SolverSettings};
+    let (freqs, points) = guarded_sweep();
+    let mut lemke = large_chain();
     lemke.set_frequency(freqs[2]).unwrap();
-    lemke.set_solver_settings(periodic_contact::periodic::SolverSettings { method: LcpMethod::Lemke, ..lemke.solver_settings().clone() }).unwrap();
+    lemke.set_solver_settings(SolverSettings { method: LcpMethod::Lemke, ..lemke.solver_settings().clone() }).unwrap();
     let t = Instant::now();
     let r = PeriodicSolver::new(lemke).solve().unwrap();
     eprintln!("dense Lemke at N = 5120: {:.2} s, {} pivots", t.elapsed().as_secs_f64(), r.lcp.pivots);

@@ -170,6 +170,9 @@ pub fn run(
                 let mut second: Option<(PeriodicSolver, Option<f64>)> = None;
                 let mut out = Vec::with_capacity(hi - lo);
                 let mut last: Option<(f64, Response)> = None;
+                // Guarded: the last solved frequency, kept past a failure with its active sets
+                // (the next point sub-steps from there instead of starting cold).
+                let mut last_solved: Option<f64> = None;
                 // A large LCP's sweep never waits for the dense fallback (see `solve_guarded`); its
                 // ω sub-steps follow the branch, and the branch check's continuation, which can
                 // reach the dense fallback, is not run there.
@@ -178,7 +181,7 @@ pub fn run(
                     let t = Instant::now();
                     let mut substeps = 0;
                     let mut r = if guarded {
-                        let (r, n) = solve_guarded(&mut solver, last.as_ref().map(|l| l.0), f);
+                        let (r, n) = solve_guarded(&mut solver, last_solved, f);
                         substeps = n;
                         r
                     } else {
@@ -207,7 +210,11 @@ pub fn run(
                     }
                     point.time_s = t.elapsed().as_secs_f64();
                     match r {
-                        Ok(r) => last = Some((f, r)),
+                        Ok(r) => {
+                            last_solved = Some(f);
+                            last = Some((f, r));
+                        }
+                        Err(_) if guarded => last = None,
                         Err(_) => {
                             // The next point starts cold, as after any failure.
                             solver.reset_warm_start();

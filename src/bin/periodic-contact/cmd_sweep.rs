@@ -152,13 +152,14 @@ pub fn run(a: &Args) -> Result<(), Failure> {
             .progress_chars("=> "),
     );
     let t = Instant::now();
-    // Each point's time and solver on the bar; a slow, sub-stepped or failed one on its own line,
-    // so that a sweep that stalls shows where.
+    // Each point's time and solver on the bar; a slow, sub-stepped or failed one on its own line
+    // (not with --quiet), so that a sweep that stalls shows where.
     let on_point = |p: &sweep::SweepPoint| {
         let what = format!("ω = {}: {:.2} s, {}, {} iterations", p.frequency, p.time_s, sweep::solver_label(&p.lcp_path), p.pivots);
-        if p.time_s > SLOW_POINT_S || p.substeps > 0 || p.error.is_some() {
+        if !a.quiet && (p.time_s > SLOW_POINT_S || p.substeps > 0 || p.error.is_some()) {
             let status = p.error.as_deref().map_or_else(|| format!("{} ω sub-steps", p.substeps), |e| format!("failed: {e}"));
-            bar.println(format!("  point {what}; {status}"));
+            // Printed even where the bar is hidden (stderr not a terminal, a log file).
+            bar.suspend(|| eprintln!("  point {what}; {status}"));
         }
         bar.set_message(format!("(last {what})"));
         bar.inc(1);
