@@ -23,7 +23,7 @@ fn coarse_blade_sweep_of_300_points_shows_the_stiffening_shift_of_the_resonance(
     let setup = t.elapsed().as_secs_f64();
     let freqs = sweep::linspace(2000.0, 2700.0, 300);
     let t = Instant::now();
-    let points = sweep::run(&p, &freqs, &SweepSettings::default(), &|| {}).unwrap();
+    let points = sweep::run(&p, &freqs, &SweepSettings::default(), &|_| {}).unwrap();
     let wall = t.elapsed().as_secs_f64();
     let warm = points.iter().filter(|x| x.warm_start_used).count();
     eprintln!("coarse blade: set-up {setup:.2} s, 300-point sweep {wall:.2} s wall, {warm} warm-started");
@@ -55,8 +55,8 @@ fn warm_starts_save_pivots_and_agree_with_cold_solves_where_the_solution_is_uniq
     let p = problem();
     let freqs = sweep::linspace(2150.0, 2450.0, 61);
     let one = SweepSettings { threads: 1, chunks_per_thread: 1, ..Default::default() };
-    let warm = sweep::run(&p, &freqs, &one, &|| {}).unwrap();
-    let cold = sweep::run(&p, &freqs, &SweepSettings { warm_start: false, ..one.clone() }, &|| {}).unwrap();
+    let warm = sweep::run(&p, &freqs, &one, &|_| {}).unwrap();
+    let cold = sweep::run(&p, &freqs, &SweepSettings { warm_start: false, ..one.clone() }, &|_| {}).unwrap();
     let (pw, pc): (usize, usize) = (warm.iter().map(|x| x.pivots).sum(), cold.iter().map(|x| x.pivots).sum());
     eprintln!("pivots: warm {pw}, cold {pc}");
     assert!(pw < pc);
@@ -68,7 +68,7 @@ fn warm_starts_save_pivots_and_agree_with_cold_solves_where_the_solution_is_uniq
         }
     }
     // The sweep gives the same answers on two threads in contiguous chunks.
-    let two = sweep::run(&p, &freqs, &SweepSettings { threads: 2, chunks_per_thread: 2, ..Default::default() }, &|| {}).unwrap();
+    let two = sweep::run(&p, &freqs, &SweepSettings { threads: 2, chunks_per_thread: 2, ..Default::default() }, &|_| {}).unwrap();
     for (a, b) in two.iter().zip(&warm).filter(|(a, _)| a.frequency < 2320.0) {
         assert_eq!(a.frequency, b.frequency);
         assert!((a.amplitude[0] - b.amplitude[0]).abs() <= 1e-8 * b.amplitude[0]);
@@ -233,7 +233,7 @@ fn a_sequential_sweep_stays_on_the_blades_contact_branch_up_to_the_tip() {
     let p = problem();
     let freqs: Vec<f64> = (0..=49).map(|i| 2300.0 + 10.0 * i as f64).collect();
     let one = SweepSettings { threads: 1, chunks_per_thread: 1, ..Default::default() };
-    let points = sweep::run(&p, &freqs, &one, &|| {}).unwrap();
+    let points = sweep::run(&p, &freqs, &one, &|_| {}).unwrap();
     assert!(points.iter().all(|q| q.error.is_none() && q.contact_fraction.iter().any(|&c| c > 0.0)), "every point touches the casing");
     let amp: Vec<f64> = points.iter().map(|q| q.amplitude[0]).collect();
     assert!(amp.windows(2).all(|w| w[1] > w[0]), "the amplitude rises to the tip: {amp:?}");
@@ -273,7 +273,7 @@ fn sweep_estimates_every_point_as_a_standalone_solve_does() {
     p.set_discretization(periodic_contact::time::Discretization { scheme: periodic_contact::time::Scheme::Bds2, steps: 256, pairing: None }).unwrap();
     let freqs = sweep::linspace(2200.0, 2300.0, 4);
     let settings = SweepSettings { threads: 1, chunks_per_thread: 1, estimate: true, ..Default::default() };
-    let points = sweep::run(&p, &freqs, &settings, &|| {}).unwrap();
+    let points = sweep::run(&p, &freqs, &settings, &|_| {}).unwrap();
     for x in &points {
         let mut q = p.clone();
         q.set_parallel(false);
@@ -287,6 +287,60 @@ fn sweep_estimates_every_point_as_a_standalone_solve_does() {
         assert_eq!(x.estimate_method, alone.method);
     }
     // Without the setting no estimate is made.
-    let plain = sweep::run(&p, &freqs[..1], &SweepSettings { estimate: false, ..settings }, &|| {}).unwrap();
+    let plain = sweep::run(&p, &freqs[..1], &SweepSettings { estimate: false, ..settings }, &|_| {}).unwrap();
     assert!(plain[0].estimate_relative.is_none() && plain[0].estimate_method.is_empty());
+}
+
+/// The chain with its two rigid stops at k = 2560: N = 5120, above the dense fallback's quick
+/// size (4096), so its sweeps are guarded.
+fn large_chain() -> PeriodicProblem {
+    let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("fmu/scenes/chain-3dof-two-stops.toml"))
+        .unwrap()
+        .replace("steps = 256", "steps = 2560");
+    Scene::parse(&text, "chain").unwrap().to_problem("chain").unwrap()
+}
+
+/// The guarded sweep of `large_chain` over 5 points with estimates.
+fn guarded_sweep() -> (Vec<f64>, Vec<sweep::SweepPoint>) {
+    let freqs = sweep::linspace(0.5, 0.7, 5);
+    let settings = SweepSettings { threads: 1, chunks_per_thread: 1, estimate: true, ..Default::default() };
+    let t = Instant::now();
+    let points = sweep::run(&large_chain(), &freqs, &settings, &|_| {}).unwrap();
+    eprintln!("guarded sweep, 5 points at N = 5120 with estimates: {:.2} s", t.elapsed().as_secs_f64());
+    (freqs, points)
+}
+
+/// A sweep over an LCP above the dense fallback's quick size is guarded: shooting (ω sub-steps
+/// where it misses), never the dense fallback, and its error estimates start from the point's
+/// own active set carried to k/2. Every point is solved and estimated, by shooting alone.
+#[test]
+fn a_guarded_sweep_solves_and_estimates_every_point_by_shooting() {
+    let (_, points) = guarded_sweep();
+    for x in &points {
+        eprintln!("ω = {}: {} ({} sub-steps), estimate {:?}, {:?}", x.frequency, sweep::solver_label(&x.lcp_path), x.substeps, x.estimate_relative, x.error);
+        assert!(x.error.is_none() && x.estimate_relative.is_some(), "ω = {}: {:?} {}", x.frequency, x.error, x.estimate_method);
+        assert_eq!(sweep::solver_label(&x.lcp_path), "shooting", "no dense fallback in a guarded sweep");
+    }
+    assert!(points.iter().any(|x| x.max_force.iter().any(|&f| f > 0.0)), "the stops are hit");
+}
+
+/// The guarded sweep's middle point equals dense lexicographic Lemke on the same LCP (the
+/// independent reference). Opt-in (dense Lemke at N = 5120: about 100 s at load 10):
+/// `cargo test --release --test suite sweep::a_guarded_sweep_equals_dense_lemke -- --ignored`.
+#[test]
+#[ignore]
+fn a_guarded_sweep_equals_dense_lemke() {
+    use periodic_contact::periodic::{LcpMethod, PeriodicSolver, SolverSettings};
+    let (freqs, points) = guarded_sweep();
+    let mut lemke = large_chain();
+    lemke.set_frequency(freqs[2]).unwrap();
+    lemke.set_solver_settings(SolverSettings { method: LcpMethod::Lemke, ..lemke.solver_settings().clone() }).unwrap();
+    let t = Instant::now();
+    let r = PeriodicSolver::new(lemke).solve().unwrap();
+    eprintln!("dense Lemke at N = 5120: {:.2} s, {} pivots", t.elapsed().as_secs_f64(), r.lcp.pivots);
+    for (i, d) in ["0", "1", "2"].iter().enumerate() {
+        let a = periodic_contact::response::Response::peak_to_peak(&r.displacement[*d]) / 2.0;
+        let ours = points[2].amplitude[i];
+        assert!((a - ours).abs() <= 1e-9 * a, "DOF {d}: sweep {ours:e}, Lemke {a:e}");
+    }
 }

@@ -32,7 +32,10 @@ pub use io::dat::{DatError, parse_dat, read_dat, write_dat};
 pub use lemke::{Lemke, LemkeSettings};
 pub use matrix::{BlockCirculant, DenseMatrix, LcpMatrix};
 pub use pivoting::{BlockPivoting, PivotingSettings};
-pub use policy::{AUTO_LEMKE_MAX, DENSE_MAX, DENSE_MEMORY_MAX, GIB, LcpMethod, LcpMethodError, dense_memory, solve_circulant_lcp, solve_periodic_lcp};
+pub use policy::{
+    AUTO_LEMKE_MAX, DENSE_MAX, DENSE_MEMORY_MAX, GIB, LEMKE_AFTER_SHOOTING_MAX, LcpMethod, LcpMethodError, dense_memory, solve_circulant_lcp,
+    solve_periodic_lcp,
+};
 pub use reference::solve_by_enumeration;
 pub use status::{LcpInfo, LcpOutcome, LcpSolution, LcpStep, WarmOutcome, residuals};
 pub use structured::{

@@ -23,7 +23,7 @@ pub use tuning::Tuning;
 use crate::error::{Error, ErrorKind};
 /// The step map's type, for analyses that march it (continuation, stability).
 pub use crate::lcp::StepMapLcp;
-pub use crate::lcp::{AUTO_LEMKE_MAX, DENSE_MAX, LcpMethod, solve_circulant_lcp};
+pub use crate::lcp::{AUTO_LEMKE_MAX, DENSE_MAX, LEMKE_AFTER_SHOOTING_MAX, LcpMethod, solve_circulant_lcp};
 use crate::lcp::{LcpOutcome, LcpSolution};
 use crate::model::ModelError;
 

@@ -188,6 +188,23 @@ impl PeriodicSolver {
         }
     }
 
+    /// Solves by shooting alone (`solver.method = "shooting"` for this solve): from the warm
+    /// start when `warm` and there is one, else cold; no cold retry and no dense fallback. A
+    /// failure costs one shooting budget (seconds), where the dense fallback of a large LCP costs
+    /// minutes: a sweep's quick try before it sub-steps ω. The answer's active set becomes the
+    /// next warm start, as in [`Self::solve`].
+    pub fn solve_by_shooting(&mut self, warm: bool) -> Result<Response, SolveError> {
+        let settings = self.problem.solver_settings().clone();
+        self.problem.set_solver_settings(super::SolverSettings { method: crate::lcp::LcpMethod::Shooting, ..settings.clone() })?;
+        let guess = self.warm_start.clone().filter(|_| warm && self.warm_starts);
+        let result = self.solve_cached(guess.as_deref());
+        self.problem.set_solver_settings(settings)?;
+        let r = result?;
+        self.last_start = if guess.is_some() { WarmStart::Used } else { WarmStart::Cold };
+        self.set_warm_start(&r.active_set);
+        Ok(r)
+    }
+
     /// One solve on the session's assembly (built or re-used).
     fn solve_cached(&mut self, warm_start: Option<&[usize]>) -> Result<Response, SolveError> {
         let t_start = std::time::Instant::now();

@@ -18,7 +18,7 @@ pub mod spectrum;
 
 use crate::analysis::{accuracy, continuation};
 use crate::model::{Labels, Quantity};
-use crate::periodic::{PeriodicProblem, PeriodicSolver, SolveError, Tuning, WarmStart};
+use crate::periodic::{LEMKE_AFTER_SHOOTING_MAX, LcpMethod, PeriodicProblem, PeriodicSolver, SolveError, Tuning, WarmStart};
 use crate::response::Response;
 use rayon::prelude::*;
 use std::time::Instant;
@@ -77,6 +77,9 @@ pub struct SweepPoint {
     pub error: Option<String>,
     /// The LCP methods that ran and the fallbacks taken (`lcp.path` of the JSON).
     pub lcp_path: String,
+    /// ω sub-steps solved on the way from the last point (a large LCP whose warm shooting
+    /// missed, see [`solve_guarded`]).
+    pub substeps: usize,
     /// Active set of the solution (warm start of a neighbour).
     pub active_set: Vec<usize>,
 }
@@ -103,6 +106,7 @@ impl SweepPoint {
             estimate_method: String::new(),
             error: None,
             lcp_path: r.lcp.path.clone(),
+            substeps: 0,
             active_set: r.active_set.clone(),
         }
     }
@@ -129,8 +133,14 @@ pub fn solve_point(problem: &PeriodicProblem, frequency: f64, warm: Option<&[usi
 }
 
 /// Runs the sweep over `frequencies` (any order; chunks are contiguous in the given order).
-/// `on_point` is called after each point (from worker threads), e.g. to advance a progress bar.
-pub fn run(template: &PeriodicProblem, frequencies: &[f64], settings: &SweepSettings, on_point: &(dyn Fn() + Sync)) -> Result<Vec<SweepPoint>, crate::Error> {
+/// `on_point` is called with each point (from worker threads), e.g. to advance a progress bar
+/// and show the point's time and solver.
+pub fn run(
+    template: &PeriodicProblem,
+    frequencies: &[f64],
+    settings: &SweepSettings,
+    on_point: &(dyn Fn(&SweepPoint) + Sync),
+) -> Result<Vec<SweepPoint>, crate::Error> {
     if let Some(f) = frequencies.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
         return Err(crate::Error::input(format!("frequency: {f} is not a finite angular frequency > 0 [rad/s]")));
     }
@@ -157,14 +167,29 @@ pub fn run(template: &PeriodicProblem, frequencies: &[f64], settings: &SweepSett
             .map(|&(lo, hi)| {
                 let mut solver = session.clone();
                 // The second grid of the error estimates, warm-started along the chunk too.
-                let mut second: Option<PeriodicSolver> = None;
+                let mut second: Option<(PeriodicSolver, Option<f64>)> = None;
                 let mut out = Vec::with_capacity(hi - lo);
                 let mut last: Option<(f64, Response)> = None;
+                // Guarded: the last solved frequency, kept past a failure with its active sets
+                // (the next point sub-steps from there instead of starting cold).
+                let mut last_solved: Option<f64> = None;
+                // A large LCP's sweep never waits for the dense fallback (see `solve_guarded`); its
+                // ω sub-steps follow the branch, and the branch check's continuation, which can
+                // reach the dense fallback, is not run there.
+                let guarded = settings.warm_start && guarded(solver.problem());
                 for &f in &frequencies[lo..hi] {
                     let t = Instant::now();
-                    let mut r = solver.update_frequency(f).and_then(|()| solver.solve());
+                    let mut substeps = 0;
+                    let mut r = if guarded {
+                        let (r, n) = solve_guarded(&mut solver, last_solved, f);
+                        substeps = n;
+                        r
+                    } else {
+                        solver.update_frequency(f).and_then(|()| solver.solve())
+                    };
                     if let (Some((f0, before)), Ok(now)) = (&last, &r)
                         && settings.warm_start
+                        && !guarded
                         && left_the_branch(before, now)
                     {
                         // Kept as it is when the branch cannot be followed.
@@ -176,23 +201,28 @@ pub fn run(template: &PeriodicProblem, frequencies: &[f64], settings: &SweepSett
                         Ok(r) => SweepPoint::from_response(solver.problem(), f, r),
                         Err(e) => SweepPoint { frequency: f, error: Some(e.to_string()), ..Default::default() },
                     };
+                    point.substeps = substeps;
                     point.warm_start_used = r.is_ok() && solver.last_start() == WarmStart::Used;
                     point.cold_fallback = solver.last_start() == WarmStart::ColdFallback;
                     if let (Ok(r), true) = (&r, settings.estimate) {
-                        let a = accuracy::estimate_with(solver.problem(), r, &mut |p| second_solve(&mut second, p, settings.warm_start));
+                        let a = accuracy::estimate_with(solver.problem(), r, &mut |p| second_solve(&mut second, p, r, settings.warm_start));
                         (point.estimate_relative, point.estimate_method) = (a.relative, a.method);
                     }
                     point.time_s = t.elapsed().as_secs_f64();
                     match r {
-                        Ok(r) => last = Some((f, r)),
+                        Ok(r) => {
+                            last_solved = Some(f);
+                            last = Some((f, r));
+                        }
+                        Err(_) if guarded => last = None,
                         Err(_) => {
                             // The next point starts cold, as after any failure.
                             solver.reset_warm_start();
                             last = None;
                         }
                     }
+                    on_point(&point);
                     out.push(point);
-                    on_point();
                 }
                 out
             })
@@ -201,19 +231,92 @@ pub fn run(template: &PeriodicProblem, frequencies: &[f64], settings: &SweepSett
     Ok(results.into_iter().flatten().collect())
 }
 
-/// The second solve of a point's error estimate, in the chunk's session for that grid (made on
-/// the first point, or again when the grid changes).
-fn second_solve(session: &mut Option<PeriodicSolver>, problem: &PeriodicProblem, warm: bool) -> Result<Response, SolveError> {
-    let steps = problem.discretization().steps;
-    let solver = match session {
-        Some(s) if s.problem().discretization().steps == steps => s,
-        _ => session.insert(PeriodicSolver::new(problem.clone()).with_warm_starts(warm)),
+/// Halvings of the ω step when a sub-step misses: down to 1/16 of the sweep's step.
+const SUBSTEP_HALVINGS: u32 = 4;
+
+/// A point of a sweep over an LCP too large for a quick dense fallback (N >
+/// `LEMKE_AFTER_SHOOTING_MAX`; block pivoting then dense Lemke took minutes at N = 17 408 on the
+/// real blade, issue 23): shooting from the last point's active sets; where it misses, natural
+/// continuation in ω from the last solved frequency `last` (sub-steps, halved on a miss, each
+/// warm-started from the previous); then cold shooting. Never the dense fallback: a point still
+/// missed is a typed failure naming the cause and the remedy, and the sweep goes on. Each try
+/// is bounded by shooting's work budget. Returns the answer and the sub-steps solved before it.
+fn solve_guarded(solver: &mut PeriodicSolver, last: Option<f64>, f: f64) -> (Result<Response, SolveError>, usize) {
+    let at = |solver: &mut PeriodicSolver, w: f64, warm: bool| solver.update_frequency(w).and_then(|()| solver.solve_by_shooting(warm));
+    let had_warm = solver.warm_start().is_some();
+    let first = match at(solver, f, true) {
+        Ok(r) => return (Ok(r), 0),
+        Err(e) => e,
     };
-    solver.update_frequency(problem.model().frequency)?;
-    solver.solve()
+    let mut substeps = 0;
+    if let Some(f0) = last {
+        let (mut here, mut h) = (f0, (f - f0) / 2.0);
+        let smallest = (f - f0).abs() / f64::from(1u32 << SUBSTEP_HALVINGS);
+        while h != 0.0 && h.abs() >= smallest {
+            let next = if (f - here).abs() <= h.abs() { f } else { here + h };
+            match at(solver, next, true) {
+                Ok(r) if next == f => return (Ok(r), substeps),
+                Ok(_) => {
+                    here = next;
+                    substeps += 1;
+                }
+                Err(_) => h /= 2.0,
+            }
+        }
+    }
+    // Cold shooting, unless the first try already was.
+    let cold = if had_warm { at(solver, f, false) } else { Err(first) };
+    match cold {
+        Ok(r) => (Ok(r), substeps),
+        Err(SolveError::Lcp { outcome, info, .. }) => {
+            let from = last.map_or_else(|| "no solved point before it".to_string(), |f0| format!("{substeps} ω sub-steps from {f0} rad/s"));
+            let hint = format!(
+                "shooting missed ω = {f} rad/s from the last point's active sets, after {from}, and cold; the sweep skips the dense fallback above N = {LEMKE_AFTER_SHOOTING_MAX} (block pivoting then Lemke: minutes); remedies: more --points (a smaller ω step), or `periodic-contact solve SCENE --frequency {f}` for this point alone (it runs the dense fallback)"
+            );
+            (Err(SolveError::Lcp { outcome, info, hint }), substeps)
+        }
+        Err(e) => (Err(e), substeps),
+    }
 }
 
-/// The CSV of a sweep: the parameter, amplitude per displacement output (nonlinear, then
+/// The second solve of a point's error estimate, in the chunk's session for that grid (made on
+/// the first point, or again when the grid changes), with the frequency it last solved. On a
+/// large LCP ([`guarded`]) it starts from the active set of `first`, the point's answer on the
+/// first grid, carried to this grid (the same orbit at other instants: a closer guess than this
+/// grid's last point) and never runs the dense fallback ([`solve_guarded`]).
+fn second_solve(session: &mut Option<(PeriodicSolver, Option<f64>)>, problem: &PeriodicProblem, first: &Response, warm: bool) -> Result<Response, SolveError> {
+    let steps = problem.discretization().steps;
+    let (solver, last) = match session {
+        Some(s) if s.0.problem().discretization().steps == steps => s,
+        _ => session.insert((PeriodicSolver::new(problem.clone()).with_warm_starts(warm), None)),
+    };
+    let f = problem.model().frequency;
+    if !(warm && guarded(solver.problem())) {
+        solver.update_frequency(f)?;
+        return solver.solve();
+    }
+    let m = problem.model().contacts.len();
+    let (k_first, k) = (first.lcp.size / m.max(1), solver.problem().instants());
+    let mut active = vec![false; first.lcp.size];
+    for &i in &first.active_set {
+        if let Some(a) = active.get_mut(i) {
+            *a = true;
+        }
+    }
+    // Instant j of this grid takes the sets of instant ⌊j·k_first/k⌋ of the first.
+    let carried: Vec<usize> = (0..k * m).filter(|&i| active.get((i / m) * k_first / k * m + i % m) == Some(&true)).collect();
+    solver.set_warm_start(&carried);
+    let (r, _) = solve_guarded(solver, *last, f);
+    *last = r.as_ref().ok().map(|_| f);
+    r
+}
+
+/// Whether a sweep guards this problem's points ([`solve_guarded`]): `auto` on an LCP above
+/// `LEMKE_AFTER_SHOOTING_MAX`, where the dense fallback costs minutes.
+fn guarded(problem: &PeriodicProblem) -> bool {
+    problem.solver_settings().method == LcpMethod::Auto && problem.instants() * problem.model().contacts.len() > LEMKE_AFTER_SHOOTING_MAX
+}
+
 /// A warm-started answer whose amplitude differs from the last point's (an orbit in contact) by
 /// more than this (relative) is checked by continuing the last orbit to the new frequency: the
 /// active-set warm start alone can land on a coexisting orbit (the coarse blade's contact branch,
@@ -234,8 +337,10 @@ fn follow_from(solver: &mut PeriodicSolver, base: &PeriodicProblem, f0: f64, bef
     continuation::resolve(solver, base, disc, Tuning { frequency: f, ..tuning }, Some(current)).map(|r| r.response)
 }
 
-/// linear), max force and contact fraction per contact, LCP size, pivots, warm start, fallback,
-/// time and status. A column with a unit names it after its key, `amplitude_1903 [mm]`, in the
+/// The CSV of a sweep: the parameter, amplitude per displacement output (nonlinear, then
+/// linear), max force and contact fraction per contact, LCP size, pivots (shooting: Newton
+/// iterations), warm start, fallback, the solver's methods ([`solver_label`]), the ω sub-steps,
+/// time (the point's, its estimate included) and status. A column with a unit names it after its key, `amplitude_1903 [mm]`, in the
 /// scene's units (`labels`); the key before " [" is stable.
 pub fn to_csv(param: &str, values: &[f64], problem: &PeriodicProblem, points: &[SweepPoint], labels: &Labels) -> String {
     let mut s = String::new();
@@ -249,7 +354,7 @@ pub fn to_csv(param: &str, values: &[f64], problem: &PeriodicProblem, points: &[
     let contact_dofs = contact_labels(problem);
     head.extend(contact_dofs.iter().enumerate().map(|(i, d)| format!("max_force_c{i}_dof{d} {kn}")));
     head.extend(contact_dofs.iter().enumerate().map(|(i, d)| format!("contact_fraction_c{i}_dof{d}")));
-    head.extend(["lcp_size", "pivots", "warm_start_used", "cold_fallback", "time_s", "status"].map(String::from));
+    head.extend(["lcp_size", "pivots", "warm_start_used", "cold_fallback", "solver", "substeps", "time_s", "status"].map(String::from));
     let estimated = points.iter().any(|p| !p.estimate_method.is_empty());
     if estimated {
         head.push("error_estimate_relative".into());
@@ -272,6 +377,8 @@ pub fn to_csv(param: &str, values: &[f64], problem: &PeriodicProblem, points: &[
         row.push(p.pivots.to_string());
         row.push(u8::from(p.warm_start_used).to_string());
         row.push(u8::from(p.cold_fallback).to_string());
+        row.push(solver_label(&p.lcp_path));
+        row.push(p.substeps.to_string());
         row.push(format!("{:.6}", p.time_s));
         row.push(match &p.error {
             None => "solved".to_string(),
@@ -284,6 +391,21 @@ pub fn to_csv(param: &str, values: &[f64], problem: &PeriodicProblem, points: &[
         s.push('\n');
     }
     s
+}
+
+/// The methods of an LCP path (`render_path`'s line) in one CSV cell: "shooting",
+/// "shooting>pivoting>lemke", "lemke"; "none" without an LCP.
+pub fn solver_label(path: &str) -> String {
+    let Some((_, steps)) = path.split_once("): ") else { return "none".to_string() };
+    let names: Vec<&str> = steps
+        .split("; fallback: ")
+        .map(|step| match step {
+            s if s.starts_with("shooting") => "shooting",
+            s if s.starts_with("block pivoting") => "pivoting",
+            _ => "lemke",
+        })
+        .collect();
+    names.join(">")
 }
 
 /// The user's DOF that labels each contact (its normal's largest |coefficient|).

@@ -79,6 +79,9 @@ pub(crate) fn sibling(path: &Path, suffix: &str, ext: &str) -> PathBuf {
     path.with_file_name(format!("{stem}{suffix}.{ext}"))
 }
 
+/// A point slower than this [s] gets its own line above the progress bar.
+const SLOW_POINT_S: f64 = 2.0;
+
 pub fn run(a: &Args) -> Result<(), Failure> {
     if a.points == 0 {
         return Err(Failure::input("--points: is 0, a sweep needs at least one point"));
@@ -144,10 +147,24 @@ pub fn run(a: &Args) -> Result<(), Failure> {
     let settings = SweepSettings { warm_start: !a.cold, threads: a.threads, chunks_per_thread: a.chunks_per_thread, estimate: a.estimate };
     let bar = if a.quiet { ProgressBar::hidden() } else { ProgressBar::new(a.points as u64) };
     bar.set_style(
-        ProgressStyle::with_template("{spinner} sweep [{bar:40}] {pos}/{len} points, {elapsed_precise} elapsed, ETA {eta}").unwrap().progress_chars("=> "),
+        ProgressStyle::with_template("{spinner} sweep [{bar:40}] {pos}/{len} points, {elapsed_precise} elapsed, ETA {eta} {msg}")
+            .unwrap()
+            .progress_chars("=> "),
     );
     let t = Instant::now();
-    let points = sweep::run(problem, &freqs, &settings, &|| bar.inc(1)).map_err(Failure::from)?;
+    // Each point's time and solver on the bar; a slow, sub-stepped or failed one on its own line
+    // (not with --quiet), so that a sweep that stalls shows where.
+    let on_point = |p: &sweep::SweepPoint| {
+        let what = format!("ω = {}: {:.2} s, {}, {} iterations", p.frequency, p.time_s, sweep::solver_label(&p.lcp_path), p.pivots);
+        if !a.quiet && (p.time_s > SLOW_POINT_S || p.substeps > 0 || p.error.is_some()) {
+            let status = p.error.as_deref().map_or_else(|| format!("{} ω sub-steps", p.substeps), |e| format!("failed: {e}"));
+            // Printed even where the bar is hidden (stderr not a terminal, a log file).
+            bar.suspend(|| eprintln!("  point {what}; {status}"));
+        }
+        bar.set_message(format!("(last {what})"));
+        bar.inc(1);
+    };
+    let points = sweep::run(problem, &freqs, &settings, &on_point).map_err(Failure::from)?;
     let wall = t.elapsed().as_secs_f64();
     bar.finish_and_clear();
 

@@ -30,12 +30,15 @@ pub fn product(a: &Mat<f64>, b: &Mat<f64>) -> Mat<f64> {
         faer::linalg::matmul::matmul(c.as_mut(), faer::Accum::Replace, a.as_ref(), b.as_ref(), 1.0, faer::Par::Seq);
         return c;
     }
+    // Column slices (no per-element bounds checks) let the compiler vectorise the axpy; the
+    // operations and their order are those of the indexed loop, so the result is bit-identical.
     for j in 0..m {
+        let cj = c.col_as_slice_mut(j);
         for l in 0..inner {
             let blj = b[(l, j)];
             if blj != 0.0 {
-                for i in 0..n {
-                    c[(i, j)] += a[(i, l)] * blj;
+                for (ci, &ail) in cj.iter_mut().zip(a.col_as_slice(l)) {
+                    *ci += ail * blj;
                 }
             }
         }
@@ -133,7 +136,7 @@ pub(super) fn period_jacobian(sm: &StepMapLcp, masks: &[u64], powers: &PhiPowers
     // squaring rounds differently, and the discrete walk's kink tests on NLvib 03 at k = 4096
     // (tests/continuation.rs, nlvib03_branch_events_amplitudes_stability) lose the branch with it.
     if sm.d <= STEPWISE_MAX_D {
-        *j = period_jacobian_by_steps(sm, masks);
+        *j = by_steps(sm, masks, powers);
         return masks.len();
     }
     let d = sm.d;
@@ -150,17 +153,28 @@ pub(super) fn period_jacobian(sm: &StepMapLcp, masks: &[u64], powers: &PhiPowers
     formed
 }
 
-/// Up to this state size the period Jacobian is formed step by step.
-const STEPWISE_MAX_D: usize = 64;
+/// Up to this state size the period Jacobian is formed step by step: NLvib 03's small state
+/// keeps it (see above). Not above: at 64 the k products made the rigid coarse blade's (d = 46)
+/// 100-point sweep 6× costlier (9.4 s of CPU against 1.4 s by runs, issue 23).
+const STEPWISE_MAX_D: usize = 16;
 
 /// The same Jacobian step by step (k products): the reference of the runs' product.
+#[cfg(test)]
 pub(super) fn period_jacobian_by_steps(sm: &StepMapLcp, masks: &[u64]) -> Mat<f64> {
+    by_steps(sm, masks, &PhiPowers::new(sm))
+}
+
+fn by_steps(sm: &StepMapLcp, masks: &[u64], powers: &PhiPowers) -> Mat<f64> {
     let d = sm.d;
-    let powers = PhiPowers::new(sm);
     let mut acc = Mat::<f64>::identity(d + 1, d + 1);
+    // A run of steps with one set shares its T_a: formed once per run (the same numbers).
+    let mut run: Option<(u64, Mat<f64>)> = None;
     for &mask in masks {
-        let t = if mask == 0 { powers.0[0].clone() } else { step_matrix(sm, &powers, mask) };
-        acc = product(&t, &acc);
+        if run.as_ref().is_none_or(|(m, _)| *m != mask) {
+            run = Some((mask, if mask == 0 { powers.0[0].clone() } else { step_matrix(sm, powers, mask) }));
+        }
+        let (_, t) = run.as_ref().expect("set above");
+        acc = product(t, &acc);
     }
     acc.as_ref().submatrix(0, 0, d, d + 1).to_owned()
 }
@@ -180,7 +194,7 @@ mod tests {
             seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
             (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
         };
-        for (d, m, k) in [(7, 3, 300), (120, 5, 1000)] {
+        for (d, m, k) in [(7, 3, 300), (40, 6, 1000), (120, 5, 1000)] {
             // Φ near the identity (a damped step) with a carry on its diagonal, as the schemes'.
             let phi: Vec<f64> = (0..d * d).map(|e| if e / d == e % d { -0.002 } else { 0.02 / d as f64 } * (1.0 + draw())).collect();
             let h: Vec<f64> = (0..m * d).map(|_| draw()).collect();

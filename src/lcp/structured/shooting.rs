@@ -279,17 +279,18 @@ fn shoot(nt: &mut Newton<'_>, warm: Option<&[u64]>) -> ShootingSolution {
         work: nt.work,
         work_per_iteration: nt.march_work + nt.jacobian_work,
     };
-    // The contact-free orbit: the fixed point of the affine map without contact.
-    let Some(free) = fixed_point(nt, Contacts::Free) else {
-        return fail(nt, ShootingOutcome::Breakdown, None, 0);
-    };
-    // 1. Newton from the warm sets' orbit, then from the contact-free orbit.
+    // 1. Newton from the warm sets' orbit, then from the contact-free orbit (formed only when
+    // the warm start fails: its Jacobian costs as much as a Newton iteration).
     if let Some(sets) = warm.filter(|w| w.len() == k)
         && let Some((s, _)) = fixed_point(nt, Contacts::Frozen(sets))
         && let Ok(it) = nt.solve(s, 0.0, sets, settings.max_iterations)
     {
         return done(nt, it, 0, "warm");
     }
+    // The contact-free orbit: the fixed point of the affine map without contact.
+    let Some(free) = fixed_point(nt, Contacts::Free) else {
+        return fail(nt, ShootingOutcome::Breakdown, None, 0);
+    };
     let (s_free, free_march) = free;
     if free_march.min_w >= 0.0 {
         // No pair is active on the contact-free orbit: it is the answer.
