@@ -151,4 +151,3 @@ pub(super) fn march_massless(model: &Model, settings: &MarchSettings, massless: 
     }
     Ok(rec.finish(omega_max, start))
 }
-
