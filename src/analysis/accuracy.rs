@@ -92,26 +92,26 @@ pub fn estimate(problem: &PeriodicProblem, r: &Response) -> Accuracy {
         // period map then starts on the right pieces, where a cold start's offset homotopy
         // fails on stiff blades (the fine blade's 2k solve fell back to minutes of dense Lemke).
         let mut session = PeriodicSolver::new(second.clone());
-        session.set_warm_start(&resampled_active_set(&r.active_set, r.lcp.size / instants.max(1), instants, second.instants()));
+        session.set_warm_start(&carried_active_set(&r.active_set, r.lcp.size / instants.max(1), instants, second.instants()));
         session.solve()
     })
 }
 
-/// An active set (indices j·m + c of instant j, row c) of a grid of `from` instants, on a grid of
-/// `to` = 2·from or from/2 instants over the same period: instant j of k is instants 2j and
-/// 2j + 1 of 2k; instant j of k/2 is instant 2j of k.
-fn resampled_active_set(active: &[usize], rows: usize, from: usize, to: usize) -> Vec<usize> {
-    if rows == 0 {
+/// An active set (indices j·m + c of instant j, row c of `rows`) of a grid of `from` instants,
+/// carried to a grid of `to` instants over the same period: instant j of the new grid takes the
+/// set of instant ⌊j·from/to⌋ (k → 2k: instants 2j and 2j + 1 take j; k → k/2: j takes 2j).
+/// A warm start for the same orbit sampled at other instants (the estimate, a sweep's k/2 grid).
+pub(crate) fn carried_active_set(active: &[usize], rows: usize, from: usize, to: usize) -> Vec<usize> {
+    if rows == 0 || from == 0 {
         return Vec::new();
     }
-    let split = |i: usize| (i / rows, i % rows);
-    if to == 2 * from {
-        active.iter().map(|&i| split(i)).flat_map(|(j, c)| [(2 * j) * rows + c, (2 * j + 1) * rows + c]).collect()
-    } else if 2 * to == from {
-        active.iter().map(|&i| split(i)).filter(|(j, _)| j % 2 == 0).map(|(j, c)| (j / 2) * rows + c).collect()
-    } else {
-        Vec::new()
+    let mut on = vec![false; from * rows];
+    for &i in active {
+        if let Some(a) = on.get_mut(i) {
+            *a = true;
+        }
     }
+    (0..to * rows).filter(|&i| on[(i / rows) * from / to * rows + i % rows]).collect()
 }
 
 /// [`estimate`] with the second solve made by `solve_second` (given the problem at k/2 or 2k):
@@ -171,16 +171,15 @@ fn short(e: &SolveError) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::resampled_active_set;
+    use super::carried_active_set;
 
     #[test]
     fn an_active_set_moves_to_the_doubled_and_the_halved_grid() {
         // 2 rows, 4 instants: row 1 active at instants 1 and 2, row 0 at instant 3.
         let active = [3, 5, 6];
-        assert_eq!(resampled_active_set(&active, 2, 4, 8), vec![5, 7, 9, 11, 12, 14]);
+        assert_eq!(carried_active_set(&active, 2, 4, 8), vec![5, 7, 9, 11, 12, 14]);
         // Halved: only the even instants survive (instant 2 → 1).
-        assert_eq!(resampled_active_set(&active, 2, 4, 2), vec![3]);
-        assert!(resampled_active_set(&active, 2, 4, 3).is_empty());
-        assert!(resampled_active_set(&active, 0, 4, 8).is_empty());
+        assert_eq!(carried_active_set(&active, 2, 4, 2), vec![3]);
+        assert!(carried_active_set(&active, 0, 4, 8).is_empty());
     }
 }

@@ -296,15 +296,8 @@ fn second_solve(session: &mut Option<(PeriodicSolver, Option<f64>)>, problem: &P
         return solver.solve();
     }
     let m = problem.model().contacts.len();
-    let (k_first, k) = (first.lcp.size / m.max(1), solver.problem().instants());
-    let mut active = vec![false; first.lcp.size];
-    for &i in &first.active_set {
-        if let Some(a) = active.get_mut(i) {
-            *a = true;
-        }
-    }
-    // Instant j of this grid takes the sets of instant ⌊j·k_first/k⌋ of the first.
-    let carried: Vec<usize> = (0..k * m).filter(|&i| active.get((i / m) * k_first / k * m + i % m) == Some(&true)).collect();
+    let k_first = first.lcp.size / m.max(1);
+    let carried = accuracy::carried_active_set(&first.active_set, m, k_first, solver.problem().instants());
     solver.set_warm_start(&carried);
     let (r, _) = solve_guarded(solver, *last, f);
     *last = r.as_ref().ok().map(|_| f);
