@@ -25,7 +25,6 @@ fn c_api_reads_friction_contacts_and_scales_their_normal_load() {
         let p = pc_problem_from_scene_file(path.as_ptr());
         assert!(!p.is_null());
         assert_eq!(pc_problem_friction_count(p), 1);
-        assert_eq!(pc_problem_set_error_estimate(p, 0), PC_OK);
         for bad in [-0.5, f64::NAN, f64::INFINITY] {
             assert_eq!(pc_problem_set_normal_force_scale(p, bad), PC_ERROR_ARGUMENT, "scale {bad}");
         }
@@ -93,37 +92,39 @@ fn linear_amplitude(k: f64, omega: f64) -> f64 {
 
 #[test]
 fn normal_load_continuation_against_the_event_driven_simulation() {
-    // Ω = 1 (the free resonance): from free sliding (N = 0) to stuck (N = 8, μN = 2 above the
-    // stuck spring force k_t·X ≈ 1), at k = 128 and 256.
-    let (omega, mu) = (1.0, 0.25);
-    let text = |k: usize| DAMPER.replacen("frequency = 0.8", &format!("frequency = {omega}"), 1).replacen("steps = 256", &format!("steps = {k}"), 1);
+    // The shipped damper (Ω = 0.8) from free sliding (N = 0) to stuck (N = 8: μN = 2, above the
+    // stuck spring force), at k = 128 and 256. Exact: the linear oscillator at N = 0 and, from
+    // N = 5 on, with k + k_t (stuck for good: the simulation sticks from N ≈ 4.25); the event-driven
+    // simulation in between.
+    let (omega, mu) = (0.8, 0.25);
     let settings = ContinuationSettings { max_step: 1.0 / 8.0, ..ContinuationSettings::default() };
     let branch = |k: usize| {
-        let problem = Scene::parse(&text(k), "d.toml").unwrap().to_problem("d.toml").unwrap();
+        let text = DAMPER.replacen("steps = 256", &format!("steps = {k}"), 1);
+        let problem = Scene::parse(&text, "d.toml").unwrap().to_problem("d.toml").unwrap();
         let b = continuation::run(&problem, Parameter::NormalForce, 0.0, 8.0, &settings, &|_| {}).expect("branch");
         assert!(b.reached(), "{}", b.stop);
         b
     };
     let (coarse, fine) = (branch(128), branch(256));
-    assert_eq!(coarse.points.len(), 9);
+    let grid = |b: &continuation::Branch| b.points.iter().filter(|p| p.detail.is_empty()).map(|p| (p.parameter, p.amplitude[0])).collect::<Vec<_>>();
+    let (coarse, fine) = (grid(&coarse), grid(&fine));
+    assert_eq!(coarse.len(), 9);
     let stuck = linear_amplitude(3.0, omega);
-    for (a, b) in coarse.points.iter().zip(&fine.points) {
-        let n = a.parameter;
-        assert_eq!(n, b.parameter);
+    for (&(n, a), &(n2, b)) in coarse.iter().zip(&fine) {
+        assert_eq!(n, n2);
         let exact = match n {
             0.0 => linear_amplitude(1.0, omega),
             n if n >= 5.0 => stuck,
             n => FrictionOrbit::solve(&damper(omega, mu * n), 2000, 1e-11, 5000).expect("orbit").amplitude(0, 4000),
         };
-        let (e1, e2) = ((a.amplitude[0] - exact).abs() / exact, (b.amplitude[0] - exact).abs() / exact);
-        let extrapolated = (2.0 * b.amplitude[0] - a.amplitude[0] - exact).abs() / exact;
+        let (e1, e2) = ((a - exact).abs() / exact, (b - exact).abs() / exact);
+        let extrapolated = (2.0 * b - a - exact).abs() / exact;
         println!("N = {n}: exact amplitude {exact:.6}, errors {e1:.3e} (k = 128), {e2:.3e} (k = 256), extrapolated {extrapolated:.3e}");
-        assert!(e2 < 2.5e-2 && e2 < 0.75 * e1 + 1e-4, "N = {n}: errors {e1:.3e} → {e2:.3e}");
-        assert!(extrapolated < 5e-3, "N = {n}: extrapolated {extrapolated:.3e}");
-        assert!(a.stable && a.multipliers.is_empty());
+        assert!(e2 < 0.75 * e1 + 1e-4, "N = {n}: errors {e1:.3e} → {e2:.3e}: not converging");
+        assert!(e2 < 4e-2 && extrapolated < 1e-2, "N = {n}: errors {e2:.3e}, extrapolated {extrapolated:.3e}");
     }
-    // Free to stuck: the amplitude falls from the free resonance to the stuck plateau.
-    assert!(fine.points[0].amplitude[0] > 10.0 * stuck);
+    // Free to stuck: the amplitude falls from the free one to the stuck plateau.
+    assert!(fine[0].1 > 5.0 * stuck && (fine[8].1 - stuck).abs() < 2e-2 * stuck);
     // A scene without [[friction]] has no normal load to continue: refused by name.
     let plain = "[structure]\nmass = [[1.0]]\nstiffness = [[1.0]]\n[excitation]\nfrequency = 1.0\n[[force]]\ndof = 0\namplitude = 1.0\n[discretization]\nscheme = \"bds1\"\nsteps = 64\n";
     let p = Scene::parse(plain, "p.toml").unwrap().to_problem("p.toml").unwrap();
