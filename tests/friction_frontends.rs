@@ -94,7 +94,7 @@ fn linear_amplitude(k: f64, omega: f64) -> f64 {
 fn normal_load_continuation_against_the_event_driven_simulation() {
     // The shipped damper (Ω = 0.8) from free sliding (N = 0) to stuck (N = 8: μN = 2, above the
     // stuck spring force), at k = 128 and 256. Exact: the linear oscillator at N = 0 and, from
-    // N = 5 on, with k + k_t (stuck for good: the simulation sticks from N ≈ 4.25); the event-driven
+    // N = 5 on, with k + k_t (stuck for good: the simulation's amplitude is the plateau's from N = 4 on); the event-driven
     // simulation in between.
     let (omega, mu) = (0.8, 0.25);
     let settings = ContinuationSettings { max_step: 1.0 / 8.0, ..ContinuationSettings::default() };
