@@ -62,6 +62,10 @@ static int print_result(const char *prefix, const pc_result *r) {
         snprintf(key, sizeof key, "%s.force%zu", prefix, i);
         if (print_series(key, r, i, pc_result_contact_force)) return 1;
     }
+    for (size_t i = 0; i < pc_result_friction_count(r); i++) {
+        snprintf(key, sizeof key, "%s.friction_force%zu", prefix, i);
+        if (print_series(key, r, i, pc_result_friction_force)) return 1;
+    }
     for (size_t i = 0; i < pc_result_warning_count(r); i++)
         fprintf(stderr, "%s warning: %s\n", prefix, pc_result_warning(r, i));
     return 0;

@@ -186,6 +186,23 @@ int pc_result_state_at(const pc_result *r, size_t dof, double t, double *displac
  * samples are impulse per step / h). Outputs may be NULL. */
 int pc_result_contact_at(const pc_result *r, size_t i, double t, double *force, double *gap,
                          int *exact);
+/* Friction contacts ([[friction]], the JSON's friction entries), in scene order. The force f
+ * acts on the structure as -f along the sliding direction: |f| <= mu*N, f = mu*N*sign(v) while
+ * slipping. pc_problem_friction_count: 0 without friction or for NULL. normal_force_scale
+ * multiplies every friction contact's normal load N at the next solve (finite, >= 0; 1: the
+ * scene's loads). Series at the k instants, PC_ERROR_ARGUMENT when i is out of range or the
+ * buffer is NULL or shorter than k: force, slip velocity v (bds1's backward difference; a
+ * Jenkins element's slider velocity; 0 while stuck), tangential displacement u (the loop's
+ * abscissa), stuck flags (1: |f| < mu*N). pc_result_friction: the energy dissipated per period
+ * (force unit x length unit, >= 0) and the slip force mu*N; outputs may be NULL. */
+size_t pc_problem_friction_count(const pc_problem *p);
+int pc_problem_set_normal_force_scale(pc_problem *p, double scale);
+size_t pc_result_friction_count(const pc_result *r);
+int pc_result_friction_force(const pc_result *r, size_t i, double *out, size_t len);
+int pc_result_friction_slip_velocity(const pc_result *r, size_t i, double *out, size_t len);
+int pc_result_friction_displacement(const pc_result *r, size_t i, double *out, size_t len);
+int pc_result_friction_stuck(const pc_result *r, size_t i, int *out, size_t len);
+int pc_result_friction(const pc_result *r, size_t i, double *dissipated_energy, double *slip_force);
 size_t pc_result_warning_count(const pc_result *r);
 /* Warning i, owned by the result (valid until pc_result_free); NULL when out of range. */
 const char *pc_result_warning(const pc_result *r, size_t i);

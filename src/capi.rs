@@ -21,6 +21,8 @@ use crate::time::{Discretization, Pairing, Scheme};
 mod branch;
 pub use branch::{pc_problem_set_stability, pc_result_jump, pc_result_stability};
 mod estimate;
+mod friction;
+pub use friction::*;
 mod inspect;
 mod polish;
 

@@ -331,7 +331,15 @@ struct CApi {
     result_free: unsafe extern "C" fn(P),
 }
 
-const C_API_FUNCTIONS: [&str; 52] = [
+const C_API_FUNCTIONS: [&str; 60] = [
+    "pc_problem_friction_count",
+    "pc_problem_set_normal_force_scale",
+    "pc_result_friction_count",
+    "pc_result_friction_force",
+    "pc_result_friction_slip_velocity",
+    "pc_result_friction_displacement",
+    "pc_result_friction_stuck",
+    "pc_result_friction",
     "pc_version",
     "pc_problem_set_polish",
     "pc_result_polish",

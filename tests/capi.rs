@@ -146,7 +146,7 @@ fn the_c_example_links_solves_and_prints_what_the_rust_api_computes() {
     assert!(out["scene.accuracy_method"][0].starts_with("richardson"), "{:?}", out["scene.accuracy_method"]);
 
     // 2. frequency × 1.05 and force scale 2.
-    let tuning = Tuning { frequency: 1.05 * 1.7, force_scale: 2.0, gap_offset: 0.0, motion_scale: 1.0 };
+    let tuning = Tuning { frequency: 1.05 * 1.7, force_scale: 2.0, gap_offset: 0.0, motion_scale: 1.0, normal_force_scale: 1.0 };
     let r2 = tuning.apply(&p, p.discretization()).unwrap().solve().unwrap();
     assert_eq!(numbers(&out, "tuned.period")[0], r2.period);
     assert_close(&numbers(&out, "tuned.x"), &r2.displacement["0"], "tuned.x");

@@ -40,6 +40,8 @@ mod fmu_description;
 mod fmu_host;
 #[path = "friction.rs"]
 mod friction;
+#[path = "friction_frontends.rs"]
+mod friction_frontends;
 #[path = "frontends.rs"]
 mod frontends;
 #[path = "hard_cases.rs"]

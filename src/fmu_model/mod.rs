@@ -83,6 +83,7 @@ impl Values {
             force_scale: p.force_scale * i.force_scale,
             gap_offset: p.gap_offset + i.gap_offset,
             motion_scale: p.motion_scale * i.motion_scale,
+            normal_force_scale: p.normal_force_scale * i.normal_force_scale,
         };
         Config { tuning, steps: self.steps, scheme: self.scheme, polish: self.polish }
     }
@@ -173,7 +174,7 @@ impl ContactModel {
             max_output_derivative_order: 1,
         };
         let scene_tuning = Tuning::of(&problem);
-        let neutral = Tuning { frequency: 0.0, force_scale: 1.0, gap_offset: 0.0, motion_scale: 1.0 };
+        let neutral = Tuning { frequency: 0.0, force_scale: 1.0, gap_offset: 0.0, motion_scale: 1.0, normal_force_scale: 1.0 };
         let polish = built.polish && !model.contacts.is_empty();
         let start = Values { params: scene_tuning, inputs: neutral, steps: k, scheme: problem.discretization().scheme, polish };
         let nout = outputs.len();
@@ -277,6 +278,10 @@ impl ContactModel {
                 Output::AccuracyAvailable => Series::Constant(f64::from(u8::from(r.accuracy.estimate.is_some()))),
                 // Set by `solve`, which knows the stability and the jumps.
                 Output::Stable | Output::Multiplier | Output::Jumps => Series::Constant(0.0),
+                Output::FrictionForce(i) => Series::Linear(r.friction[i].force.clone()),
+                Output::FrictionSlipVelocity(i) => Series::Linear(r.friction[i].slip_velocity.clone()),
+                // 0/1 samples; `evaluate` rounds to the nearest instant's flag.
+                Output::FrictionStuck(i) => Series::Linear(r.friction[i].stuck.iter().map(|s| f64::from(u8::from(*s))).collect()),
                 Output::PolishStatus => Series::Constant(match r.polish.as_ref().map(|p| p.status.as_str()) {
                     None => 0.0,
                     Some("polished") => 1.0,
@@ -325,8 +330,11 @@ impl ContactModel {
         }
         for (i, series) in sol.series.iter().enumerate() {
             let (v, d) = series.eval(j, j1, s, sol.h, sol.omega, &self.powers);
-            self.out[i] = v;
-            self.der[i] = d;
+            (self.out[i], self.der[i]) = match self.outputs[i] {
+                // A flag: the nearest instant's (a tie goes to slip).
+                Output::FrictionStuck(_) => (f64::from(u8::from(v > 0.5)), 0.0),
+                _ => (v, d),
+            };
         }
         if let Some(orbit) = &sol.polished {
             sol.eval_polished(orbit, &self.outputs, self.base.output_map(), tau, &mut self.out, &mut self.der);
@@ -401,6 +409,8 @@ impl CoSimModel for ContactModel {
             Role::ForceScale => p.force_scale = v,
             Role::GapOffset => p.gap_offset = v,
             Role::MotionScale => p.motion_scale = v,
+            Role::NormalForceScale if v >= 0.0 => p.normal_force_scale = v,
+            Role::NormalForceScale => return Err(Error::input(format!("normal_force_scale = {v}: must be >= 0 (a tensile normal load cannot hold friction)"))),
             Role::ForceScaleIn => i.force_scale = v,
             Role::GapOffsetIn => i.gap_offset = v,
             Role::MotionScaleIn => i.motion_scale = v,
@@ -427,6 +437,7 @@ impl CoSimModel for ContactModel {
             Role::ForceScale => p.force_scale,
             Role::GapOffset => p.gap_offset,
             Role::MotionScale => p.motion_scale,
+            Role::NormalForceScale => p.normal_force_scale,
             Role::FrequencyIn => i.frequency,
             Role::ForceScaleIn => i.force_scale,
             Role::GapOffsetIn => i.gap_offset,

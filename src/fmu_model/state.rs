@@ -12,7 +12,7 @@ use num_complex::Complex64 as C;
 use std::sync::Arc;
 
 /// Raise when [`write`] changes (older states are then refused by name).
-pub const STATE_VERSION: u16 = 2;
+pub const STATE_VERSION: u16 = 3;
 
 /// What `fmi2GetFMUstate` keeps of a [`ContactModel`].
 #[derive(Clone, Debug, PartialEq)]
@@ -31,11 +31,11 @@ fn bad(message: impl std::fmt::Display) -> Error {
 }
 
 fn write_tuning(w: &mut StateWriter, t: &Tuning) {
-    [t.frequency, t.force_scale, t.gap_offset, t.motion_scale].iter().for_each(|v| w.f64(*v));
+    [t.frequency, t.force_scale, t.gap_offset, t.motion_scale, t.normal_force_scale].iter().for_each(|v| w.f64(*v));
 }
 
 fn read_tuning(r: &mut StateReader<'_>) -> Result<Tuning> {
-    Ok(Tuning { frequency: r.f64()?, force_scale: r.f64()?, gap_offset: r.f64()?, motion_scale: r.f64()? })
+    Ok(Tuning { frequency: r.f64()?, force_scale: r.f64()?, gap_offset: r.f64()?, motion_scale: r.f64()?, normal_force_scale: r.f64()? })
 }
 
 fn write_config(w: &mut StateWriter, steps: usize, scheme: Scheme, polish: bool) {

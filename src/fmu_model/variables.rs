@@ -19,6 +19,8 @@ pub(super) enum Role {
     ForceScale,
     GapOffset,
     MotionScale,
+    /// Multiplies every friction contact's normal load.
+    NormalForceScale,
     Steps,
     Scheme,
     /// The event-fitted polish on (Boolean).
@@ -52,6 +54,10 @@ pub(super) enum Output {
     Jumps,
     /// 0 polish off, 1 polished, 2 fell back to the interpolated samples.
     PolishStatus,
+    /// Friction contact i: its force f, slip velocity v, and whether it sticks (Boolean).
+    FrictionForce(usize),
+    FrictionSlipVelocity(usize),
+    FrictionStuck(usize),
 }
 
 /// The table with the role of each value reference and the quantity of each output slot.
@@ -147,6 +153,11 @@ fn parameters(b: &mut Variables, problem: &PeriodicProblem, labels: &Labels, pro
         let kind = b.real(Some(1.0), Quantity::Ratio, labels);
         b.add(Variable::parameter("motion_scale", Tunable, kind, "Multiplies every obstacle-motion amplitude"), Role::MotionScale);
     }
+    if !model.frictions.is_empty() {
+        let kind = b.real(Some(1.0), Quantity::Ratio, labels);
+        let text = "Multiplies every friction contact's normal load N, so its slip force mu*N (1 = the scene's loads; >= 0)";
+        b.add(Variable::parameter("normal_force_scale", Tunable, kind, text), Role::NormalForceScale);
+    }
     let k = problem.discretization().steps;
     b.add(
         Variable::parameter("steps", Fixed, Kind::Integer { start: Some(k as i32), min: Some(MIN_STEPS as i32), max: None }, "Number of instants k per period"),
@@ -220,6 +231,7 @@ fn outputs(b: &mut Variables, problem: &PeriodicProblem, labels: &Labels) {
             b.output(Variable::output(&format!("contact[{i}].gap"), Continuous, kind, &gap), Output::Gap(i));
         }
     }
+    friction_outputs(b, problem, labels, &name);
     // Only with contacts: without them no LCP is solved (the scene's effects, nothing more).
     if !model.contacts.is_empty() {
         b.output(Variable::output("lcp.pivots", Discrete, Kind::Integer { start: None, min: None, max: None }, "Pivots of the last LCP solve"), Output::Pivots);
@@ -231,6 +243,35 @@ fn outputs(b: &mut Variables, problem: &PeriodicProblem, labels: &Labels) {
         let kind = Kind::Integer { start: None, min: None, max: None };
         let what = "Event-fitted polish of the last solve: 0 off (parameter polish = false), 1 polished (outputs exact between the instants), 2 fell back to the interpolated samples (the reason is logged as a warning)";
         b.output(Variable::output("polish.status", Discrete, kind, what), Output::PolishStatus);
+    }
+}
+
+/// Force, slip velocity and stuck flag of each `[[friction]]` (none without).
+fn friction_outputs(b: &mut Variables, problem: &PeriodicProblem, labels: &Labels, name: &dyn Fn(usize) -> String) {
+    for (i, f) in problem.model().frictions.iter().enumerate() {
+        let on = match f.row.as_slice() {
+            [(d, _)] if problem.output_map().is_none() => name(*d),
+            // A clamped scene numbers the model's DOFs apart from the user's.
+            [(d, _)] => format!("model DOF {d}"),
+            _ => "its sliding direction".to_string(),
+        };
+        let (force, length) = (labels.units.force(), labels.units.length());
+        let element = match f.stiffness {
+            Some(kt) => format!("a Jenkins element (tangential stiffness {kt} {force}/{length})"),
+            None => "rigid Coulomb friction".to_string(),
+        };
+        let slip = format!("{} {force}", f.slip_force());
+        let kind = b.real(None, Quantity::Force, labels);
+        let what = format!(
+            "Friction force of friction contact {i} on {on}, {element}: acts on the structure as minus the force along the sliding direction; |force| <= mu*N ({slip} times normal_force_scale), = mu*N*sign(slip_velocity) while slipping"
+        );
+        b.output(Variable::output(&format!("friction[{i}].force"), Continuous, kind, &what), Output::FrictionForce(i));
+        let kind = b.real(None, Quantity::Velocity, labels);
+        let what =
+            format!("Slip velocity of friction contact {i} (bds1's backward difference at the instants; a Jenkins element's slider velocity); 0 while stuck");
+        b.output(Variable::output(&format!("friction[{i}].slip_velocity"), Continuous, kind, &what), Output::FrictionSlipVelocity(i));
+        let what = format!("true while friction contact {i} sticks (|force| < mu*N): the flag of the nearest instant");
+        b.output(Variable::output(&format!("friction[{i}].stuck"), Discrete, Kind::Boolean { start: None }, &what), Output::FrictionStuck(i));
     }
 }
 

@@ -18,6 +18,7 @@ mod exact;
 mod exact_follow;
 mod floquet;
 mod follow;
+mod friction;
 pub mod output;
 mod parameter;
 mod switch;
@@ -158,6 +159,9 @@ impl Branch {
 /// ([`BranchPoint::source`]). `on_point(λ)` after each point (a progress bar).
 pub fn run(problem: &PeriodicProblem, param: Parameter, from: f64, to: f64, settings: &ContinuationSettings, on_point: &dyn Fn(f64)) -> Result<Branch, Error> {
     check_range(from, to)?;
+    if !problem.model().frictions.is_empty() || param == Parameter::NormalForce {
+        return friction::walk(problem, param, from, to, settings, on_point);
+    }
     let walked = match exact::walk(problem, param, from, to, settings, on_point) {
         Ok(w) => w,
         Err(e) => {

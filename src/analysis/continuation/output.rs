@@ -19,7 +19,8 @@ pub fn to_csv(branches: &[Branch], problem: &PeriodicProblem, labels: &Labels) -
         let mut row = vec![format!("{:e}", p.parameter)];
         row.extend(p.amplitude.iter().map(|a| format!("{a:e}")));
         row.push(p.stable.to_string());
-        row.push(format!("{:e}", p.max_multiplier));
+        // Friction orbits have no multipliers (no step map): the cell stays empty.
+        row.push(if p.multipliers.is_empty() { String::new() } else { format!("{:e}", p.max_multiplier) });
         row.push(p.period_multiple.to_string());
         row.push(p.event.map_or(String::new(), |e| e.name().to_string()));
         row.push(p.certified.to_string());

@@ -15,6 +15,9 @@ pub enum Parameter {
     /// The casing's rotation speed Ω [rad/s]: the excitation frequency is ω = lobes·Ω (engine
     /// order; the front end reads `lobes` from the scene's casing).
     Speed { lobes: u32 },
+    /// The normal load N of every friction contact (force unit; 0: free, large: stuck): the
+    /// optimal-normal-load curve.
+    NormalForce,
 }
 
 impl Parameter {
@@ -24,8 +27,9 @@ impl Parameter {
             "frequency" => Ok(Parameter::Frequency),
             "force_scale" => Ok(Parameter::ForceScale),
             "gap_offset" => Ok(Parameter::GapOffset),
+            "normal_force" => Ok(Parameter::NormalForce),
             "speed" => Err(Error::input("--param speed: the casing's lobes are needed (ω = lobes·Ω): the scene's [casing] gives them")),
-            other => Err(Error::input(format!("--param: is \"{other}\"; continuation takes frequency, speed, force_scale or gap_offset"))),
+            other => Err(Error::input(format!("--param: is \"{other}\"; continuation takes frequency, speed, force_scale, gap_offset or normal_force"))),
         }
     }
     pub fn name(self) -> &'static str {
@@ -34,6 +38,7 @@ impl Parameter {
             Parameter::ForceScale => "force_scale",
             Parameter::GapOffset => "gap_offset",
             Parameter::Speed { .. } => "speed",
+            Parameter::NormalForce => "normal_force",
         }
     }
     /// What the parameter is, for an axis or a column, with its quantity.
@@ -44,6 +49,7 @@ impl Parameter {
             Parameter::ForceScale => ("force scale (× the scene's forces)", Quantity::Ratio),
             Parameter::GapOffset => ("gap offset (added to every clearance)", Quantity::Length),
             Parameter::Speed { .. } => ("casing speed Ω (ω = lobes·Ω)", Quantity::Frequency),
+            Parameter::NormalForce => ("normal load N of every friction contact", Quantity::Force),
         }
     }
     /// Sets the parameter of `problem` (the scene's, unchanged until now) to `value`, checked.
@@ -61,6 +67,18 @@ impl Parameter {
                 } else {
                     model.contacts.iter_mut().for_each(|c| c.gap += value);
                 }
+                *problem = problem.with_model(model, problem.discretization())?;
+                Ok(())
+            }
+            Parameter::NormalForce => {
+                let mut model = problem.model().clone();
+                if model.frictions.is_empty() {
+                    return Err(Error::input(
+                        "--param normal_force: the scene has no [[friction]] contact whose normal load could vary; add one or continue another parameter",
+                    ));
+                }
+                // Checked by the model (finite, ≥ 0) with the field named.
+                model.frictions.iter_mut().for_each(|f| f.normal_force = value);
                 *problem = problem.with_model(model, problem.discretization())?;
                 Ok(())
             }

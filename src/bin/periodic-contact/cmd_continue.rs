@@ -15,8 +15,9 @@ pub struct Args {
     /// The scene (TOML; see the README's "Scene format"): a difference scheme, not fourier.
     pub scene: PathBuf,
     /// The continued parameter: frequency (ω [rad/s]), speed (Ω [rad/s] of the casing; ω =
-    /// lobes·Ω), force_scale (× every force of the scene) or gap_offset (added to every contact's
-    /// clearance, length unit).
+    /// lobes·Ω), force_scale (× every force of the scene), gap_offset (added to every contact's
+    /// clearance, length unit) or normal_force (the normal load N of every [[friction]], force
+    /// unit, from 0: the optimal-normal-load curve; friction scenes are solved point by point).
     #[arg(long, default_value = "frequency")]
     pub param: String,
     /// Where the branch starts (the parameter's value; a cold solve there).
@@ -50,8 +51,11 @@ pub fn run(a: &Args) -> Result<(), Failure> {
     if a.param != "speed" {
         Parameter::parse(&a.param).map_err(Failure::from)?;
     }
-    if !(a.from.is_finite() && a.to.is_finite() && a.from > 0.0 && a.to > 0.0 && a.from != a.to) {
-        return Err(Failure::input(format!("--from/--to: are {} and {}, must be finite, > 0 and different", a.from, a.to)));
+    // A normal load may start at 0 (free sliding); the other parameters are > 0.
+    let least = if a.param == "normal_force" { 0.0 } else { f64::MIN_POSITIVE };
+    if !(a.from.is_finite() && a.to.is_finite() && a.from >= least && a.to >= least && a.from != a.to) {
+        let bound = if least == 0.0 { ">= 0" } else { "> 0" };
+        return Err(Failure::input(format!("--from/--to: are {} and {}, must be finite, {bound} and different", a.from, a.to)));
     }
     if let Some(s) = a.max_step.filter(|s| !(s.is_finite() && *s > 0.0)) {
         return Err(Failure::input(format!("--max-step: is {s}, must be finite and > 0")));

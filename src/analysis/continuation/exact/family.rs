@@ -71,6 +71,7 @@ impl Family {
             Parameter::Speed { lobes } => m.frequency = f64::from(lobes) * lambda,
             Parameter::ForceScale => m.forces.iter_mut().for_each(|f| f.term.amplitude *= lambda),
             Parameter::GapOffset => m.contacts.iter_mut().for_each(|c| c.gap += lambda),
+            Parameter::NormalForce => m.frictions.iter_mut().for_each(|f| f.normal_force = lambda),
         }
         m
     }
