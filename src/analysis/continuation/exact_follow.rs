@@ -153,6 +153,8 @@ fn jump(session: &mut PeriodicSolver, c: &Current<'_>, param: Parameter, at: f64
         Parameter::Frequency | Parameter::Speed { .. } => fold.frequency = at,
         Parameter::ForceScale => fold.force_scale = at,
         Parameter::GapOffset => fold.gap_offset = at,
+        // Friction has no exact orbit, so its normal load is never followed here.
+        Parameter::NormalForce => {}
     }
     let jump = Jump { fold, from_amplitude: c.amplitude, to_amplitude: amplitude(&response) };
     Ok(Resolved { response, jump: Some(jump), not_followed: None, orbit, stability, exact: None })
