@@ -289,9 +289,9 @@ mod tests {
         for cut in 0..b.len() {
             assert!(read(&m, &b[..cut]).is_err(), "a state cut at {cut} of {} bytes was accepted", b.len());
         }
-        // The scheme code (after the magic, the versions and two tunings) set to 9.
+        // The scheme code (after the magic, the versions, two tunings of 5 numbers and steps) set to 9.
         let mut bad = b.clone();
-        let at = crate::fmi::state::HEADER_LEN + 64 + 8;
+        let at = crate::fmi::state::HEADER_LEN + 2 * 5 * 8 + 8;
         bad[at..at + 4].copy_from_slice(&9i32.to_le_bytes());
         assert!(read(&m, &bad).unwrap_err().message().contains("9 is not a scheme code"));
         // A state of another model version.
