@@ -25,16 +25,16 @@ pub(super) fn walk(
     settings: &ContinuationSettings,
     on_point: &dyn Fn(f64),
 ) -> Result<Branch, Error> {
-    if !problem.model().contacts.is_empty() {
-        return Err(Error::input(
-            "continuation of a scene with both [[contact]] and [[friction]]: not yet supported (the orbit may not be unique, and friction rows have no step map to follow it); solve points with `solve`, or remove the contacts",
-        ));
-    }
     let name = param.name();
     if problem.model().frictions.is_empty() {
         return Err(Error::input(format!(
             "--param {name}: the scene has no [[friction]] contact whose normal load could vary; add one or continue another parameter"
         )));
+    }
+    if !problem.model().contacts.is_empty() {
+        return Err(Error::input(
+            "continuation of a scene with both [[contact]] and [[friction]]: not yet supported (the orbit may not be unique, and friction rows have no step map to follow it); solve points with `solve`, or remove the contacts",
+        ));
     }
     let mut solver = PeriodicSolver::new(problem.clone());
     let mut solve_at = |lambda: f64| -> Result<BranchPoint, Error> {
