@@ -126,7 +126,14 @@ pub fn solve_periodic_lcp(
     };
     match (method, step_map) {
         (LcpMethod::Shooting | LcpMethod::Auto, Some(sm)) => {
-            let (sol, state) = shooting(a, q, sm, tolerance, warm_start);
+            // Shooting may spend up to half of what its fallback would (dense Lemke: about N/2
+            // pivots of 2N² flops each), not a fixed second: on the fine blade (N = 6144) Newton
+            // converges in 189 iterations where the fixed budget handed over to 20 s of dense
+            // Lemke. Without a fallback (`shooting` alone, as guarded sweeps ask) the fixed budget
+            // bounds each try.
+            let defaults = ShootingSettings::default();
+            let max_work = if method == LcpMethod::Auto && dense_ok { defaults.max_work.max(0.5 * (q.len() as f64).powi(3)) } else { defaults.max_work };
+            let (sol, state) = shooting(a, q, sm, tolerance, warm_start, &ShootingSettings { max_work, ..defaults });
             if sol.outcome == LcpOutcome::Solved || method == LcpMethod::Shooting || !dense_ok {
                 return (sol, state);
             }
@@ -143,7 +150,14 @@ pub fn solve_periodic_lcp(
 
 /// Shooting on the step map, certified on (A, q) by FFT products (exactly summed when round-off
 /// could reach the tolerance). Steps' counts: Newton iterations.
-fn shooting(a: &BlockCirculant, q: &[f64], sm: &StepMapLcp, tolerance: f64, warm_start: Option<&[usize]>) -> (LcpSolution, Option<Vec<f64>>) {
+fn shooting(
+    a: &BlockCirculant,
+    q: &[f64],
+    sm: &StepMapLcp,
+    tolerance: f64,
+    warm_start: Option<&[usize]>,
+    settings: &ShootingSettings,
+) -> (LcpSolution, Option<Vec<f64>>) {
     let start = Instant::now();
     let m = sm.pairs();
     let warm: Option<Vec<u64>> = warm_start.map(|set| {
@@ -153,12 +167,7 @@ fn shooting(a: &BlockCirculant, q: &[f64], sm: &StepMapLcp, tolerance: f64, warm
         }
         masks
     });
-    // Shooting may spend up to half of what its fallback would (dense Lemke: about N/2 pivots of
-    // 2N² flops each), not a fixed second: on the fine blade (N = 6144) Newton converges in 189
-    // iterations where a 6e9-flop budget handed over to 20 s of dense Lemke.
-    let defaults = ShootingSettings::default();
-    let settings = ShootingSettings { max_work: defaults.max_work.max(0.5 * (q.len() as f64).powi(3)), ..defaults };
-    let shot = solve_shooting(sm, warm.as_deref(), &settings);
+    let shot = solve_shooting(sm, warm.as_deref(), settings);
     let clock = Instant::now();
     let qmax = q.iter().fold(1.0f64, |acc, v| acc.max(v.abs()));
     let cert = tolerance * qmax;
