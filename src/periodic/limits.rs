@@ -125,46 +125,55 @@ impl ContactClass {
 }
 
 /// `scheme = "auto"`: the scheme, its pairing and the first k, with the reasons. The policy
-/// (README "Scheme limits", tables of README "Accuracy" and "Which scheme and pairing converge"):
+/// (README "Scheme limits", the tables of README "Accuracy", "Which scheme and pairing converge"
+/// and "Exact-flow reference for compliant contact"):
 /// - no contact: fourier, exact for a linear response once its harmonics are below k/2;
-/// - rigid contact on a DOF with mass: galerkin with forward pairing (second order with sticking,
-///   the only second-order choice that converges to the plastic-impact orbit; cds is as accurate
-///   but its stability limit ω_max·h < 2 is 1.73× tighter than galerkin's 2√3), or bds1 with same
-///   pairing (first order, A-stable) when galerkin's stable k exceeds `max_steps`;
-/// - compliant contacts and rigid ones on massless DOFs (finite forces): galerkin with same
-///   pairing (second order, the smallest error constant measured), or bds2 (second order,
-///   A-stable) when galerkin's stable k exceeds `max_steps`. Not fourier: at the force's kink its
-///   error is not C·h^p (observed orders −0.6 … 5.7), so its own estimate reads 0.11–17× the error
-///   and cannot certify a tolerance.
+/// - the second-order time stepper: galerkin when every DOF carries mass (its stability limit
+///   ω_max·h < 2√3 is 1.73× looser than cds's 2, and its error on the compliant stop is half
+///   cds's), cds when some DOF is massless (a massless-boundary reduction: galerkin has no step
+///   map there and measured order 1.37 on the two-lobe blade, cds order 1.95 and 1e-4 at
+///   k = 2048);
+/// - rigid contact on a DOF with mass: that stepper with forward pairing on it (second order with
+///   sticking, first for pure impacts; the only second-order choice that converges to the
+///   plastic-impact orbit), or bds1 with same pairing (first order, A-stable) when the stepper's
+///   stable k passes `max_steps`;
+/// - compliant contacts and rigid ones on massless DOFs (finite forces): the stepper with same
+///   pairing, or bds2 (second order, A-stable) when its stable k passes `max_steps`. Not fourier:
+///   at the force's kink its error is not C·h^p (observed orders −0.6 … 5.7), so its own estimate
+///   reads 0.11–17× the error and cannot certify a tolerance.
 pub fn auto_scheme(model: &Model, omega_max: f64, target: &AccuracyTarget) -> (Discretization, String) {
     let frequency = model.frequency;
     let class = ContactClass::of(model);
     let resolution = (2 * model.highest_harmonic() as usize + 2).next_power_of_two();
     let first = AUTO_FIRST_STEPS.max(resolution);
-    let galerkin_k = smallest_stable_steps(Scheme::Galerkin, omega_max, frequency, AUTO_MARGIN).unwrap_or(0).next_power_of_two();
-    let stiff =
-        format!("ω_max = {omega_max:.3e} rad/s, so galerkin needs k ≥ {galerkin_k} (ω_max·h ≤ {AUTO_MARGIN}·2√3) against max_steps = {}", target.max_steps);
+    let mass = &model.structure.mass;
+    let massless = (0..model.n()).any(|i| mass.get(i, i) <= 0.0);
+    let stepper = if massless { Scheme::Cds } else { Scheme::Galerkin };
+    let stable_k = smallest_stable_steps(stepper, omega_max, frequency, AUTO_MARGIN).unwrap_or(0).next_power_of_two();
+    let limit = stepper.stability_limit().unwrap_or(f64::INFINITY);
+    let stiff = format!(
+        "{stepper} ({}) needs k ≥ {stable_k} for ω_max = {omega_max:.3e} rad/s (ω_max·h ≤ {AUTO_MARGIN}·{limit:.3}), max_steps = {}",
+        if massless { "the model has massless DOFs" } else { "every DOF carries mass" },
+        target.max_steps
+    );
+    let fits = stable_k <= target.max_steps;
     let (scheme, pairing, k, why) = if model.contacts.is_empty() {
         (Scheme::Fourier, Some(Pairing::Same), first, "no contact: fourier is exact for the linear response once its harmonics are below k/2".to_string())
     } else if class.rigid_massive > 0 {
-        if galerkin_k <= target.max_steps {
-            let why = format!(
-                "{} rigid contact(s) on DOFs with mass: galerkin with forward pairing on them (second order with sticking, first order for pure impacts), same on the others; {stiff}",
-                class.rigid_massive
-            );
+        let what = format!("{} rigid contact(s) on DOFs with mass", class.rigid_massive);
+        if fits {
             // Per contact: forward for rigid, same for compliant (rigid-on-massless: the caller).
-            (Scheme::Galerkin, None, first.max(galerkin_k), why)
-        } else {
             let why = format!(
-                "{} rigid contact(s) on DOFs with mass and a stiff model: bds1 with same pairing (first order, A-stable); {stiff}",
-                class.rigid_massive
+                "{what}: {stepper} with forward pairing on them (second order with sticking, first order for pure impacts), same on the others; {stiff}"
             );
-            (Scheme::Bds1, Some(Pairing::Same), first, why)
+            (stepper, None, first.max(stable_k), why)
+        } else {
+            (Scheme::Bds1, Some(Pairing::Same), first, format!("{what} and a stiff model: bds1 with same pairing (first order, A-stable); {stiff}"))
         }
     } else {
         let what = format!("{} compliant and {} rigid-on-massless contact(s) (finite forces)", class.compliant, class.rigid_massless);
-        if galerkin_k <= target.max_steps {
-            (Scheme::Galerkin, Some(Pairing::Same), first.max(galerkin_k), format!("{what}: galerkin with same pairing (second order); {stiff}"))
+        if fits {
+            (stepper, Some(Pairing::Same), first.max(stable_k), format!("{what}: {stepper} with same pairing (second order); {stiff}"))
         } else {
             (Scheme::Bds2, Some(Pairing::Same), first, format!("{what} and a stiff model: bds2 with same pairing (second order, A-stable); {stiff}"))
         }
