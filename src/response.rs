@@ -145,7 +145,8 @@ pub struct SchemeChoice {
     pub pairing: String,
     /// The k of the result.
     pub steps: usize,
-    /// The result's relative error estimate (`accuracy.relative`).
+    /// The result's relative error bound (the envelope of the Richardson estimates, at least
+    /// `accuracy.relative`), compared with the tolerance.
     pub estimate: Option<f64>,
     /// Why this scheme, why this k, and if `met` is false why the refinement stopped.
     pub why: String,
@@ -159,6 +160,9 @@ pub struct SchemeTrial {
     pub steps: usize,
     /// Relative error estimate at this k (`None`: none could be made, see `why`).
     pub estimate: Option<f64>,
+    /// The relative error bound at this k that "auto" compares with the tolerance: the envelope
+    /// of the estimates so far (`analysis::scheme_auto::envelope`).
+    pub bound: Option<f64>,
     /// Wall time of this k's solve and its estimate [s].
     pub seconds: f64,
 }
