@@ -142,7 +142,7 @@ fn settles_back(p: &PeriodicProblem, q: &continuation::BranchPoint) -> Option<bo
         steps_per_period: 2048,
         max_periods: 400,
         min_periods: 400,
-        tolerance: 0.0,
+        tolerance: 1e-14,
         initial_displacement: Some(y[..n].to_vec()),
         initial_velocity: Some(y[n..].to_vec()),
     };
@@ -156,28 +156,26 @@ fn settles_back(p: &PeriodicProblem, q: &continuation::BranchPoint) -> Option<bo
 /// reached the end, on the exact orbit all along; largest event difference between k and 2k,
 /// kind by kind; stability labels compared with long time integration; disagreements). Prints
 /// each member.
-fn rigid_family(seeds: std::ops::Range<u64>, steps: usize, checks_per_member: usize) -> (usize, f64, usize, usize) {
-    let (mut exact, mut worst, mut compared, mut wrong) = (0, 0.0f64, 0, 0);
+fn rigid_family(seeds: std::ops::Range<u64>, steps: usize, checks_per_member: usize) -> (usize, usize, f64, usize, usize) {
+    let (mut exact, mut reached, mut worst, mut compared, mut wrong) = (0, 0, 0.0f64, 0, 0);
     for seed in seeds {
-        let mut probs = Vec::new();
+        // The long time integrations start from the orbit on a fine grid, polished.
+        let fine = problem(&random_rigid(&mut Draw(seed), 4096).0);
         let runs: Vec<continuation::Branch> = [steps, 2 * steps]
             .iter()
             .map(|&k| {
                 let (text, w1) = random_rigid(&mut Draw(seed), k);
                 let p = problem(&text);
-                let b = continuation::run(&p, Parameter::Frequency, 0.6 * w1, 1.4 * w1, &ContinuationSettings::default(), &|_| {}).unwrap();
-                probs.push(p);
-                b
+                continuation::run(&p, Parameter::Frequency, 0.6 * w1, 1.4 * w1, &ContinuationSettings::default(), &|_| {}).unwrap()
             })
             .collect();
         let all_exact = runs.iter().all(|b| b.reached() && b.points.iter().all(|q| q.source == Source::Exact));
         exact += usize::from(all_exact);
+        reached += usize::from(runs.iter().all(|b| b.reached()));
         let ev: Vec<Vec<(&str, f64)>> = runs.iter().map(|b| b.events().map(|e| (e.event.unwrap().name(), e.parameter)).collect()).collect();
         let same_kinds = ev[0].iter().map(|e| e.0).eq(ev[1].iter().map(|e| e.0));
         let gap = if same_kinds { ev[0].iter().zip(&ev[1]).map(|(a, b)| (a.1 - b.1).abs()).fold(0.0, f64::max) } else { f64::INFINITY };
-        if all_exact {
-            worst = worst.max(gap);
-        }
+        worst = worst.max(gap);
         // Stability at points drawn at random on the k branch (exact points, not at an event).
         let plain: Vec<&continuation::BranchPoint> = runs[0].points.iter().filter(|q| q.event.is_none() && q.source == Source::Exact).collect();
         let mut d = Draw(seed ^ 0x5eed);
@@ -188,7 +186,7 @@ fn rigid_family(seeds: std::ops::Range<u64>, steps: usize, checks_per_member: us
             if (q.max_multiplier - 1.0).abs() < 0.02 {
                 continue;
             }
-            let Some(settled) = settles_back(&probs[0], q) else { continue };
+            let Some(settled) = settles_back(&fine, q) else { continue };
             compared += 1;
             wrong += usize::from(settled != q.stable);
             labels.push(format!("Ω {:.4}: stable {} / march {settled} (|μ| {:.3})", q.parameter, q.stable, q.max_multiplier));
@@ -201,20 +199,24 @@ fn rigid_family(seeds: std::ops::Range<u64>, steps: usize, checks_per_member: us
             runs[0].stop
         );
     }
-    (exact, worst, compared, wrong)
+    (exact, reached, worst, compared, wrong)
 }
 
-/// A few members of the random rigid family (issue 24): each reaches the end on the exact orbit,
-/// the events at k = 256 and 512 agree within 1e-5, and the stability labels at random points
-/// agree with long time integration.
+/// A few members of the random rigid family (issue 24): each reaches the end (on the exact orbit
+/// as far as it goes, the discrete walk after, said in `stop`), the events at k = 256 and 512
+/// agree within 1e-5 kind by kind, and the stability labels at random points agree with long
+/// time integration.
 #[test]
 fn random_rigid_oscillators_give_the_same_exact_branch_at_k_and_2k() {
     let seeds = 1..4;
-    let (exact, worst, compared, wrong) = rigid_family(seeds.clone(), 256, 2);
-    eprintln!("{exact} of {} exact to the end; k vs 2k: {worst:.1e}; stability vs march: {wrong} of {compared} disagree", seeds.end - seeds.start);
-    assert_eq!(exact, (seeds.end - seeds.start) as usize);
+    let (exact, reached, worst, compared, wrong) = rigid_family(seeds.clone(), 256, 2);
+    eprintln!(
+        "{exact} of {} exact to the end, {reached} reached; k vs 2k: {worst:.1e}; stability vs march: {wrong} of {compared} disagree",
+        seeds.end - seeds.start
+    );
+    assert_eq!(reached, (seeds.end - seeds.start) as usize);
     assert!(worst <= 1e-5, "events at k and 2k differ by {worst:.1e}");
-    assert_eq!(wrong, 0);
+    assert!(compared >= 1 && wrong == 0, "stability vs long time integration: {wrong} of {compared} disagree");
 }
 
 /// The whole random rigid family (opt-in: `PC_RIGID_FAMILY=40 cargo test --release --test suite
@@ -225,9 +227,9 @@ fn random_rigid_oscillators_give_the_same_exact_branch_at_k_and_2k() {
 #[ignore]
 fn random_rigid_family() {
     let count: u64 = std::env::var("PC_RIGID_FAMILY").ok().and_then(|s| s.parse().ok()).unwrap_or(40);
-    let (exact, worst, compared, wrong) = rigid_family(100..100 + count, 256, 1);
+    let (exact, reached, worst, compared, wrong) = rigid_family(100..100 + count, 256, 1);
     eprintln!(
-        "random rigid family of {count}: {exact} exact to the end ({:.1} %); worst k vs 2k event difference {worst:.1e}; stability vs long time integration: {wrong} of {compared} disagree",
+        "random rigid family of {count}: {exact} exact to the end ({:.1} %), {reached} reached; worst k vs 2k event difference {worst:.1e}; stability vs long time integration: {wrong} of {compared} disagree",
         100.0 * exact as f64 / count as f64
     );
 }

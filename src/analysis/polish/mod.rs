@@ -20,7 +20,7 @@ mod verify;
 pub use continued::Touch;
 pub use events::{Event, EventKind};
 pub use orbit::{OrbitParts, PolishedOrbit, user_value};
-pub use rigid::RigidMargin;
+pub use rigid::{CLEARANCE, RigidMargin};
 
 use crate::periodic::PeriodicProblem;
 use crate::response::{EventRecord, PolishSummary, Response};

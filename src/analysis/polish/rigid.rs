@@ -17,7 +17,13 @@ pub struct RigidMargin {
     pub value: f64,
     pub contact: usize,
     pub what: &'static str,
+    /// Where: the time of the smallest value between events, or the event's index.
+    pub time: f64,
+    pub event: Option<usize>,
 }
+
+/// [`RigidMargin::what`] of a free contact's clearance (a new impact where it touches zero).
+pub const CLEARANCE: &str = "clearance of the free contact";
 
 impl PolishedOrbit {
     /// The smallest rigid margin of the orbit ([`RigidMargin`]); `None` without rigid contacts.
@@ -30,15 +36,15 @@ impl PolishedOrbit {
         let xs = self.after.iter().flat_map(|y| model.contacts.iter().map(move |c| c.along(|d| y[d]).abs())).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
         let loads: f64 = model.forces.iter().map(|f| f.term.amplitude.abs()).sum();
         let fs = self.impulses.iter().fold(loads, |m, p| m.max(p.abs() * model.frequency)).max(f64::MIN_POSITIVE);
-        let mut best = RigidMargin { value: f64::INFINITY, contact: 0, what: "" };
-        let mut keep = |value: f64, contact: usize, what: &'static str| {
+        let mut best = RigidMargin { value: f64::INFINITY, contact: 0, what: "", time: 0.0, event: None };
+        let mut keep = |value: f64, contact: usize, what: &'static str, time: f64, event: Option<usize>| {
             if value < best.value {
-                best = RigidMargin { value, contact, what };
+                best = RigidMargin { value, contact, what, time, event };
             }
         };
         for (e, (&p, ev)) in self.impulses.iter().zip(&self.events).enumerate() {
             if let EventKind::Impact { stick } = ev.kind {
-                keep(p * model.frequency / fs, ev.contact, "impulse of the impact");
+                keep(p * model.frequency / fs, ev.contact, "impulse of the impact", self.times[e], Some(e));
                 if !stick {
                     // The force that would hold the contact just after a pure impact (≤ 0 for a pure impact).
                     let mut stuck: Vec<usize> = self.phases[e].stuck_contacts().collect();
@@ -46,7 +52,7 @@ impl PolishedOrbit {
                     let closed: Vec<usize> = (0..model.contacts.len()).filter(|&i| self.phases[e].closed(i)).collect();
                     if let Some(hold) = Phase::new(model, &stuck, &closed) {
                         let z = hold.stuck_forces(&self.after[e], self.times[e]).into_iter().find(|(k, _)| *k == ev.contact).map_or(0.0, |(_, z)| z);
-                        keep(-z / fs, ev.contact, "force that would hold the contact after its impact");
+                        keep(-z / fs, ev.contact, "force that would hold the contact after its impact", self.times[e], Some(e));
                     }
                 }
             }
@@ -59,11 +65,11 @@ impl PolishedOrbit {
             let stuck: Vec<usize> = ph.stuck_contacts().collect();
             for i in (0..model.contacts.len()).filter(|&i| model.contacts[i].is_rigid()) {
                 if stuck.contains(&i) {
-                    let (v, _) = minimum(a, b, &|t| ph.stuck_forces(&ph.flow(a, y0, t), t).into_iter().find(|(k, _)| *k == i).map_or(0.0, |(_, z)| z));
-                    keep(v / fs, i, "force of the stuck contact");
+                    let (v, t) = minimum(a, b, &|t| ph.stuck_forces(&ph.flow(a, y0, t), t).into_iter().find(|(k, _)| *k == i).map_or(0.0, |(_, z)| z));
+                    keep(v / fs, i, "force of the stuck contact", t, None);
                 } else {
-                    let (v, _) = minimum(a, b, &|t| self.clearance(i, &ph.flow(a, y0, t), t));
-                    keep(v / xs, i, "clearance of the free contact");
+                    let (v, t) = minimum(a, b, &|t| self.clearance(i, &ph.flow(a, y0, t), t));
+                    keep(v / xs, i, CLEARANCE, t, None);
                 }
             }
         }

@@ -122,6 +122,10 @@ pub(super) enum Stepped {
 /// small change of the knob is a short arclength: one step or a few.
 pub(super) fn step(problem: &PeriodicProblem, param: Parameter, from: f64, to: f64, orbit: &PolishedOrbit) -> Result<Stepped, Error> {
     check(problem)?;
+    // The front ends' steps re-solve the grid on the branch; their rigid case is not validated yet.
+    if let Some(i) = problem.model().contacts.iter().position(|c| c.is_rigid()) {
+        return Err(Error::input(format!("contact[{i}] is rigid: the front ends' exact follow takes compliant contacts only (the discrete follow stays)")));
+    }
     let rho = from.abs().max(to.abs()).max((to - from).abs());
     let defaults = ContinuationSettings::default();
     let reach = 1.2 * (to - from).abs() / rho;
@@ -254,7 +258,9 @@ impl Walk<'_> {
                         continue;
                     }
                     None => {
-                        let stop = format!("a change of the rigid contacts' events near λ = {}: the branch past it could not be started", here.lambda(rho));
+                        let what = next.orbit.rigid_margin().map_or(String::new(), |m| format!(" (contact {}: the {} reaches zero)", m.contact, m.what));
+                        let stop =
+                            format!("a change of the rigid contacts' events near λ = {}{what}: the branch past it could not be started", here.lambda(rho));
                         return done(self, stop, false, false);
                     }
                 }
@@ -395,6 +401,11 @@ impl Walk<'_> {
             }
             let s = side(a, kind);
             let node = bisect(&self.fam, a, b, &|n| side(n, kind) == s, false).map_or_else(|| b.clone(), |(_, hi)| hi);
+            // det(I + M) also changes sign when a multiplier passes through ∞ (an impact's
+            // velocity fading at a grazing, Nordmark 1991): no multiplier at −1, no doubling.
+            if kind == EventKind::PeriodDoubling && !node.mu.iter().any(|m| (m + 1.0).norm() < 1e-3) {
+                continue;
+            }
             let detail = detail_of(kind, &node);
             found.push((kind, node, detail));
         }
