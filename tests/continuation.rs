@@ -229,16 +229,16 @@ fn random_family() {
     );
 }
 
-/// Where the exact orbit cannot be continued (a rigid stop: impacts and sticking), `run` falls
-/// back to the discrete walk and says so in `stop` and in every point's source.
+/// A rigid stop (plastic impacts, sticking) is continued on the exact orbit too (issue 24; the
+/// closed-form and time-integration checks are tests/rigid_branch.rs), and `run` says in every
+/// point's source which walk produced it.
 #[test]
-fn a_rigid_stop_falls_back_to_the_discrete_walk() {
+fn a_rigid_stop_is_continued_on_the_exact_orbit() {
     let text = scene(256).replace("stiffness = 100.0\n", "").replace("scheme = \"cds\"", "scheme = \"bds1\"");
     let p = periodic_contact::scene::Scene::parse(&text, "rigid").unwrap().to_problem("rigid").unwrap();
     let b = continuation::run(&p, Parameter::Frequency, 0.5, 0.52, &ContinuationSettings::default(), &|_| {}).unwrap();
     assert!(b.reached(), "{}", b.stop);
-    assert!(b.stop.contains("discrete walk") && b.stop.contains("rigid"), "{}", b.stop);
-    assert!(b.points.iter().all(|q| q.source == continuation::Source::Discrete));
+    assert!(b.points.iter().all(|q| q.source == continuation::Source::Exact), "{}", b.stop);
 }
 
 /// The DISCRETE walk (the fallback where no exact orbit can be had) on NLvib 03 from Ω = 0.5 to

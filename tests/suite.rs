@@ -62,6 +62,8 @@ mod references;
 mod results;
 #[path = "rigid_blade.rs"]
 mod rigid_blade;
+#[path = "rigid_branch.rs"]
+mod rigid_branch;
 #[path = "scheme_auto.rs"]
 mod scheme_auto;
 #[path = "scheme_limits.rs"]

@@ -14,11 +14,13 @@ mod continued;
 pub mod events;
 mod orbit;
 mod phase;
+mod rigid;
 mod verify;
 
 pub use continued::Touch;
 pub use events::{Event, EventKind};
 pub use orbit::{OrbitParts, PolishedOrbit, user_value};
+pub use rigid::{CLEARANCE, RigidMargin};
 
 use crate::periodic::PeriodicProblem;
 use crate::response::{EventRecord, PolishSummary, Response};
