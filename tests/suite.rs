@@ -62,6 +62,8 @@ mod references;
 mod results;
 #[path = "rigid_blade.rs"]
 mod rigid_blade;
+#[path = "rubbing.rs"]
+mod rubbing;
 #[path = "scheme_limits.rs"]
 mod scheme_limits;
 #[path = "session.rs"]
