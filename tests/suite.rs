@@ -66,6 +66,8 @@ mod rigid_blade;
 mod rigid_branch;
 #[path = "scheme_auto.rs"]
 mod scheme_auto;
+#[path = "rubbing.rs"]
+mod rubbing;
 #[path = "scheme_limits.rs"]
 mod scheme_limits;
 #[path = "session.rs"]

@@ -32,6 +32,8 @@ pub struct Assembly {
     pub bxlin_hat: Vec<C>,
     /// Ẑ_p⁻¹ Bᵀ at `dofs`: [p][dofs.len()][m].
     pub h_hat: Vec<C>,
+    /// The rubbing contacts' tangential rows, folded into the contacts' columns (`rubbing.rs`).
+    pub tangential: Vec<super::TangentialRow>,
 }
 
 /// Samples of the external force at the k instants of `period`, DOF by DOF, only for loaded DOFs.
@@ -295,6 +297,7 @@ pub fn assemble(model: &Model, scheme: Scheme, period: f64, dofs: &[usize], fft:
         xlin_hat: Vec::with_capacity(nh * nd),
         bxlin_hat: Vec::with_capacity(nh * m),
         h_hat: Vec::with_capacity(nh * nd * m),
+        tangential: Vec::new(),
     };
     for b in blocks {
         asm.g_hat.extend(b.g);
@@ -361,6 +364,7 @@ fn assemble_modal(
         xlin_hat: vec![C::ZERO; nh * nd],
         bxlin_hat: vec![C::ZERO; nh * m],
         h_hat: vec![C::ZERO; nh * nd * m],
+        tangential: Vec::new(),
     };
     for p in 0..nh {
         for r in 0..nd {

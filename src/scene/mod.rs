@@ -156,7 +156,7 @@ impl Scene {
         let contact_rows: Vec<Vec<(usize, f64)>> = placed.iter().map(|p| p.user_row.clone()).collect();
         let contact_dofs: Vec<usize> = contact_rows.iter().map(|r| crate::model::label_of(r).0).collect();
         let contacts: Vec<_> = placed.into_iter().map(|p| p.contact).collect();
-        let frictions = self.frictions(&resolver)?;
+        let (frictions, rubbing) = self.frictions(&resolver)?;
         let outputs = self.outputs(&resolver, matches!(source, Source::Inline), &contact_dofs, &forces)?;
 
         // The reduction, or the full model.
@@ -165,7 +165,7 @@ impl Scene {
         let (model, map, reduction) = match &self.reduction {
             None => {
                 let map = outputs::clamped_map(&outputs, &dofs, &contact_rows, !self.structure.fixed.is_empty());
-                (Model { structure: full.clone(), forces, contacts, frequency, frictions }, map, None)
+                (Model { structure: full.clone(), forces, contacts, frequency, frictions, rubbing }, map, None)
             }
             Some(spec) => {
                 let parts = reduce::FullModel { structure: &full, damping: &damping, forces: &forces, contacts: &contacts, frequency };

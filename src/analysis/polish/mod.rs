@@ -49,6 +49,9 @@ pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<PolishedOrbit, 
     if !model.frictions.is_empty() {
         return Err(PolishFailure("the polish does not fit stick and slip events yet: friction contacts (src/formulation.md §9) keep the LCP's orbit".into()));
     }
+    if !model.rubbing.is_empty() {
+        return Err(PolishFailure("the polish does not fit rubbing contacts yet (their force leaves the normal): the LCP's orbit is kept".into()));
+    }
     if r.contacts.len() != model.contacts.len() {
         return Err(PolishFailure("the result has no contact outputs ([output] contacts = false): the event sequence cannot be read".into()));
     }
