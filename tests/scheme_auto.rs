@@ -123,6 +123,7 @@ fn massless_point(osc: &Oscillator, k2: f64, gap: f64) -> Model {
         contacts: vec![Contact::on_dof(1, 1.0, gap, Compliance::Rigid)],
         frequency: osc.omega,
         frictions: Vec::new(),
+        rubbing: Vec::new(),
     }
 }
 

@@ -488,6 +488,7 @@ mod tests {
             ],
             frequency: 37.0,
             frictions: Vec::new(),
+            rubbing: Vec::new(),
         }
     }
 
