@@ -107,3 +107,32 @@ fn polish_meets_the_event_driven_simulation_with_damping_stops_and_jenkins() {
         assert!(*rho < 1.0, "spectral radius {rho}");
     }
 }
+
+#[test]
+fn bds1_error_estimate_within_10x_of_the_true_error_on_a_random_family() {
+    // The Richardson estimate (order 1, a second solve at k/2) against the true error max_j
+    // |x_j − x(t_j)| from the event-driven simulation, on Den Hartog's oscillator (c = 0) and
+    // damped stick–slip, rigid and Jenkins.
+    let mut draw = Draw(7);
+    let mut rows = Vec::new();
+    for case in 0..6 {
+        let c = if case < 2 { 0.0 } else { draw.next(0.02, 0.2) };
+        let (omega, slip) = (draw.next(0.4, 1.8), draw.next(0.05, 0.6));
+        let kt = (case % 3 == 2).then(|| draw.next(1.0, 6.0));
+        let o = oscillator(c, omega, slip, kt);
+        let Ok(reference) = FrictionOrbit::solve(&o, 500, 1e-10, 20000) else { continue };
+        let outputs = OutputSelection { displacement: vec![0], velocity: vec![], acceleration: vec![], contacts: true };
+        let disc = Discretization { scheme: Scheme::Bds1, steps: 256, pairing: None };
+        let problem = PeriodicProblem::new(o.model(), disc, outputs, SolverSettings::default()).expect("problem");
+        let r = problem.solve().expect("solve");
+        let estimate = periodic_contact::analysis::accuracy::estimate(&problem, &r).estimate.expect("an estimate");
+        let truth = r.time.iter().zip(&r.displacement["0"]).map(|(&t, x)| (x - reference.displacement(t)[0]).abs()).fold(0.0, f64::max);
+        rows.push((estimate / truth, c, omega, slip, kt, estimate, truth));
+    }
+    rows.sort_by(|a, b| (b.0.ln().abs()).total_cmp(&a.0.ln().abs()));
+    for (ratio, c, omega, slip, kt, estimate, truth) in &rows {
+        println!("c {c:.3} Ω {omega:.3} μN {slip:.3} k_t {kt:?}, k = 256: estimate {estimate:.3e}, true error {truth:.3e}, ratio {ratio:.2}");
+        assert!((0.1..10.0).contains(ratio), "estimate {estimate:.3e} against the true error {truth:.3e}");
+    }
+    assert!(rows.len() >= 5, "the references converged");
+}
