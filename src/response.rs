@@ -184,9 +184,10 @@ pub struct Accuracy {
 pub struct EventRecord {
     /// Time in [0, T) [s].
     pub time: f64,
-    /// Contact index.
+    /// Contact index (the friction contact's index for "stick", "slip", "reversal").
     pub contact: usize,
-    /// "impact", "release", "contact_on" (compliant), "contact_off" (compliant).
+    /// "impact", "release", "contact_on" (compliant), "contact_off" (compliant); friction:
+    /// "stick" (onset), "slip" (release), "reversal" (slip direction flips at v = 0).
     pub kind: String,
     /// Impulse of an impact ≥ 0 [force·time]; 0 for the other kinds.
     pub impulse: f64,

@@ -42,6 +42,8 @@ mod fmu_host;
 mod friction;
 #[path = "friction_frontends.rs"]
 mod friction_frontends;
+#[path = "friction_polish.rs"]
+mod friction_polish;
 #[path = "frontends.rs"]
 mod frontends;
 #[path = "hard_cases.rs"]
