@@ -66,10 +66,10 @@ mod results;
 mod rigid_blade;
 #[path = "rigid_branch.rs"]
 mod rigid_branch;
-#[path = "scheme_auto.rs"]
-mod scheme_auto;
 #[path = "rubbing.rs"]
 mod rubbing;
+#[path = "scheme_auto.rs"]
+mod scheme_auto;
 #[path = "scheme_limits.rs"]
 mod scheme_limits;
 #[path = "session.rs"]
