@@ -93,3 +93,18 @@ fn rubbing_slower_than_the_structure_is_a_typed_outcome() {
     let e = Scene::parse(&text, "r.toml").unwrap().to_problem("r.toml").unwrap_err().to_string();
     assert!(e.contains("friction[0].contact") && e.contains('3'), "{e}");
 }
+
+#[test]
+fn export_refuses_a_rubbing_scene_and_writes_nothing() {
+    // B alone would misstate a rubbing contact's force row (n − μ·sign(V)·t), so export refuses.
+    let dir = std::env::temp_dir().join(format!("pc-rubbing-export-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("rub.toml");
+    std::fs::write(&scene, SCENE).unwrap();
+    let out = dir.join("model");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_periodic-contact")).arg("export").arg(&scene).arg("-o").arg(&out).output().unwrap();
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && e.contains("rubbing") && e.contains("rub.toml"), "{e}");
+    assert!(!out.join("B.mtx").exists() && !out.join("M.mtx").exists(), "export wrote files for a scene it refused");
+    let _ = std::fs::remove_dir_all(&dir);
+}
