@@ -1,6 +1,7 @@
 //! The exact walk on rigid stops (issue 24): plastic impacts (e = 0) and sticking arcs, against
 //! the closed-form impact oscillator of src/exact/rigid.rs (its impact map and multiplier, not
 //! the polish) and against long time integration (the explicit marcher of src/marching).
+use crate::common::family::{Chain, Draw};
 use periodic_contact::analysis::continuation::{self, ContinuationSettings, Parameter, Source};
 use periodic_contact::analysis::polish;
 use periodic_contact::exact::{Oscillator, RigidRegime, RigidStopOrbit};
@@ -60,64 +61,19 @@ fn impact_oscillator_branches_match_the_closed_form() {
     }
 }
 
-/// A small deterministic generator (SplitMix64).
-struct Draw(u64);
-impl Draw {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.next()
-    }
-}
-
 /// A random oscillator of 1–3 DOFs (a grounded chain: masses 0.5–2, springs 0.5–2, Rayleigh
 /// damping of 2–6 % at the first mode) with a RIGID stop on a random DOF, forced on a random DOF;
 /// the gap is 0.3–0.8 of that DOF's linear peak near the first mode, so the branch over
 /// [0.6, 1.4]·ω₁ impacts and, where the gap is small, sticks. (scene, ω₁)
 fn random_rigid(d: &mut Draw, steps: usize) -> (String, f64) {
-    use nalgebra::{DMatrix, DVector};
-    use num_complex::Complex64 as C;
-    let n = 1 + (d.next() * 3.0) as usize;
-    let m: Vec<f64> = (0..n).map(|_| d.range(0.5, 2.0)).collect();
-    let springs: Vec<f64> = (0..n).map(|_| d.range(0.5, 2.0)).collect();
-    let mut k = DMatrix::zeros(n, n);
-    for (i, s) in springs.iter().enumerate() {
-        k[(i, i)] += s;
-        if i > 0 {
-            k[(i - 1, i - 1)] += s;
-            k[(i, i - 1)] -= s;
-            k[(i - 1, i)] -= s;
-        }
-    }
-    let minv = DMatrix::from_diagonal(&DVector::from_iterator(n, m.iter().map(|x| 1.0 / x.sqrt())));
-    let w1 = (&minv * &k * &minv).symmetric_eigen().eigenvalues.min().sqrt();
+    let chain = Chain::draw(d);
+    let (n, w1) = (chain.n, chain.w1);
     let alpha = 2.0 * d.range(0.02, 0.06) / w1;
     let (fdof, cdof) = ((d.next() * n as f64) as usize, (d.next() * n as f64) as usize);
     let amp = 0.1;
-    let linear = |w: f64| {
-        let a = DMatrix::from_fn(n, n, |r, c| C::new(k[(r, c)] - if r == c { w * w * m[r] } else { 0.0 }, w * alpha * k[(r, c)]));
-        let mut f = DVector::zeros(n);
-        f[fdof] = C::new(amp, 0.0);
-        a.lu().solve(&f).map_or(0.0, |x| x[cdof].norm())
-    };
-    let peak = (0..400).map(|j| linear(w1 * (0.6 + 0.8 * j as f64 / 400.0))).fold(0.0, f64::max);
+    let peak = (0..400).map(|j| chain.linear_amplitude(alpha, fdof, cdof, amp, w1 * (0.6 + 0.8 * j as f64 / 400.0))).fold(0.0, f64::max);
     let gap = d.range(0.3, 0.8) * peak;
-    let row = |r: usize, a: &dyn Fn(usize, usize) -> f64| format!("[{}]", (0..n).map(|c| format!("{:e}", a(r, c))).collect::<Vec<_>>().join(", "));
-    let mat = |a: &dyn Fn(usize, usize) -> f64| format!("[{}]", (0..n).map(|r| row(r, a)).collect::<Vec<_>>().join(", "));
-    let text = format!(
-        "[structure]\nmass = {}\nstiffness = {}\n[damping]\nmatrix = {}\n[excitation]\nfrequency = {}\n[[force]]\ndof = {fdof}\namplitude = {amp}\n\
-         [[contact]]\ndof = {cdof}\ngap = {gap:e}\n[discretization]\nscheme = \"bds1\"\nsteps = {steps}\n[output]\ndisplacement = [{cdof}]\n",
-        mat(&|r, c| if r == c { m[r] } else { 0.0 }),
-        mat(&|r, c| k[(r, c)]),
-        mat(&|r, c| alpha * k[(r, c)]),
-        0.6 * w1
-    );
-    (text, w1)
+    (chain.scene(alpha, (fdof, amp), &format!("dof = {cdof}\ngap = {gap:e}\n"), "bds1", steps, cdof), w1)
 }
 
 /// Long time integration started near the branch point `q`: the orbit at its λ (the grid's,

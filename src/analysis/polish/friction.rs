@@ -513,17 +513,7 @@ pub fn write(orbit: &StickSlipOrbit, problem: &PeriodicProblem, r: &mut Response
             (&orbit.flows.a[p.index()] * y).rows(n, n).into_owned()
         })
         .collect();
-    let label =
-        |key: &str, v: &DVector<f64>, off: usize| super::user_value(problem.output_map(), key.parse().unwrap_or(usize::MAX), v, off, n).unwrap_or(f64::NAN);
-    for (key, series) in r.displacement.iter_mut() {
-        series.iter_mut().zip(&states).for_each(|(x, y)| *x = label(key, y, 0));
-    }
-    for (key, series) in r.velocity.iter_mut() {
-        series.iter_mut().zip(&states).for_each(|(x, y)| *x = label(key, y, n));
-    }
-    for (key, series) in r.acceleration.iter_mut() {
-        series.iter_mut().zip(&accs).for_each(|(x, a)| *x = label(key, a, 0));
-    }
+    super::orbit::write_kinematics(r, problem.output_map(), &states, &accs, n);
     if let Some(f) = r.friction.first_mut() {
         for (j, &t) in r.time.iter().enumerate() {
             (f.force[j], f.slip_velocity[j], f.displacement[j], f.stuck[j]) = orbit.contact(t);
