@@ -18,18 +18,8 @@ impl Draw {
     }
 }
 
-fn oscillator(c: f64, omega: f64, slip: f64, kt: Option<f64>) -> FrictionOscillator {
-    FrictionOscillator {
-        mass: vec![vec![1.0]],
-        damping: vec![vec![c]],
-        stiffness: vec![vec![1.0]],
-        force: vec![1.0],
-        omega,
-        dof: 0,
-        slip_force: slip,
-        tangential_stiffness: kt,
-    }
-}
+// The unit oscillator with friction: the same one tests/friction.rs checks the LCP on.
+use crate::friction::oscillator;
 
 /// The LCP at k = `steps` (bds1) and its stick–slip polish.
 fn polished(o: &FrictionOscillator, steps: usize) -> (Response, Result<StickSlipOrbit, polish::PolishFailure>) {
