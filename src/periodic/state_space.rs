@@ -16,7 +16,8 @@
 //! differences s_j = (x, ∇x, …, ∇^(p−1) x) at x_{j+L−1}, advanced in summed form (see
 //! [`step_map`]): round-off then stays at ε relative per step instead of the k²·ε a state of raw
 //! samples loses to 2x_j − x_(j−1). The predictor is y_j = Φ s_j + c_j and s_{j+1} = y_j + Γ z_j,
-//! Γ = (−W Bᵀ, …, −W Bᵀ). Contact c is paired with the gap at t_{j+s} (s its pairing offset):
+//! Γ = (−W Eᵀ, …, −W Eᵀ), E the contacts' force rows (E = B but for rubbing contacts, whose force
+//! row is n − μ·sign(V)·t, src/formulation.md §9: S is then non-symmetric). Contact c is paired with the gap at t_{j+s} (s its pairing offset):
 //! - s = L (cds/galerkin forward, bds same): w = gap_c(t_{j+L}) − B_c x_{j+L} + z/k_c, read in
 //!   y's first block after the step: implicit, S_cc = B_c W B_cᵀ + 1/k_c;
 //! - s = L − 1 (cds/galerkin same): w = gap_c(t_j) − B_c x_j + z/k_c, x_j = y's first block minus
@@ -96,9 +97,6 @@ pub fn step_map(problem: &PeriodicProblem) -> Result<StepMapLcp, NoStepMap> {
     if !model.frictions.is_empty() {
         return Err(NoStepMap("friction contacts have no step map yet (src/formulation.md §9)".to_string()));
     }
-    if !model.rubbing.is_empty() {
-        return Err(NoStepMap("rubbing contacts have no step map yet: their force leaves the normal (src/formulation.md §9)".to_string()));
-    }
     let offsets: Vec<usize> = (0..m).map(|c| problem.pairing_at(c).offset()).collect();
     if let Some(c) = offsets.iter().position(|&s| s > lead) {
         return Err(NoStepMap(format!("contact[{c}] is paired forward under {}: its force waits for a later step's gap", disc.scheme)));
@@ -175,7 +173,8 @@ pub fn step_map(problem: &PeriodicProblem) -> Result<StepMapLcp, NoStepMap> {
     // D: the static flexibility of the massless DOFs plus each compliant contact's 1/k_c.
     let mut flexibility = cond.flexibility.clone();
     let mut r = vec![0.0; k * m];
-    let wb = dense_product(&w, &cond.rows.transpose().to_owned());
+    // The contacts' forces enter through Ẽᵀ (rubbing: Ẽ ≠ B̃, S non-symmetric), their gaps through B̃.
+    let wb = dense_product(&w, &cond.force_rows.transpose().to_owned());
     for (ci, contact) in model.contacts.iter().enumerate() {
         // Implicit (s = L) reads x_(j+L), y's first block; explicit (s = L − 1) reads
         // x_(j+L−1) = x_(j+L) − ∇x_(j+L), known before the step (Γ's blocks are equal: HΓ = 0).
@@ -211,7 +210,10 @@ struct Condensed {
     damping: Option<Mat<f64>>,
     /// B̃, m × n_a (the model's sign: w = gap − B x).
     rows: Mat<f64>,
-    /// D = B_b K_bb⁻¹ B_bᵀ, m×m row-major.
+    /// Ẽ, m × n_a: the rows through which the contacts' forces act, −Ẽᵀz. Ẽ = B̃ but for
+    /// rubbing contacts, whose force row is n − μ·sign(V)·t (src/formulation.md §9).
+    force_rows: Mat<f64>,
+    /// D = B_b K_bb⁻¹ E_bᵀ, m×m row-major.
     flexibility: Vec<f64>,
     /// The massless DOFs b and −K_bb⁻¹ K_ba (n_b × n_a), K_bb⁻¹ (n_b × n_b).
     massless: Vec<usize>,
@@ -230,11 +232,13 @@ impl Condensed {
                 full_rows[(c, dof)] = v;
             }
         }
+        let full_force_rows = force_rows(model, &full_rows);
         let dense = |a: &crate::model::Matrix, r: &[usize], c: &[usize]| a.block(r, c).to_dense();
         let damping = s.damping.as_ref().map(|c| dense(c, &massive, &massive));
         if massless.is_empty() {
             let (mass, stiffness) = (s.mass.to_dense(), s.stiffness.to_dense());
-            return Ok(Condensed { massive, mass, stiffness, damping, rows: full_rows, flexibility: vec![0.0; m * m], massless, k_bb_inv: Mat::zeros(0, 0) });
+            let (rows, force_rows) = (full_rows, full_force_rows);
+            return Ok(Condensed { massive, mass, stiffness, damping, rows, force_rows, flexibility: vec![0.0; m * m], massless, k_bb_inv: Mat::zeros(0, 0) });
         }
         let nonzero: Vec<usize> = (0..a0.len()).filter(|&i| a0[i] != 0.0).collect();
         let &[star] = nonzero.as_slice() else {
@@ -258,13 +262,16 @@ impl Condensed {
         let k_ba = dense(&s.stiffness, &massless, &massive);
         let x_b = -(&k_bb_inv * &k_ba); // x_b = −K_bb⁻¹ K_ba x_a (+ force and contact terms)
         let stiffness = dense(&s.stiffness, &massive, &massive) + k_ba.transpose() * &x_b;
-        let b_a = Mat::from_fn(m, massive.len(), |c, j| full_rows[(c, massive[j])]);
-        let b_b = Mat::from_fn(m, massless.len(), |c, j| full_rows[(c, massless[j])]);
+        let split = |full: &Mat<f64>, dofs: &[usize]| Mat::from_fn(m, dofs.len(), |c, j| full[(c, dofs[j])]);
+        let (b_a, b_b) = (split(&full_rows, &massive), split(&full_rows, &massless));
+        let (e_a, e_b) = (split(&full_force_rows, &massive), split(&full_force_rows, &massless));
         let rows = &b_a + &b_b * &x_b;
-        let dmat = &b_b * &k_bb_inv * b_b.transpose();
+        // The force −E_bᵀz on the massless DOFs moves them by −K_bb⁻¹E_bᵀz: on the massive ones −(E_a − E_b K_bb⁻¹ K_ba)ᵀz (K symmetric).
+        let force_rows = &e_a + &e_b * &x_b;
+        let dmat = &b_b * &k_bb_inv * e_b.transpose();
         let flexibility = (0..m * m).map(|e| dmat[(e / m, e % m)]).collect();
         let mass = dense(&s.mass, &massive, &massive);
-        Ok(Condensed { massive, mass, stiffness, damping, rows, flexibility, massless, k_bb_inv })
+        Ok(Condensed { massive, mass, stiffness, damping, rows, force_rows, flexibility, massless, k_bb_inv })
     }
 
     /// f̃(t_j) on the massive DOFs (k × n_a) and the gap shift −B_b K_bb⁻¹ f_b(t_j) (k × m).
@@ -293,6 +300,18 @@ impl Condensed {
         }
         (f, shift)
     }
+}
+
+/// E (m×n): the contacts' force rows, B plus −μ·sign(V)·t on each rubbing contact's row
+/// (src/formulation.md §9; `rubbing.rs` folds the same term into the LCP's columns).
+fn force_rows(model: &Model, rows: &Mat<f64>) -> Mat<f64> {
+    let mut e = rows.clone();
+    for r in &model.rubbing {
+        for &(dof, v) in &r.row {
+            e[(r.contact, dof)] += r.traction() * v;
+        }
+    }
+    e
 }
 
 /// f(t_j) DOF by DOF (k×n), sampled as the assembly samples them.
