@@ -303,6 +303,42 @@ impl Resolver<'_> {
     }
 }
 
+impl Resolver<'_> {
+    /// A rubbing contact's sliding direction t over a node's DOFs (full numbering): `direction =
+    /// [tx, ty, tz]` (normalised) or `"tangential"`, the direction of rotation e_θ = axis × e_r at
+    /// the node (src/formulation.md §9), at `node` or `dofs` (with `position`).
+    pub(super) fn sliding_row(
+        &self,
+        field: &str,
+        at: (Option<&NodeSpec>, Option<&[usize]>, Option<[f64; 3]>),
+        direction: &NormalSpec,
+        rotor: Option<&Rotor>,
+    ) -> Result<Vec<(usize, f64)>, BuildError> {
+        let node = match at {
+            (Some(NodeSpec::Name(n)), None, _) => NodeRef::Named(n),
+            (Some(NodeSpec::Number(n)), None, _) => NodeRef::Number(*n),
+            (None, Some(d), _) => NodeRef::Dofs(d),
+            _ => return Err(BuildError::field(field, "with direction, give one of node = … or dofs = [i, j, k] (the node the counter-face slides along)")),
+        };
+        let nd = self.node_dofs(field, node, at.2)?;
+        let key = format!("{field}.direction");
+        let t = match direction {
+            NormalSpec::Name(name) if name == "tangential" => {
+                let Some(rotor) = rotor else {
+                    return Err(BuildError::field(key, "is \"tangential\", which needs the rotation axis: a [casing] (with a blade generator) or casing.axis"));
+                };
+                let (Some(p), 3) = (nd.position, nd.dofs.len()) else {
+                    return Err(BuildError::field(key, "is \"tangential\", which needs the node's 3 DOFs x, y, z and its coordinates (position = [x, y, z])"));
+                };
+                rotor.tangential(&key, p)?.to_vec()
+            }
+            NormalSpec::Vector(_) => unit_normal(&key, direction, nd.dofs.len(), nd.position, rotor)?,
+            other => return Err(BuildError::field(key, format!("is {other:?}, expected [tx, ty, tz] or \"tangential\""))),
+        };
+        Ok(nd.dofs.iter().zip(t).filter(|(_, v)| *v != 0.0).map(|(&(_, f), v)| (f, v)).collect())
+    }
+}
+
 /// A node as a `[[contact]]` names it.
 enum NodeRef<'a> {
     Named(&'a str),

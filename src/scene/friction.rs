@@ -8,11 +8,14 @@
 //! stiffness = 3.0        # optional: a Jenkins element (k_t in series with the slider)
 //! ```
 //! Rubbing in gross slip: `contact = i` with `sliding_velocity = V` (the counter-face of
-//! `[[contact]]` i slides along `dof` at V, faster than the structure): the friction force is
-//! μ·λ_n along V, no normal_force. `contact` without `sliding_velocity` (coupled stick/slip),
-//! `node` and `direction` are part of the interface but not yet solved: refused by name.
+//! `[[contact]]` i slides at V along `dof`, or along `direction = [tx, ty, tz]` or
+//! `"tangential"` (the direction of rotation) at `node` or `dofs`, faster than the structure):
+//! the friction force is μ·λ_n along V, no normal_force; with [reduction] too. `contact` without
+//! `sliding_velocity` (coupled stick/slip), and `node` and `direction` under a normal load, are
+//! part of the interface but not yet solved: refused by name.
 use super::contacts::Resolver;
-use super::{BuildError, DofSpec, Scene};
+use super::rotor::Rotor;
+use super::{BuildError, DofSpec, NodeSpec, NormalSpec, Scene};
 use crate::model::{Friction, Rubbing};
 use serde::Deserialize;
 
@@ -21,9 +24,14 @@ use serde::Deserialize;
 #[serde(deny_unknown_fields)]
 pub struct FrictionSpec {
     pub dof: Option<usize>,
-    /// A node with a sliding `direction`: kept to be refused by name (not yet supported).
-    pub node: Option<toml::Value>,
-    pub direction: Option<toml::Value>,
+    /// Rubbing: the node the counter-face slides along, with `direction` (under a normal load:
+    /// refused by name, not yet supported).
+    pub node: Option<NodeSpec>,
+    /// Rubbing: `[tx, ty, tz]` or `"tangential"` (the direction of rotation at the node).
+    pub direction: Option<NormalSpec>,
+    /// Rubbing: the node's DOFs (x, y, z) by index, with `position`, in Matrix Market scenes.
+    pub dofs: Option<Vec<usize>>,
+    pub position: Option<[f64; 3]>,
     /// μ ≥ 0.
     pub coefficient: f64,
     /// N ≥ 0, constant.
@@ -46,16 +54,10 @@ const NOT_YET: [(&str, &str); 3] = [
 impl Scene {
     /// The `[[friction]]` entries in the full (clamped) numbering: Coulomb contacts under a
     /// normal load, and rubbing in gross slip (`contact` with `sliding_velocity`).
-    pub(super) fn frictions(&self, resolver: &Resolver) -> Result<(Vec<Friction>, Vec<Rubbing>), BuildError> {
-        if !self.friction.is_empty() && self.reduction.is_some() {
-            return Err(BuildError::field(
-                "friction",
-                "is not yet supported together with [reduction] (the friction DOFs would have to be kept physical); solve the full model",
-            ));
-        }
+    pub(super) fn frictions(&self, resolver: &Resolver, rotor: Option<&Rotor>) -> Result<(Vec<Friction>, Vec<Rubbing>), BuildError> {
         let mut out = (Vec::new(), Vec::new());
         for (i, f) in self.friction.iter().enumerate() {
-            match f.build(i, resolver)? {
+            match f.build(i, resolver, rotor)? {
                 Built::Load(f) => out.0.push(f),
                 Built::Rubbing(r) => out.1.push(r),
             }
@@ -64,6 +66,12 @@ impl Scene {
             return Err(BuildError::field(
                 "friction",
                 "mixes rubbing (contact with sliding_velocity) and friction under a normal load: this version solves one kind per scene",
+            ));
+        }
+        if !out.0.is_empty() && self.reduction.is_some() {
+            return Err(BuildError::field(
+                "friction",
+                "under a normal load is not yet supported together with [reduction] (the friction DOFs would have to be kept physical); solve the full model",
             ));
         }
         Ok(out)
@@ -77,9 +85,9 @@ enum Built {
 }
 
 impl FrictionSpec {
-    fn build(&self, i: usize, resolver: &Resolver) -> Result<Built, BuildError> {
+    fn build(&self, i: usize, resolver: &Resolver, rotor: Option<&Rotor>) -> Result<Built, BuildError> {
         if let (Some(contact), Some(sliding_velocity)) = (self.contact, self.sliding_velocity) {
-            return self.rubbing(i, resolver, contact, sliding_velocity).map(Built::Rubbing);
+            return self.rubbing(i, resolver, rotor, contact, sliding_velocity).map(Built::Rubbing);
         }
         if self.sliding_velocity.is_some() {
             return Err(BuildError::field(
@@ -87,7 +95,7 @@ impl FrictionSpec {
                 "needs contact = index: rubbing presses with the normal force of that [[contact]] (a constant normal_force with a sliding counter-face is not yet supported)",
             ));
         }
-        let given = [self.contact.is_some(), self.node.is_some(), self.direction.is_some()];
+        let given = [self.contact.is_some(), self.node.is_some() || self.dofs.is_some() || self.position.is_some(), self.direction.is_some()];
         if let Some(((key, what), _)) = NOT_YET.iter().zip(given).find(|(_, g)| *g) {
             return Err(BuildError::field(
                 format!("friction[{i}].{key}"),
@@ -106,24 +114,29 @@ impl FrictionSpec {
         Ok(Built::Load(Friction::on_dof(full, self.coefficient, normal_force, self.stiffness)))
     }
 
-    /// Rubbing in gross slip on `[[contact]]` `contact`, sliding along `dof`.
-    fn rubbing(&self, i: usize, resolver: &Resolver, contact: usize, sliding_velocity: f64) -> Result<Rubbing, BuildError> {
-        let refused = [
-            ("node", self.node.is_some()),
-            ("direction", self.direction.is_some()),
-            ("normal_force", self.normal_force.is_some()),
-            ("stiffness", self.stiffness.is_some()),
-        ];
+    /// Rubbing in gross slip on `[[contact]]` `contact`, sliding along `dof`, or along `direction`
+    /// at `node` or `dofs`.
+    fn rubbing(&self, i: usize, resolver: &Resolver, rotor: Option<&Rotor>, contact: usize, sliding_velocity: f64) -> Result<Rubbing, BuildError> {
+        let refused = [("normal_force", self.normal_force.is_some()), ("stiffness", self.stiffness.is_some())];
         if let Some((key, _)) = refused.iter().find(|(_, g)| *g) {
             return Err(BuildError::field(
                 format!("friction[{i}].{key}"),
-                "is not taken by rubbing in gross slip (contact with sliding_velocity) in this version: the normal force is the contact's, the sliding direction one DOF (dof = index), the friction rigid Coulomb",
+                "is not taken by rubbing in gross slip (contact with sliding_velocity) in this version: the normal force is the contact's, the friction rigid Coulomb",
             ));
         }
-        let Some(dof) = self.dof else {
-            return Err(BuildError::field(format!("friction[{i}]"), "needs dof = index (the DOF along which the counter-face slides)"));
+        let field = format!("friction[{i}]");
+        let row = match (self.dof, &self.direction) {
+            (Some(dof), None) if self.node.is_none() && self.dofs.is_none() => {
+                vec![(resolver.output_pair(&format!("{field}.dof"), &DofSpec::Index(dof))?.1, 1.0)]
+            }
+            (None, Some(direction)) => resolver.sliding_row(&field, (self.node.as_ref(), self.dofs.as_deref(), self.position), direction, rotor)?,
+            _ => {
+                return Err(BuildError::field(
+                    field,
+                    "needs the sliding direction: dof = index, or direction = [tx, ty, tz] or \"tangential\" with node = … or dofs = [i, j, k] (not both)",
+                ));
+            }
         };
-        let (_, full) = resolver.output_pair(&format!("friction[{i}].dof"), &DofSpec::Index(dof))?;
-        Ok(Rubbing { contact, row: vec![(full, 1.0)], coefficient: self.coefficient, sliding_velocity })
+        Ok(Rubbing { contact, row, coefficient: self.coefficient, sliding_velocity })
     }
 }

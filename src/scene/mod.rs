@@ -150,13 +150,14 @@ impl Scene {
         let casing = self.checked_casing(dir)?;
         let rotor = self.rotor(casing.as_ref(), &source)?;
         let mut placed = self.contacts(&resolver, rotor.as_ref())?;
+        // Rubbing's "tangential" direction needs the axis as the contacts have it (not the casing's θ = 0 it fixes).
+        let (frictions, rubbing) = self.frictions(&resolver, rotor.as_ref())?;
         self.casing_motion(&mut placed, casing.as_ref(), &source, rotor)?;
         let spec_pairings = self.contact_pairings()?;
         let pairings: Vec<_> = placed.iter().map(|p| spec_pairings[p.spec]).collect();
         let contact_rows: Vec<Vec<(usize, f64)>> = placed.iter().map(|p| p.user_row.clone()).collect();
         let contact_dofs: Vec<usize> = contact_rows.iter().map(|r| crate::model::label_of(r).0).collect();
         let contacts: Vec<_> = placed.into_iter().map(|p| p.contact).collect();
-        let (frictions, rubbing) = self.frictions(&resolver)?;
         let outputs = self.outputs(&resolver, matches!(source, Source::Inline), &contact_dofs, &forces)?;
 
         // The reduction, or the full model.
@@ -168,7 +169,7 @@ impl Scene {
                 (Model { structure: full.clone(), forces, contacts, frequency, frictions, rubbing }, map, None)
             }
             Some(spec) => {
-                let parts = reduce::FullModel { structure: &full, damping: &damping, forces: &forces, contacts: &contacts, frequency };
+                let parts = reduce::FullModel { structure: &full, damping: &damping, forces: &forces, contacts: &contacts, rubbing: &rubbing, frequency };
                 let (model, map, red) = reduce::reduce(spec, parts, &resolver, &outputs, &contact_rows)?;
                 (model, Some(map), Some(red))
             }

@@ -4,7 +4,7 @@
 use super::contacts::Resolver;
 use super::structure::DampingGiven;
 use super::{BuildError, ReductionSpec};
-use crate::model::{Contact, Force, Harmonic, Model, Structure};
+use crate::model::{Contact, Force, Harmonic, Model, Rubbing, Structure};
 use crate::periodic::{OutputMap, OutputSelection};
 use crate::reduction::{CraigBamptonOptions, DEFAULT_MODES, Damping, Method, ReducedModel, ReductionError};
 
@@ -14,6 +14,8 @@ pub(super) struct FullModel<'a> {
     pub damping: &'a DampingGiven,
     pub forces: &'a [Force],
     pub contacts: &'a [Contact],
+    /// Rubbing contacts: their sliding rows are kept physical like the contacts' rows.
+    pub rubbing: &'a [Rubbing],
     pub frequency: f64,
 }
 
@@ -30,7 +32,7 @@ pub(super) fn reduce(
         "massless-boundary" => Method::MasslessBoundary,
         other => return Err(BuildError::field("reduction.method", format!("is \"{other}\", expected \"craig-bampton\" or \"massless-boundary\""))),
     };
-    let boundary = boundary(spec, full.contacts, resolver)?;
+    let boundary = boundary(spec, full.contacts, full.rubbing, resolver)?;
     let damping = match (&full.damping.modal_ratios, full.damping.rayleigh, &full.structure.damping) {
         (Some(z), _, _) => Damping::ModalRatios(z.clone()),
         (None, Some((alpha, beta)), _) => Damping::Rayleigh { alpha, beta },
@@ -60,21 +62,20 @@ pub(super) fn reduce(
         }
     }
     // Every DOF of a contact's row is a boundary DOF: the row keeps its coefficients.
-    let contacts = full
-        .contacts
-        .iter()
-        .map(|c| Contact { row: c.row.iter().map(|&(d, v)| (red.reduced_dof(d).expect("contacts are boundary DOFs"), v)).collect(), ..c.clone() })
-        .collect();
-    let model = Model { structure: red.structure(), forces, contacts, frequency: full.frequency, frictions: Vec::new(), rubbing: Vec::new() };
+    let boundary_row = |row: &[(usize, f64)]| row.iter().map(|&(d, v)| (red.reduced_dof(d).expect("contacts and sliding rows are boundary DOFs"), v)).collect();
+    let contacts = full.contacts.iter().map(|c| Contact { row: boundary_row(&c.row), ..c.clone() }).collect();
+    let rubbing = full.rubbing.iter().map(|r| Rubbing { row: boundary_row(&r.row), ..r.clone() }).collect();
+    let model = Model { structure: red.structure(), forces, contacts, frequency: full.frequency, frictions: Vec::new(), rubbing };
     let rows = outputs.dofs().into_iter().map(|u| (u, row(resolver.dofs.new_index(u).expect("checked")))).collect();
     let map = OutputMap { rows, contact_rows: contact_rows.to_vec(), effects: vec!["reduction".into()] };
     Ok((model, map, red))
 }
 
-/// The boundary DOFs (full numbering): the contacts', then `extra_boundary`, each once.
-fn boundary(spec: &ReductionSpec, contacts: &[Contact], resolver: &Resolver) -> Result<Vec<usize>, BuildError> {
+/// The boundary DOFs (full numbering): the contacts', the rubbing contacts' sliding rows', then
+/// `extra_boundary`, each once.
+fn boundary(spec: &ReductionSpec, contacts: &[Contact], rubbing: &[Rubbing], resolver: &Resolver) -> Result<Vec<usize>, BuildError> {
     let mut boundary: Vec<usize> = Vec::new();
-    for &(d, _) in contacts.iter().flat_map(|c| &c.row) {
+    for &(d, _) in contacts.iter().flat_map(|c| &c.row).chain(rubbing.iter().flat_map(|r| &r.row)) {
         if !boundary.contains(&d) {
             boundary.push(d);
         }

@@ -72,6 +72,11 @@ impl Rotor {
         Ok(r.map(|v| v / length))
     }
 
+    /// The unit direction of rotation e_θ = axis × e_r at `p` (right-hand rule about the axis).
+    pub fn tangential(&self, field: &str, p: V3) -> Result<V3, BuildError> {
+        Ok(cross(self.axis, self.radial(field, p)?))
+    }
+
     /// θ of `p` about the axis, from the direction of θ = 0 (set by the first point asked for
     /// when the scene does not fix it).
     pub fn angle(&mut self, field: &str, p: V3) -> Result<f64, BuildError> {
