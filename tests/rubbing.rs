@@ -145,6 +145,12 @@ fn shooting_on_the_step_map_equals_the_dense_lcp_with_rubbing() {
     let e = shooting_against_dense(&CHAIN.replacen("\"cds\"", "\"bds2\"", 1));
     println!("rubbing chain, bds2 k = 256: shooting vs dense Lemke {e:.3e}");
     assert!(e < 1e-10, "{e}");
+    // DOF 3 massless (condensed out of the step map): contact 1's sliding row acts on it, so the
+    // force rows E differ from B on a massless DOF (D = B_b K_bb⁻¹ E_bᵀ).
+    let massless = CHAIN.replacen("[0, 0, 0, 1.0]]", "[0, 0, 0, 0.0]]", 1).replacen("[0.03, 0.01]", "[0.05, 0.0]", 1).replacen("gap = 0.3", "gap = 0.1", 1);
+    let e = shooting_against_dense(&massless);
+    println!("rubbing chain, sliding on a massless DOF, cds k = 256: shooting vs dense Lemke {e:.3e}");
+    assert!(e < 1e-10, "{e}");
 }
 
 const CHAIN: &str = r#"[structure]
