@@ -265,3 +265,22 @@ fn the_reduced_rubbing_blade_matches_the_full_model() {
     assert!(full.contacts.iter().any(|c| c.force.iter().any(|&f| f > 0.0)), "the point is in contact");
     assert!(e < 1e-3 && shift > 10.0 * e, "reduced vs full {e:e}, friction's effect {shift:e}");
 }
+
+#[test]
+fn a_sliding_direction_without_its_node_or_axis_is_refused_by_name() {
+    let refused = |from: &str, to: &str| Scene::parse(&SCENE.replacen(from, to, 1), "r.toml").unwrap().to_problem("r.toml").unwrap_err().to_string();
+    // direction needs the node it applies at.
+    let e = refused("dof = 1\ncoefficient", "direction = [0.0, 1.0]\ncoefficient");
+    assert!(e.contains("friction[0]") && e.contains("node"), "{e}");
+    // "tangential" needs the rotation axis (a [casing] or casing.axis).
+    let e = refused("dof = 1\ncoefficient", "dofs = [0, 1]\ndirection = \"tangential\"\ncoefficient");
+    assert!(e.contains("friction[0].direction") && e.contains("rotation axis"), "{e}");
+    // dof and direction together: one sliding direction, not two.
+    let e = refused("dof = 1\ncoefficient", "dof = 1\ndirection = [1.0]\ncoefficient");
+    assert!(e.contains("friction[0]") && e.contains("not both"), "{e}");
+    // A given direction over the node's DOFs is normalised: [0, 2] is dof = 1.
+    let by_dofs = Scene::parse(&SCENE.replacen("dof = 1\ncoefficient", "dofs = [0, 1]\ndirection = [0.0, 2.0]\ncoefficient", 1), "r.toml").unwrap();
+    let by_dof = Scene::parse(SCENE, "r.toml").unwrap();
+    let (a, b) = (by_dofs.to_problem("r.toml").unwrap().solve().unwrap(), by_dof.to_problem("r.toml").unwrap().solve().unwrap());
+    assert_eq!(a.displacement, b.displacement);
+}
