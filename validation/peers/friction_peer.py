@@ -187,9 +187,9 @@ def report(results, sweep):
     return "\n".join(lines) + "\n"
 
 
-def sweep_chain(points, steps, workdir):
+def sweep_chain(points, steps, workdir, omegas=None):
     rows = []
-    for omega in np.linspace(0.3, 2.6, points):
+    for omega in np.linspace(0.3, 2.6, points) if omegas is None else omegas:
         omega = float(omega)
         exact, cpu = exact_orbit(CHAIN, omega)
         scale = float(exact.amplitude().max())
