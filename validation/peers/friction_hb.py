@@ -22,8 +22,9 @@ with Y): on N samples,
 
 looped twice over the period (the second pass starts from the first's end: periodic). The
 residual is W − Y (displacement units); at a root Λ = Λ_X and the law holds on the samples.
-Solved by scipy's fsolve (MINPACK hybrd, finite-difference Jacobian), seeded by the stuck (linear)
-response. The displacement harmonics then follow from Λ.
+Solved by scipy's fsolve (MINPACK hybrd) with the analytic DLFT Jacobian (y is piecewise linear in
+W: a slip sample follows w and λ_X, a stuck one repeats the last slip), seeded by the stuck (linear)
+response or a smaller H's root. The displacement harmonics then follow from Λ.
 """
 from __future__ import annotations
 
@@ -89,20 +90,23 @@ def _harmonics(w: np.ndarray, H: int) -> np.ndarray:
 
 
 def _dlft_contact(w, lam_x, eps, slip):
-    """The DLFT time loop (Nacivet et al. 2003, in the contact displacement y): y(t_n)."""
+    """The DLFT time loop (Nacivet et al. 2003, in the contact displacement y): y(t_n), and for
+    the Jacobian the sample each y(t_n) was last set at (a slip sample; −1: stuck all period)."""
     N = len(w)
     w, lam_x = w.tolist(), lam_x.tolist()
     y = [0.0] * N
-    prev = w[-1]                # first pass from "stuck where the slider is"
+    source = [-1] * N
+    prev, last = w[-1], -1      # first pass from "stuck where the slider is"
     for _ in range(2):
         for n in range(N):
             lp = lam_x[n] + eps * (w[n] - prev)
             if lp > slip:
-                prev = w[n] - (slip - lam_x[n]) / eps
+                prev, last = w[n] - (slip - lam_x[n]) / eps, n
             elif lp < -slip:
-                prev = w[n] - (-slip - lam_x[n]) / eps
+                prev, last = w[n] - (-slip - lam_x[n]) / eps, n
             y[n] = prev
-    return np.array(y)
+            source[n] = last
+    return np.array(y), np.array(source)
 
 
 # ε = EPS_FACTOR/|r_1|: 10 is where hybrd converged most often on the chain at Ω = 0.4, 0.8, 1.85
@@ -111,9 +115,11 @@ EPS_FACTOR = 10.0
 
 
 def solve(M, C, K, F, omega: float, dof: int, slip_force: float, kt: float | None, H: int,
-          N: int | None = None, eps: float | None = None, guess: np.ndarray | None = None, xtol: float = 1e-12):
+          N: int | None = None, eps: float | None = None, guess: np.ndarray | None = None, xtol: float = 1e-12,
+          analytic: bool = True):
     """HB at H harmonics, N time samples (default the power of two ≥ 16(H+1)); `guess`: the slider
-    harmonics W (complex, length ≥ 1) of a previous solve, e.g. at fewer harmonics."""
+    harmonics W (complex, length ≥ 1) of a previous solve, e.g. at fewer harmonics; `analytic`:
+    the DLFT Jacobian (piecewise linear in W), else hybrd's finite differences."""
     n = len(M)
     N = N or int(2 ** np.ceil(np.log2(16 * (H + 1))))
     if N < 2 * H + 2:
@@ -128,15 +134,34 @@ def solve(M, C, K, F, omega: float, dof: int, slip_force: float, kt: float | Non
     eps = eps or EPS_FACTOR / abs(r[1])
     evals = [0]
 
-    def law(W):
-        lam_x = _samples((w0 - W) / r, N)
-        y = _dlft_contact(_samples(W, N), lam_x, eps, slip_force)
-        return _harmonics(y, H)
+    # Real-coefficient operators: samples of w and λ_X from z = [W0, Re W1, Im W1, …], and the
+    # harmonics of y back to z (for the analytic Jacobian).
+    theta = 2 * np.pi * np.arange(N) / N
+    E = np.zeros((N, 2 * H + 1))
+    L = np.zeros((N, 2 * H + 1))
+    Fm = np.zeros((2 * H + 1, N))
+    E[:, 0], L[:, 0], Fm[0] = 1.0, (-1.0 / r[0]).real, 1.0 / N
+    for h in range(1, H + 1):
+        e = np.exp(1j * h * theta)
+        E[:, 2 * h - 1], E[:, 2 * h] = e.real, -e.imag
+        L[:, 2 * h - 1], L[:, 2 * h] = (-e / r[h]).real, (-1j * e / r[h]).real
+        Fm[2 * h - 1], Fm[2 * h] = 2 / N * e.real, -2 / N * e.imag
+    last = {}
 
     def residual(z):
         evals[0] += 1
         W = _to_complex(z, H)
-        return _to_real(W - law(W))
+        y, source = _dlft_contact(_samples(W, N), _samples((w0 - W) / r, N), eps, slip_force)
+        last["source"] = source
+        return _to_real(W - _harmonics(y, H))
+
+    def jacobian(z):
+        # y(t_n) = w(t_m) − (±μN − λ_X(t_m))/ε with m the last slip sample: dy_n = E_m + L_m/ε;
+        # stuck all period: y = w(t_{N−1}).
+        residual(z)
+        src = last["source"]
+        rows = np.where(src[:, None] >= 0, E[np.maximum(src, 0)] + L[np.maximum(src, 0)] / eps, E[N - 1])
+        return np.eye(2 * H + 1) - Fm @ rows
 
     W = np.zeros(H + 1, dtype=complex)
     if guess is None:
@@ -144,9 +169,11 @@ def solve(M, C, K, F, omega: float, dof: int, slip_force: float, kt: float | Non
     else:
         m = min(len(guess), H + 1)
         W[:m] = guess[:m]
-    z, info, ier, msg = fsolve(residual, _to_real(W), xtol=xtol, full_output=True)
+    z, info, ier, msg = fsolve(residual, _to_real(W), fprime=jacobian if analytic else None, xtol=xtol, full_output=True)
     W = _to_complex(z, H)
     res = np.abs(residual(z)).max() / max(np.abs(z).max(), 1e-300)
     lam = (w0 - W) / r
     X = np.array([Hs[h] @ (Fh[h] - np.eye(n)[dof] * lam[h]) for h in range(H + 1)])
-    return HBSolution(X, omega, H, N, res, evals[0], ier == 1, W)
+    # Converged: the sampled law holds through H harmonics (hybrd may end with 'no progress' on
+    # a root it already reached, so its flag alone is not the test).
+    return HBSolution(X, omega, H, N, res, evals[0], bool(res < 1e-10), W)
