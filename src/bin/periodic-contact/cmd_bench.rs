@@ -64,23 +64,10 @@ fn reduced(steps: usize, mut rng: Option<&mut SplitMix>) -> Member {
     let omega = pick(&mut rng, 0.8, (0.6, 1.0));
     let masses: Vec<f64> = (0..n).map(|_| pick(&mut rng, 1.0, (0.5, 2.0))).collect();
     let springs: Vec<f64> = (0..=n).map(|_| pick(&mut rng, 1.0, (0.5, 2.0))).collect();
-    let row = |entry: &dyn Fn(usize) -> f64| format!("[{}]", (0..n).map(|j| format!("{}", entry(j))).collect::<Vec<_>>().join(", "));
-    let mass: Vec<String> = (0..n).map(|i| row(&|j| if i == j { masses[i] } else { 0.0 })).collect();
-    let stiffness: Vec<String> = (0..n)
-        .map(|i| {
-            row(&|j| match j {
-                _ if j == i => springs[i] + springs[i + 1],
-                _ if j == i + 1 => -springs[i + 1],
-                _ if j + 1 == i => -springs[i],
-                _ => 0.0,
-            })
-        })
-        .collect();
+    let (mass, stiffness) = chain_matrices(&masses, &springs);
     let mut scene = format!(
-        "[structure]\nmass = [{}]\nstiffness = [{}]\n\n[damping]\nrayleigh = [0.01, 0.02]\n\n[excitation]\nfrequency = {omega}\n\n\
-         [[force]]\ndof = 50\namplitude = 0.5\n\n",
-        mass.join(", "),
-        stiffness.join(", ")
+        "[structure]\nmass = {mass}\nstiffness = {stiffness}\n\n[damping]\nrayleigh = [0.01, 0.02]\n\n[excitation]\nfrequency = {omega}\n\n\
+         [[force]]\ndof = 50\namplitude = 0.5\n\n"
     );
     for c in 0..32 {
         let gap = pick(&mut rng, 0.1, (0.05, 0.15));
@@ -97,7 +84,49 @@ fn reduced(steps: usize, mut rng: Option<&mut SplitMix>) -> Member {
     Member { scene, summary: format!("ω={omega:.3}, m̄={:.3}", masses.iter().sum::<f64>() / n as f64) }
 }
 
-const CASES: [Case; 6] = [
+/// M and K of a fixed–fixed spring–mass chain (n masses, n + 1 springs) as dense TOML arrays.
+fn chain_matrices(masses: &[f64], springs: &[f64]) -> (String, String) {
+    let n = masses.len();
+    let row = |entry: &dyn Fn(usize) -> f64| format!("[{}]", (0..n).map(|j| format!("{}", entry(j))).collect::<Vec<_>>().join(", "));
+    let mass: Vec<String> = (0..n).map(|i| row(&|j| if i == j { masses[i] } else { 0.0 })).collect();
+    let stiffness: Vec<String> = (0..n)
+        .map(|i| {
+            row(&|j| match j {
+                _ if j == i => springs[i] + springs[i + 1],
+                _ if j == i + 1 => -springs[i + 1],
+                _ if j + 1 == i => -springs[i],
+                _ => 0.0,
+            })
+        })
+        .collect();
+    (format!("[{}]", mass.join(", ")), format!("[{}]", stiffness.join(", ")))
+}
+
+/// The friction size case (issue 25): a 16-DOF fixed–fixed chain with a friction contact under a
+/// constant normal load on every mass (Jenkins elements on the even DOFs, rigid Coulomb on the
+/// odd ones), Rayleigh damping, a harmonic force on DOF 8, bds1: N = 2·16·k. Drawn: masses and
+/// springs 0.5–2, ω, each μN and k_t.
+fn friction_chain(steps: usize, mut rng: Option<&mut SplitMix>) -> Member {
+    let n = 16;
+    let omega = pick(&mut rng, 1.0, (0.6, 1.4));
+    let masses: Vec<f64> = (0..n).map(|_| pick(&mut rng, 1.0, (0.5, 2.0))).collect();
+    let springs: Vec<f64> = (0..=n).map(|_| pick(&mut rng, 1.0, (0.5, 2.0))).collect();
+    let (mass, stiffness) = chain_matrices(&masses, &springs);
+    let mut scene = format!(
+        "[structure]\nmass = {mass}\nstiffness = {stiffness}\n\n[damping]\nrayleigh = [0.01, 0.02]\n\n[excitation]\nfrequency = {omega}\n\n\
+         [[force]]\ndof = 8\namplitude = 1.0\n\n"
+    );
+    for dof in 0..n {
+        let slip = pick(&mut rng, 0.05, (0.02, 0.1));
+        let kt = pick(&mut rng, 2.0, (0.5, 5.0));
+        let jenkins = if dof % 2 == 0 { format!("stiffness = {kt}\n") } else { String::new() };
+        scene += &format!("[[friction]]\ndof = {dof}\ncoefficient = 1.0\nnormal_force = {slip}\n{jenkins}\n");
+    }
+    scene += &format!("[discretization]\nscheme = \"bds1\"\nsteps = {steps}\n\n[output]\ndisplacement = [0, 8, 15]\n");
+    Member { scene, summary: format!("ω={omega:.3}, m̄={:.3}", masses.iter().sum::<f64>() / n as f64) }
+}
+
+const CASES: [Case; 7] = [
     Case {
         name: "rigid-stick",
         about: "rigid 1-DOF stop with sticking (0 < k·g0 < F; src/formulation.md §6.3): m = k = 1, F = 1, cds, forward pairing",
@@ -144,6 +173,11 @@ const CASES: [Case; 6] = [
         name: "reduced",
         about: "100-DOF model (dense matrices), 32 compliant stops (stiffness 1–4) against obstacles moving at ω, cds, same pairing (issue 23's size case: N = 32·k)",
         member: reduced,
+    },
+    Case {
+        name: "friction",
+        about: "16-DOF chain (dense matrices), a friction contact on every mass (μN 0.02–0.1; Jenkins k_t 0.5–5 on the even DOFs, rigid Coulomb on the odd), bds1 (issue 25's size case: N = 2·16·k)",
+        member: friction_chain,
     },
 ];
 
