@@ -17,7 +17,7 @@
 //! (friction alone). The slip velocity is α − w₁.
 //!
 //! The matrix is dense: N = k·(m_c + 2·m_f) unknowns, at most [`FRICTION_DENSE_MAX`].
-use super::friction_shooting::FrictionStepMap;
+use super::friction_shooting::{FrictionStepMap, coarse_start};
 use super::{Assembly, NoStepMap, PeriodFft, PeriodicProblem, SolveError, lcp_failure, recovery};
 use crate::lcp::{DenseMatrix, LcpInfo, LcpMethod, LcpOutcome, LcpSolution, LcpStep, Lemke, LemkeSettings, residuals};
 use crate::model::{Compliance, Contact, Model};
@@ -205,7 +205,7 @@ pub(super) fn solve(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, 
             }
             Err(why) => return Err(check_size(k, lay.mc, lay.mf).err().map_or(SolveError::Invalid(why.to_string()), |e| shooting_refused(e, &why))),
         };
-        let shot = map.shoot().map_err(|e| SolveError::Lcp {
+        let shot = map.shoot(coarse_start(problem, k, problem.period())).map_err(|e| SolveError::Lcp {
             outcome: LcpOutcome::PivotLimit,
             info: LcpInfo { pivots: e.iterations, residual: e.residual, ..LcpInfo::default() },
             hint: format!(

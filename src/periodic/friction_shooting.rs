@@ -22,6 +22,13 @@ use faer::Mat;
 /// march; a set that keeps changing (a cycle of the piecewise-affine map) ends as a typed failure.
 const MAX_ITERATIONS: usize = 60;
 
+/// Halvings of a Newton step that raises the periodicity residual, at most.
+const HALVINGS: i32 = 6;
+
+/// Fewest instants of a coarse grid worth solving first ([`coarse_start`]). Why: below, Newton
+/// from rest costs less than the coarse solve saves.
+const COARSE_MIN: usize = 256;
+
 /// The bds1 step map of a problem whose only nonsmooth rows are friction contacts.
 pub(super) struct FrictionStepMap {
     n: usize,
@@ -46,6 +53,8 @@ pub(super) struct FrictionStepMap {
 
 /// A converged friction orbit: the forces f_j (k × mf, time-major) and Newton's figures.
 pub(super) struct FrictionShot {
+    /// The periodic state y = (x, v, g) at t_(k−1).
+    pub state: Vec<f64>,
     pub forces: Vec<f64>,
     pub iterations: usize,
     /// max |y_end − y| / max(|y|, tiny) of the last march.
@@ -59,12 +68,11 @@ pub(super) struct ShotFailure {
     pub why: &'static str,
 }
 
-/// One march over the period: the end state, each instant's modes and forces, the tangent.
+/// One march over the period: the end state, each instant's modes and forces.
 struct March {
     end: Vec<f64>,
     modes: Vec<i8>,
     forces: Vec<f64>,
-    tangent: Option<Mat<f64>>,
 }
 
 impl FrictionStepMap {
@@ -163,12 +171,11 @@ impl FrictionStepMap {
     }
 
     /// Marches one period from `y`; step j starts from `guess[j]`'s modes (or the previous step's).
-    fn march(&self, y: &[f64], guess: Option<&[i8]>, tangent: bool) -> March {
+    fn march(&self, y: &[f64], guess: Option<&[i8]>) -> March {
         let (n, mf, d) = (self.n, self.mf, self.state_size());
         let mut state = y.to_vec();
         let mut modes = vec![0i8; self.k * mf];
         let mut forces = vec![0.0; self.k * mf];
-        let mut p = tangent.then(|| Mat::<f64>::identity(d, d));
         let mut pred = vec![0.0; n + mf];
         let mut last = vec![0i8; mf];
         for j in 0..self.k {
@@ -197,11 +204,8 @@ impl FrictionStepMap {
                     state[2 * n + s] = f[i];
                 }
             }
-            if let Some(p) = p.as_mut() {
-                *p = self.step_tangent(p, mode);
-            }
         }
-        March { end: state, modes, forces, tangent: p }
+        March { end: state, modes, forces }
     }
 
     /// ∂y_j/∂y₀ from ∂y_(j−1)/∂y₀ with step j's modes fixed (stuck rows: T_SS df_S = dQ_S).
@@ -314,26 +318,43 @@ impl FrictionStepMap {
         moved
     }
 
-    /// Newton on the periodic state with each march's sets fixed, from rest.
-    pub(super) fn shoot(&self) -> Result<FrictionShot, ShotFailure> {
+    /// max |y_end − y| relative to the states' size.
+    fn residual(y: &[f64], march: &March) -> f64 {
+        let scale = y.iter().chain(&march.end).fold(0.0f64, |a, v| a.max(v.abs())).max(f64::MIN_POSITIVE);
+        march.end.iter().zip(y).fold(0.0f64, |a, (e, s)| a.max((e - s).abs())) / scale
+    }
+
+    /// ∂y_end/∂y₀ with every instant's modes fixed (the state does not enter: a replay).
+    fn period_tangent(&self, modes: &[i8]) -> Mat<f64> {
         let d = self.state_size();
-        let mut y = vec![0.0; d];
-        let mut guess: Option<Vec<i8>> = None;
-        let mut residual = f64::INFINITY;
+        let mut p = Mat::<f64>::identity(d, d);
+        for j in 0..self.k {
+            p = self.step_tangent(&p, &modes[j * self.mf..(j + 1) * self.mf]);
+        }
+        p
+    }
+
+    /// Newton on the periodic state with each march's sets fixed, from `start` (a coarser
+    /// grid's orbit, [`coarse_start`]) or rest. A step that does not lower the residual is
+    /// halved (at most [`HALVINGS`] times, then taken at the least length): the piecewise-affine
+    /// map can make full steps cycle between sets.
+    pub(super) fn shoot(&self, start: Option<Vec<f64>>) -> Result<FrictionShot, ShotFailure> {
+        let d = self.state_size();
+        let mut y = start.filter(|s| s.len() == d).unwrap_or_else(|| vec![0.0; d]);
+        let mut march = self.march(&y, None);
+        let mut residual = Self::residual(&y, &march);
+        let mut unchanged = false;
         for iteration in 0..MAX_ITERATIONS {
-            let march = self.march(&y, guess.as_deref(), true);
-            let r: Vec<f64> = march.end.iter().zip(&y).map(|(e, s)| e - s).collect();
-            let scale = y.iter().chain(&march.end).fold(0.0f64, |a, v| a.max(v.abs())).max(f64::MIN_POSITIVE);
-            residual = r.iter().fold(0.0f64, |a, v| a.max(v.abs())) / scale;
             if !residual.is_finite() {
                 return Err(ShotFailure { iterations: iteration, residual, why: "the march overflowed" });
             }
             // Round-off, or the sets of the affine solve came back unchanged (its fixed point).
-            if residual <= 1e-12 || (guess.as_deref() == Some(&march.modes[..]) && residual <= 1e-8) {
-                return Ok(FrictionShot { forces: march.forces, iterations: iteration, residual });
+            if residual <= 1e-12 || (unchanged && residual <= 1e-8) {
+                return Ok(FrictionShot { state: y, forces: march.forces, iterations: iteration, residual });
             }
-            let p = march.tangent.expect("asked for");
+            let p = self.period_tangent(&march.modes);
             let i_minus_p = Mat::from_fn(d, d, |a, b| if a == b { 1.0 } else { 0.0 } - p[(a, b)]);
+            let r: Vec<f64> = march.end.iter().zip(&y).map(|(e, s)| e - s).collect();
             let delta = DenseLu::new(&i_minus_p).solve(&r);
             if delta.iter().any(|v| !v.is_finite()) {
                 return Err(ShotFailure {
@@ -342,9 +363,33 @@ impl FrictionStepMap {
                     why: "I − P is singular (a rigid contact stuck over the whole period leaves its position undetermined)",
                 });
             }
-            y.iter_mut().zip(&delta).for_each(|(s, dl)| *s += dl);
-            guess = Some(march.modes);
+            let mut length = 1.0;
+            let (next_y, next) = loop {
+                let cand: Vec<f64> = y.iter().zip(&delta).map(|(s, dl)| s + length * dl).collect();
+                let m = self.march(&cand, Some(&march.modes));
+                if Self::residual(&cand, &m) < residual || length < 0.5f64.powi(HALVINGS) {
+                    break (cand, m);
+                }
+                length *= 0.5;
+            };
+            unchanged = length == 1.0 && next.modes == march.modes;
+            y = next_y;
+            march = next;
+            residual = Self::residual(&y, &march);
         }
         Err(ShotFailure { iterations: MAX_ITERATIONS, residual, why: "the stick/slip sets kept changing" })
     }
+}
+
+/// The orbit's state on the grid of k/4 instants (recursively from k/16, …, down to
+/// [`COARSE_MIN`]), a start for Newton on k instants: the state at t_(k−1) is the state at
+/// t = T to first order on either grid, and most instants' sets are already right. `None` when
+/// k is small or the coarse shooting fails (Newton then starts from rest).
+pub(super) fn coarse_start(problem: &PeriodicProblem, k: usize, period: f64) -> Option<Vec<f64>> {
+    let kc = k / 4;
+    if kc < COARSE_MIN || k % 4 != 0 {
+        return None;
+    }
+    let map = FrictionStepMap::new(problem, kc, period).ok()?;
+    map.shoot(coarse_start(problem, kc, period)).ok().map(|shot| shot.state)
 }
