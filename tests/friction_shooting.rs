@@ -97,3 +97,19 @@ fn a_friction_problem_beyond_the_dense_limit_is_certified_and_converges_to_the_e
     let law = r.friction.iter().all(|f| f.force.iter().zip(&f.slip_velocity).all(|(f, v)| f * v >= -1e-12));
     assert!(law, "f·v ≥ 0 at every instant");
 }
+
+#[test]
+fn friction_with_a_unilateral_contact_beyond_the_dense_limit_is_refused_with_the_reason() {
+    let mut model = oscillator(0.1, 0.8, 0.5, Some(2.0)).model();
+    model.contacts.push(Contact::on_dof(0, 1.0, 2.0, Compliance::Rigid));
+    let problem = |steps: usize, method: LcpMethod| {
+        let outputs = OutputSelection { displacement: vec![0], velocity: vec![], acceleration: vec![], contacts: true };
+        let disc = Discretization { scheme: Scheme::Bds1, steps, pairing: None };
+        PeriodicProblem::new(model.clone(), disc, outputs, SolverSettings { method, ..SolverSettings::default() }).expect("problem")
+    };
+    // k·(1 + 2) = 6144 > 4096 unknowns: the dense path refuses, and shooting does not apply.
+    let e = problem(2048, LcpMethod::Auto).solve().unwrap_err().to_string();
+    assert!(e.contains("6144 unknowns") && e.contains("1365 or fewer") && e.contains("shooting does not apply") && e.contains("unilateral"), "{e}");
+    let e = problem(64, LcpMethod::Shooting).solve().unwrap_err().to_string();
+    assert!(e.contains("solver.method") && e.contains("unilateral"), "{e}");
+}
