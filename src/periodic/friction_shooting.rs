@@ -387,7 +387,7 @@ impl FrictionStepMap {
 /// k is small or the coarse shooting fails (Newton then starts from rest).
 pub(super) fn coarse_start(problem: &PeriodicProblem, k: usize, period: f64) -> Option<Vec<f64>> {
     let kc = k / 4;
-    if kc < COARSE_MIN || k % 4 != 0 {
+    if kc < COARSE_MIN || !k.is_multiple_of(4) {
         return None;
     }
     let map = FrictionStepMap::new(problem, kc, period).ok()?;
