@@ -8,7 +8,7 @@ use periodic_contact::periodic::*;
 use periodic_contact::response::Response;
 use periodic_contact::time::{Discretization, Scheme};
 
-use crate::friction::oscillator;
+use crate::friction::{chain_oscillator, oscillator};
 
 fn solve(model: Model, steps: usize, method: LcpMethod) -> Response {
     let n = model.n();
@@ -21,17 +21,7 @@ fn solve(model: Model, steps: usize, method: LcpMethod) -> Response {
 /// Ground–k1–m1–k2–m2, the load on m1 (tests/friction.rs's chain), friction on m2 and, with
 /// `both`, a Jenkins element on m1 too.
 fn chain(omega: f64, both: bool) -> Model {
-    let o = FrictionOscillator {
-        mass: vec![vec![1.0, 0.0], vec![0.0, 0.5]],
-        damping: vec![vec![0.06, -0.02], vec![-0.02, 0.02]],
-        stiffness: vec![vec![2.0, -1.0], vec![-1.0, 1.0]],
-        force: vec![1.0, 0.0],
-        omega,
-        dof: 1,
-        slip_force: 0.25,
-        tangential_stiffness: None,
-    };
-    let mut model = o.model();
+    let mut model = chain_oscillator(omega).model();
     if both {
         model.frictions.push(Friction::on_dof(0, 1.0, 0.3, Some(1.5)));
     }

@@ -60,15 +60,7 @@ const BLADE: &str = include_str!("../../../fmu/scenes/blade-casing-rigid.toml");
 /// Newton on the period map does not converge with 12 or more stops (measured). Drawn: masses and springs 0.5–2, ω, the gaps, the obstacles' amplitudes and
 /// phases, the contact stiffnesses.
 fn reduced(steps: usize, mut rng: Option<&mut SplitMix>) -> Member {
-    let n = 100;
-    let omega = pick(&mut rng, 0.8, (0.6, 1.0));
-    let masses: Vec<f64> = (0..n).map(|_| pick(&mut rng, 1.0, (0.5, 2.0))).collect();
-    let springs: Vec<f64> = (0..=n).map(|_| pick(&mut rng, 1.0, (0.5, 2.0))).collect();
-    let (mass, stiffness) = chain_matrices(&masses, &springs);
-    let mut scene = format!(
-        "[structure]\nmass = {mass}\nstiffness = {stiffness}\n\n[damping]\nrayleigh = [0.01, 0.02]\n\n[excitation]\nfrequency = {omega}\n\n\
-         [[force]]\ndof = 50\namplitude = 0.5\n\n"
-    );
+    let (mut scene, omega, mean_mass) = drawn_chain(&mut rng, 100, (0.8, (0.6, 1.0)), (50, 0.5));
     for c in 0..32 {
         let gap = pick(&mut rng, 0.1, (0.05, 0.15));
         let amplitude = pick(&mut rng, 0.25, (0.2, 0.3));
@@ -81,7 +73,23 @@ fn reduced(steps: usize, mut rng: Option<&mut SplitMix>) -> Member {
         );
     }
     scene += &format!("[discretization]\nscheme = \"cds\"\nsteps = {steps}\npairing = \"same\"\n\n[output]\ndisplacement = [0, 50, 99]\n");
-    Member { scene, summary: format!("ω={omega:.3}, m̄={:.3}", masses.iter().sum::<f64>() / n as f64) }
+    Member { scene, summary: format!("ω={omega:.3}, m̄={mean_mass:.3}") }
+}
+
+/// The head of a drawn chain scene (structure, Rayleigh damping 0.01/0.02, ω, one harmonic
+/// force `load` = (DOF, amplitude)): ω (nominal, range) first, then n masses and n + 1 springs in
+/// 0.5–2 (nominal 1). Returns the text, ω and the mean mass.
+fn drawn_chain(rng: &mut Option<&mut SplitMix>, n: usize, omega: (f64, (f64, f64)), load: (usize, f64)) -> (String, f64, f64) {
+    let omega = pick(rng, omega.0, omega.1);
+    let masses: Vec<f64> = (0..n).map(|_| pick(rng, 1.0, (0.5, 2.0))).collect();
+    let springs: Vec<f64> = (0..=n).map(|_| pick(rng, 1.0, (0.5, 2.0))).collect();
+    let (mass, stiffness) = chain_matrices(&masses, &springs);
+    let head = format!(
+        "[structure]\nmass = {mass}\nstiffness = {stiffness}\n\n[damping]\nrayleigh = [0.01, 0.02]\n\n[excitation]\nfrequency = {omega}\n\n\
+         [[force]]\ndof = {}\namplitude = {}\n\n",
+        load.0, load.1
+    );
+    (head, omega, masses.iter().sum::<f64>() / n as f64)
 }
 
 /// M and K of a fixed–fixed spring–mass chain (n masses, n + 1 springs) as dense TOML arrays.
@@ -108,14 +116,7 @@ fn chain_matrices(masses: &[f64], springs: &[f64]) -> (String, String) {
 /// springs 0.5–2, ω, each μN and k_t.
 fn friction_chain(steps: usize, mut rng: Option<&mut SplitMix>) -> Member {
     let n = 16;
-    let omega = pick(&mut rng, 1.0, (0.6, 1.4));
-    let masses: Vec<f64> = (0..n).map(|_| pick(&mut rng, 1.0, (0.5, 2.0))).collect();
-    let springs: Vec<f64> = (0..=n).map(|_| pick(&mut rng, 1.0, (0.5, 2.0))).collect();
-    let (mass, stiffness) = chain_matrices(&masses, &springs);
-    let mut scene = format!(
-        "[structure]\nmass = {mass}\nstiffness = {stiffness}\n\n[damping]\nrayleigh = [0.01, 0.02]\n\n[excitation]\nfrequency = {omega}\n\n\
-         [[force]]\ndof = 8\namplitude = 1.0\n\n"
-    );
+    let (mut scene, omega, mean_mass) = drawn_chain(&mut rng, n, (1.0, (0.6, 1.4)), (8, 1.0));
     for dof in 0..n {
         let slip = pick(&mut rng, 0.05, (0.02, 0.1));
         let kt = pick(&mut rng, 2.0, (0.5, 5.0));
@@ -123,7 +124,7 @@ fn friction_chain(steps: usize, mut rng: Option<&mut SplitMix>) -> Member {
         scene += &format!("[[friction]]\ndof = {dof}\ncoefficient = 1.0\nnormal_force = {slip}\n{jenkins}\n");
     }
     scene += &format!("[discretization]\nscheme = \"bds1\"\nsteps = {steps}\n\n[output]\ndisplacement = [0, 8, 15]\n");
-    Member { scene, summary: format!("ω={omega:.3}, m̄={:.3}", masses.iter().sum::<f64>() / n as f64) }
+    Member { scene, summary: format!("ω={omega:.3}, m̄={mean_mass:.3}") }
 }
 
 const CASES: [Case; 7] = [
