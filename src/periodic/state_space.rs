@@ -296,7 +296,7 @@ impl Condensed {
 }
 
 /// f(t_j) DOF by DOF (k×n), sampled as the assembly samples them.
-fn force_samples(model: &Model, k: usize, h: f64) -> Vec<f64> {
+pub(super) fn force_samples(model: &Model, k: usize, h: f64) -> Vec<f64> {
     let n = model.n();
     let mut f = vec![0.0; k * n];
     for j in 0..k {
