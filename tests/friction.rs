@@ -40,6 +40,20 @@ pub(crate) fn oscillator(c: f64, omega: f64, slip: f64, kt: Option<f64>) -> Fric
     }
 }
 
+/// Ground–k1–m1–k2–m2, the load on m1, friction (μN = 0.25, rigid Coulomb) on m2.
+pub(crate) fn chain_oscillator(omega: f64) -> FrictionOscillator {
+    FrictionOscillator {
+        mass: vec![vec![1.0, 0.0], vec![0.0, 0.5]],
+        damping: vec![vec![0.06, -0.02], vec![-0.02, 0.02]],
+        stiffness: vec![vec![2.0, -1.0], vec![-1.0, 1.0]],
+        force: vec![1.0, 0.0],
+        omega,
+        dof: 1,
+        slip_force: 0.25,
+        tangential_stiffness: None,
+    }
+}
+
 /// The LCP's solutions at k/2 and k.
 fn pair(model: &Model, k: usize) -> (Response, Response) {
     (solve(model.clone(), k / 2), solve(model.clone(), k))
@@ -121,16 +135,7 @@ fn two_dof_chain_with_friction_on_one_mass_against_the_event_driven_simulation()
     // (0.77, 1.85 rad/s). At the first resonance (Ω = 0.8) bds1 is off by 9.6e-2 at k = 512
     // (extrapolated 8.5e-3): its numerical damping, not the friction.
     for omega in [0.4, 1.2] {
-        let o = FrictionOscillator {
-            mass: vec![vec![1.0, 0.0], vec![0.0, 0.5]],
-            damping: vec![vec![0.06, -0.02], vec![-0.02, 0.02]],
-            stiffness: vec![vec![2.0, -1.0], vec![-1.0, 1.0]],
-            force: vec![1.0, 0.0],
-            omega,
-            dof: 1,
-            slip_force: 0.25,
-            tangential_stiffness: None,
-        };
+        let o = chain_oscillator(omega);
         let orbit = FrictionOrbit::solve(&o, 2000, 1e-11, 5000).expect("orbit");
         let p = pair(&o.model(), 512);
         let r = &p.1;

@@ -44,6 +44,8 @@ mod friction;
 mod friction_frontends;
 #[path = "friction_polish.rs"]
 mod friction_polish;
+#[path = "friction_shooting.rs"]
+mod friction_shooting;
 #[path = "frontends.rs"]
 mod frontends;
 #[path = "hard_cases.rs"]

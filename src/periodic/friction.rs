@@ -17,8 +17,9 @@
 //! (friction alone). The slip velocity is α − w₁.
 //!
 //! The matrix is dense: N = k·(m_c + 2·m_f) unknowns, at most [`FRICTION_DENSE_MAX`].
-use super::{Assembly, PeriodFft, PeriodicProblem, SolveError, lcp_failure, recovery};
-use crate::lcp::{DenseMatrix, LcpMethod, LcpOutcome, LcpSolution, LcpStep, Lemke, LemkeSettings};
+use super::friction_shooting::{FrictionStepMap, coarse_start};
+use super::{Assembly, NoStepMap, PeriodFft, PeriodicProblem, SolveError, lcp_failure, recovery};
+use crate::lcp::{DenseMatrix, LcpInfo, LcpMethod, LcpOutcome, LcpSolution, LcpStep, Lemke, LemkeSettings, residuals};
 use crate::model::{Compliance, Contact, Model};
 use crate::response::{FrictionResponse, Response};
 use crate::time::Scheme;
@@ -187,23 +188,76 @@ pub(super) fn solve(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, 
     let (k, m) = (asm.k, asm.m);
     let lay = Layout { k, mc: model.contacts.len(), mf: model.frictions.len() };
     debug_assert_eq!(m, lay.mc + lay.mf, "assembled with the friction rows");
-    let nn = check_size(k, lay.mc, lay.mf)?;
+    let nn = k * (lay.mc + 2 * lay.mf);
     let grid = FrictionGrid::new(problem.discretization().scheme, k, problem.period())?;
-    let (a, q) = friction_lcp(problem, asm, fft, &grid);
-    if let Some(i) = q.iter().chain(a.as_slice()).position(|v| !v.is_finite()) {
-        return Err(SolveError::Invalid(format!(
-            "friction: the LCP holds a non-finite value (entry {i}): loads, gaps, μN or stiffnesses overflow floating point; rescale the units"
-        )));
-    }
-    let t_assembly = t_start.elapsed().as_secs_f64();
-    let t_lcp = Instant::now();
-    let settings = LemkeSettings { certify_tol: problem.solver_settings().tolerance, max_pivots_per_dim: FRICTION_PIVOTS_PER_DIM, ..LemkeSettings::default() };
-    let mut sol = Lemke::new(settings).solve(&a, &q);
-    let lcp_time = t_lcp.elapsed().as_secs_f64();
-    sol.info.path = vec![LcpStep { method: LcpMethod::Lemke, size: nn, pivots: sol.info.pivots, outcome: sol.outcome, time_s: lcp_time }];
-    if sol.outcome != LcpOutcome::Solved {
-        return Err(lcp_failure(sol));
-    }
+    let method = problem.solver_settings().method;
+    // Shooting where the dense LCP is refused (or asked for); the dense path keeps small N.
+    let shoot = method == LcpMethod::Shooting || (method == LcpMethod::Auto && nn > FRICTION_DENSE_MAX);
+    let (sol, t_assembly, lcp_time, path) = if shoot {
+        let t_assembly = t_start.elapsed().as_secs_f64();
+        let t_lcp = Instant::now();
+        let map = match FrictionStepMap::new(problem, k, problem.period()) {
+            Ok(map) => map,
+            Err(why) if method == LcpMethod::Shooting => {
+                return Err(SolveError::Invalid(format!(
+                    "solver.method: \"shooting\" needs a time-stepping map, and this friction problem has none: {why}; use \"auto\""
+                )));
+            }
+            Err(why) => return Err(check_size(k, lay.mc, lay.mf).err().map_or(SolveError::Invalid(why.to_string()), |e| shooting_refused(e, &why))),
+        };
+        let shot = map.shoot(coarse_start(problem, k, problem.period())).map_err(|e| SolveError::Lcp {
+            outcome: LcpOutcome::PivotLimit,
+            info: LcpInfo { pivots: e.iterations, residual: e.residual, ..LcpInfo::default() },
+            hint: format!(
+                "friction shooting: {} after {} Newton iterations (relative periodicity residual {:.1e}); remedies: add damping, or reduce discretization.steps to {} or fewer for the dense LCP",
+                e.why,
+                e.iterations,
+                e.residual,
+                FRICTION_DENSE_MAX / (lay.mc + 2 * lay.mf)
+            ),
+        })?;
+        let mut sol = certify(problem, asm, fft, &grid, &shot.forces);
+        let lcp_time = t_lcp.elapsed().as_secs_f64();
+        sol.info.pivots = shot.iterations;
+        sol.info.time_s = lcp_time;
+        sol.info.path = vec![LcpStep { method: LcpMethod::Shooting, size: nn, pivots: shot.iterations, outcome: sol.outcome, time_s: lcp_time }];
+        if sol.outcome != LcpOutcome::Solved {
+            let hint = "the shooting orbit does not satisfy the periodic friction LCP to solver.tolerance (a set change the march missed); reduce discretization.steps or use solver.method = \"lemke\" where the dense LCP fits".to_string();
+            return Err(SolveError::Lcp { outcome: sol.outcome, info: sol.info, hint });
+        }
+        let path = format!(
+            "friction by shooting (N = {nn}: the box LCP of the friction rows, src/formulation.md §9): Newton on the bds1 period map, {} iterations (periodicity {:.1e}), certified on the full LCP by FFT products (residual {:.1e}), {lcp_time:.3} s → {}",
+            shot.iterations,
+            shot.residual,
+            sol.info.residual,
+            sol.outcome.name()
+        );
+        (sol, t_assembly, lcp_time, path)
+    } else {
+        check_size(k, lay.mc, lay.mf)?;
+        let (a, q) = friction_lcp(problem, asm, fft, &grid);
+        if let Some(i) = q.iter().chain(a.as_slice()).position(|v| !v.is_finite()) {
+            return Err(SolveError::Invalid(format!(
+                "friction: the LCP holds a non-finite value (entry {i}): loads, gaps, μN or stiffnesses overflow floating point; rescale the units"
+            )));
+        }
+        let t_assembly = t_start.elapsed().as_secs_f64();
+        let t_lcp = Instant::now();
+        let settings =
+            LemkeSettings { certify_tol: problem.solver_settings().tolerance, max_pivots_per_dim: FRICTION_PIVOTS_PER_DIM, ..LemkeSettings::default() };
+        let mut sol = Lemke::new(settings).solve(&a, &q);
+        let lcp_time = t_lcp.elapsed().as_secs_f64();
+        sol.info.path = vec![LcpStep { method: LcpMethod::Lemke, size: nn, pivots: sol.info.pivots, outcome: sol.outcome, time_s: lcp_time }];
+        if sol.outcome != LcpOutcome::Solved {
+            return Err(lcp_failure(sol));
+        }
+        let path = format!(
+            "friction (N = {nn}: contacts and the box LCP of the friction rows, src/formulation.md §9): dense lexicographic Lemke, {} pivots, {lcp_time:.3} s → {}",
+            sol.info.pivots,
+            sol.outcome.name()
+        );
+        (sol, t_assembly, lcp_time, path)
+    };
     let slip: Vec<f64> = model.frictions.iter().map(|f| f.slip_force()).collect();
     // The forces in the assembly's row order (j·m + a), friction forces f = z₁ − μN.
     let mut z = vec![0.0; k * m];
@@ -224,11 +278,7 @@ pub(super) fn solve(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, 
     let mut response = recovery::recover(problem, asm, fft, &rows)?;
     response.friction = (0..lay.mf).map(|t| friction_response(problem, asm, fft, (&rows.z, &forces[t]), &sol, &lay, t)).collect::<Result<_, _>>()?;
     response.lcp.size = nn;
-    response.lcp.path = format!(
-        "friction (N = {nn}: contacts and the box LCP of the friction rows, src/formulation.md §9): dense lexicographic Lemke, {} pivots, {lcp_time:.3} s → {}",
-        sol.info.pivots,
-        sol.outcome.name()
-    );
+    response.lcp.path = path;
     // Warm starts are not used by this path: no active set to carry.
     response.active_set.clear();
     response.timing_s.assembly = t_assembly;
@@ -236,6 +286,49 @@ pub(super) fn solve(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, 
     response.timing_s.recovery = t_rec.elapsed().as_secs_f64();
     response.timing_s.total = t_start.elapsed().as_secs_f64();
     Ok(response)
+}
+
+/// The full friction LCP's certificate of the forces f (k × m_f, time-major) of a friction-only
+/// problem: z₁ = f + μN, α = max(v, 0) with v = b_q-side slip velocity D(b xlin − G f) (− D f/k_t)
+/// by FFT products, w from the LCP's own rows; residual ‖min(z, w)‖∞ against solver.tolerance ×
+/// max(1, ‖q‖∞).
+fn certify(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, grid: &FrictionGrid, forces: &[f64]) -> LcpSolution {
+    let model = problem.model();
+    let (k, m, nh) = (asm.k, asm.m, asm.k / 2 + 1);
+    let lay = Layout { k, mc: 0, mf: m };
+    let nn = 2 * k * m;
+    let (mut z, mut w, mut q) = (vec![0.0; nn], vec![0.0; nn], vec![0.0; nn]);
+    let f_hat: Vec<Vec<C>> = (0..m).map(|t| fft.forward(&(0..k).map(|j| forces[j * m + t]).collect::<Vec<_>>())).collect();
+    for (t, fr) in model.frictions.iter().enumerate() {
+        let mu_n = fr.slip_force();
+        let bq = fft.inverse(&(0..nh).map(|p| -asm.bxlin_hat[p * m + t] * grid.velocity[p]).collect::<Vec<_>>());
+        let jenkins = fr.stiffness.map_or(0.0, |kt| 1.0 / kt);
+        let af_hat: Vec<C> =
+            (0..nh).map(|p| grid.velocity[p] * ((0..m).map(|b| asm.g_hat[(p * m + t) * m + b] * f_hat[b][p]).sum::<C>() + f_hat[t][p] * jenkins)).collect();
+        let af = fft.inverse(&af_hat);
+        for j in 0..k {
+            let (r, sl) = (lay.row(t, j), lay.slack(t, j));
+            let slip_velocity = -(af[j] + bq[j]);
+            z[r] = forces[j * m + t] + mu_n;
+            z[sl] = slip_velocity.max(0.0);
+            w[r] = af[j] + bq[j] + z[sl];
+            w[sl] = 2.0 * mu_n - z[r];
+            q[r] = bq[j];
+            q[sl] = 2.0 * mu_n;
+        }
+    }
+    let (residual, relative_error) = residuals(&q, &z, &w);
+    let qmax = q.iter().fold(1.0f64, |a, v| a.max(v.abs()));
+    let outcome = if residual <= problem.solver_settings().tolerance * qmax { LcpOutcome::Solved } else { LcpOutcome::Inaccurate };
+    LcpSolution { outcome, z, w, info: LcpInfo { residual, relative_error, ..LcpInfo::default() } }
+}
+
+/// The dense size refusal, with why shooting does not apply either.
+fn shooting_refused(dense: SolveError, why: &NoStepMap) -> SolveError {
+    match dense {
+        SolveError::Limit(text) => SolveError::Limit(format!("{text}; shooting does not apply: {why}")),
+        other => other,
+    }
 }
 
 /// Force, slip velocity, stuck flags, tangential displacement and dissipated energy of friction `t`.

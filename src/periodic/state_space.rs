@@ -315,7 +315,7 @@ fn force_rows(model: &Model, rows: &Mat<f64>) -> Mat<f64> {
 }
 
 /// f(t_j) DOF by DOF (k×n), sampled as the assembly samples them.
-fn force_samples(model: &Model, k: usize, h: f64) -> Vec<f64> {
+pub(super) fn force_samples(model: &Model, k: usize, h: f64) -> Vec<f64> {
     let n = model.n();
     let mut f = vec![0.0; k * n];
     for j in 0..k {

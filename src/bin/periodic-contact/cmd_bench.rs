@@ -60,28 +60,7 @@ const BLADE: &str = include_str!("../../../fmu/scenes/blade-casing-rigid.toml");
 /// Newton on the period map does not converge with 12 or more stops (measured). Drawn: masses and springs 0.5–2, ω, the gaps, the obstacles' amplitudes and
 /// phases, the contact stiffnesses.
 fn reduced(steps: usize, mut rng: Option<&mut SplitMix>) -> Member {
-    let n = 100;
-    let omega = pick(&mut rng, 0.8, (0.6, 1.0));
-    let masses: Vec<f64> = (0..n).map(|_| pick(&mut rng, 1.0, (0.5, 2.0))).collect();
-    let springs: Vec<f64> = (0..=n).map(|_| pick(&mut rng, 1.0, (0.5, 2.0))).collect();
-    let row = |entry: &dyn Fn(usize) -> f64| format!("[{}]", (0..n).map(|j| format!("{}", entry(j))).collect::<Vec<_>>().join(", "));
-    let mass: Vec<String> = (0..n).map(|i| row(&|j| if i == j { masses[i] } else { 0.0 })).collect();
-    let stiffness: Vec<String> = (0..n)
-        .map(|i| {
-            row(&|j| match j {
-                _ if j == i => springs[i] + springs[i + 1],
-                _ if j == i + 1 => -springs[i + 1],
-                _ if j + 1 == i => -springs[i],
-                _ => 0.0,
-            })
-        })
-        .collect();
-    let mut scene = format!(
-        "[structure]\nmass = [{}]\nstiffness = [{}]\n\n[damping]\nrayleigh = [0.01, 0.02]\n\n[excitation]\nfrequency = {omega}\n\n\
-         [[force]]\ndof = 50\namplitude = 0.5\n\n",
-        mass.join(", "),
-        stiffness.join(", ")
-    );
+    let (mut scene, omega, mean_mass) = drawn_chain(&mut rng, 100, (0.8, (0.6, 1.0)), (50, 0.5));
     for c in 0..32 {
         let gap = pick(&mut rng, 0.1, (0.05, 0.15));
         let amplitude = pick(&mut rng, 0.25, (0.2, 0.3));
@@ -94,10 +73,61 @@ fn reduced(steps: usize, mut rng: Option<&mut SplitMix>) -> Member {
         );
     }
     scene += &format!("[discretization]\nscheme = \"cds\"\nsteps = {steps}\npairing = \"same\"\n\n[output]\ndisplacement = [0, 50, 99]\n");
-    Member { scene, summary: format!("ω={omega:.3}, m̄={:.3}", masses.iter().sum::<f64>() / n as f64) }
+    Member { scene, summary: format!("ω={omega:.3}, m̄={mean_mass:.3}") }
 }
 
-const CASES: [Case; 6] = [
+/// The head of a drawn chain scene (structure, Rayleigh damping 0.01/0.02, ω, one harmonic
+/// force `load` = (DOF, amplitude)): ω (nominal, range) first, then n masses and n + 1 springs in
+/// 0.5–2 (nominal 1). Returns the text, ω and the mean mass.
+fn drawn_chain(rng: &mut Option<&mut SplitMix>, n: usize, omega: (f64, (f64, f64)), load: (usize, f64)) -> (String, f64, f64) {
+    let omega = pick(rng, omega.0, omega.1);
+    let masses: Vec<f64> = (0..n).map(|_| pick(rng, 1.0, (0.5, 2.0))).collect();
+    let springs: Vec<f64> = (0..=n).map(|_| pick(rng, 1.0, (0.5, 2.0))).collect();
+    let (mass, stiffness) = chain_matrices(&masses, &springs);
+    let head = format!(
+        "[structure]\nmass = {mass}\nstiffness = {stiffness}\n\n[damping]\nrayleigh = [0.01, 0.02]\n\n[excitation]\nfrequency = {omega}\n\n\
+         [[force]]\ndof = {}\namplitude = {}\n\n",
+        load.0, load.1
+    );
+    (head, omega, masses.iter().sum::<f64>() / n as f64)
+}
+
+/// M and K of a fixed–fixed spring–mass chain (n masses, n + 1 springs) as dense TOML arrays.
+fn chain_matrices(masses: &[f64], springs: &[f64]) -> (String, String) {
+    let n = masses.len();
+    let row = |entry: &dyn Fn(usize) -> f64| format!("[{}]", (0..n).map(|j| format!("{}", entry(j))).collect::<Vec<_>>().join(", "));
+    let mass: Vec<String> = (0..n).map(|i| row(&|j| if i == j { masses[i] } else { 0.0 })).collect();
+    let stiffness: Vec<String> = (0..n)
+        .map(|i| {
+            row(&|j| match j {
+                _ if j == i => springs[i] + springs[i + 1],
+                _ if j == i + 1 => -springs[i + 1],
+                _ if j + 1 == i => -springs[i],
+                _ => 0.0,
+            })
+        })
+        .collect();
+    (format!("[{}]", mass.join(", ")), format!("[{}]", stiffness.join(", ")))
+}
+
+/// The friction size case (issue 25): a 16-DOF fixed–fixed chain with a friction contact under a
+/// constant normal load on every mass (Jenkins elements on the even DOFs, rigid Coulomb on the
+/// odd ones), Rayleigh damping, a harmonic force on DOF 8, bds1: N = 2·16·k. Drawn: masses and
+/// springs 0.5–2, ω, each μN and k_t.
+fn friction_chain(steps: usize, mut rng: Option<&mut SplitMix>) -> Member {
+    let n = 16;
+    let (mut scene, omega, mean_mass) = drawn_chain(&mut rng, n, (1.0, (0.6, 1.4)), (8, 1.0));
+    for dof in 0..n {
+        let slip = pick(&mut rng, 0.05, (0.02, 0.1));
+        let kt = pick(&mut rng, 2.0, (0.5, 5.0));
+        let jenkins = if dof % 2 == 0 { format!("stiffness = {kt}\n") } else { String::new() };
+        scene += &format!("[[friction]]\ndof = {dof}\ncoefficient = 1.0\nnormal_force = {slip}\n{jenkins}\n");
+    }
+    scene += &format!("[discretization]\nscheme = \"bds1\"\nsteps = {steps}\n\n[output]\ndisplacement = [0, 8, 15]\n");
+    Member { scene, summary: format!("ω={omega:.3}, m̄={mean_mass:.3}") }
+}
+
+const CASES: [Case; 7] = [
     Case {
         name: "rigid-stick",
         about: "rigid 1-DOF stop with sticking (0 < k·g0 < F; src/formulation.md §6.3): m = k = 1, F = 1, cds, forward pairing",
@@ -144,6 +174,11 @@ const CASES: [Case; 6] = [
         name: "reduced",
         about: "100-DOF model (dense matrices), 32 compliant stops (stiffness 1–4) against obstacles moving at ω, cds, same pairing (issue 23's size case: N = 32·k)",
         member: reduced,
+    },
+    Case {
+        name: "friction",
+        about: "16-DOF chain (dense matrices), a friction contact on every mass (μN 0.02–0.1; Jenkins k_t 0.5–5 on the even DOFs, rigid Coulomb on the odd), bds1 (issue 25's size case: N = 2·16·k)",
+        member: friction_chain,
     },
 ];
 

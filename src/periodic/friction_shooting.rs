@@ -1,0 +1,395 @@
+//! Shooting for friction contacts under a constant normal load (src/formulation.md §9, "Friction
+//! by shooting").
+//!
+//! bds1 is implicit Euler in (x, v), v_j = (x_j − x_(j−1))/h:
+//! (M/h + C + hK) v_j = M v_(j−1)/h − K x_(j−1) + f(t_j) − B_fᵀ f_j, x_j = x_(j−1) + h v_j,
+//! so with W = (M/h + C + hK)⁻¹ the slip velocity of friction i at t_j is
+//! σ = s⁰ − T f_j, s⁰ = B_f W (M v/h − K x + f(t_j)) + g/(h k_t), T = B_f W B_fᵀ + diag(1/(h k_t)),
+//! where g = f_(j−1) is carried in the state for a Jenkins element (its slider velocity is
+//! D(u − f/k_t), the `friction_lcp`'s A + D/k_t) and 1/k_t = 0 for rigid Coulomb. Each instant
+//! is a box problem f ∈ [−μN, μN], f_i = μN·sign(σ_i) when σ_i ≠ 0: the KKT conditions of
+//! min ½fᵀTf − s⁰ᵀf over the box, monotone because T's symmetric part is positive definite for a
+//! passive structure (Moreau's time stepping). Each instant's set is stick / slip+ / slip−;
+//! with the sets fixed the period map is affine, so Newton's step (I − P) δ = y_end − y is exact
+//! and the march re-checks the sets, as shooting does for unilateral contacts.
+//!
+//! The answer is certified by the caller on the full periodic LCP (FFT products).
+use super::{NoStepMap, PeriodicProblem, SHOOTING_WORK_MAX};
+use crate::lcp::{DenseLu, DenseMatrix, LcpOutcome, Lemke, LemkeSettings, dense_product};
+use faer::Mat;
+
+/// Newton iterations of the friction shooting at most. Why: each fixes the sets of the last
+/// march; a set that keeps changing (a cycle of the piecewise-affine map) ends as a typed failure.
+const MAX_ITERATIONS: usize = 60;
+
+/// Halvings of a Newton step that raises the periodicity residual, at most.
+const HALVINGS: i32 = 6;
+
+/// Fewest instants of a coarse grid worth solving first ([`coarse_start`]). Why: below, Newton
+/// from rest costs less than the coarse solve saves.
+const COARSE_MIN: usize = 256;
+
+/// The bds1 step map of a problem whose only nonsmooth rows are friction contacts.
+pub(super) struct FrictionStepMap {
+    n: usize,
+    mf: usize,
+    k: usize,
+    h: f64,
+    /// Slot of friction i's previous force in the state (Jenkins elements only).
+    jenkins: Vec<Option<usize>>,
+    /// μN of friction i.
+    slip: Vec<f64>,
+    /// [E; Q] ((n + mf) × d): v_pred = E y + W f(t_j), s⁰ = Q y + B_f W f(t_j).
+    rows: Mat<f64>,
+    /// W B_fᵀ (n × mf).
+    wbt: Mat<f64>,
+    /// T (mf × mf, row-major).
+    t: Vec<f64>,
+    /// W f(t_j) at the k instants (k × n).
+    forcing: Vec<f64>,
+    /// The sliding DOF and its sign per friction contact.
+    dofs: Vec<(usize, f64)>,
+}
+
+/// A converged friction orbit: the forces f_j (k × mf, time-major) and Newton's figures.
+pub(super) struct FrictionShot {
+    /// The periodic state y = (x, v, g) at t_(k−1).
+    pub state: Vec<f64>,
+    pub forces: Vec<f64>,
+    pub iterations: usize,
+    /// max |y_end − y| / max(|y|, tiny) of the last march.
+    pub residual: f64,
+}
+
+/// Why the shooting did not converge (a typed outcome for the caller).
+pub(super) struct ShotFailure {
+    pub iterations: usize,
+    pub residual: f64,
+    pub why: &'static str,
+}
+
+/// One march over the period: the end state, each instant's modes and forces.
+struct March {
+    end: Vec<f64>,
+    modes: Vec<i8>,
+    forces: Vec<f64>,
+}
+
+impl FrictionStepMap {
+    /// The step map of `problem` (bds1, friction contacts only, no massless DOF), or why not.
+    pub(super) fn new(problem: &PeriodicProblem, k: usize, period: f64) -> Result<Self, NoStepMap> {
+        let model = problem.model();
+        if !model.contacts.is_empty() {
+            return Err(NoStepMap("friction together with unilateral contacts has no step map yet (the dense LCP solves them)".to_string()));
+        }
+        if !model.massless_dofs().is_empty() {
+            return Err(NoStepMap(format!("DOFs {:?} are massless: the friction step map needs a mass on every DOF", model.massless_dofs())));
+        }
+        let (n, mf) = (model.n(), model.frictions.len());
+        let mut dofs = Vec::with_capacity(mf);
+        for (i, f) in model.frictions.iter().enumerate() {
+            let &[(dof, dir)] = f.row.as_slice() else {
+                return Err(NoStepMap(format!("friction[{i}] slides along several DOFs")));
+            };
+            dofs.push((dof, dir));
+        }
+        let h = period / k as f64;
+        let mut jenkins = vec![None; mf];
+        let mut slots = 0;
+        for (i, f) in model.frictions.iter().enumerate() {
+            if f.stiffness.is_some() {
+                jenkins[i] = Some(slots);
+                slots += 1;
+            }
+        }
+        let d = 2 * n + slots;
+        let work = k as f64 * (n + mf) as f64 * (d * d) as f64;
+        if work > SHOOTING_WORK_MAX {
+            return Err(NoStepMap(format!(
+                "shooting on {n} DOFs with {mf} friction contacts over k = {k} steps costs ≈ {work:.1e} flops per Newton iteration (at most {SHOOTING_WORK_MAX:.0e})"
+            )));
+        }
+        let s = &model.structure;
+        let (mass, stiffness) = (s.mass.to_dense(), s.stiffness.to_dense());
+        let damping = s.damping.as_ref().map(|c| c.to_dense());
+        let n0 = Mat::from_fn(n, n, |r, c| mass[(r, c)] / h + damping.as_ref().map_or(0.0, |d| d[(r, c)]) + h * stiffness[(r, c)]);
+        let lu = DenseLu::new(&n0);
+        let unit = |c: usize| (0..n).map(|r| if r == c { 1.0 } else { 0.0 }).collect::<Vec<_>>();
+        let columns: Vec<Vec<f64>> = (0..n).map(|c| lu.solve(&unit(c))).collect();
+        let w = Mat::from_fn(n, n, |r, c| columns[c][r]);
+        if columns.iter().flatten().any(|v| !v.is_finite()) {
+            return Err(NoStepMap("M/h + C + hK is singular: no implicit Euler step".to_string()));
+        }
+        // E = W [−K, M/h, 0].
+        let wk = dense_product(&w, &stiffness);
+        let wm = dense_product(&w, &mass);
+        let e = Mat::from_fn(n, d, |r, c| {
+            if c < n {
+                -wk[(r, c)]
+            } else if c < 2 * n {
+                wm[(r, c - n)] / h
+            } else {
+                0.0
+            }
+        });
+        let wbt = Mat::from_fn(n, mf, |r, i| w[(r, dofs[i].0)] * dofs[i].1);
+        let inv_kt_h: Vec<f64> = model.frictions.iter().map(|f| f.stiffness.map_or(0.0, |kt| 1.0 / (h * kt))).collect();
+        let mut rows = Mat::zeros(n + mf, d);
+        for r in 0..n {
+            for c in 0..d {
+                rows[(r, c)] = e[(r, c)];
+            }
+        }
+        for (i, &(dof, dir)) in dofs.iter().enumerate() {
+            for c in 0..d {
+                rows[(n + i, c)] = dir * e[(dof, c)];
+            }
+            if let Some(slot) = jenkins[i] {
+                rows[(n + i, 2 * n + slot)] += inv_kt_h[i];
+            }
+        }
+        let mut t = vec![0.0; mf * mf];
+        for (i, &(dof, dir)) in dofs.iter().enumerate() {
+            for l in 0..mf {
+                t[i * mf + l] = dir * wbt[(dof, l)];
+            }
+            t[i * mf + i] += inv_kt_h[i];
+        }
+        let forces = super::state_space::force_samples(model, k, h);
+        let mut forcing = vec![0.0; k * n];
+        for j in 0..k {
+            for r in 0..n {
+                forcing[j * n + r] = (0..n).map(|l| w[(r, l)] * forces[j * n + l]).sum();
+            }
+        }
+        let slip = model.frictions.iter().map(|f| f.slip_force()).collect();
+        Ok(FrictionStepMap { n, mf, k, h, jenkins, slip, rows, wbt, t, forcing, dofs })
+    }
+
+    fn state_size(&self) -> usize {
+        2 * self.n + self.jenkins.iter().flatten().count()
+    }
+
+    /// Marches one period from `y`; step j starts from `guess[j]`'s modes (or the previous step's).
+    fn march(&self, y: &[f64], guess: Option<&[i8]>) -> March {
+        let (n, mf, d) = (self.n, self.mf, self.state_size());
+        let mut state = y.to_vec();
+        let mut modes = vec![0i8; self.k * mf];
+        let mut forces = vec![0.0; self.k * mf];
+        let mut pred = vec![0.0; n + mf];
+        let mut last = vec![0i8; mf];
+        for j in 0..self.k {
+            for (r, out) in pred.iter_mut().enumerate() {
+                *out = (0..d).map(|c| self.rows[(r, c)] * state[c]).sum::<f64>();
+            }
+            for r in 0..n {
+                pred[r] += self.forcing[j * n + r];
+            }
+            for (i, &(dof, dir)) in self.dofs.iter().enumerate() {
+                pred[n + i] += dir * self.forcing[j * n + dof];
+            }
+            let mode = &mut modes[j * mf..(j + 1) * mf];
+            mode.copy_from_slice(guess.map_or(&last[..], |g| &g[j * mf..(j + 1) * mf]));
+            let f = &mut forces[j * mf..(j + 1) * mf];
+            self.box_step(&pred[n..], mode, f);
+            last.copy_from_slice(mode);
+            // v = v_pred − W B_fᵀ f, x += h v, g = f.
+            for r in 0..n {
+                let v = pred[r] - (0..mf).map(|i| self.wbt[(r, i)] * f[i]).sum::<f64>();
+                state[n + r] = v;
+                state[r] += self.h * v;
+            }
+            for (i, slot) in self.jenkins.iter().enumerate() {
+                if let Some(s) = slot {
+                    state[2 * n + s] = f[i];
+                }
+            }
+        }
+        March { end: state, modes, forces }
+    }
+
+    /// ∂y_j/∂y₀ from ∂y_(j−1)/∂y₀ with step j's modes fixed (stuck rows: T_SS df_S = dQ_S).
+    fn step_tangent(&self, p: &Mat<f64>, mode: &[i8]) -> Mat<f64> {
+        let (n, d) = (self.n, p.ncols());
+        let rp = dense_product(&self.rows, p);
+        let stuck: Vec<usize> = (0..self.mf).filter(|&i| mode[i] == 0).collect();
+        let mut df = Mat::<f64>::zeros(self.mf, d);
+        if !stuck.is_empty() {
+            let ts = Mat::from_fn(stuck.len(), stuck.len(), |a, b| self.t[stuck[a] * self.mf + stuck[b]]);
+            let lu = DenseLu::new(&ts);
+            for c in 0..d {
+                let col = lu.solve(&stuck.iter().map(|&i| rp[(n + i, c)]).collect::<Vec<_>>());
+                for (a, &i) in stuck.iter().enumerate() {
+                    df[(i, c)] = col[a];
+                }
+            }
+        }
+        let mut next = Mat::<f64>::zeros(d, d);
+        for c in 0..d {
+            for r in 0..n {
+                let dv = rp[(r, c)] - stuck.iter().map(|&i| self.wbt[(r, i)] * df[(i, c)]).sum::<f64>();
+                next[(n + r, c)] = dv;
+                next[(r, c)] = p[(r, c)] + self.h * dv;
+            }
+            for (i, slot) in self.jenkins.iter().enumerate() {
+                if let Some(s) = slot {
+                    next[(2 * n + s, c)] = df[(i, c)];
+                }
+            }
+        }
+        next
+    }
+
+    /// The instant's box problem σ = s⁰ − T f, f ∈ [−μN, μN] ⊥ σ: from the guessed modes by a
+    /// primal–dual active set (mode updates from the violations), else Lemke on the relay LCP.
+    fn box_step(&self, s0: &[f64], mode: &mut [i8], f: &mut [f64]) {
+        let mf = self.mf;
+        for _ in 0..2 * mf + 2 {
+            self.solve_modes(s0, mode, f);
+            if !self.update_modes(s0, mode, f) {
+                return;
+            }
+        }
+        // relay_to_lcp: z₁ = f + μN, slack α; w₁ = T z₁ + α − s⁰ − T μN, w₂ = 2μN − z₁.
+        let nn = 2 * mf;
+        let mut data = vec![0.0; nn * nn];
+        let mut q = vec![0.0; nn];
+        for i in 0..mf {
+            for l in 0..mf {
+                data[i * nn + l] = self.t[i * mf + l];
+            }
+            data[i * nn + mf + i] = 1.0;
+            data[(mf + i) * nn + i] = -1.0;
+            q[i] = -s0[i] - (0..mf).map(|l| self.t[i * mf + l] * self.slip[l]).sum::<f64>();
+            q[mf + i] = 2.0 * self.slip[i];
+        }
+        let sol = Lemke::new(LemkeSettings::default()).solve(&DenseMatrix::from_row_major(nn, data), &q);
+        if sol.outcome != LcpOutcome::Solved {
+            return; // the march's end state shows the failure to Newton (no convergence)
+        }
+        for i in 0..mf {
+            let fi = sol.z[i] - self.slip[i];
+            mode[i] = if fi.abs() < self.slip[i] * (1.0 - 1e-9) { 0 } else { fi.signum() as i8 };
+        }
+        self.solve_modes(s0, mode, f);
+        if self.update_modes(s0, mode, f) {
+            // Lemke's own forces when the modes it names do not reproduce them (degenerate ties).
+            (0..mf).for_each(|i| f[i] = sol.z[i] - self.slip[i]);
+        }
+    }
+
+    /// f with the modes fixed: slipping rows at ±μN, stuck rows from T_SS f_S = s⁰_S − T_SL f_L.
+    fn solve_modes(&self, s0: &[f64], mode: &[i8], f: &mut [f64]) {
+        let mf = self.mf;
+        let stuck: Vec<usize> = (0..mf).filter(|&i| mode[i] == 0).collect();
+        for i in 0..mf {
+            f[i] = f64::from(mode[i]) * self.slip[i];
+        }
+        if stuck.is_empty() {
+            return;
+        }
+        let rhs: Vec<f64> = stuck.iter().map(|&i| s0[i] - (0..mf).filter(|&l| mode[l] != 0).map(|l| self.t[i * mf + l] * f[l]).sum::<f64>()).collect();
+        let ts = Mat::from_fn(stuck.len(), stuck.len(), |a, b| self.t[stuck[a] * mf + stuck[b]]);
+        let fs = DenseLu::new(&ts).solve(&rhs);
+        for (a, &i) in stuck.iter().enumerate() {
+            f[i] = fs[a];
+        }
+    }
+
+    /// Moves violated rows to their other mode; whether any moved.
+    fn update_modes(&self, s0: &[f64], mode: &mut [i8], f: &[f64]) -> bool {
+        let mf = self.mf;
+        let scale = s0.iter().fold(0.0f64, |a, v| a.max(v.abs()))
+            + (0..mf).map(|i| (0..mf).map(|l| self.t[i * mf + l].abs() * self.slip[l]).sum::<f64>()).fold(0.0, f64::max);
+        let tol = 1e-12 * scale.max(f64::MIN_POSITIVE);
+        let mut moved = false;
+        for i in 0..mf {
+            let sigma = s0[i] - (0..mf).map(|l| self.t[i * mf + l] * f[l]).sum::<f64>();
+            let next = match mode[i] {
+                0 if f[i] > self.slip[i] * (1.0 + 1e-12) => 1,
+                0 if f[i] < -self.slip[i] * (1.0 + 1e-12) => -1,
+                1 if sigma < -tol => 0,
+                -1 if sigma > tol => 0,
+                other => other,
+            };
+            moved |= next != mode[i] || !f[i].is_finite();
+            mode[i] = next;
+        }
+        moved
+    }
+
+    /// max |y_end − y| relative to the states' size.
+    fn residual(y: &[f64], march: &March) -> f64 {
+        let scale = y.iter().chain(&march.end).fold(0.0f64, |a, v| a.max(v.abs())).max(f64::MIN_POSITIVE);
+        march.end.iter().zip(y).fold(0.0f64, |a, (e, s)| a.max((e - s).abs())) / scale
+    }
+
+    /// ∂y_end/∂y₀ with every instant's modes fixed (the state does not enter: a replay).
+    fn period_tangent(&self, modes: &[i8]) -> Mat<f64> {
+        let d = self.state_size();
+        let mut p = Mat::<f64>::identity(d, d);
+        for j in 0..self.k {
+            p = self.step_tangent(&p, &modes[j * self.mf..(j + 1) * self.mf]);
+        }
+        p
+    }
+
+    /// Newton on the periodic state with each march's sets fixed, from `start` (a coarser
+    /// grid's orbit, [`coarse_start`]) or rest. A step that does not lower the residual is
+    /// halved (at most [`HALVINGS`] times, then taken at the least length): the piecewise-affine
+    /// map can make full steps cycle between sets.
+    pub(super) fn shoot(&self, start: Option<Vec<f64>>) -> Result<FrictionShot, ShotFailure> {
+        let d = self.state_size();
+        let mut y = start.filter(|s| s.len() == d).unwrap_or_else(|| vec![0.0; d]);
+        let mut march = self.march(&y, None);
+        let mut residual = Self::residual(&y, &march);
+        let mut unchanged = false;
+        for iteration in 0..MAX_ITERATIONS {
+            if !residual.is_finite() {
+                return Err(ShotFailure { iterations: iteration, residual, why: "the march overflowed" });
+            }
+            // Round-off, or the sets of the affine solve came back unchanged (its fixed point).
+            if residual <= 1e-12 || (unchanged && residual <= 1e-8) {
+                return Ok(FrictionShot { state: y, forces: march.forces, iterations: iteration, residual });
+            }
+            let p = self.period_tangent(&march.modes);
+            let i_minus_p = Mat::from_fn(d, d, |a, b| if a == b { 1.0 } else { 0.0 } - p[(a, b)]);
+            let r: Vec<f64> = march.end.iter().zip(&y).map(|(e, s)| e - s).collect();
+            let delta = DenseLu::new(&i_minus_p).solve(&r);
+            if delta.iter().any(|v| !v.is_finite()) {
+                return Err(ShotFailure {
+                    iterations: iteration,
+                    residual,
+                    why: "I − P is singular (a rigid contact stuck over the whole period leaves its position undetermined)",
+                });
+            }
+            let mut length = 1.0;
+            let (next_y, next) = loop {
+                let cand: Vec<f64> = y.iter().zip(&delta).map(|(s, dl)| s + length * dl).collect();
+                let m = self.march(&cand, Some(&march.modes));
+                if Self::residual(&cand, &m) < residual || length < 0.5f64.powi(HALVINGS) {
+                    break (cand, m);
+                }
+                length *= 0.5;
+            };
+            unchanged = length == 1.0 && next.modes == march.modes;
+            y = next_y;
+            march = next;
+            residual = Self::residual(&y, &march);
+        }
+        Err(ShotFailure { iterations: MAX_ITERATIONS, residual, why: "the stick/slip sets kept changing" })
+    }
+}
+
+/// The orbit's state on the grid of k/4 instants (recursively from k/16, …, down to
+/// [`COARSE_MIN`]), a start for Newton on k instants: the state at t_(k−1) is the state at
+/// t = T to first order on either grid, and most instants' sets are already right. `None` when
+/// k is small or the coarse shooting fails (Newton then starts from rest).
+pub(super) fn coarse_start(problem: &PeriodicProblem, k: usize, period: f64) -> Option<Vec<f64>> {
+    let kc = k / 4;
+    if kc < COARSE_MIN || !k.is_multiple_of(4) {
+        return None;
+    }
+    let map = FrictionStepMap::new(problem, kc, period).ok()?;
+    map.shoot(coarse_start(problem, kc, period)).ok().map(|shot| shot.state)
+}
