@@ -10,8 +10,8 @@
 //! beyond it is started from the grid LCP's orbit, polished, a short way past the change
 //! ([`RESEED`] of the range, growing until the polish accepts the grid's signature): the
 //! stretch between is not traced, and the grazing's detail says so.
-use super::family::{Node, Signature};
-use super::{EventKind, Walk, bisect};
+use super::family::{Family, Node, Signature};
+use super::{BRACKET, EventKind, Walk, bisect};
 use crate::analysis::polish::{self, Event};
 use crate::periodic::{PeriodicProblem, PeriodicSolver};
 use crate::time::Discretization;
@@ -61,6 +61,10 @@ impl Walk<'_> {
             }
             ("impulse of the impact", Some(e)) if lo.orbit.events()[e].kind == (polish::EventKind::Impact { stick: false }) => {
                 list.remove(e);
+                // Located on the orbit without the impact, regular where the impacting one is singular.
+                if let Some(n) = self.fade(here, next, &lo, list.clone(), &what) {
+                    return Some(n);
+                }
                 true
             }
             _ => false,
@@ -69,6 +73,38 @@ impl Walk<'_> {
             return Some(n);
         }
         self.reseed(&lo, &what, to)
+    }
+
+    /// An impact's impulse fades between `here` (positive) and `next` (negative): the grazing where
+    /// it vanishes is the point where the orbit without it (signature `list`, events at fractions
+    /// of the period as on `near`) touches the stop (Nordmark 1991: both orbits coincide there).
+    /// Located by bisection in λ on that orbit, corrected at λ fixed (regular, unlike the impacting
+    /// orbit whose impact velocity vanishes there), on the sign of its rigid margin between λ(here)
+    /// and λ(next); the branch goes on towards the side where that margin is ≥ 0, which reverses λ
+    /// when the impacting orbit and the admissible contact-free one lie on the same side (the
+    /// unstable impacting orbit from a fold ending at the grazing). `None` without a sign change.
+    fn fade(&mut self, here: &Node, next: &Node, near: &Node, list: Vec<(f64, Event)>, what: &str) -> Option<Node> {
+        let rho = self.fam.rho;
+        let t = near.orbit.period();
+        let t0 = list.first().map_or(0.0, |l| l.0 * t);
+        let mut guess: Vec<f64> = near.orbit.state(t0).iter().map(|y| y / self.fam.ys).collect();
+        guess.extend(list.iter().map(|l| l.0));
+        guess.push(0.0);
+        let sig = Signature { events: list.iter().map(|l| l.1).collect(), always: near.orbit.always_closed().to_vec() };
+        let before = self.fam.ne();
+        let old = std::mem::replace(&mut self.fam.sig, sig);
+        let located = touch_point(&mut self.fam, &guess, here.lambda(rho), next.lambda(rho));
+        match located {
+            Some(n) => {
+                let detail = format!("{what}; events per period {before} -> {} (located on the orbit without the impact)", self.fam.ne());
+                self.push(&n, Some(EventKind::Grazing), detail);
+                Some(n)
+            }
+            None => {
+                self.fam.sig = old;
+                None
+            }
+        }
     }
 
     /// The branch of the signature `list` (events at fractions of the period) through the orbit
@@ -184,4 +220,60 @@ fn grid_orbit(problem: &PeriodicProblem, param: super::Parameter, lambda: f64) -
     let disc = p.discretization();
     p.set_discretization(Discretization { steps: REFINE * disc.steps, ..disc }).ok()?;
     solve(&p)
+}
+
+/// The point between λ = `la` and `lb` where the orbit of the family's signature (corrected at λ
+/// fixed from `guess`'s unknowns) stops being admissible: bisection in λ on the sign of its
+/// rigid margin, to [`BRACKET`] of the range; the node on the admissible side, its tangent
+/// pointing away from the inadmissible one. `None` without a sign change or where the corrector fails.
+fn touch_point(fam: &mut Family, guess: &[f64], la: f64, lb: f64) -> Option<Node> {
+    let (rho, d) = (fam.rho, fam.dim());
+    let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
+    // The orbit at λ from the unknowns `from`: (unknowns, admissible).
+    let at = |fam: &mut Family, from: &[f64], lambda: f64| -> Option<(Vec<f64>, bool)> {
+        let mut g = from.to_vec();
+        g[d - 1] = lambda / rho;
+        let w = correct_far(fam, &g, &e_l, lambda / rho)?;
+        let n = fam.node_with(w, &e_l, false)?;
+        let ok = margin(&n) >= -TOL;
+        Some((n.w, ok))
+    };
+    let a = at(fam, guess, la)?;
+    let b = at(fam, &a.0, lb)?;
+    let (mut ok, mut lok, mut lbad) = match (a.1, b.1) {
+        (true, false) => (a.0, la, lb),
+        (false, true) => (b.0, lb, la),
+        _ => return None,
+    };
+    while (lok - lbad).abs() > BRACKET * rho {
+        let mid = 0.5 * (lok + lbad);
+        match at(fam, &ok, mid)? {
+            (w, true) => (ok, lok) = (w, mid),
+            (_, false) => lbad = mid,
+        }
+    }
+    let prev: Vec<f64> = e_l.iter().map(|x| x * (lok - lbad).signum()).collect();
+    fam.node(ok, &prev)
+}
+
+/// [`Family::correct`] from a guess whose state may lie further than the state scale from the
+/// solution (the orbit without an impact, guessed from the impacting one far from the grazing):
+/// where Newton's first steps exceed the scale, corrected on a 10× and 100× coarser state scale
+/// first, then on the family's own.
+fn correct_far(fam: &mut Family, guess: &[f64], normal: &[f64], target: f64) -> Option<Vec<f64>> {
+    if let Some(w) = fam.correct(guess, normal, target) {
+        return Some(w);
+    }
+    let (ys, states) = (fam.ys, fam.dim() - 1 - fam.ne());
+    for f in [10.0, 100.0] {
+        fam.ys = ys * f;
+        let g: Vec<f64> = guess.iter().enumerate().map(|(i, w)| if i < states { w / f } else { *w }).collect();
+        let coarse = fam.correct(&g, normal, target);
+        fam.ys = ys;
+        let fine = coarse.map(|w| w.iter().enumerate().map(|(i, w)| if i < states { w * f } else { *w }).collect::<Vec<f64>>());
+        if let Some(w) = fine.and_then(|w| fam.correct(&w, normal, target)) {
+            return Some(w);
+        }
+    }
+    None
 }
