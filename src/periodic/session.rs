@@ -33,7 +33,7 @@ pub struct PeriodicSolver {
     warm_starts: bool,
     last_start: WarmStart,
     /// The last assembly, reused while only gaps, motions or a common force scale change.
-    cache: Option<AssemblyCache>,
+    pub(super) cache: Option<AssemblyCache>,
     /// Assemblies built by this session (the others were reused).
     assemblies: usize,
 }
