@@ -2,7 +2,7 @@
 //! private: every way in (constructor, updaters) runs the checks, so a `PeriodicProblem` is
 //! always ready to solve.
 use super::{Assembly, OutputMap, OutputSelection, PeriodFft, SolveError, SolverSettings, assembly, lcp_failure, limits, recovery};
-use crate::lcp::{BlockCirculant, DENSE_MAX, DENSE_MEMORY_MAX, GIB, LcpMethod, LcpOutcome, LcpSolution, dense_memory, solve_periodic_lcp};
+use crate::lcp::{BlockCirculant, DENSE_MAX, DENSE_MEMORY_MAX, GIB, LcpMethod, LcpOutcome, LcpSolution, dense_memory, solve_periodic_lcp_with};
 use crate::model::{Contact, Model};
 use crate::response::Response;
 use crate::time::{Discretization, Pairing};
@@ -460,7 +460,7 @@ impl PeriodicProblem {
             }
         }
         let step_map = step_map.and_then(Result::ok);
-        let (sol, _state) = solve_periodic_lcp(a, q, step_map.as_ref(), method, self.solver.tolerance, warm_start);
+        let (sol, _state) = solve_periodic_lcp_with(a, q, step_map.as_ref(), method, self.solver.tolerance, warm_start, self.solver.shooting_warm_only);
         if sol.outcome == LcpOutcome::Solved { Ok(sol) } else { Err(lcp_failure(sol)) }
     }
 
