@@ -228,15 +228,24 @@ pub fn run(
             .collect()
     });
     let mut points: Vec<SweepPoint> = results.into_iter().flatten().collect();
-    if settings.warm_start && guarded(session.problem()) && points.iter().any(|x| x.error.is_some()) {
-        let mut solver = session.clone();
-        let mut second = None;
-        // From the solved neighbour above first (the branch below a fold, followed down), then below.
-        for reverse in [true, false] {
-            refill(&mut solver, &mut second, settings, &mut points, reverse);
-        }
+    if settings.warm_start && guarded(session.problem()) {
+        refill(base, &mut points, settings);
     }
     Ok(points)
+}
+
+/// Retries the failed points of a sweep of `template` from their nearest solved neighbours
+/// ([`refill_pass`]): from the neighbour after each first (the branch beyond a fold, followed
+/// back), then from the one before. `run` does this for a guarded sweep.
+pub fn refill(template: &PeriodicProblem, points: &mut [SweepPoint], settings: &SweepSettings) {
+    if points.iter().all(|x| x.error.is_none()) {
+        return;
+    }
+    let mut solver = PeriodicSolver::new(template.clone());
+    let mut second = None;
+    for reverse in [true, false] {
+        refill_pass(&mut solver, &mut second, settings, points, reverse);
+    }
 }
 
 /// The point's error estimate ([`SweepSettings::estimate`]): a second solve on the other grid,
@@ -255,7 +264,13 @@ fn estimate(point: &mut SweepPoint, solver: &PeriodicSolver, r: &Response, secon
 /// branch ends, the forward pass loses the orbit (the neighbour's sets lead nowhere and cold
 /// shooting's homotopy misses), while the other branch, once reached further up, continues
 /// down to those points in a few Newton iterations each. A point still missed keeps its failure.
-fn refill(solver: &mut PeriodicSolver, second: &mut Option<(PeriodicSolver, Option<f64>)>, settings: &SweepSettings, points: &mut [SweepPoint], reverse: bool) {
+fn refill_pass(
+    solver: &mut PeriodicSolver,
+    second: &mut Option<(PeriodicSolver, Option<f64>)>,
+    settings: &SweepSettings,
+    points: &mut [SweepPoint],
+    reverse: bool,
+) {
     let order: Vec<usize> = if reverse { (0..points.len()).rev().collect() } else { (0..points.len()).collect() };
     let mut neighbour: Option<usize> = None;
     for i in order {
