@@ -125,7 +125,7 @@ mod tests {
             session.update_frequency(omega).unwrap();
             let swept = session.solve().unwrap();
             let op = session.cache.as_ref().and_then(|c| c.structure.as_ref()).map(|(_, op)| op.clone()).unwrap();
-            assert!(first.get_or_insert_with(|| op.clone()).as_ref() as *const _ == op.as_ref() as *const _, "ω = {omega}: the operator was rebuilt");
+            assert!(Arc::ptr_eq(first.get_or_insert_with(|| op.clone()), &op), "ω = {omega}: the operator was rebuilt");
             let mut fresh = problem.clone();
             fresh.set_frequency(omega).unwrap();
             let alone = fresh.solve().unwrap();
