@@ -34,7 +34,7 @@ pub use matrix::{BlockCirculant, DenseMatrix, LcpMatrix};
 pub use pivoting::{BlockPivoting, PivotingSettings};
 pub use policy::{
     AUTO_LEMKE_MAX, DENSE_MAX, DENSE_MEMORY_MAX, GIB, LEMKE_AFTER_SHOOTING_MAX, LcpMethod, LcpMethodError, dense_memory, solve_circulant_lcp,
-    solve_periodic_lcp,
+    solve_periodic_lcp, solve_periodic_lcp_with,
 };
 pub use reference::solve_by_enumeration;
 pub use status::{LcpInfo, LcpOutcome, LcpSolution, LcpStep, WarmOutcome, residuals};

@@ -78,6 +78,20 @@ pub fn solve_periodic_lcp(
     tolerance: f64,
     warm_start: Option<&[usize]>,
 ) -> (LcpSolution, Option<Vec<f64>>) {
+    solve_periodic_lcp_with(a, q, step_map, method, tolerance, warm_start, false)
+}
+
+/// [`solve_periodic_lcp`]; `warm_only`: shooting with a warm start stops where Newton from it
+/// misses ([`ShootingSettings::warm_only`]).
+pub fn solve_periodic_lcp_with(
+    a: &BlockCirculant,
+    q: &[f64],
+    step_map: Option<&StepMapLcp>,
+    method: LcpMethod,
+    tolerance: f64,
+    warm_start: Option<&[usize]>,
+    warm_only: bool,
+) -> (LcpSolution, Option<Vec<f64>>) {
     if q.is_empty() {
         return (LcpSolution { outcome: LcpOutcome::Solved, z: vec![], w: vec![], info: Default::default() }, None);
     }
@@ -133,7 +147,7 @@ pub fn solve_periodic_lcp(
             // bounds each try.
             let defaults = ShootingSettings::default();
             let max_work = if method == LcpMethod::Auto && dense_ok { defaults.max_work.max(0.5 * (q.len() as f64).powi(3)) } else { defaults.max_work };
-            let (sol, state) = shooting(a, q, sm, tolerance, warm_start, &ShootingSettings { max_work, ..defaults });
+            let (sol, state) = shooting(a, q, sm, tolerance, warm_start, &ShootingSettings { max_work, warm_only, ..defaults });
             if sol.outcome == LcpOutcome::Solved || method == LcpMethod::Shooting || !dense_ok {
                 return (sol, state);
             }

@@ -232,6 +232,44 @@ struct HarmonicBlock {
 /// (k instants over `period`: T, or p·T for an orbit of p forcing periods).
 /// `parallel`: spread the harmonics over rayon's threads (never from inside an FMU).
 pub fn assemble(model: &Model, scheme: Scheme, period: f64, dofs: &[usize], fft: &PeriodFft, parallel: bool) -> Result<Assembly, SolveError> {
+    assemble_with(model, &StructureOperator::new(model)?, scheme, period, dofs, fft, parallel)
+}
+
+/// The ω-independent part of the assembly, built once per structure (M, C, K) and reused at every
+/// frequency and grid: the modes and MacNeal's residual flexibility of a modal model, the dense
+/// matrices, or the sparse LU's symbolic analysis. Per ω only the diagonal D_p (or the numeric
+/// factorisations of a non-modal model) is redone, as Clarabel updates data instead of rebuilding.
+pub struct StructureOperator(Operator);
+
+impl StructureOperator {
+    pub fn new(model: &Model) -> Result<Self, SolveError> {
+        Operator::new(model).map(StructureOperator)
+    }
+}
+
+impl std::fmt::Debug for StructureOperator {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let form = match &self.0 {
+            Operator::Dense { .. } => "dense",
+            Operator::Modal { .. } => "modal",
+            Operator::Sparse { .. } => "sparse",
+        };
+        write!(f, "StructureOperator({form})")
+    }
+}
+
+/// [`assemble`] on a structure operator built before (by [`StructureOperator::new`] on a model
+/// with the same M, C and K; the contacts, forces and frequency are `model`'s).
+pub fn assemble_with(
+    model: &Model,
+    op: &StructureOperator,
+    scheme: Scheme,
+    period: f64,
+    dofs: &[usize],
+    fft: &PeriodFft,
+    parallel: bool,
+) -> Result<Assembly, SolveError> {
+    let op = &op.0;
     let k = fft.k();
     let n = model.n();
     let m = model.contacts.len();
@@ -245,8 +283,7 @@ pub fn assemble(model: &Model, scheme: Scheme, period: f64, dofs: &[usize], fft:
             "force: the samples of the force on DOF {d} overflow floating point (amplitudes too large); rescale the units"
         )));
     }
-    let op = Operator::new(model)?;
-    if let Operator::Modal { phi, lambda, c, residual } = &op {
+    if let Operator::Modal { phi, lambda, c, residual } = op {
         let mut asm = assemble_modal(model, symbols, &forces, dofs, phi, lambda, c, k)?;
         if let Some(r) = residual {
             add_residual(&mut asm, model, &forces, r)?;
@@ -455,13 +492,13 @@ fn check_pivots(u: faer::MatRef<'_, C>, terms: f64) -> Result<(), ()> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::model::{Compliance, Contact, Force, Harmonic, Structure};
 
     /// A 20-DOF spring chain whose first 4 DOFs are massless (a massless-boundary model), mass-
     /// proportional damping, contacts on massless and massive DOFs, forces on both.
-    fn chain_with_massless_boundary() -> Model {
+    pub(in crate::periodic) fn chain_with_massless_boundary() -> Model {
         let n = 20;
         let massless = 4;
         let stiffness = |i: usize| 1.0e4 * (1.0 + 0.3 * i as f64);

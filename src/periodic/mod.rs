@@ -79,11 +79,14 @@ pub struct SolverSettings {
     pub tolerance: f64,
     /// Spread the harmonics over threads (rayon). Off inside an FMU.
     pub parallel: bool,
+    /// Shooting from a warm start stops where Newton from it misses, without the contact-free
+    /// start and the offset homotopy (a guarded sweep's quick tries; default off).
+    pub shooting_warm_only: bool,
 }
 
 impl Default for SolverSettings {
     fn default() -> Self {
-        SolverSettings { method: LcpMethod::Auto, tolerance: 1e-9, parallel: true }
+        SolverSettings { method: LcpMethod::Auto, tolerance: 1e-9, parallel: true, shooting_warm_only: false }
     }
 }
 

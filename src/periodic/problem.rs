@@ -2,7 +2,7 @@
 //! private: every way in (constructor, updaters) runs the checks, so a `PeriodicProblem` is
 //! always ready to solve.
 use super::{Assembly, OutputMap, OutputSelection, PeriodFft, SolveError, SolverSettings, assembly, lcp_failure, limits, recovery};
-use crate::lcp::{BlockCirculant, DENSE_MAX, DENSE_MEMORY_MAX, GIB, LcpMethod, LcpOutcome, LcpSolution, dense_memory, solve_periodic_lcp};
+use crate::lcp::{BlockCirculant, DENSE_MAX, DENSE_MEMORY_MAX, GIB, LcpMethod, LcpOutcome, LcpSolution, dense_memory, solve_periodic_lcp_with};
 use crate::model::{Contact, Model};
 use crate::response::Response;
 use crate::time::{Discretization, Pairing};
@@ -341,11 +341,17 @@ impl PeriodicProblem {
 
     /// The harmonic solves of this problem (Ĝ, X̂lin and Ẑ⁻¹Bᵀ at the recovered DOFs).
     pub(super) fn assemble(&self, fft: &PeriodFft) -> Result<Assembly, SolveError> {
+        self.assemble_with(fft, &assembly::StructureOperator::new(&self.model)?)
+    }
+
+    /// [`Self::assemble`] on the structure operator of this problem's M, C, K built before (a
+    /// session keeps it across frequencies and grids).
+    pub(super) fn assemble_with(&self, fft: &PeriodFft, op: &assembly::StructureOperator) -> Result<Assembly, SolveError> {
         // Friction contacts ride as extra rows of B (src/formulation.md §9).
         let model = super::friction::with_rows(&self.model)?;
         // Rubbing contacts' tangential rows too, folded into their contacts' columns.
         let model = super::rubbing::with_rows(&model);
-        let wide = assembly::assemble(&model, self.disc.scheme, self.period(), &self.recovery_dofs(), fft, self.solver.parallel)?;
+        let wide = assembly::assemble_with(&model, op, self.disc.scheme, self.period(), &self.recovery_dofs(), fft, self.solver.parallel)?;
         Ok(super::rubbing::fold(&self.model, wide))
     }
 
@@ -454,7 +460,7 @@ impl PeriodicProblem {
             }
         }
         let step_map = step_map.and_then(Result::ok);
-        let (sol, _state) = solve_periodic_lcp(a, q, step_map.as_ref(), method, self.solver.tolerance, warm_start);
+        let (sol, _state) = solve_periodic_lcp_with(a, q, step_map.as_ref(), method, self.solver.tolerance, warm_start, self.solver.shooting_warm_only);
         if sol.outcome == LcpOutcome::Solved { Ok(sol) } else { Err(lcp_failure(sol)) }
     }
 

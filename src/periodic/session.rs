@@ -33,7 +33,7 @@ pub struct PeriodicSolver {
     warm_starts: bool,
     last_start: WarmStart,
     /// The last assembly, reused while only gaps, motions or a common force scale change.
-    cache: Option<AssemblyCache>,
+    pub(super) cache: Option<AssemblyCache>,
     /// Assemblies built by this session (the others were reused).
     assemblies: usize,
 }
@@ -191,12 +191,14 @@ impl PeriodicSolver {
     /// Solves by shooting alone (`solver.method = "shooting"` for this solve): from the warm
     /// start when `warm` and there is one, else cold; no cold retry and no dense fallback. A
     /// failure costs one shooting budget (seconds), where the dense fallback of a large LCP costs
-    /// minutes: a sweep's quick try before it sub-steps ω. The answer's active set becomes the
-    /// next warm start, as in [`Self::solve`].
+    /// minutes: a sweep's quick try before it sub-steps ω. A warm try is Newton from the warm
+    /// start alone (no contact-free start nor offset homotopy: those are the cold try's). The
+    /// answer's active set becomes the next warm start, as in [`Self::solve`].
     pub fn solve_by_shooting(&mut self, warm: bool) -> Result<Response, SolveError> {
         let settings = self.problem.solver_settings().clone();
-        self.problem.set_solver_settings(super::SolverSettings { method: crate::lcp::LcpMethod::Shooting, ..settings.clone() })?;
         let guess = self.warm_start.clone().filter(|_| warm && self.warm_starts);
+        let quick = super::SolverSettings { method: crate::lcp::LcpMethod::Shooting, shooting_warm_only: guess.is_some(), ..settings.clone() };
+        self.problem.set_solver_settings(quick)?;
         let result = self.solve_cached(guess.as_deref());
         self.problem.set_solver_settings(settings)?;
         let r = result?;

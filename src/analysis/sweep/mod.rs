@@ -181,7 +181,7 @@ pub fn run(
                     let t = Instant::now();
                     let mut substeps = 0;
                     let mut r = if guarded {
-                        let (r, n) = solve_guarded(&mut solver, last_solved, f);
+                        let (r, n) = solve_guarded(&mut solver, last_solved, f, true);
                         substeps = n;
                         r
                     } else {
@@ -204,9 +204,8 @@ pub fn run(
                     point.substeps = substeps;
                     point.warm_start_used = r.is_ok() && solver.last_start() == WarmStart::Used;
                     point.cold_fallback = solver.last_start() == WarmStart::ColdFallback;
-                    if let (Ok(r), true) = (&r, settings.estimate) {
-                        let a = accuracy::estimate_with(solver.problem(), r, &mut |p| second_solve(&mut second, p, r, settings.warm_start));
-                        (point.estimate_relative, point.estimate_method) = (a.relative, a.method);
+                    if let Ok(r) = &r {
+                        estimate(&mut point, &solver, r, &mut second, settings);
                     }
                     point.time_s = t.elapsed().as_secs_f64();
                     match r {
@@ -228,7 +227,74 @@ pub fn run(
             })
             .collect()
     });
-    Ok(results.into_iter().flatten().collect())
+    let mut points: Vec<SweepPoint> = results.into_iter().flatten().collect();
+    if settings.warm_start && guarded(session.problem()) {
+        refill(base, &mut points, settings);
+    }
+    Ok(points)
+}
+
+/// Retries the failed points of a sweep of `template` from their nearest solved neighbours
+/// ([`refill_pass`]): from the neighbour after each first (the branch beyond a fold, followed
+/// back), then from the one before. `run` does this for a guarded sweep.
+pub fn refill(template: &PeriodicProblem, points: &mut [SweepPoint], settings: &SweepSettings) {
+    if points.iter().all(|x| x.error.is_none()) {
+        return;
+    }
+    let mut solver = PeriodicSolver::new(template.clone());
+    let mut second = None;
+    for reverse in [true, false] {
+        refill_pass(&mut solver, &mut second, settings, points, reverse);
+    }
+}
+
+/// The point's error estimate ([`SweepSettings::estimate`]): a second solve on the other grid,
+/// in the chunk's session for that grid.
+fn estimate(point: &mut SweepPoint, solver: &PeriodicSolver, r: &Response, second: &mut Option<(PeriodicSolver, Option<f64>)>, settings: &SweepSettings) {
+    if settings.estimate {
+        let a = accuracy::estimate_with(solver.problem(), r, &mut |p| second_solve(second, p, r, settings.warm_start));
+        (point.estimate_relative, point.estimate_method) = (a.relative, a.method);
+    }
+}
+
+/// Retries a guarded sweep's failed points from their nearest solved neighbour in the sweep's
+/// order, scanning backwards (`reverse`: the neighbour after each) or forwards: warm shooting
+/// from the neighbour's active sets with ω sub-steps from its frequency, no cold try (the
+/// point's own pass made it). Why (issue 23, real blade): past the fold where the contact
+/// branch ends, the forward pass loses the orbit (the neighbour's sets lead nowhere and cold
+/// shooting's homotopy misses), while the other branch, once reached further up, continues
+/// down to those points in a few Newton iterations each. A point still missed keeps its failure.
+fn refill_pass(
+    solver: &mut PeriodicSolver,
+    second: &mut Option<(PeriodicSolver, Option<f64>)>,
+    settings: &SweepSettings,
+    points: &mut [SweepPoint],
+    reverse: bool,
+) {
+    let order: Vec<usize> = if reverse { (0..points.len()).rev().collect() } else { (0..points.len()).collect() };
+    let mut neighbour: Option<usize> = None;
+    for i in order {
+        let Some(j) = neighbour.filter(|_| points[i].error.is_some()) else {
+            neighbour = if points[i].error.is_none() { Some(i) } else { neighbour };
+            continue;
+        };
+        let t = Instant::now();
+        let f = points[i].frequency;
+        solver.set_warm_start(&points[j].active_set);
+        let (r, substeps) = solve_guarded(solver, Some(points[j].frequency), f, false);
+        let before = points[i].time_s;
+        match r {
+            Ok(r) => {
+                let mut point = SweepPoint::from_response(solver.problem(), f, &r);
+                (point.substeps, point.warm_start_used) = (substeps, true);
+                estimate(&mut point, solver, &r, second, settings);
+                point.time_s = before + t.elapsed().as_secs_f64();
+                points[i] = point;
+                neighbour = Some(i);
+            }
+            Err(_) => points[i].time_s = before + t.elapsed().as_secs_f64(),
+        }
+    }
 }
 
 /// Halvings of the ω step when a sub-step misses: down to 1/16 of the sweep's step.
@@ -241,7 +307,8 @@ const SUBSTEP_HALVINGS: u32 = 4;
 /// warm-started from the previous); then cold shooting. Never the dense fallback: a point still
 /// missed is a typed failure naming the cause and the remedy, and the sweep goes on. Each try
 /// is bounded by shooting's work budget. Returns the answer and the sub-steps solved before it.
-fn solve_guarded(solver: &mut PeriodicSolver, last: Option<f64>, f: f64) -> (Result<Response, SolveError>, usize) {
+/// `cold`: end with cold shooting (else a miss after the sub-steps is the failure).
+fn solve_guarded(solver: &mut PeriodicSolver, last: Option<f64>, f: f64, cold: bool) -> (Result<Response, SolveError>, usize) {
     let at = |solver: &mut PeriodicSolver, w: f64, warm: bool| solver.update_frequency(w).and_then(|()| solver.solve_by_shooting(warm));
     let had_warm = solver.warm_start().is_some();
     let first = match at(solver, f, true) {
@@ -265,7 +332,7 @@ fn solve_guarded(solver: &mut PeriodicSolver, last: Option<f64>, f: f64) -> (Res
         }
     }
     // Cold shooting, unless the first try already was.
-    let cold = if had_warm { at(solver, f, false) } else { Err(first) };
+    let cold = if had_warm && cold { at(solver, f, false) } else { Err(first) };
     match cold {
         Ok(r) => (Ok(r), substeps),
         Err(SolveError::Lcp { outcome, info, .. }) => {
@@ -299,7 +366,7 @@ fn second_solve(session: &mut Option<(PeriodicSolver, Option<f64>)>, problem: &P
     let k_first = first.lcp.size / m.max(1);
     let carried = accuracy::carried_active_set(&first.active_set, m, k_first, solver.problem().instants());
     solver.set_warm_start(&carried);
-    let (r, _) = solve_guarded(solver, *last, f);
+    let (r, _) = solve_guarded(solver, *last, f, true);
     *last = r.as_ref().ok().map(|_| f);
     r
 }

@@ -40,11 +40,23 @@ pub struct ShootingSettings {
     /// so far): on a large problem one iteration alone passes `max_work` (≈ 10¹⁰ flops at d = 200,
     /// k = 8192), and there is no cheaper fallback.
     pub work_iterations: f64,
+    /// With a warm start, give up when Newton from it misses (no contact-free start, no offset
+    /// homotopy): a guarded sweep's quick try, which has other routes (ω sub-steps, a neighbour
+    /// on the other side) cheaper than a homotopy of hundreds of kinks.
+    pub warm_only: bool,
 }
 
 impl Default for ShootingSettings {
     fn default() -> Self {
-        ShootingSettings { max_iterations: 30, homotopy_iterations: 8, max_homotopy_steps: 200, tolerance: 1e-13, max_work: 6e9, work_iterations: 40.0 }
+        ShootingSettings {
+            max_iterations: 30,
+            homotopy_iterations: 8,
+            max_homotopy_steps: 200,
+            tolerance: 1e-13,
+            max_work: 6e9,
+            work_iterations: 40.0,
+            warm_only: false,
+        }
     }
 }
 
@@ -286,6 +298,9 @@ fn shoot(nt: &mut Newton<'_>, warm: Option<&[u64]>) -> ShootingSolution {
         && let Ok(it) = nt.solve(s, 0.0, sets, settings.max_iterations)
     {
         return done(nt, it, 0, "warm");
+    }
+    if settings.warm_only && warm.is_some() {
+        return fail(nt, ShootingOutcome::NotConverged, None, 0);
     }
     // The contact-free orbit: the fixed point of the affine map without contact.
     let Some(free) = fixed_point(nt, Contacts::Free) else {
