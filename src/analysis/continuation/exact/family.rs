@@ -117,12 +117,28 @@ impl Family {
         self.residual_with(&self.orbit(w[w.len() - 1] * self.rho)?, w)
     }
 
-    /// [∂F/∂w] by central differences (the λ column on orbits rebuilt at λ ± h·ρ).
+    /// [∂F/∂w]: the state and time columns from the variational flow of one period
+    /// ([`PolishedOrbit::shooting_jacobian`]; ∂τ_e/∂θ_e = T), the λ column by central differences
+    /// on orbits rebuilt at λ ± h·ρ. By central differences throughout where the variational flow
+    /// does not apply.
     pub fn jacobian(&self, w: &[f64]) -> Option<DMatrix<f64>> {
         let d = self.dim();
         let lambda = w[d - 1] * self.rho;
         let here = self.orbit(lambda)?;
+        let (y, times) = self.unpack(w, here.period());
         let mut j = DMatrix::zeros(d - 1, d);
+        if let Some((_, dr)) = here.shooting_jacobian(&y, &times) {
+            for c in 0..d - 1 {
+                let scale = if c < self.n2 { 1.0 } else { here.period() / self.ys };
+                j.set_column(c, &(dr.column(c) * scale));
+            }
+            let (mut up, mut dn) = (w.to_vec(), w.to_vec());
+            up[d - 1] += DIFF;
+            dn[d - 1] -= DIFF;
+            let col = (self.residual(&up)? - self.residual(&dn)?) / (2.0 * DIFF);
+            j.set_column(d - 1, &col);
+            return Some(j);
+        }
         for c in 0..d - 1 {
             let (mut up, mut dn) = (w.to_vec(), w.to_vec());
             up[c] += DIFF;
