@@ -241,7 +241,8 @@ pub unsafe extern "C" fn pc_problem_from_matrices(
         let stiffness = rows(stiffness, "stiffness")?;
         let damping = if damping.is_null() { None } else { Some(rows(damping, "damping")?) };
         let scheme: Scheme = unsafe { c_str(scheme, "scheme") }?.parse().map_err(input)?;
-        let model = Model { structure: Structure { mass, stiffness, damping }, forces: vec![], contacts: vec![], frequency, frictions: Vec::new() };
+        let (forces, contacts, frictions, rubbing) = (vec![], vec![], vec![], vec![]);
+        let model = Model { structure: Structure { mass, stiffness, damping }, forces, contacts, frequency, frictions, rubbing };
         let outputs = OutputSelection { displacement: (0..n).collect(), velocity: (0..n).collect(), acceleration: vec![], contacts: true };
         let disc = Discretization { scheme, steps, pairing: None };
         Ok(PcProblem::new(PeriodicProblem::new(model, disc, outputs, SolverSettings::default()).map_err(solver_error)?))

@@ -122,6 +122,9 @@ pub struct Response {
     /// The event-fitted polish (`--polish`, `[discretization] polish = true`), when it ran.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub polish: Option<PolishSummary>,
+    /// `scheme = "auto"`: the scheme and k chosen for the tolerance, and why.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub scheme_choice: Option<SchemeChoice>,
     /// The contact-free (linear) response at the displacement outputs, same keys: a by-product
     /// of the assembly, for frequency-response curves.
     #[serde(skip)]
@@ -129,6 +132,39 @@ pub struct Response {
     /// Indices of the LCP unknowns with z > 0 (time-major j·m + i): a warm start for the next solve.
     #[serde(skip)]
     pub active_set: Vec<usize>,
+}
+
+/// What `scheme = "auto"` chose and why (`analysis::scheme_auto`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct SchemeChoice {
+    /// The wanted error relative to the peak-to-peak amplitude.
+    pub tolerance: f64,
+    /// Whether the error estimate of the result met it.
+    pub met: bool,
+    pub scheme: String,
+    pub pairing: String,
+    /// The k of the result.
+    pub steps: usize,
+    /// The result's relative error bound (the envelope of the Richardson estimates, at least
+    /// `accuracy.relative`), compared with the tolerance.
+    pub estimate: Option<f64>,
+    /// Why this scheme, why this k, and if `met` is false why the refinement stopped.
+    pub why: String,
+    /// Every k solved, in order.
+    pub tried: Vec<SchemeTrial>,
+}
+
+/// One k of the refinement.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct SchemeTrial {
+    pub steps: usize,
+    /// Relative error estimate at this k (`None`: none could be made, see `why`).
+    pub estimate: Option<f64>,
+    /// The relative error bound at this k that "auto" compares with the tolerance: the envelope
+    /// of the estimates so far (`analysis::scheme_auto::envelope`).
+    pub bound: Option<f64>,
+    /// Wall time of this k's solve and its estimate [s].
+    pub seconds: f64,
 }
 
 /// An estimate of the result's own error.
@@ -148,9 +184,10 @@ pub struct Accuracy {
 pub struct EventRecord {
     /// Time in [0, T) [s].
     pub time: f64,
-    /// Contact index.
+    /// Contact index (the friction contact's index for "stick", "slip", "reversal").
     pub contact: usize,
-    /// "impact", "release", "contact_on" (compliant), "contact_off" (compliant).
+    /// "impact", "release", "contact_on" (compliant), "contact_off" (compliant); friction:
+    /// "stick" (onset), "slip" (release), "reversal" (slip direction flips at v = 0).
     pub kind: String,
     /// Impulse of an impact ≥ 0 [force·time]; 0 for the other kinds.
     pub impulse: f64,

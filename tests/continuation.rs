@@ -1,5 +1,6 @@
 //! Continuation of NLvib's Example 03 (src/formulation.md §7) against the independent reference of
 //! validation/nlvib03 (exact piecewise-linear flows, shooting, long time integration).
+use crate::common::family::{Chain, Draw};
 use periodic_contact::analysis::continuation::{self, ContinuationSettings, Parameter};
 use serde_json::Value;
 use std::time::Instant;
@@ -96,69 +97,28 @@ fn nlvib03_exact_branch_is_the_same_at_every_k() {
     eprintln!("worst event error over k = 256 … 4096: {worst_event:.1e}");
 }
 
-/// A small deterministic generator (SplitMix64) for the random families.
-struct Draw(u64);
-impl Draw {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.next()
-    }
-}
-
 /// A random oscillator of 1–3 DOFs (a grounded chain: masses 0.5–2, springs 0.5–2, Rayleigh
 /// damping of 1–4 % at the first mode) with a compliant stop (stiffness 5–100 × the chain's) on a
 /// random DOF, forced on a random DOF; the gap is 0.3–0.7 of that DOF's linear peak near the
 /// first mode, so the branch over [0.6, 1.6]·ω₁ spans a contact resonance. (scene, ω₁, the
 /// gap, the contact DOF's linear amplitude |X_c(ω)| from (K − ω²M + iωC) X = f).
 fn random_oscillator(d: &mut Draw, steps: usize) -> (String, f64, f64, Box<dyn Fn(f64) -> f64>) {
-    use nalgebra::{DMatrix, DVector};
-    use num_complex::Complex64 as C;
-    let n = 1 + (d.next() * 3.0) as usize;
-    let m: Vec<f64> = (0..n).map(|_| d.range(0.5, 2.0)).collect();
-    let springs: Vec<f64> = (0..n).map(|_| d.range(0.5, 2.0)).collect();
-    let mut k = DMatrix::zeros(n, n);
-    for (i, s) in springs.iter().enumerate() {
-        k[(i, i)] += s;
-        if i > 0 {
-            k[(i - 1, i - 1)] += s;
-            k[(i, i - 1)] -= s;
-            k[(i - 1, i)] -= s;
-        }
-    }
-    let minv = DMatrix::from_diagonal(&DVector::from_iterator(n, m.iter().map(|x| 1.0 / x.sqrt())));
-    let w1 = (&minv * &k * &minv).symmetric_eigen().eigenvalues.min().sqrt();
+    let chain = Chain::draw(d);
+    let (n, w1) = (chain.n, chain.w1);
     let zeta = d.range(0.01, 0.04);
     // C = αK with 2ζω₁ = αω₁².
     let alpha = 2.0 * zeta / w1;
     let (fdof, cdof) = ((d.next() * n as f64) as usize, (d.next() * n as f64) as usize);
     let amp = 0.1;
-    let (mm, kk) = (m.clone(), k.clone());
-    let linear = move |w: f64| {
-        let a = DMatrix::from_fn(n, n, |r, c| C::new(kk[(r, c)] - if r == c { w * w * mm[r] } else { 0.0 }, w * alpha * kk[(r, c)]));
-        let mut f = DVector::zeros(n);
-        f[fdof] = C::new(amp, 0.0);
-        a.lu().solve(&f).map_or(0.0, |x| x[cdof].norm())
+    let linear = {
+        let chain = chain.clone();
+        move |w: f64| chain.linear_amplitude(alpha, fdof, cdof, amp, w)
     };
     // The linear peak of the contact DOF over 0.6..1.6 ω₁.
     let peak = (0..400).map(|j| linear(w1 * (0.6 + j as f64 / 400.0))).fold(0.0, f64::max);
     let gap = d.range(0.3, 0.7) * peak;
-    let kc = d.range(5.0, 100.0) * springs.iter().fold(0.0f64, |a, b| a.max(*b));
-    let row = |r: usize, a: &dyn Fn(usize, usize) -> f64| format!("[{}]", (0..n).map(|c| format!("{:e}", a(r, c))).collect::<Vec<_>>().join(", "));
-    let mat = |a: &dyn Fn(usize, usize) -> f64| format!("[{}]", (0..n).map(|r| row(r, a)).collect::<Vec<_>>().join(", "));
-    let text = format!(
-        "[structure]\nmass = {}\nstiffness = {}\n[damping]\nmatrix = {}\n[excitation]\nfrequency = {}\n[[force]]\ndof = {fdof}\namplitude = {amp}\n\
-         [[contact]]\ndof = {cdof}\ngap = {gap:e}\nstiffness = {kc:e}\n[discretization]\nscheme = \"cds\"\nsteps = {steps}\n[output]\ndisplacement = [{cdof}]\n",
-        mat(&|r, c| if r == c { m[r] } else { 0.0 }),
-        mat(&|r, c| k[(r, c)]),
-        mat(&|r, c| alpha * k[(r, c)]),
-        0.6 * w1
-    );
+    let kc = d.range(5.0, 100.0) * chain.springs.iter().fold(0.0f64, |a, b| a.max(*b));
+    let text = chain.scene(alpha, (fdof, amp), &format!("dof = {cdof}\ngap = {gap:e}\nstiffness = {kc:e}\n"), "cds", steps, cdof);
     (text, w1, gap, Box::new(linear))
 }
 
@@ -229,16 +189,16 @@ fn random_family() {
     );
 }
 
-/// Where the exact orbit cannot be continued (a rigid stop: impacts and sticking), `run` falls
-/// back to the discrete walk and says so in `stop` and in every point's source.
+/// A rigid stop (plastic impacts, sticking) is continued on the exact orbit too (issue 24; the
+/// closed-form and time-integration checks are tests/rigid_branch.rs), and `run` says in every
+/// point's source which walk produced it.
 #[test]
-fn a_rigid_stop_falls_back_to_the_discrete_walk() {
+fn a_rigid_stop_is_continued_on_the_exact_orbit() {
     let text = scene(256).replace("stiffness = 100.0\n", "").replace("scheme = \"cds\"", "scheme = \"bds1\"");
     let p = periodic_contact::scene::Scene::parse(&text, "rigid").unwrap().to_problem("rigid").unwrap();
     let b = continuation::run(&p, Parameter::Frequency, 0.5, 0.52, &ContinuationSettings::default(), &|_| {}).unwrap();
     assert!(b.reached(), "{}", b.stop);
-    assert!(b.stop.contains("discrete walk") && b.stop.contains("rigid"), "{}", b.stop);
-    assert!(b.points.iter().all(|q| q.source == continuation::Source::Discrete));
+    assert!(b.points.iter().all(|q| q.source == continuation::Source::Exact), "{}", b.stop);
 }
 
 /// The DISCRETE walk (the fallback where no exact orbit can be had) on NLvib 03 from Ω = 0.5 to

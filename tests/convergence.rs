@@ -206,6 +206,7 @@ fn massless_contact_point(osc: &Oscillator, k2: f64, gap: f64, contact: Complian
         contacts: vec![Contact::on_dof(1, 1.0, gap, contact)],
         frequency: osc.omega,
         frictions: Vec::new(),
+        rubbing: Vec::new(),
     }
 }
 

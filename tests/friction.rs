@@ -27,7 +27,7 @@ fn stuck_fraction(r: &Response) -> f64 {
     s.iter().filter(|v| **v).count() as f64 / s.len() as f64
 }
 
-fn oscillator(c: f64, omega: f64, slip: f64, kt: Option<f64>) -> FrictionOscillator {
+pub(crate) fn oscillator(c: f64, omega: f64, slip: f64, kt: Option<f64>) -> FrictionOscillator {
     FrictionOscillator {
         mass: vec![vec![1.0]],
         damping: vec![vec![c]],

@@ -240,6 +240,7 @@ fn planar_pair() -> Model {
         ],
         frequency: 1.2,
         frictions: Vec::new(),
+        rubbing: Vec::new(),
     }
 }
 
@@ -368,6 +369,7 @@ fn a_mass_along_a_normal_is_the_one_dof_rigid_stop() {
             contacts: vec![Contact { row: n.iter().copied().enumerate().collect(), gap: 0.5, compliance: Compliance::Rigid, motion: vec![] }],
             frequency: osc.omega,
             frictions: Vec::new(),
+            rubbing: Vec::new(),
         };
         let outputs = OutputSelection { displacement: (0..dim).collect(), velocity: vec![], acceleration: vec![], contacts: true };
         let p = PeriodicProblem::new(model, Discretization { scheme: Scheme::Cds, steps: 256, pairing: None }, outputs, SolverSettings::default()).unwrap();

@@ -1233,6 +1233,7 @@ fn build_model(c: &ModelCase) -> Model {
             .collect(),
         frequency: c.omega * scale,
         frictions: Vec::new(),
+        rubbing: Vec::new(),
     }
 }
 

@@ -153,6 +153,7 @@ fn chain2() -> Model {
         contacts: vec![],
         frequency: 1.1,
         frictions: Vec::new(),
+        rubbing: Vec::new(),
     }
 }
 

@@ -29,6 +29,7 @@ fn chain_model(n: usize, sparse: bool, contacts: Vec<Contact>, frequency: f64) -
         contacts,
         frequency,
         frictions: Vec::new(),
+        rubbing: Vec::new(),
     }
 }
 

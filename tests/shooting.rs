@@ -132,6 +132,7 @@ fn random_chain(draw: &mut Draw, n: usize, m: usize, rigid: bool) -> Model {
         contacts: Vec::new(),
         frequency: omega,
         frictions: Vec::new(),
+        rubbing: Vec::new(),
     };
     // The contact-free amplitude of each DOF, from a linear solve (no contact).
     let outputs = OutputSelection { displacement: (0..n).collect(), velocity: vec![], acceleration: vec![], contacts: false };
@@ -373,6 +374,7 @@ fn a_step_map_past_the_estimates_is_refused_with_its_figures() {
         contacts: vec![contact],
         frequency: 1.0,
         frictions: Vec::new(),
+        rubbing: Vec::new(),
     };
     let outputs = OutputSelection { displacement: vec![0], velocity: vec![], acceleration: vec![], contacts: true };
     let p =

@@ -42,6 +42,8 @@ mod fmu_host;
 mod friction;
 #[path = "friction_frontends.rs"]
 mod friction_frontends;
+#[path = "friction_polish.rs"]
+mod friction_polish;
 #[path = "frontends.rs"]
 mod frontends;
 #[path = "hard_cases.rs"]
@@ -62,6 +64,12 @@ mod references;
 mod results;
 #[path = "rigid_blade.rs"]
 mod rigid_blade;
+#[path = "rigid_branch.rs"]
+mod rigid_branch;
+#[path = "rubbing.rs"]
+mod rubbing;
+#[path = "scheme_auto.rs"]
+mod scheme_auto;
 #[path = "scheme_limits.rs"]
 mod scheme_limits;
 #[path = "session.rs"]

@@ -12,4 +12,5 @@ pub mod continuation;
 pub mod hysteresis;
 pub mod interpolant;
 pub mod polish;
+pub mod scheme_auto;
 pub mod sweep;

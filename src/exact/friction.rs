@@ -82,6 +82,7 @@ impl FrictionOscillator {
             contacts: Vec::new(),
             frequency: self.omega,
             frictions: vec![Friction::on_dof(self.dof, 1.0, self.slip_force, self.tangential_stiffness)],
+            rubbing: Vec::new(),
         }
     }
     pub fn period(&self) -> f64 {

@@ -111,6 +111,7 @@ impl Oscillator {
             contacts,
             frequency: self.omega,
             frictions: Vec::new(),
+            rubbing: Vec::new(),
         }
     }
 

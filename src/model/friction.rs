@@ -74,3 +74,50 @@ impl Friction {
         Ok(())
     }
 }
+
+/// Rubbing in gross slip (src/formulation.md §9): the counter-face of contact `contact` slides
+/// along `row` at `sliding_velocity`, faster than the structure ever moves along it, so the
+/// friction force is μ·λ_n along the counter-face's motion. The contact force on the structure
+/// is −(n − μ·sign(V)·t)ᵀ λ_n: the LCP keeps its size and loses its symmetry.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Rubbing {
+    /// Index of the `[[contact]]` whose normal force presses the faces together.
+    pub contact: usize,
+    /// The sliding direction t as (model DOF, coefficient) terms.
+    pub row: Vec<(usize, f64)>,
+    /// Friction coefficient μ ≥ 0.
+    pub coefficient: f64,
+    /// The counter-face's speed V along t (≠ 0); its sign sets the friction's direction.
+    pub sliding_velocity: f64,
+}
+
+impl Rubbing {
+    /// −μ·sign(V): the tangential row's force per unit normal force (a row's force z acts as −tᵀz).
+    pub fn traction(&self) -> f64 {
+        -self.coefficient * self.sliding_velocity.signum()
+    }
+
+    /// Checks rubbing `i` (scene key `friction[i]`) of a model with `n` DOFs and `contacts` contacts.
+    pub(super) fn check(&self, i: usize, n: usize, contacts: usize) -> Result<(), ModelError> {
+        let field = |f: &str| format!("friction[{i}].{f}");
+        if self.contact >= contacts {
+            return Err(ModelError::new(
+                field("contact"),
+                format!("is {}, the model has {contacts} contact(s): give the index of a [[contact]]", self.contact),
+            ));
+        }
+        if self.row.is_empty() || self.row.iter().any(|&(d, c)| d >= n || !c.is_finite()) {
+            return Err(ModelError::new(field("direction"), format!("{:?} is not a sliding direction over DOFs 0..{n} with finite coefficients", self.row)));
+        }
+        if !(self.coefficient.is_finite() && self.coefficient >= 0.0) {
+            return Err(ModelError::new(field("coefficient"), format!("is {}, a friction coefficient μ must be finite and ≥ 0", self.coefficient)));
+        }
+        if !(self.sliding_velocity.is_finite() && self.sliding_velocity != 0.0) {
+            return Err(ModelError::new(
+                field("sliding_velocity"),
+                format!("is {}, the counter-face's speed must be finite and ≠ 0 (its sign gives the friction's direction)", self.sliding_velocity),
+            ));
+        }
+        Ok(())
+    }
+}

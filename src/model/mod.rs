@@ -16,7 +16,7 @@ mod spectrum;
 pub mod units;
 mod validate;
 
-pub use friction::Friction;
+pub use friction::{Friction, Rubbing};
 pub use matrix::Matrix;
 pub use units::{Labels, Quantity, Units};
 pub use validate::ModelError;
@@ -175,6 +175,9 @@ pub struct Model {
     pub contacts: Vec<Contact>,
     /// Coulomb friction contacts (src/formulation.md §9); empty: none is assembled.
     pub frictions: Vec<Friction>,
+    /// Rubbing in gross slip on contacts (src/formulation.md §9): friction along each contact's
+    /// counter-face motion, proportional to its normal force; empty: none.
+    pub rubbing: Vec<Rubbing>,
     /// Fundamental angular frequency ω [rad/s]; the period is T = 2π/ω.
     pub frequency: f64,
 }

@@ -248,6 +248,9 @@ impl Model {
         for (i, f) in self.frictions.iter().enumerate() {
             f.check(i, n)?;
         }
+        for (i, r) in self.rubbing.iter().enumerate() {
+            r.check(i, n, self.contacts.len())?;
+        }
         Ok(())
     }
 }

@@ -32,6 +32,8 @@ pub struct Assembly {
     pub bxlin_hat: Vec<C>,
     /// Ẑ_p⁻¹ Bᵀ at `dofs`: [p][dofs.len()][m].
     pub h_hat: Vec<C>,
+    /// The rubbing contacts' tangential rows, folded into the contacts' columns (`rubbing.rs`).
+    pub tangential: Vec<super::TangentialRow>,
 }
 
 /// Samples of the external force at the k instants of `period`, DOF by DOF, only for loaded DOFs.
@@ -58,9 +60,26 @@ fn force_spectra(model: &Model, period: f64, fft: &PeriodFft) -> Vec<(usize, Vec
 /// whose damping is diagonal in its modes (none, Rayleigh, modal ratios: a reduced model),
 /// Ẑ_p⁻¹ = Φ diag(1/(σ2 + σ1 c_i + w ω_i²)) Φᵀ from one eigen-decomposition: O(n²) per harmonic.
 enum Operator {
-    Dense { mass: Mat<f64>, stiffness: Mat<f64>, damping: Option<Mat<f64>> },
-    Modal { phi: Mat<f64>, lambda: Vec<f64>, c: Vec<f64> },
-    Sparse { symbolic: SymbolicLu<usize>, pattern: SymbolicSparseColMat<usize>, mass: Vec<f64>, stiffness: Vec<f64>, damping: Vec<f64> },
+    Dense {
+        mass: Mat<f64>,
+        stiffness: Mat<f64>,
+        damping: Option<Mat<f64>>,
+    },
+    /// `residual`: with massless DOFs (a massless-boundary reduction), the static flexibility the
+    /// massive modes miss, R = K⁻¹ − Φ Λ⁻¹ Φᵀ, and Ẑ_p⁻¹ = Φ D_p Φᵀ + R / w_p.
+    Modal {
+        phi: Mat<f64>,
+        lambda: Vec<f64>,
+        c: Vec<f64>,
+        residual: Option<Mat<f64>>,
+    },
+    Sparse {
+        symbolic: SymbolicLu<usize>,
+        pattern: SymbolicSparseColMat<usize>,
+        mass: Vec<f64>,
+        stiffness: Vec<f64>,
+        damping: Vec<f64>,
+    },
 }
 
 impl Operator {
@@ -107,25 +126,55 @@ impl Operator {
             return None;
         }
         let (mass, stiffness) = (s.mass.to_dense(), s.stiffness.to_dense());
-        let modes = crate::reduction::dense_modes(stiffness.as_ref(), mass.as_ref(), n).ok()?;
-        if modes.omega.len() != n || modes.residual.iter().any(|r| !(*r < 1e-8)) {
+        // Massless DOFs (zero rows of M after validation): only the r = n − #massless massive
+        // modes exist; the rest of Ẑ_p⁻¹ is the static residual flexibility.
+        let massless = (0..n).filter(|&d| s.mass.get(d, d) <= 0.0).count();
+        let r = n - massless;
+        let modes = crate::reduction::dense_modes(stiffness.as_ref(), mass.as_ref(), r).ok()?;
+        if modes.omega.len() != r || modes.residual.iter().any(|e| !(*e < 1e-8)) {
             return None;
         }
         let phi = modes.shapes;
         let lambda: Vec<f64> = modes.omega.iter().map(|w| w * w).collect();
         let c = match &s.damping {
-            None => vec![0.0; n],
+            None => vec![0.0; r],
             Some(c) => {
-                let d = phi.transpose() * c.to_dense() * &phi;
-                let scale = (0..n).map(|i| d[(i, i)].abs()).fold(0.0, f64::max);
-                let off = (0..n).flat_map(|i| (0..n).map(move |j| (i, j))).filter(|(i, j)| i != j).map(|(i, j)| d[(i, j)].abs()).fold(0.0, f64::max);
+                let c = c.to_dense();
+                let d = phi.transpose() * &c * &phi;
+                let scale = (0..r).map(|i| d[(i, i)].abs()).fold(0.0, f64::max);
+                let off = (0..r).flat_map(|i| (0..r).map(move |j| (i, j))).filter(|(i, j)| i != j).map(|(i, j)| d[(i, j)].abs()).fold(0.0, f64::max);
                 if !(off <= 1e-9 * scale) {
                     return None;
                 }
-                (0..n).map(|i| d[(i, i)]).collect()
+                let diag: Vec<f64> = (0..r).map(|i| d[(i, i)]).collect();
+                // With massless DOFs the modes do not span the space: C must be M Φ diag(c) Φᵀ M
+                // (no damping on the massless DOFs), else the modal form would drop part of it.
+                if massless > 0 {
+                    let mphi = &mass * &phi;
+                    let rebuilt = &mphi * Mat::<f64>::from_fn(r, r, |i, j| if i == j { diag[i] } else { 0.0 }) * mphi.transpose();
+                    let big = (0..n).flat_map(|j| (0..n).map(move |i| (i, j))).fold(0.0f64, |a, (i, j)| a.max(c[(i, j)].abs()));
+                    let miss = (0..n).flat_map(|j| (0..n).map(move |i| (i, j))).fold(0.0f64, |a, (i, j)| a.max((c[(i, j)] - rebuilt[(i, j)]).abs()));
+                    if !(miss <= 1e-9 * big) {
+                        return None;
+                    }
+                }
+                diag
             }
         };
-        Some(Operator::Modal { phi, lambda, c })
+        let residual = if massless > 0 { Some(Operator::residual_flexibility(&stiffness, &phi, &lambda)?) } else { None };
+        Some(Operator::Modal { phi, lambda, c, residual })
+    }
+
+    /// R = K⁻¹ − Φ Λ⁻¹ Φᵀ (MacNeal's residual flexibility, src/formulation.md §4.1): the part of
+    /// Ẑ_p⁻¹ the massive modes miss, static (1/w_p) on a massless DOF. `None` if K is singular.
+    fn residual_flexibility(stiffness: &Mat<f64>, phi: &Mat<f64>, lambda: &[f64]) -> Option<Mat<f64>> {
+        let n = stiffness.nrows();
+        let llt = stiffness.llt(faer::Side::Lower).ok()?;
+        let kinv = llt.solve(Mat::<f64>::identity(n, n));
+        let scaled = Mat::<f64>::from_fn(n, phi.ncols(), |i, j| phi[(i, j)] / lambda[j]);
+        let r = kinv - &scaled * phi.transpose();
+        let finite = (0..n).all(|j| (0..n).all(|i| r[(i, j)].is_finite()));
+        finite.then(|| Mat::from_fn(n, n, |i, j| 0.5 * (r[(i, j)] + r[(j, i)])))
     }
 
     /// Solves Ẑ_p Y = rhs for one harmonic.
@@ -197,8 +246,12 @@ pub fn assemble(model: &Model, scheme: Scheme, period: f64, dofs: &[usize], fft:
         )));
     }
     let op = Operator::new(model)?;
-    if let Operator::Modal { phi, lambda, c } = &op {
-        return assemble_modal(model, symbols, &forces, dofs, phi, lambda, c, k);
+    if let Operator::Modal { phi, lambda, c, residual } = &op {
+        let mut asm = assemble_modal(model, symbols, &forces, dofs, phi, lambda, c, k)?;
+        if let Some(r) = residual {
+            add_residual(&mut asm, model, &forces, r)?;
+        }
+        return Ok(asm);
     }
     let nd = dofs.len();
     let one = |p: usize| -> Result<HarmonicBlock, SolveError> {
@@ -244,6 +297,7 @@ pub fn assemble(model: &Model, scheme: Scheme, period: f64, dofs: &[usize], fft:
         xlin_hat: Vec::with_capacity(nh * nd),
         bxlin_hat: Vec::with_capacity(nh * m),
         h_hat: Vec::with_capacity(nh * nd * m),
+        tangential: Vec::new(),
     };
     for b in blocks {
         asm.g_hat.extend(b.g);
@@ -268,7 +322,8 @@ fn assemble_modal(
     c: &[f64],
     k: usize,
 ) -> Result<Assembly, SolveError> {
-    let n = phi.nrows();
+    // Modes (columns of Φ): n without massless DOFs, fewer with them.
+    let n = phi.ncols();
     let m = model.contacts.len();
     let nd = dofs.len();
     let nh = k / 2 + 1;
@@ -309,6 +364,7 @@ fn assemble_modal(
         xlin_hat: vec![C::ZERO; nh * nd],
         bxlin_hat: vec![C::ZERO; nh * m],
         h_hat: vec![C::ZERO; nh * nd * m],
+        tangential: Vec::new(),
     };
     for p in 0..nh {
         for r in 0..nd {
@@ -340,6 +396,43 @@ fn assemble_modal(
     Ok(asm)
 }
 
+/// Adds the residual flexibility's part R / w_p of Ẑ_p⁻¹ to a modal assembly: B R Bᵀ / w_p to Ĝ_p,
+/// R_out Bᵀ / w_p to Ẑ_p⁻¹Bᵀ, and R F̂_p (the right-hand side is w_p F̂_p) to X̂lin_p and B X̂lin_p.
+fn add_residual(asm: &mut Assembly, model: &Model, forces: &[(usize, Vec<C>)], r: &Mat<f64>) -> Result<(), SolveError> {
+    let (m, nd, nh) = (asm.m, asm.dofs.len(), asm.k / 2 + 1);
+    let n = r.nrows();
+    let rbt = Mat::<f64>::from_fn(n, m, |d, b| model.contacts[b].along(|e| r[(d, e)]));
+    let brbt = Mat::<f64>::from_fn(m, m, |a, b| model.contacts[a].along(|d| rbt[(d, b)]));
+    // B R at each loaded DOF's column: the static response of the contacts to that force.
+    let brf: Vec<Vec<f64>> = forces.iter().map(|(l, _)| (0..m).map(|a| model.contacts[a].along(|d| r[(d, *l)])).collect()).collect();
+    for p in 0..nh {
+        let w = asm.symbols.weight[p];
+        let inv_w = 1.0 / w;
+        if !(w != 0.0 && inv_w.is_finite()) {
+            return Err(SolveError::SingularOperator { harmonic: p, frequency: p as f64 * model.frequency });
+        }
+        for a in 0..m {
+            for b in 0..m {
+                asm.g_hat[(p * m + a) * m + b] += C::from(brbt[(a, b)] * inv_w);
+            }
+        }
+        for (row, &d) in asm.dofs.iter().enumerate() {
+            for b in 0..m {
+                asm.h_hat[(p * nd + row) * m + b] += C::from(rbt[(d, b)] * inv_w);
+            }
+            for (dof, spec) in forces {
+                asm.xlin_hat[p * nd + row] += spec[p] * r[(d, *dof)];
+            }
+        }
+        for (l, (_, spec)) in forces.iter().enumerate() {
+            for a in 0..m {
+                asm.bxlin_hat[p * m + a] += spec[p] * brf[l][a];
+            }
+        }
+    }
+    Ok(())
+}
+
 /// From this many DOFs a dense model with modal damping is solved in its modes.
 const MODAL_MIN_DOFS: usize = 16;
 
@@ -359,4 +452,83 @@ fn check_pivots(u: faer::MatRef<'_, C>, terms: f64) -> Result<(), ()> {
         return Err(());
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::{Compliance, Contact, Force, Harmonic, Structure};
+
+    /// A 20-DOF spring chain whose first 4 DOFs are massless (a massless-boundary model), mass-
+    /// proportional damping, contacts on massless and massive DOFs, forces on both.
+    fn chain_with_massless_boundary() -> Model {
+        let n = 20;
+        let massless = 4;
+        let stiffness = |i: usize| 1.0e4 * (1.0 + 0.3 * i as f64);
+        let mut k = vec![vec![0.0; n]; n];
+        for i in 0..n {
+            // Spring i joins DOF i to DOF i − 1 (DOF 0 to the ground); a light spring to the ground too.
+            k[i][i] += stiffness(i) + 50.0;
+            if i > 0 {
+                k[i - 1][i - 1] += stiffness(i);
+                k[i][i - 1] -= stiffness(i);
+                k[i - 1][i] -= stiffness(i);
+            }
+        }
+        let mass: Vec<Vec<f64>> = (0..n).map(|i| (0..n).map(|j| if i == j && i >= massless { 1.0 + 0.1 * i as f64 } else { 0.0 }).collect()).collect();
+        let damping: Vec<Vec<f64>> = mass.iter().map(|row| row.iter().map(|v| 0.8 * v).collect()).collect();
+        let harmonic = |amplitude, harmonic| Harmonic { amplitude, harmonic, phase: 0.3 };
+        Model {
+            structure: Structure { mass: Matrix::from_rows(&mass), stiffness: Matrix::from_rows(&k), damping: Some(Matrix::from_rows(&damping)) },
+            forces: vec![Force { dof: 12, term: harmonic(3.0, 1) }, Force { dof: 2, term: harmonic(0.5, 2) }],
+            contacts: vec![
+                Contact::on_dof(0, 1.0, 1e-3, Compliance::Rigid),
+                Contact::on_dof(3, -1.0, 1e-3, Compliance::Rigid),
+                Contact::on_dof(7, 1.0, 1e-3, Compliance::Rigid),
+            ],
+            frequency: 37.0,
+            frictions: Vec::new(),
+            rubbing: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn modal_assembly_with_massless_dofs_equals_the_dense_factorisation() {
+        let model = chain_with_massless_boundary();
+        let op = Operator::new(&model).unwrap();
+        assert!(matches!(op, Operator::Modal { residual: Some(_), .. }), "a massless-boundary model is solved in its modes plus the residual flexibility");
+        let (k, period) = (32, 2.0 * std::f64::consts::PI / model.frequency);
+        let fft = PeriodFft::new(k);
+        let dofs = [1, 3, 9, 12];
+        let asm = assemble(&model, Scheme::Cds, period, &dofs, &fft, false).unwrap();
+        // Reference: Ẑ_p factorised by dense LU at every harmonic, the right-hand sides Bᵀ and w_p F̂_p.
+        let s = &model.structure;
+        let dense = Operator::Dense { mass: s.mass.to_dense(), stiffness: s.stiffness.to_dense(), damping: s.damping.as_ref().map(Matrix::to_dense) };
+        let forces = force_spectra(&model, period, &fft);
+        let (n, m, nd) = (model.n(), model.contacts.len(), dofs.len());
+        let mut worst = 0.0f64;
+        for p in 0..=k / 2 {
+            let (s1, s2, w) = (asm.symbols.sigma1[p], asm.symbols.sigma2[p], asm.symbols.weight[p]);
+            let rhs = Mat::<C>::from_fn(n, m + 1, |d, j| match j {
+                j if j < m => C::from(model.contacts[j].along(|e| if e == d { 1.0 } else { 0.0 })),
+                _ => forces.iter().filter(|(l, _)| *l == d).map(|(_, f)| f[p] * w).sum(),
+            });
+            let y = dense.solve(p, s2, s1, w, model.frequency, &rhs).unwrap();
+            let scale = (0..n).flat_map(|i| (0..=m).map(move |j| (i, j))).fold(0.0f64, |a, (i, j)| a.max(y[(i, j)].norm()));
+            for a in 0..m {
+                for b in 0..m {
+                    worst = worst.max((asm.g_hat[(p * m + a) * m + b] - model.contacts[a].along(|d| y[(d, b)])).norm() / scale);
+                }
+                worst = worst.max((asm.bxlin_hat[p * m + a] - model.contacts[a].along(|d| y[(d, m)])).norm() / scale);
+            }
+            for (r, &d) in dofs.iter().enumerate() {
+                worst = worst.max((asm.xlin_hat[p * nd + r] - y[(d, m)]).norm() / scale);
+                for b in 0..m {
+                    worst = worst.max((asm.h_hat[(p * nd + r) * m + b] - y[(d, b)]).norm() / scale);
+                }
+            }
+        }
+        println!("modal + residual flexibility against dense LU: worst relative difference {worst:.2e}");
+        assert!(worst < 1e-9, "worst relative difference {worst:e}");
+    }
 }

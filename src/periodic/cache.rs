@@ -46,6 +46,10 @@ fn key(p: &PeriodicProblem) -> (u64, f64) {
     for f in &model.frictions {
         f.row.iter().for_each(|&(d, c)| (d, c.to_bits()).hash(&mut h));
     }
+    for r in &model.rubbing {
+        r.row.iter().for_each(|&(d, c)| (d, c.to_bits()).hash(&mut h));
+        (r.contact, r.traction().to_bits()).hash(&mut h);
+    }
     let reference = model.forces.iter().map(|f| f.term.amplitude).find(|&a| a != 0.0).unwrap_or(0.0);
     for f in &model.forces {
         let shape = if reference == 0.0 { 0.0 } else { f.term.amplitude / reference };

@@ -6,7 +6,7 @@
 //! ω = 2300 rad/s, k = 512 under cds: ω_max·h ≈ 3.2, Lemke wanders for 31 477 pivots; src/formulation.md §7).
 use super::SolveError;
 use crate::model::Model;
-use crate::time::{Discretization, Scheme};
+use crate::time::{Discretization, Pairing, Scheme};
 
 /// `steps = "auto"` keeps ω_max·h at most this fraction of the scheme's limit.
 pub const AUTO_MARGIN: f64 = 0.9;
@@ -68,4 +68,115 @@ pub fn auto_steps(model: &Model, scheme: Scheme, omega_max: f64, frequency: f64)
         None => format!("no stability limit, ω_max·h = {wh:.3}; the floor {AUTO_FLOOR}"),
     };
     (k, format!("steps = \"auto\": k = {k} ({scheme}, ω = {frequency} rad/s, ω_max = {omega_max:.4e} rad/s, {why}; a power of two)"))
+}
+
+/// `scheme = "auto"`: what the user asks of the result. The scheme and k are chosen to meet it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AccuracyTarget {
+    /// Wanted error, relative to the peak-to-peak amplitude (`[discretization] tolerance`).
+    pub tolerance: f64,
+    /// Largest k the refinement may reach (`[discretization] max_steps`).
+    pub max_steps: usize,
+    /// The refinement stops when the next solve is projected to take longer than this [s]
+    /// (`[discretization] time_budget`).
+    pub time_budget: f64,
+}
+
+/// Default `[discretization] tolerance` with `scheme = "auto"`: 1e-3 of the peak-to-peak
+/// amplitude, the figure issue 23 asks of the blade sweeps.
+pub const AUTO_TOLERANCE: f64 = 1e-3;
+/// Default `[discretization] max_steps`: 16 384 (N = 16 384·m; the largest k our measured stiff
+/// blades needed under cds/galerkin, README "What accuracy costs").
+pub const AUTO_MAX_STEPS: usize = 16_384;
+/// Default `[discretization] time_budget` [s] for one solve of the refinement.
+pub const AUTO_TIME_BUDGET: f64 = 600.0;
+/// The first k of `scheme = "auto"` (unless stability or the harmonics need more): below it the
+/// k/2 of the Richardson estimate is pre-asymptotic on our families (README "What accuracy costs").
+pub const AUTO_FIRST_STEPS: usize = 128;
+
+impl Default for AccuracyTarget {
+    fn default() -> Self {
+        AccuracyTarget { tolerance: AUTO_TOLERANCE, max_steps: AUTO_MAX_STEPS, time_budget: AUTO_TIME_BUDGET }
+    }
+}
+
+/// The contact regimes that decide the scheme (src/formulation.md §3–§4.1).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ContactClass {
+    pub compliant: usize,
+    /// Rigid on a massless DOF: a finite force through the static stiffness, like a compliant one.
+    pub rigid_massless: usize,
+    /// Rigid on a DOF with mass: plastic impacts, impulses.
+    pub rigid_massive: usize,
+}
+
+impl ContactClass {
+    pub fn of(model: &Model) -> Self {
+        let mut c = ContactClass::default();
+        for contact in &model.contacts {
+            match contact.compliance {
+                crate::model::Compliance::Compliant { .. } => c.compliant += 1,
+                crate::model::Compliance::Rigid if model.contact_is_massless(contact) => c.rigid_massless += 1,
+                crate::model::Compliance::Rigid => c.rigid_massive += 1,
+            }
+        }
+        c
+    }
+}
+
+/// `scheme = "auto"`: the scheme, its pairing and the first k, with the reasons. The policy
+/// (README "Scheme limits", the tables of README "Accuracy", "Which scheme and pairing converge"
+/// and "Exact-flow reference for compliant contact"):
+/// - no contact: fourier, exact for a linear response once its harmonics are below k/2;
+/// - the second-order time stepper: galerkin when every DOF carries mass (its stability limit
+///   ω_max·h < 2√3 is 1.73× looser than cds's 2, and its error on the compliant stop is half
+///   cds's), cds when some DOF is massless (a massless-boundary reduction: galerkin has no step
+///   map there and measured order 1.37 on the two-lobe blade, cds order 1.95 and 1e-4 at
+///   k = 2048);
+/// - rigid contact on a DOF with mass: that stepper with forward pairing on it (second order with
+///   sticking, first for pure impacts; the only second-order choice that converges to the
+///   plastic-impact orbit), or bds1 with same pairing (first order, A-stable) when the stepper's
+///   stable k passes `max_steps`;
+/// - compliant contacts and rigid ones on massless DOFs (finite forces): the stepper with same
+///   pairing, or bds2 (second order, A-stable) when its stable k passes `max_steps`. Not fourier:
+///   at the force's kink its error is not C·h^p (observed orders −0.6 … 5.7), so its own estimate
+///   reads 0.11–17× the error and cannot certify a tolerance.
+pub fn auto_scheme(model: &Model, omega_max: f64, target: &AccuracyTarget) -> (Discretization, String) {
+    let frequency = model.frequency;
+    let class = ContactClass::of(model);
+    let resolution = (2 * model.highest_harmonic() as usize + 2).next_power_of_two();
+    let first = AUTO_FIRST_STEPS.max(resolution);
+    let mass = &model.structure.mass;
+    let massless = (0..model.n()).any(|i| mass.get(i, i) <= 0.0);
+    let stepper = if massless { Scheme::Cds } else { Scheme::Galerkin };
+    let stable_k = smallest_stable_steps(stepper, omega_max, frequency, AUTO_MARGIN).unwrap_or(0).next_power_of_two();
+    let limit = stepper.stability_limit().unwrap_or(f64::INFINITY);
+    let stiff = format!(
+        "{stepper} ({}) needs k ≥ {stable_k} for ω_max = {omega_max:.3e} rad/s (ω_max·h ≤ {AUTO_MARGIN}·{limit:.3}), max_steps = {}",
+        if massless { "the model has massless DOFs" } else { "every DOF carries mass" },
+        target.max_steps
+    );
+    let fits = stable_k <= target.max_steps;
+    let (scheme, pairing, k, why) = if model.contacts.is_empty() {
+        (Scheme::Fourier, Some(Pairing::Same), first, "no contact: fourier is exact for the linear response once its harmonics are below k/2".to_string())
+    } else if class.rigid_massive > 0 {
+        let what = format!("{} rigid contact(s) on DOFs with mass", class.rigid_massive);
+        if fits {
+            // Per contact: forward for rigid, same for compliant (rigid-on-massless: the caller).
+            let why = format!(
+                "{what}: {stepper} with forward pairing on them (second order with sticking, first order for pure impacts), same on the others; {stiff}"
+            );
+            (stepper, None, first.max(stable_k), why)
+        } else {
+            (Scheme::Bds1, Some(Pairing::Same), first, format!("{what} and a stiff model: bds1 with same pairing (first order, A-stable); {stiff}"))
+        }
+    } else {
+        let what = format!("{} compliant and {} rigid-on-massless contact(s) (finite forces)", class.compliant, class.rigid_massless);
+        if fits {
+            (stepper, Some(Pairing::Same), first.max(stable_k), format!("{what}: {stepper} with same pairing (second order); {stiff}"))
+        } else {
+            (Scheme::Bds2, Some(Pairing::Same), first, format!("{what} and a stiff model: bds2 with same pairing (second order, A-stable); {stiff}"))
+        }
+    };
+    (Discretization { scheme, steps: k, pairing }, why)
 }

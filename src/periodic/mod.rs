@@ -7,6 +7,7 @@ pub mod limits;
 use crate::linalg::fft; // the crate's one FFT plan type, shared with lcp
 mod problem;
 mod recovery;
+mod rubbing;
 mod session;
 mod state_space;
 mod tuning;
@@ -16,6 +17,7 @@ pub use fft::PeriodFft;
 pub use friction::{FRICTION_DENSE_MAX, FrictionGrid, friction_lcp};
 pub use problem::{MAX_DENSE_FLOPS, MAX_LCP_SIZE, MAX_STEPS, MIN_STEPS, PeriodicProblem};
 pub use recovery::render_path as render_lcp_path;
+pub use rubbing::TangentialRow;
 pub use session::{PeriodicSolver, WarmStart};
 pub use state_space::{NoStepMap, SHOOTING_MEMORY_MAX, SHOOTING_WORK_MAX, shooting_memory, shooting_work, step_map};
 pub use tuning::Tuning;

@@ -343,7 +343,10 @@ impl PeriodicProblem {
     pub(super) fn assemble(&self, fft: &PeriodFft) -> Result<Assembly, SolveError> {
         // Friction contacts ride as extra rows of B (src/formulation.md §9).
         let model = super::friction::with_rows(&self.model)?;
-        assembly::assemble(&model, self.disc.scheme, self.period(), &self.recovery_dofs(), fft, self.solver.parallel)
+        // Rubbing contacts' tangential rows too, folded into their contacts' columns.
+        let model = super::rubbing::with_rows(&model);
+        let wide = assembly::assemble(&model, self.disc.scheme, self.period(), &self.recovery_dofs(), fft, self.solver.parallel)?;
+        Ok(super::rubbing::fold(&self.model, wide))
     }
 
     /// Solves with an assembly of this problem (a session's cached one); `t_start`: when the
@@ -359,6 +362,7 @@ impl PeriodicProblem {
         let t_lcp = Instant::now();
         let sol = self.solve_lcp(&a, &q, warm_start)?;
         let t_lcp = t_lcp.elapsed().as_secs_f64();
+        super::rubbing::check_gross_slip(self, asm, fft, &sol.z)?;
 
         let t_rec = Instant::now();
         let mut response = recovery::recover(self, asm, fft, &sol)?;

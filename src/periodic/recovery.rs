@@ -154,6 +154,7 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
         timing_s: Default::default(),
         accuracy: Default::default(),
         polish: None,
+        scheme_choice: None,
         linear_displacement,
         active_set,
     })

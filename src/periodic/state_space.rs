@@ -96,6 +96,9 @@ pub fn step_map(problem: &PeriodicProblem) -> Result<StepMapLcp, NoStepMap> {
     if !model.frictions.is_empty() {
         return Err(NoStepMap("friction contacts have no step map yet (src/formulation.md §9)".to_string()));
     }
+    if !model.rubbing.is_empty() {
+        return Err(NoStepMap("rubbing contacts have no step map yet: their force leaves the normal (src/formulation.md §9)".to_string()));
+    }
     let offsets: Vec<usize> = (0..m).map(|c| problem.pairing_at(c).offset()).collect();
     if let Some(c) = offsets.iter().position(|&s| s > lead) {
         return Err(NoStepMap(format!("contact[{c}] is paired forward under {}: its force waits for a later step's gap", disc.scheme)));

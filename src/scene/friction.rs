@@ -7,11 +7,13 @@
 //! normal_force = 1.0     # constant normal load N: slip force μ·N
 //! stiffness = 3.0        # optional: a Jenkins element (k_t in series with the slider)
 //! ```
-//! `contact` (the normal force of a `[[contact]]`) and `sliding_velocity` (rubbing) are part of
-//! the interface but not yet solved: they are refused by name, never ignored.
+//! Rubbing in gross slip: `contact = i` with `sliding_velocity = V` (the counter-face of
+//! `[[contact]]` i slides along `dof` at V, faster than the structure): the friction force is
+//! μ·λ_n along V, no normal_force. `contact` without `sliding_velocity` (coupled stick/slip),
+//! `node` and `direction` are part of the interface but not yet solved: refused by name.
 use super::contacts::Resolver;
 use super::{BuildError, DofSpec, Scene};
-use crate::model::Friction;
+use crate::model::{Friction, Rubbing};
 use serde::Deserialize;
 
 /// One `[[friction]]` entry as written.
@@ -28,36 +30,64 @@ pub struct FrictionSpec {
     pub normal_force: Option<f64>,
     /// Tangential stiffness k_t > 0 of a Jenkins element.
     pub stiffness: Option<f64>,
-    /// The normal force of `[[contact]]` i (coupled normal–tangential): not yet supported.
-    pub contact: Option<toml::Value>,
-    /// The counter-face's sliding speed (rubbing): not yet supported.
-    pub sliding_velocity: Option<toml::Value>,
+    /// The normal force of `[[contact]]` i: with `sliding_velocity`, rubbing in gross slip.
+    pub contact: Option<usize>,
+    /// The counter-face's sliding speed V along `dof` (rubbing in gross slip).
+    pub sliding_velocity: Option<f64>,
 }
 
 /// Keys of the interface that this version refuses, with what they would do.
-const NOT_YET: [(&str, &str); 4] = [
-    ("contact", "coupled normal–tangential friction (the normal force of a [[contact]])"),
-    ("sliding_velocity", "rubbing against a counter-face sliding at a given speed"),
+const NOT_YET: [(&str, &str); 3] = [
+    ("contact", "coupled stick/slip normal–tangential friction (contact without sliding_velocity; give sliding_velocity = V for rubbing in gross slip)"),
     ("node", "a friction contact on a named node"),
     ("direction", "a sliding direction over several DOFs"),
 ];
 
 impl Scene {
-    /// The `[[friction]]` entries in the full (clamped) numbering.
-    pub(super) fn frictions(&self, resolver: &Resolver) -> Result<Vec<Friction>, BuildError> {
+    /// The `[[friction]]` entries in the full (clamped) numbering: Coulomb contacts under a
+    /// normal load, and rubbing in gross slip (`contact` with `sliding_velocity`).
+    pub(super) fn frictions(&self, resolver: &Resolver) -> Result<(Vec<Friction>, Vec<Rubbing>), BuildError> {
         if !self.friction.is_empty() && self.reduction.is_some() {
             return Err(BuildError::field(
                 "friction",
                 "is not yet supported together with [reduction] (the friction DOFs would have to be kept physical); solve the full model",
             ));
         }
-        self.friction.iter().enumerate().map(|(i, f)| f.build(i, resolver)).collect()
+        let mut out = (Vec::new(), Vec::new());
+        for (i, f) in self.friction.iter().enumerate() {
+            match f.build(i, resolver)? {
+                Built::Load(f) => out.0.push(f),
+                Built::Rubbing(r) => out.1.push(r),
+            }
+        }
+        if !out.0.is_empty() && !out.1.is_empty() {
+            return Err(BuildError::field(
+                "friction",
+                "mixes rubbing (contact with sliding_velocity) and friction under a normal load: this version solves one kind per scene",
+            ));
+        }
+        Ok(out)
     }
 }
 
+/// One `[[friction]]` entry built.
+enum Built {
+    Load(Friction),
+    Rubbing(Rubbing),
+}
+
 impl FrictionSpec {
-    fn build(&self, i: usize, resolver: &Resolver) -> Result<Friction, BuildError> {
-        let given = [self.contact.is_some(), self.sliding_velocity.is_some(), self.node.is_some(), self.direction.is_some()];
+    fn build(&self, i: usize, resolver: &Resolver) -> Result<Built, BuildError> {
+        if let (Some(contact), Some(sliding_velocity)) = (self.contact, self.sliding_velocity) {
+            return self.rubbing(i, resolver, contact, sliding_velocity).map(Built::Rubbing);
+        }
+        if self.sliding_velocity.is_some() {
+            return Err(BuildError::field(
+                format!("friction[{i}].sliding_velocity"),
+                "needs contact = index: rubbing presses with the normal force of that [[contact]] (a constant normal_force with a sliding counter-face is not yet supported)",
+            ));
+        }
+        let given = [self.contact.is_some(), self.node.is_some(), self.direction.is_some()];
         if let Some(((key, what), _)) = NOT_YET.iter().zip(given).find(|(_, g)| *g) {
             return Err(BuildError::field(
                 format!("friction[{i}].{key}"),
@@ -73,6 +103,27 @@ impl FrictionSpec {
         let Some(normal_force) = self.normal_force else {
             return Err(BuildError::field(format!("friction[{i}]"), "needs normal_force = N (a constant normal load ≥ 0)"));
         };
-        Ok(Friction::on_dof(full, self.coefficient, normal_force, self.stiffness))
+        Ok(Built::Load(Friction::on_dof(full, self.coefficient, normal_force, self.stiffness)))
+    }
+
+    /// Rubbing in gross slip on `[[contact]]` `contact`, sliding along `dof`.
+    fn rubbing(&self, i: usize, resolver: &Resolver, contact: usize, sliding_velocity: f64) -> Result<Rubbing, BuildError> {
+        let refused = [
+            ("node", self.node.is_some()),
+            ("direction", self.direction.is_some()),
+            ("normal_force", self.normal_force.is_some()),
+            ("stiffness", self.stiffness.is_some()),
+        ];
+        if let Some((key, _)) = refused.iter().find(|(_, g)| *g) {
+            return Err(BuildError::field(
+                format!("friction[{i}].{key}"),
+                "is not taken by rubbing in gross slip (contact with sliding_velocity) in this version: the normal force is the contact's, the sliding direction one DOF (dof = index), the friction rigid Coulomb",
+            ));
+        }
+        let Some(dof) = self.dof else {
+            return Err(BuildError::field(format!("friction[{i}]"), "needs dof = index (the DOF along which the counter-face slides)"));
+        };
+        let (_, full) = resolver.output_pair(&format!("friction[{i}].dof"), &DofSpec::Index(dof))?;
+        Ok(Rubbing { contact, row: vec![(full, 1.0)], coefficient: self.coefficient, sliding_velocity })
     }
 }

@@ -23,12 +23,13 @@ pub use casing::Casing;
 pub use error::{BuildError, SceneError};
 pub use files::FileReference;
 pub use friction::FrictionSpec;
-pub use settings::{discretization, error_estimate, period_multiple, solver_settings};
+pub use settings::{accuracy_target, discretization, error_estimate, period_multiple, solver_settings};
 pub use spec::*;
 
 use crate::fe::{Blade, DofMap, NodeMap};
 use crate::model::{Labels, Model, Structure};
 use crate::periodic::PeriodicProblem;
+use crate::periodic::limits::AccuracyTarget;
 use crate::reduction::ReducedModel;
 use contacts::Resolver;
 use std::path::{Path, PathBuf};
@@ -63,6 +64,11 @@ pub struct SceneModel {
     pub timings: BuildTimings,
     /// `[discretization] error_estimate`: estimate the error of every result (default true).
     pub error_estimate: bool,
+    /// `[discretization] scheme = "auto"`: the accuracy the front ends refine k for (the CLI's
+    /// `solve` by `analysis::scheme_auto`; the FMU and the C API solve at the first k).
+    pub accuracy_target: Option<AccuracyTarget>,
+    /// With `scheme = "auto"`: the policy's choice of scheme, pairing and first k, and why.
+    pub scheme_choice: Option<String>,
     /// `[discretization] polish`: refine by the event-fitted polish (default false).
     pub polish: bool,
     /// `[output] stability`: the front ends report the Floquet stability of every result
@@ -150,7 +156,7 @@ impl Scene {
         let contact_rows: Vec<Vec<(usize, f64)>> = placed.iter().map(|p| p.user_row.clone()).collect();
         let contact_dofs: Vec<usize> = contact_rows.iter().map(|r| crate::model::label_of(r).0).collect();
         let contacts: Vec<_> = placed.into_iter().map(|p| p.contact).collect();
-        let frictions = self.frictions(&resolver)?;
+        let (frictions, rubbing) = self.frictions(&resolver)?;
         let outputs = self.outputs(&resolver, matches!(source, Source::Inline), &contact_dofs, &forces)?;
 
         // The reduction, or the full model.
@@ -159,7 +165,7 @@ impl Scene {
         let (model, map, reduction) = match &self.reduction {
             None => {
                 let map = outputs::clamped_map(&outputs, &dofs, &contact_rows, !self.structure.fixed.is_empty());
-                (Model { structure: full.clone(), forces, contacts, frequency, frictions }, map, None)
+                (Model { structure: full.clone(), forces, contacts, frequency, frictions, rubbing }, map, None)
             }
             Some(spec) => {
                 let parts = reduce::FullModel { structure: &full, damping: &damping, forces: &forces, contacts: &contacts, frequency };
@@ -173,10 +179,19 @@ impl Scene {
         let (disc, auto) = discretization(&self.discretization)?;
         let solver = solver_settings(self.solver.as_ref())?;
         let estimate = error_estimate(&self.discretization)?;
+        let target = accuracy_target(&self.discretization)?;
         let mut problem = outputs::problem(model, (disc, auto), outputs, map, solver)?;
+        if let Some((i, _)) = pairings.iter().enumerate().find(|(_, p)| p.is_some() && target.is_some()) {
+            let why = "is given with discretization.scheme = \"auto\", which chooses the pairing with the scheme; remove the key or name a scheme";
+            return Err(BuildError::field(format!("contact[{i}].pairing"), why.to_string()));
+        }
         for (i, p) in pairings.into_iter().enumerate().filter(|(_, p)| p.is_some()) {
             problem.set_contact_pairing(i, p)?;
         }
+        let scheme_choice = match &target {
+            Some(t) => Some(settings::choose_scheme(&mut problem, t, &self.discretization)?),
+            None => None,
+        };
         problem.set_period_multiple(period_multiple(&self.discretization)?)?;
         let timings = BuildTimings { structure: t_structure, reduction: t_reduction, total: t0.elapsed().as_secs_f64() };
         let stability = self.output.as_ref().is_some_and(|o| o.stability);
@@ -192,6 +207,8 @@ impl Scene {
             labels,
             timings,
             error_estimate: estimate,
+            accuracy_target: target,
+            scheme_choice,
             polish: self.discretization.polish,
             stability,
         })

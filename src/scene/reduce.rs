@@ -65,7 +65,7 @@ pub(super) fn reduce(
         .iter()
         .map(|c| Contact { row: c.row.iter().map(|&(d, v)| (red.reduced_dof(d).expect("contacts are boundary DOFs"), v)).collect(), ..c.clone() })
         .collect();
-    let model = Model { structure: red.structure(), forces, contacts, frequency: full.frequency, frictions: Vec::new() };
+    let model = Model { structure: red.structure(), forces, contacts, frequency: full.frequency, frictions: Vec::new(), rubbing: Vec::new() };
     let rows = outputs.dofs().into_iter().map(|u| (u, row(resolver.dofs.new_index(u).expect("checked")))).collect();
     let map = OutputMap { rows, contact_rows: contact_rows.to_vec(), effects: vec!["reduction".into()] };
     Ok((model, map, red))

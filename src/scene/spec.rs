@@ -283,6 +283,13 @@ pub struct DiscretizationSpec {
     /// Orbits of period p·T (default 1): the LCP over p forcing periods, `steps` per forcing
     /// period (`PeriodicProblem::set_period_multiple`).
     pub period_multiple: Option<i64>,
+    /// With `scheme = "auto"`: the wanted error relative to the peak-to-peak amplitude
+    /// (default `periodic::limits::AUTO_TOLERANCE`).
+    pub tolerance: Option<f64>,
+    /// With `scheme = "auto"`: the largest k the refinement may reach.
+    pub max_steps: Option<i64>,
+    /// With `scheme = "auto"`: stop refining when the next solve is projected past this [s].
+    pub time_budget: Option<f64>,
 }
 
 /// `steps = 512` or `steps = "auto"`; anything else is kept to be refused naming the field.
@@ -313,7 +320,17 @@ fn default_steps() -> StepsSpec {
 
 impl Default for DiscretizationSpec {
     fn default() -> Self {
-        DiscretizationSpec { scheme: default_scheme(), steps: default_steps(), pairing: None, error_estimate: None, polish: false, period_multiple: None }
+        DiscretizationSpec {
+            scheme: default_scheme(),
+            steps: default_steps(),
+            pairing: None,
+            error_estimate: None,
+            polish: false,
+            tolerance: None,
+            max_steps: None,
+            time_budget: None,
+            period_multiple: None,
+        }
     }
 }
 

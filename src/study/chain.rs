@@ -22,6 +22,7 @@ pub fn model() -> Model {
         contacts: vec![Contact::on_dof(1, 1.0, 0.3, Compliance::Compliant { stiffness: 20.0 })],
         frequency: 1.2,
         frictions: Vec::new(),
+        rubbing: Vec::new(),
     }
 }
 

@@ -135,9 +135,10 @@ impl PolishedOrbit {
     /// exponentials: exact when every phase is free (compliant contacts), because a compliant
     /// contact's force is continuous at its switch (zero at clearance 0), so its saltation matrix
     /// S = I + (f⁺ − f⁻)∇hᵀ/(∇h·f⁻) is the identity (Leine & Nijmeijer, "Dynamics and
-    /// Bifurcations of Non-Smooth Mechanical Systems", §7.1). `None` with a stuck contact.
+    /// Bifurcations of Non-Smooth Mechanical Systems", §7.1). `None` with a stuck contact or an
+    /// impact (its velocity reset is not the identity: the relocated one-period map then).
     pub(super) fn flow_product(&self) -> Option<DMatrix<f64>> {
-        if !self.phases.iter().all(|p| p.all_free()) {
+        if !self.phases.iter().all(|p| p.all_free()) || self.events.iter().any(|e| matches!(e.kind, super::EventKind::Impact { .. })) {
             return None;
         }
         let n2 = 2 * self.model.n();

@@ -12,13 +12,16 @@
 //! for sticking); otherwise the LCP's orbit is kept, with a warning that says why.
 mod continued;
 pub mod events;
+pub mod friction;
 mod orbit;
 mod phase;
+mod rigid;
 mod verify;
 
 pub use continued::Touch;
 pub use events::{Event, EventKind};
 pub use orbit::{OrbitParts, PolishedOrbit, user_value};
+pub use rigid::{CLEARANCE, RigidMargin};
 
 use crate::periodic::PeriodicProblem;
 use crate::response::{EventRecord, PolishSummary, Response};
@@ -45,7 +48,10 @@ pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<PolishedOrbit, 
         )));
     }
     if !model.frictions.is_empty() {
-        return Err(PolishFailure("the polish does not fit stick and slip events yet: friction contacts (src/formulation.md §9) keep the LCP's orbit".into()));
+        return Err(PolishFailure("friction contacts are fitted by the stick–slip polish (`polish::apply`), not as contact events: continuation on the exact orbit does not take friction".into()));
+    }
+    if !model.rubbing.is_empty() {
+        return Err(PolishFailure("the polish does not fit rubbing contacts yet (their force leaves the normal): the LCP's orbit is kept".into()));
     }
     if r.contacts.len() != model.contacts.len() {
         return Err(PolishFailure("the result has no contact outputs ([output] contacts = false): the event sequence cannot be read".into()));
@@ -63,40 +69,52 @@ pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<PolishedOrbit, 
 /// with a warning and `polish.status = "fallback"`.
 pub fn apply(problem: &PeriodicProblem, r: &mut Response) -> Option<PolishedOrbit> {
     let t0 = Instant::now();
+    if !problem.model().frictions.is_empty() {
+        // The stick–slip orbit writes the samples; the front ends interpolate those.
+        match friction::polish(problem, r) {
+            Ok(orbit) => {
+                friction::write(&orbit, problem, r);
+                let how = "stick–slip orbit (exact flows between stick, slip and reversal events)";
+                record(r, how, orbit.event_records(), (orbit.iterations, orbit.residual, orbit.correction), t0);
+            }
+            Err(e) => fall_back(r, e, t0),
+        }
+        return None;
+    }
     match polish(problem, r) {
         Ok(orbit) => {
             orbit.write(problem, r);
-            let events = orbit.event_records();
-            let scale = r.displacement.values().map(|x| Response::peak_to_peak(x)).fold(0.0, f64::max);
-            let e = orbit.correction().max(f64::EPSILON * scale);
-            r.accuracy.estimate = Some(e);
-            r.accuracy.relative = (scale > 0.0).then(|| e / scale);
-            r.accuracy.method = format!(
-                "polish: event-fitted exact orbit ({} events), Newton converged in {} iterations; the estimate is the last Newton correction (round-off level)",
-                events.len(),
-                orbit.iterations()
-            );
-            r.polish = Some(PolishSummary {
-                status: "polished".into(),
-                reason: String::new(),
-                events,
-                iterations: orbit.iterations(),
-                residual: orbit.residual(),
-                time_s: t0.elapsed().as_secs_f64(),
-            });
+            record(r, "event-fitted exact orbit", orbit.event_records(), (orbit.iterations(), orbit.residual(), orbit.correction()), t0);
             Some(orbit)
         }
         Err(e) => {
-            r.warnings.push(format!("polish: fell back to the LCP's orbit: {e}"));
-            r.polish = Some(PolishSummary {
-                status: "fallback".into(),
-                reason: e.0,
-                events: Vec::<EventRecord>::new(),
-                iterations: 0,
-                residual: 0.0,
-                time_s: t0.elapsed().as_secs_f64(),
-            });
+            fall_back(r, e, t0);
             None
         }
     }
+}
+
+/// The polished orbit's summary and its accuracy: the last Newton correction (round-off level).
+fn record(r: &mut Response, how: &str, events: Vec<EventRecord>, (iterations, residual, correction): (usize, f64, f64), t0: Instant) {
+    let scale = r.displacement.values().map(|x| Response::peak_to_peak(x)).fold(0.0, f64::max);
+    let e = correction.max(f64::EPSILON * scale);
+    r.accuracy.estimate = Some(e);
+    r.accuracy.relative = (scale > 0.0).then(|| e / scale);
+    r.accuracy.method = format!(
+        "polish: {how} ({} events), Newton converged in {iterations} iterations; the estimate is the last Newton correction (round-off level)",
+        events.len()
+    );
+    r.polish = Some(PolishSummary { status: "polished".into(), reason: String::new(), events, iterations, residual, time_s: t0.elapsed().as_secs_f64() });
+}
+
+fn fall_back(r: &mut Response, e: PolishFailure, t0: Instant) {
+    r.warnings.push(format!("polish: fell back to the LCP's orbit: {e}"));
+    r.polish = Some(PolishSummary {
+        status: "fallback".into(),
+        reason: e.0,
+        events: Vec::<EventRecord>::new(),
+        iterations: 0,
+        residual: 0.0,
+        time_s: t0.elapsed().as_secs_f64(),
+    });
 }

@@ -511,18 +511,7 @@ impl PolishedOrbit {
         let h = r.period / r.steps as f64;
         let states: Vec<DVector<f64>> = r.time.iter().map(|&t| self.state(t)).collect();
         let accs: Vec<DVector<f64>> = if r.acceleration.is_empty() { vec![] } else { r.time.iter().map(|&t| self.acceleration(t)).collect() };
-        let label = |key: &str, v: &DVector<f64>, off: usize| -> f64 {
-            user_value(problem.output_map(), key.parse().unwrap_or(usize::MAX), v, off, n).unwrap_or(f64::NAN)
-        };
-        for (key, series) in r.displacement.iter_mut() {
-            series.iter_mut().zip(&states).for_each(|(x, y)| *x = label(key, y, 0));
-        }
-        for (key, series) in r.velocity.iter_mut() {
-            series.iter_mut().zip(&states).for_each(|(x, y)| *x = label(key, y, n));
-        }
-        for (key, series) in r.acceleration.iter_mut() {
-            series.iter_mut().zip(&accs).for_each(|(x, a)| *x = label(key, a, 0));
-        }
+        write_kinematics(r, problem.output_map(), &states, &accs, n);
         for (i, rc) in r.contacts.iter_mut().enumerate() {
             for (j, &t) in r.time.iter().enumerate() {
                 rc.gap[j] = self.clearance(i, &states[j], t);
@@ -532,6 +521,21 @@ impl PolishedOrbit {
             let k = rc.gap.len();
             rc.paired_gap = (0..k).map(|j| rc.gap[(j + s) % k]).collect();
         }
+    }
+}
+
+/// Overwrites `r`'s displacement, velocity and acceleration series, output by output, with the
+/// states (x, ẋ) and accelerations of an exact orbit at `r`'s instants.
+pub(super) fn write_kinematics(r: &mut Response, map: Option<&OutputMap>, states: &[DVector<f64>], accs: &[DVector<f64>], n: usize) {
+    let label = |key: &str, v: &DVector<f64>, off: usize| user_value(map, key.parse().unwrap_or(usize::MAX), v, off, n).unwrap_or(f64::NAN);
+    for (key, series) in r.displacement.iter_mut() {
+        series.iter_mut().zip(states).for_each(|(x, y)| *x = label(key, y, 0));
+    }
+    for (key, series) in r.velocity.iter_mut() {
+        series.iter_mut().zip(states).for_each(|(x, y)| *x = label(key, y, n));
+    }
+    for (key, series) in r.acceleration.iter_mut() {
+        series.iter_mut().zip(accs).for_each(|(x, a)| *x = label(key, a, 0));
     }
 }
 

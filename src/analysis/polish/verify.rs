@@ -17,7 +17,7 @@ const TOL: f64 = 1e-9;
 
 /// The smallest value of `f` over [a, b]: dense samples, then golden section around each
 /// sampled local minimum.
-fn minimum(a: f64, b: f64, f: &dyn Fn(f64) -> f64) -> (f64, f64) {
+pub(super) fn minimum(a: f64, b: f64, f: &dyn Fn(f64) -> f64) -> (f64, f64) {
     let ts: Vec<f64> = (0..=SAMPLES).map(|i| a + (b - a) * i as f64 / SAMPLES as f64).collect();
     let vs: Vec<f64> = ts.iter().map(|&t| f(t)).collect();
     let mut best = (vs[0], ts[0]);

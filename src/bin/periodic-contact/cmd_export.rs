@@ -98,8 +98,12 @@ pub fn run(scene: &Path, dir: &Path) -> Result<(), Failure> {
     let built = s.build_in(&scene.display().to_string(), &folder).map_err(|e| Failure::input(e.to_string()))?;
     let problem = &built.problem;
     let model = problem.model();
-    if !model.frictions.is_empty() {
-        return Err(Failure::input(format!("{}: export writes contacts along normals only; the scene's friction contacts are not exported", scene.display())));
+    if !model.frictions.is_empty() || !model.rubbing.is_empty() {
+        // A rubbing contact's force row differs from its gap row (n − μ·sign(V)·t): B alone would misstate it.
+        return Err(Failure::input(format!(
+            "{}: export writes contacts along normals only; the scene's friction or rubbing contacts ([[friction]]) are not exported: remove them to export the rest",
+            scene.display()
+        )));
     }
     let st = &model.structure;
     let files = json!({

@@ -1,9 +1,10 @@
 //! `solve` and the default run.
 use crate::{Failure, ensure_writable, write_output};
-use periodic_contact::analysis::{accuracy, hysteresis, polish};
+use periodic_contact::analysis::{accuracy, hysteresis, polish, scheme_auto};
 use periodic_contact::linalg::PeriodFft;
 use periodic_contact::model::Labels;
 use periodic_contact::periodic::PeriodicProblem;
+use periodic_contact::periodic::limits::AccuracyTarget;
 use periodic_contact::response::Response;
 use periodic_contact::scene::Scene;
 use std::path::Path;
@@ -47,6 +48,8 @@ struct Loaded {
     refine: Refine,
     labels: Labels,
     friction_dofs: Vec<usize>,
+    /// `scheme = "auto"`: the tolerance and the policy's choice.
+    auto: Option<(AccuracyTarget, String)>,
 }
 
 fn load(scene: &Path, overrides: Overrides, flags: Refine) -> Result<Loaded, Failure> {
@@ -65,12 +68,15 @@ fn load(scene: &Path, overrides: Overrides, flags: Refine) -> Result<Loaded, Fai
     let friction_dofs = s.friction.iter().map(|f| f.dof.unwrap_or(usize::MAX)).collect();
     let built = s.build_in(&scene.display().to_string(), &dir).map_err(|e| Failure::input(e.to_string()))?;
     let refine = Refine { estimate: flags.estimate && built.error_estimate, polish: flags.polish || built.polish };
-    Ok(Loaded { problem: built.problem, refine, labels: built.labels, friction_dofs })
+    let auto = built.accuracy_target.zip(built.scheme_choice);
+    Ok(Loaded { problem: built.problem, refine, labels: built.labels, friction_dofs, auto })
 }
 
 /// The error estimate, then the polish (whose estimate replaces it), as `refine` asks.
 fn refine(problem: &PeriodicProblem, r: &mut Response, refine: Refine) {
-    if refine.estimate {
+    if r.scheme_choice.is_some() {
+        // `scheme = "auto"` estimated every k it solved.
+    } else if refine.estimate {
         r.accuracy = accuracy::estimate(problem, r);
     } else {
         r.accuracy.method = "none: not requested (--no-estimate or error_estimate = \"none\")".to_string();
@@ -114,7 +120,7 @@ pub fn run(scene: &Path, files: Files, overrides: Overrides, flags: Refine) -> R
     if let Some(p) = hysteresis {
         ensure_writable(p, "--hysteresis")?;
     }
-    let Loaded { problem, refine: flags, labels, friction_dofs } = load(scene, overrides, flags)?;
+    let Loaded { mut problem, refine: flags, labels, friction_dofs, auto } = load(scene, overrides, flags)?;
     if hysteresis.is_some() && problem.model().frictions.is_empty() {
         return Err(Failure::input(format!(
             "--hysteresis: {} has no [[friction]] contact, so there is no force–displacement loop to draw; add a [[friction]] entry or leave --hysteresis out",
@@ -125,7 +131,14 @@ pub fn run(scene: &Path, files: Files, overrides: Overrides, flags: Refine) -> R
         export_lcp(&problem, p)?;
     }
     // Errors found while solving name the scene too (those of loading already do).
-    let mut r = solve(&problem).map_err(|f| Failure { message: format!("{}: {}", scene.display(), f.message), ..f })?;
+    let named = |f: Failure| Failure { message: format!("{}: {}", scene.display(), f.message), ..f };
+    let mut r = match &auto {
+        Some((target, choice)) => {
+            eprintln!("{choice}");
+            scheme_auto::solve_to_tolerance(&mut problem, target, choice).map_err(|e| named(Failure::from(periodic_contact::Error::from(e))))?
+        }
+        None => solve(&problem).map_err(named)?,
+    };
     refine(&problem, &mut r, flags);
     let json = serde_json::to_string_pretty(&r).map_err(|e| Failure::solver(e.to_string()))?;
     write_output(output, &json)?;
@@ -143,6 +156,21 @@ pub fn run(scene: &Path, files: Files, overrides: Overrides, flags: Refine) -> R
         eprintln!("hysteresis loop(s) → {}", p.display());
     }
     eprintln!("solver: {}", r.lcp.path);
+    if let Some(c) = &r.scheme_choice {
+        let tried: Vec<String> = c
+            .tried
+            .iter()
+            .map(|t| format!("k = {}: {} in {:.2} s", t.steps, t.estimate.map_or("no estimate".into(), |e| format!("{e:.2e}")), t.seconds))
+            .collect();
+        eprintln!(
+            "scheme auto: {} {} k = {} ({}), {}",
+            c.scheme,
+            c.pairing,
+            c.steps,
+            tried.join("; "),
+            if c.met { "tolerance met" } else { "tolerance NOT met" }
+        );
+    }
     match (r.accuracy.estimate, r.accuracy.relative) {
         (Some(e), Some(rel)) => eprintln!("error estimate: {e:.3e} ({rel:.2e} of the peak-to-peak amplitude), {}", r.accuracy.method),
         (Some(e), None) => eprintln!("error estimate: {e:.3e}, {}", r.accuracy.method),
@@ -159,7 +187,11 @@ pub fn run(scene: &Path, files: Files, overrides: Overrides, flags: Refine) -> R
             output.display()
         );
     }
-    Ok(())
+    match &r.scheme_choice {
+        // The result is written; the exit status says it misses the tolerance (a Limit).
+        Some(c) if !c.met => Err(Failure::input(format!("{}: {}", scene.display(), r.warnings.last().map_or("", String::as_str)))),
+        _ => Ok(()),
+    }
 }
 
 /// `cargo run --release` without arguments: the built-in scene and a short table.

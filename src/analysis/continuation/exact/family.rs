@@ -28,7 +28,7 @@ const DIFF: f64 = 1e-7;
 
 pub(super) struct Family {
     base: Model,
-    param: Parameter,
+    pub param: Parameter,
     pub rho: f64,
     pub ys: f64,
     pub sig: Signature,

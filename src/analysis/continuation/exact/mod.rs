@@ -11,9 +11,12 @@
 //! (located where the touch's sign flips; a pair of events is inserted there and the new branch
 //! starts with its phase 1e-5 of the period long), or a phase between two events of one contact
 //! shrinking below 1e-6 of the period (steps land on it by quarters; the pair is removed and the
-//! branch goes on in the same direction of the parameter). Compliant contacts only: a rigid one
-//! (impacts, sticking) is the discrete walk's.
+//! branch goes on in the same direction of the parameter). Rigid contacts (plastic impacts,
+//! sticking arcs, releases; the monodromy is the relocated one-period map, rank-deficient at an
+//! impact): their signature changes are located on the exact orbit and the branch past them is
+//! started from the grid LCP ([`rigid`]).
 mod family;
+mod rigid;
 mod signature;
 
 use super::{BranchPoint, ContinuationSettings, EventKind, Parameter, Source, floquet};
@@ -54,15 +57,10 @@ struct Walk<'a> {
     end: Option<PolishedOrbit>,
 }
 
-/// The scenes the exact walk takes: compliant contacts, orbits of one forcing period.
+/// The scenes the exact walk takes: orbits of one forcing period.
 fn check(problem: &PeriodicProblem) -> Result<(), Error> {
     if problem.period_multiple() != 1 {
         return Err(Error::input("the exact continuation follows orbits of one forcing period (period_multiple = 1)"));
-    }
-    if let Some(i) = problem.model().contacts.iter().position(|c| c.is_rigid()) {
-        return Err(Error::input(format!(
-            "contact[{i}] is rigid: the exact continuation takes compliant contacts only (impacts and sticking are the discrete walk's)"
-        )));
     }
     Ok(())
 }
@@ -124,6 +122,10 @@ pub(super) enum Stepped {
 /// small change of the knob is a short arclength: one step or a few.
 pub(super) fn step(problem: &PeriodicProblem, param: Parameter, from: f64, to: f64, orbit: &PolishedOrbit) -> Result<Stepped, Error> {
     check(problem)?;
+    // The front ends' steps re-solve the grid on the branch; their rigid case is not validated yet.
+    if let Some(i) = problem.model().contacts.iter().position(|c| c.is_rigid()) {
+        return Err(Error::input(format!("contact[{i}] is rigid: the front ends' exact follow takes compliant contacts only (the discrete follow stays)")));
+    }
     let rho = from.abs().max(to.abs()).max((to - from).abs());
     let defaults = ContinuationSettings::default();
     let reach = 1.2 * (to - from).abs() / rho;
@@ -192,7 +194,8 @@ impl Walk<'_> {
             let shrinking = self.shrinking(&here);
             if let Some(&(e, len, rate)) = shrinking.iter().find(|s| s.1 < VANISH) {
                 let _ = (len, rate);
-                match self.remove_pair(&here, e) {
+                let next = if self.rigid_event(e) { self.rigid_vanish(&here, e, to) } else { self.remove_pair(&here, e) };
+                match next {
                     Some(next) => {
                         here = next;
                         ds = settings.initial_step;
@@ -217,6 +220,13 @@ impl Walk<'_> {
                 _ => {
                     ds = step / 2.0;
                     if ds < settings.min_step {
+                        // Rigid events merging (a flight between two impacts, an impact fading): the branch past them.
+                        if let Some(n) = self.rigid_stall(&here, to) {
+                            on_point(n.lambda(rho));
+                            here = n;
+                            ds = settings.initial_step;
+                            continue;
+                        }
                         let stop = format!("no exact orbit at {} = {} with the smallest step", self.name(), here.lambda(rho));
                         return done(self, stop, false, false);
                     }
@@ -238,6 +248,23 @@ impl Walk<'_> {
             } else {
                 next
             };
+            // A rigid contact's signature broken between here and next: located, the branch goes on past it.
+            if rigid::margin(&next) < -1e-9 && rigid::margin(&here) >= -1e-9 {
+                match self.rigid_crossing(&here, &next, to) {
+                    Some(n) => {
+                        on_point(n.lambda(rho));
+                        here = n;
+                        ds = settings.initial_step;
+                        continue;
+                    }
+                    None => {
+                        let what = next.orbit.rigid_margin().map_or(String::new(), |m| format!(" (contact {}: the {} reaches zero)", m.contact, m.what));
+                        let stop =
+                            format!("a change of the rigid contacts' events near λ = {}{what}: the branch past it could not be started", here.lambda(rho));
+                        return done(self, stop, false, false);
+                    }
+                }
+            }
             // A contact's clearance crossed zero between its events: a grazing on the way.
             let tol = TOUCH_TOL * self.fam.ys;
             let crossed = |n: &Node| n.touches.iter().any(|t| t.value < -tol);
@@ -374,6 +401,11 @@ impl Walk<'_> {
             }
             let s = side(a, kind);
             let node = bisect(&self.fam, a, b, &|n| side(n, kind) == s, false).map_or_else(|| b.clone(), |(_, hi)| hi);
+            // det(I + M) also changes sign when a multiplier passes through ∞ (an impact's
+            // velocity fading at a grazing, Nordmark 1991): no multiplier at −1, no doubling.
+            if kind == EventKind::PeriodDoubling && !node.mu.iter().any(|m| (m + 1.0).norm() < 1e-3) {
+                continue;
+            }
             let detail = detail_of(kind, &node);
             found.push((kind, node, detail));
         }

@@ -1,0 +1,95 @@
+//! Rubbing in gross slip (src/formulation.md §9): contact a's counter-face slides along t at V,
+//! faster than the structure moves along t, so the friction force is μ·λ_a along V and the
+//! contact force on the structure is −(n − μ·sign(V)·t)ᵀ λ_a. The tangential rows are assembled
+//! as extra rows of B and folded into the contacts' columns: the LCP keeps its k·m unknowns and
+//! becomes non-symmetric (Ĝ_ab + c·Ĝ_a,t with c = −μ·sign(V)).
+use super::{Assembly, PeriodFft, PeriodicProblem, SolveError};
+use crate::model::{Compliance, Contact, Model};
+use num_complex::Complex64 as C;
+use std::borrow::Cow;
+
+/// The tangential row of a rubbing contact after the fold: its response to each contact's
+/// force (with the friction it carries) and its linear part, per harmonic.
+#[derive(Clone, Debug)]
+pub struct TangentialRow {
+    /// [p][m]: t Ẑ_p⁻¹ (n_b − μ·sign(V_b)·t_b)ᵀ.
+    pub g_hat: Vec<C>,
+    /// [p]: t X̂lin_p.
+    pub bxlin_hat: Vec<C>,
+}
+
+/// `model` with one extra contact row per rubbing contact (after the contacts); borrowed
+/// unchanged without rubbing.
+pub(super) fn with_rows(model: &Model) -> Cow<'_, Model> {
+    if model.rubbing.is_empty() {
+        return Cow::Borrowed(model);
+    }
+    let mut rows = model.clone();
+    for r in &model.rubbing {
+        rows.contacts.push(Contact { row: r.row.clone(), gap: 0.0, compliance: Compliance::Rigid, motion: Vec::new() });
+    }
+    Cow::Owned(rows)
+}
+
+/// Folds the tangential rows of `wide` (assembled with [`with_rows`]) into the contacts' columns.
+pub(super) fn fold(model: &Model, wide: Assembly) -> Assembly {
+    if model.rubbing.is_empty() {
+        return wide;
+    }
+    let (mw, m, nh, nd) = (wide.m, model.contacts.len(), wide.k / 2 + 1, wide.dofs.len());
+    // Column b of the folded problem: column b plus c_r times the column of each tangential row r on b.
+    let column = |b: usize, entry: &dyn Fn(usize) -> C| -> C {
+        model.rubbing.iter().enumerate().filter(|(_, r)| r.contact == b).fold(entry(b), |v, (r, rub)| v + entry(m + r) * rub.traction())
+    };
+    let g = |p: usize, a: usize, b: usize| column(b, &|c| wide.g_hat[(p * mw + a) * mw + c]);
+    let mut g_hat = vec![C::ZERO; nh * m * m];
+    let mut h_hat = vec![C::ZERO; nh * nd * m];
+    for p in 0..nh {
+        for b in 0..m {
+            for a in 0..m {
+                g_hat[(p * m + a) * m + b] = g(p, a, b);
+            }
+            for d in 0..nd {
+                h_hat[(p * nd + d) * m + b] = column(b, &|c| wide.h_hat[(p * nd + d) * mw + c]);
+            }
+        }
+    }
+    let tangential = (0..model.rubbing.len())
+        .map(|r| TangentialRow {
+            g_hat: (0..nh).flat_map(|p| (0..m).map(move |b| (p, b))).map(|(p, b)| g(p, m + r, b)).collect(),
+            bxlin_hat: (0..nh).map(|p| wide.bxlin_hat[p * mw + m + r]).collect(),
+        })
+        .collect();
+    let bxlin_hat = (0..nh).flat_map(|p| (0..m).map(move |a| (p, a))).map(|(p, a)| wide.bxlin_hat[p * mw + a]).collect();
+    Assembly { m, g_hat, h_hat, bxlin_hat, tangential, ..wide }
+}
+
+/// Gross slip holds only while the structure's tangential speed stays below |V|: checked at the
+/// solution (the spectral derivative of the tangential displacement at the instants); a typed
+/// outcome when it does not, never an answer. `forces`: the contacts' forces, `[j·m + a]`.
+pub(super) fn check_gross_slip(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, forces: &[f64]) -> Result<(), SolveError> {
+    let model = problem.model();
+    let (k, m, nh) = (asm.k, asm.m, asm.k / 2 + 1);
+    let lambda: Vec<Vec<C>> = (0..m).map(|b| fft.forward(&(0..k).map(|j| forces[j * m + b]).collect::<Vec<_>>())).collect();
+    let omega = 2.0 * std::f64::consts::PI / problem.period();
+    for (r, (rub, row)) in model.rubbing.iter().zip(&asm.tangential).enumerate() {
+        // The Nyquist harmonic of an even grid has no odd derivative on the samples: dropped.
+        let velocity_hat: Vec<C> = (0..nh)
+            .map(|p| {
+                let u = row.bxlin_hat[p] - (0..m).map(|b| row.g_hat[p * m + b] * lambda[b][p]).sum::<C>();
+                if 2 * p == k { C::ZERO } else { C::new(0.0, omega * p as f64) * u }
+            })
+            .collect();
+        let fastest = fft.inverse(&velocity_hat).iter().fold(0.0_f64, |v, s| v.max(s.abs()));
+        if !fastest.is_finite() {
+            return Err(SolveError::NonFinite(format!("friction[{r}] (rubbing): the tangential velocity")));
+        }
+        if fastest >= rub.sliding_velocity.abs() {
+            return Err(SolveError::Invalid(format!(
+                "friction[{r}].sliding_velocity: is {}, but the structure slides along it at up to {fastest:.4e} at the solution: gross slip (the friction force μ·λ_n along the counter-face's motion) does not hold; rubbing with stick/slip is not yet solved: give a faster counter-face or solve without friction",
+                rub.sliding_velocity
+            )));
+        }
+    }
+    Ok(())
+}

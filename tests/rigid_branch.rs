@@ -1,0 +1,194 @@
+//! The exact walk on rigid stops (issue 24): plastic impacts (e = 0) and sticking arcs, against
+//! the closed-form impact oscillator of src/exact/rigid.rs (its impact map and multiplier, not
+//! the polish) and against long time integration (the explicit marcher of src/marching).
+use crate::common::family::{Chain, Draw};
+use periodic_contact::analysis::continuation::{self, ContinuationSettings, Parameter, Source};
+use periodic_contact::analysis::polish;
+use periodic_contact::exact::{Oscillator, RigidRegime, RigidStopOrbit};
+use periodic_contact::marching::{MarchSettings, march};
+use periodic_contact::periodic::PeriodicProblem;
+
+fn problem(text: &str) -> PeriodicProblem {
+    periodic_contact::scene::Scene::parse(text, "rigid").unwrap().to_problem("rigid").unwrap()
+}
+
+/// The 1-DOF impact oscillator m x'' + c x' + k x = F cos Ωt, x ≤ g0 (rigid, plastic impacts).
+fn impact_oscillator(osc: &Oscillator, gap: f64, steps: usize) -> String {
+    format!(
+        "[structure]\nmass = [[{}]]\nstiffness = [[{}]]\n[damping]\nmatrix = [[{}]]\n[excitation]\nfrequency = {}\n[[force]]\ndof = 0\namplitude = {}\n\
+         [[contact]]\ndof = 0\ngap = {gap}\n[discretization]\nscheme = \"bds1\"\nsteps = {steps}\n[output]\ndisplacement = [0]\n",
+        osc.mass, osc.stiffness, osc.damping, osc.omega, osc.force
+    )
+}
+
+/// Two 1-DOF impact oscillators' branches against the closed form of src/exact/rigid.rs (the
+/// impact instant from the free flight of exactly one period, or the departure at
+/// Ω t_d = arccos(k g0 / F) and the sticking arc; bisection on its own flows, not the polish):
+/// pure impacts (k g0 > F) over Ω ∈ [0.7, 1.3], where the one nonzero Floquet multiplier is the
+/// impact map's derivative μ = dt_next/dt0 (a plastic impact leaves one degree of freedom, the
+/// impact time); and impacts with sticking (k g0 < F) over Ω ∈ [0.55, 0.8], where the departure
+/// is fixed and every multiplier is 0, through the merging of a pure impact and a sticking
+/// impact into one at Ω ≈ 0.6384.
+#[test]
+fn impact_oscillator_branches_match_the_closed_form() {
+    let (m, c, k, f) = (1.0, 0.1, 1.0, 1.0);
+    for (gap, from, to, regime) in [(1.5, 0.7, 1.3, RigidRegime::Impacting), (0.5, 0.55, 0.8, RigidRegime::Sticking)] {
+        let p = problem(&impact_oscillator(&Oscillator::new(m, c, k, f, from), gap, 512));
+        let b = continuation::run(&p, Parameter::Frequency, from, to, &ContinuationSettings::default(), &|_| {}).unwrap();
+        assert!(b.reached(), "{}", b.stop);
+        assert!(b.points.iter().all(|q| q.source == Source::Exact), "{}", b.stop);
+        let (mut worst_amp, mut worst_mu, mut compared) = (0.0f64, 0.0f64, 0);
+        for q in b.points.iter().filter(|q| q.event.is_none()) {
+            let Ok(r) = RigidStopOrbit::solve(&Oscillator::new(m, c, k, f, q.parameter), gap) else { continue };
+            if r.regime() != regime {
+                continue;
+            }
+            let amp = 0.5 * r.peak_to_peak();
+            worst_amp = worst_amp.max((q.amplitude[0] - amp).abs() / amp);
+            let mu = r.multiplier().unwrap_or(0.0);
+            worst_mu = worst_mu.max((q.max_multiplier - mu.abs()).abs());
+            assert_eq!(q.stable, mu.abs() < 1.0, "Ω = {}: stable {} but |μ| = {}", q.parameter, q.stable, mu.abs());
+            compared += 1;
+        }
+        eprintln!(
+            "impact oscillator, gap {gap}: {} points, {compared} {regime:?} points vs closed form: amplitude {worst_amp:.1e} (relative), largest |μ| {worst_mu:.1e}; events {:?}",
+            b.points.len(),
+            b.events().map(|e| (e.event.unwrap().name(), e.parameter)).collect::<Vec<_>>()
+        );
+        assert!(compared >= 5, "only {compared} {regime:?} points");
+        assert!(worst_amp < 1e-6, "amplitude off the closed form by {worst_amp:.1e}");
+        assert!(worst_mu < 1e-4, "multiplier off the closed form's by {worst_mu:.1e}");
+    }
+}
+
+/// A random oscillator of 1–3 DOFs (a grounded chain: masses 0.5–2, springs 0.5–2, Rayleigh
+/// damping of 2–6 % at the first mode) with a RIGID stop on a random DOF, forced on a random DOF;
+/// the gap is 0.3–0.8 of that DOF's linear peak near the first mode, so the branch over
+/// [0.6, 1.4]·ω₁ impacts and, where the gap is small, sticks. (scene, ω₁)
+fn random_rigid(d: &mut Draw, steps: usize) -> (String, f64) {
+    let chain = Chain::draw(d);
+    let (n, w1) = (chain.n, chain.w1);
+    let alpha = 2.0 * d.range(0.02, 0.06) / w1;
+    let (fdof, cdof) = ((d.next() * n as f64) as usize, (d.next() * n as f64) as usize);
+    let amp = 0.1;
+    let peak = (0..400).map(|j| chain.linear_amplitude(alpha, fdof, cdof, amp, w1 * (0.6 + 0.8 * j as f64 / 400.0))).fold(0.0, f64::max);
+    let gap = d.range(0.3, 0.8) * peak;
+    (chain.scene(alpha, (fdof, amp), &format!("dof = {cdof}\ngap = {gap:e}\n"), "bds1", steps, cdof), w1)
+}
+
+/// Long time integration started near the branch point `q`: the orbit at its λ (the grid's,
+/// polished; `None` when that is another branch than `q`'s: amplitudes differ by 1e-6), its state
+/// at t = 0 perturbed by 1e-3 of its size, marched 400 periods at N = 2048 steps per period.
+/// Stable when the march's amplitude comes back to the point's within 1 % (the marcher's O(h)
+/// error is ~1e-3).
+fn settles_back(p: &PeriodicProblem, q: &continuation::BranchPoint) -> Option<bool> {
+    let mut p = p.clone();
+    p.set_frequency(q.parameter).unwrap();
+    let n = p.model().n();
+    let r = p.solve().ok()?;
+    let orbit = polish::polish(&p, &r).ok()?;
+    let dof = p.outputs().displacement[0];
+    if (orbit.amplitude(None, dof)? - q.amplitude[0]).abs() > 1e-6 * q.amplitude[0] {
+        return None;
+    }
+    let y = orbit.state(0.0);
+    let size = y.amax().max(1e-12);
+    let y: Vec<f64> = y.iter().enumerate().map(|(i, v)| v + 1e-3 * size * if i % 2 == 0 { 1.0 } else { -1.0 }).collect();
+    let settings = MarchSettings {
+        steps_per_period: 2048,
+        max_periods: 400,
+        min_periods: 400,
+        tolerance: 1e-14,
+        initial_displacement: Some(y[..n].to_vec()),
+        initial_velocity: Some(y[n..].to_vec()),
+    };
+    let m = march(p.model(), &settings).ok()?;
+    let xs: Vec<f64> = m.displacement.iter().map(|x| x[dof]).collect();
+    let amp = 0.5 * (xs.iter().fold(f64::MIN, |a, &b| a.max(b)) - xs.iter().fold(f64::MAX, |a, &b| a.min(b)));
+    Some((amp - q.amplitude[0]).abs() < 1e-2 * q.amplitude[0])
+}
+
+/// The random rigid family's members `seeds`, each over [0.6, 1.4]·ω₁ at k and 2k: (members that
+/// reached the end, on the exact orbit all along; largest event difference between k and 2k,
+/// kind by kind; stability labels compared with long time integration; disagreements). Prints
+/// each member.
+fn rigid_family(seeds: std::ops::Range<u64>, steps: usize, checks_per_member: usize) -> (usize, usize, f64, usize, usize) {
+    let (mut exact, mut reached, mut worst, mut compared, mut wrong) = (0, 0, 0.0f64, 0, 0);
+    for seed in seeds {
+        // The long time integrations start from the orbit on a fine grid, polished.
+        let fine = problem(&random_rigid(&mut Draw(seed), 4096).0);
+        let runs: Vec<continuation::Branch> = [steps, 2 * steps]
+            .iter()
+            .map(|&k| {
+                let (text, w1) = random_rigid(&mut Draw(seed), k);
+                let p = problem(&text);
+                continuation::run(&p, Parameter::Frequency, 0.6 * w1, 1.4 * w1, &ContinuationSettings::default(), &|_| {}).unwrap()
+            })
+            .collect();
+        let all_exact = runs.iter().all(|b| b.reached() && b.points.iter().all(|q| q.source == Source::Exact));
+        exact += usize::from(all_exact);
+        reached += usize::from(runs.iter().all(|b| b.reached()));
+        let ev: Vec<Vec<(&str, f64)>> = runs.iter().map(|b| b.events().map(|e| (e.event.unwrap().name(), e.parameter)).collect()).collect();
+        let same_kinds = ev[0].iter().map(|e| e.0).eq(ev[1].iter().map(|e| e.0));
+        let gap = if same_kinds { ev[0].iter().zip(&ev[1]).map(|(a, b)| (a.1 - b.1).abs()).fold(0.0, f64::max) } else { f64::INFINITY };
+        worst = worst.max(gap);
+        // Stability at points drawn at random on the k branch (exact points, not at an event).
+        let plain: Vec<&continuation::BranchPoint> = runs[0].points.iter().filter(|q| q.event.is_none() && q.source == Source::Exact).collect();
+        let mut d = Draw(seed ^ 0x5eed);
+        let mut labels = Vec::new();
+        for _ in 0..checks_per_member.min(plain.len()) {
+            let q = plain[(d.next() * plain.len() as f64) as usize];
+            // Not near a change of stability: the largest multiplier clear of the unit circle.
+            if (q.max_multiplier - 1.0).abs() < 0.02 {
+                continue;
+            }
+            let Some(settled) = settles_back(&fine, q) else { continue };
+            compared += 1;
+            wrong += usize::from(settled != q.stable);
+            labels.push(format!("Ω {:.4}: stable {} / march {settled} (|μ| {:.3})", q.parameter, q.stable, q.max_multiplier));
+        }
+        eprintln!(
+            "seed {seed}: exact {all_exact}, {} events at k, {} at 2k, largest difference {gap:.1e}; {}; stop: {}",
+            ev[0].len(),
+            ev[1].len(),
+            labels.join(", "),
+            runs[0].stop
+        );
+    }
+    (exact, reached, worst, compared, wrong)
+}
+
+/// A few members of the random rigid family (issue 24): each reaches the end (on the exact orbit
+/// as far as it goes, the discrete walk after, said in `stop`), the events at k = 256 and 512
+/// agree within 1e-5 kind by kind, and the stability labels at random points agree with long
+/// time integration. Opt-in (`cargo test --release --test suite rigid_branch:: -- --ignored`)
+/// until the restart past a fading impact on the way back from the fold is fixed (README
+/// "Rigid stops on the exact branch": the 3 members turn back below their start there).
+#[test]
+#[ignore]
+fn random_rigid_oscillators_give_the_same_exact_branch_at_k_and_2k() {
+    let seeds = 1..4;
+    let (exact, reached, worst, compared, wrong) = rigid_family(seeds.clone(), 256, 2);
+    eprintln!(
+        "{exact} of {} exact to the end, {reached} reached; k vs 2k: {worst:.1e}; stability vs march: {wrong} of {compared} disagree",
+        seeds.end - seeds.start
+    );
+    assert_eq!(reached, (seeds.end - seeds.start) as usize);
+    assert!(worst <= 1e-5, "events at k and 2k differ by {worst:.1e}");
+    assert!(compared >= 1 && wrong == 0, "stability vs long time integration: {wrong} of {compared} disagree");
+}
+
+/// The whole random rigid family (opt-in: `PC_RIGID_FAMILY=40 cargo test --release --test suite
+/// rigid_branch:: -- --ignored`): the fraction that reaches the end on the exact orbit, the worst
+/// k vs 2k event disagreement, and the stability labels at random points against long time
+/// integration.
+#[test]
+#[ignore]
+fn random_rigid_family() {
+    let count: u64 = std::env::var("PC_RIGID_FAMILY").ok().and_then(|s| s.parse().ok()).unwrap_or(40);
+    let (exact, reached, worst, compared, wrong) = rigid_family(100..100 + count, 256, 1);
+    eprintln!(
+        "random rigid family of {count}: {exact} exact to the end ({:.1} %), {reached} reached; worst k vs 2k event difference {worst:.1e}; stability vs long time integration: {wrong} of {compared} disagree",
+        100.0 * exact as f64 / count as f64
+    );
+}
