@@ -28,6 +28,8 @@ mod cli;
 mod continuation;
 #[path = "convergence.rs"]
 mod convergence;
+#[path = "exact_jacobian.rs"]
+mod exact_jacobian;
 #[path = "fail_fast.rs"]
 mod fail_fast;
 #[path = "fast_solver.rs"]

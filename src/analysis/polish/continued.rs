@@ -4,7 +4,7 @@
 //! phases' exponentials, the contacts' interior extrema that announce a grazing, and the
 //! amplitudes over the period.
 use super::PolishFailure;
-use super::events::Event;
+use super::events::{Event, EventKind};
 use super::orbit::{PolishedOrbit, user_value};
 use crate::model::Model;
 use crate::periodic::OutputMap;
@@ -47,6 +47,60 @@ impl PolishedOrbit {
         }
         let u = DVector::from_iterator(y0.len() + tau.len(), y0.iter().chain(tau).copied());
         self.residual_of(&u)
+    }
+
+    /// [`Self::shooting_residual`] and its Jacobian in (y0, times), from one flow of the period:
+    /// the variational equations of ẏ = A y + b(t) between events, ∂y(t₁)/∂y(t₀) = e^{A(t₁−t₀)},
+    /// ∂y(t₁)/∂t₀ = −e^{A(t₁−t₀)} f(t₀, y(t₀)), ∂y(t₁)/∂t₁ = f(t₁, y(t₁)) (f the phase's vector
+    /// field; Hairer, Nørsett & Wanner I, §I.14), chained through the events with identity
+    /// saltation (compliant switches, see [`Self::flow_product`]). `None` with a stuck contact
+    /// or an impact or release event, or where [`Self::shooting_residual`] gives none.
+    pub fn shooting_jacobian(&self, y0: &[f64], times: &[f64]) -> Option<(DVector<f64>, DMatrix<f64>)> {
+        let compliant = self.events.iter().all(|e| matches!(e.kind, EventKind::On | EventKind::Off));
+        if !compliant || !self.phases.iter().all(|p| p.all_free()) {
+            return None;
+        }
+        let (n, ne) = (self.model.n(), self.events.len());
+        let n2 = 2 * n;
+        let tau: &[f64] = if ne == 0 { &[] } else { times };
+        if tau.windows(2).any(|w| w[0] >= w[1]) || tau.last().is_some_and(|&l| l >= tau[0] + self.period) {
+            return None;
+        }
+        let start = DVector::from_column_slice(y0);
+        let mut res = DVector::zeros(n2 + ne);
+        let mut jac = DMatrix::zeros(n2 + ne, n2 + ne);
+        let mut y = start.clone();
+        let mut dy = DMatrix::identity(n2, n2 + ne);
+        let field = |e: usize, y: &DVector<f64>, t: f64| {
+            let mut f = DVector::zeros(n2);
+            f.rows_mut(0, n).copy_from(&y.rows(n, n));
+            f.rows_mut(n, n).copy_from(&self.phases[e].acceleration(y, t));
+            f
+        };
+        for e in 0..ne.max(1) {
+            let (t0, t1) = if ne == 0 { (0.0, self.period) } else { (tau[e], if e + 1 < ne { tau[e + 1] } else { tau[0] + self.period }) };
+            let ex = self.phases[e].exp(t1 - t0);
+            let ym = self.phases[e].flow_with(&ex, t0, &y, t1);
+            dy = &ex * dy;
+            if ne > 0 {
+                let next = (e + 1) % ne;
+                let (f0, f1) = (&ex * field(e, &y, t0), field(e, &ym, t1));
+                for r in 0..n2 {
+                    dy[(r, n2 + e)] -= f0[r];
+                    dy[(r, n2 + next)] += f1[r];
+                }
+                let c = self.events[next].contact;
+                res[n2 + next] = self.clearance(c, &ym, t1);
+                for col in 0..n2 + ne {
+                    jac[(n2 + next, col)] = -self.model.contacts[c].along(|d| dy[(d, col)]);
+                }
+                jac[(n2 + next, n2 + next)] += self.gap(c, t1, 1);
+            }
+            y = ym;
+        }
+        res.rows_mut(0, n2).copy_from(&(&y - &start));
+        jac.view_mut((0, 0), (n2, n2 + ne)).copy_from(&(dy - DMatrix::identity(n2, n2 + ne)));
+        res.iter().all(|v| v.is_finite()).then_some((res, jac))
     }
 
     /// This orbit at the solution (`y0`, `times`) of [`Self::shooting_residual`]: the states after
@@ -115,13 +169,34 @@ impl PolishedOrbit {
         out
     }
 
+    /// The states at the samples, each flowed from the one before in its phase (short flows).
+    fn sampled_states(&self, samples: &[(f64, usize)]) -> Vec<DVector<f64>> {
+        let mut out: Vec<DVector<f64>> = Vec::with_capacity(samples.len());
+        for (j, &(t, e)) in samples.iter().enumerate() {
+            let y = match j.checked_sub(1).map(|i| (samples[i], &out[i])) {
+                Some(((s, f), prev)) if f == e => self.phases[e].flow(s, prev, t),
+                _ => self.phases[e].flow(self.times[e], &self.after[e], t),
+            };
+            out.push(y);
+        }
+        out
+    }
+
+    /// The state at `t` (in [τ_0, τ_0 + T), as [`Self::locate`] gives it) flowed from the last
+    /// sample at or before it, which is in its phase (each phase's start is a sample).
+    fn state_near(&self, samples: &[(f64, usize)], states: &[DVector<f64>], t: f64) -> DVector<f64> {
+        let j = samples.partition_point(|s| s.0 <= t).saturating_sub(1);
+        let (s, e) = samples[j];
+        self.phases[e].flow(s, &states[j], t)
+    }
+
     /// Each compliant contact's smallest local minimum of its signed clearance between its own
     /// events ([`Touch`]): on samples of the whole period (cyclic), refined by golden section.
     /// A contact's own events, where its signed clearance comes down to 0 from both sides, are
     /// not minima.
     pub fn touches(&self) -> Vec<Touch> {
         let samples = self.samples();
-        let states: Vec<DVector<f64>> = samples.iter().map(|&(t, e)| self.phases[e].flow(self.times[e], &self.after[e], t)).collect();
+        let states = self.sampled_states(&samples);
         let len = samples.len();
         let mut out = Vec::new();
         for (i, c) in self.model.contacts.iter().enumerate() {
@@ -131,7 +206,7 @@ impl PolishedOrbit {
             let sign = |e: usize| if self.phases[e].closed(i) { -1.0 } else { 1.0 };
             let f = |t: f64| {
                 let (e, tt) = self.locate(t);
-                sign(e) * self.clearance(i, &self.state(tt), tt)
+                sign(e) * self.clearance(i, &self.state_near(&samples, &states, tt), tt)
             };
             let v: Vec<f64> = samples.iter().zip(&states).map(|(&(t, e), y)| sign(e) * self.clearance(i, y, t)).collect();
             let own = |j: usize| {
@@ -161,10 +236,14 @@ impl PolishedOrbit {
     /// map when there is one): samples, each extremum refined by golden section.
     pub fn amplitude(&self, map: Option<&OutputMap>, dof: usize) -> Option<f64> {
         let n = self.model.n();
-        let x = |t: f64| user_value(map, dof, &self.state(t), 0, n).unwrap_or(0.0);
         user_value(map, dof, &self.y0, 0, n)?;
         let samples = self.samples();
-        let xs: Vec<f64> = samples.iter().map(|&(t, _)| x(t)).collect();
+        let states = self.sampled_states(&samples);
+        let x = |t: f64| {
+            let (_, tt) = self.locate(t);
+            user_value(map, dof, &self.state_near(&samples, &states, tt), 0, n).unwrap_or(0.0)
+        };
+        let xs: Vec<f64> = states.iter().map(|y| user_value(map, dof, y, 0, n).unwrap_or(0.0)).collect();
         let len = xs.len();
         let (mut hi, mut lo) = (f64::MIN, f64::MAX);
         for j in 0..len {
