@@ -95,7 +95,10 @@ pub fn step_map(problem: &PeriodicProblem) -> Result<StepMapLcp, NoStepMap> {
     // p·k steps over p·T for an orbit of p forcing periods (h = T/k either way).
     let (n, m, k) = (model.n(), model.contacts.len(), problem.instants());
     if !model.frictions.is_empty() {
-        return Err(NoStepMap("friction contacts have no step map yet (src/formulation.md §9)".to_string()));
+        return Err(NoStepMap(
+            "friction rows are stepped by their own map (src/periodic/friction_shooting.rs, friction alone), not the contacts' (src/formulation.md §9)"
+                .to_string(),
+        ));
     }
     let offsets: Vec<usize> = (0..m).map(|c| problem.pairing_at(c).offset()).collect();
     if let Some(c) = offsets.iter().position(|&s| s > lead) {

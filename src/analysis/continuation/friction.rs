@@ -1,6 +1,7 @@
 //! Branches of friction orbits (src/formulation.md §9): the normal load's optimal curve and any
-//! other parameter. Friction rows have no step map yet, so no pseudo-arclength here: each point is
-//! the friction LCP's certified solve (bds1, dense Lemke) at its parameter value. That suffices
+//! other parameter. No pseudo-arclength here (the friction step map has no tangent predictor):
+//! each point is the friction LCP's certified solve (bds1; dense Lemke, or friction shooting
+//! by size) at its parameter value. That suffices
 //! because the orbit is unique at each value: with a constant normal load the LCP's matrix is
 //! positive semi-definite and its slip velocity unique (§9), so the branch is a graph over the
 //! parameter, without folds. Why no multipliers: they need the step map; the orbit of a passive
