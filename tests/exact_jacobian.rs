@@ -69,26 +69,7 @@ fn check(name: &str, p: &PeriodicProblem) {
 
 #[test]
 fn variational_jacobian_matches_central_differences_on_a_compliant_chain() {
-    let scene = r#"
-[structure]
-mass = [[1.0, 0.0], [0.0, 1.0]]
-stiffness = [[2.0, -1.0], [-1.0, 2.0]]
-[damping]
-matrix = [[0.1, 0.0], [0.0, 0.1]]
-[excitation]
-frequency = 1.2
-[[force]]
-dof = 0
-amplitude = 1.0
-[[contact]]
-dof = 1
-gap = 0.3
-stiffness = 20.0
-[discretization]
-scheme = "cds"
-steps = 256
-"#;
-    let p = periodic_contact::scene::Scene::parse(scene, "chain").unwrap().to_problem("chain").unwrap();
+    let p = crate::common::compliant_chain();
     check("2-DOF chain", &p);
 }
 

@@ -97,26 +97,7 @@ fn compliant_stop_is_polished_to_1e_8() {
 #[test]
 fn two_dof_compliant_chain_agrees_with_long_time_integration() {
     use periodic_contact::marching::{MarchSettings, march};
-    let scene = r#"
-[structure]
-mass = [[1.0, 0.0], [0.0, 1.0]]
-stiffness = [[2.0, -1.0], [-1.0, 2.0]]
-[damping]
-matrix = [[0.1, 0.0], [0.0, 0.1]]
-[excitation]
-frequency = 1.2
-[[force]]
-dof = 0
-amplitude = 1.0
-[[contact]]
-dof = 1
-gap = 0.3
-stiffness = 20.0
-[discretization]
-scheme = "cds"
-steps = 256
-"#;
-    let p = periodic_contact::scene::Scene::parse(scene, "chain").unwrap().to_problem("chain").unwrap();
+    let p = crate::common::compliant_chain();
     let t0 = Instant::now();
     let mut r = p.solve().unwrap();
     polish::apply(&p, &mut r);
