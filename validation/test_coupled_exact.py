@@ -40,3 +40,27 @@ def test_cli_converges_to_the_exact_coupled_orbit(cli):
     for a, b in zip(e1, e2):
         assert b < a and 0.8 < np.log2(a / b) < 1.3
     assert e2[0] < 0.1 and e2[1] < 0.04
+
+
+@pytest.mark.engine
+def test_fmu_equals_the_cli_on_the_coupled_scene(cli, tmp_path):
+    # The FMU's contact[0].force and friction[0].force/stuck at t = iT/16 (instants of k = 256)
+    # against the CLI's JSON of the same scene.
+    import json
+    import subprocess
+
+    import fmpy
+    fmu, out = str(tmp_path / "coupled.fmu"), str(tmp_path / "r.json")
+    subprocess.run([cli, "fmu", ce.SCENE, "-o", fmu], check=True, capture_output=True)
+    subprocess.run([cli, "solve", ce.SCENE, "--no-estimate", "-o", out], check=True, capture_output=True)
+    raw = json.load(open(out))
+    T = 2 * np.pi / 1.5
+    names = ["contact[0].force", "friction[0].force", "friction[0].stuck"]
+    r = fmpy.simulate_fmu(fmu, stop_time=T * 15 / 16, output_interval=T / 16, output=names)
+    want = [np.array(raw["contacts"][0]["force"])[::16], np.array(raw["friction"][0]["force"])[::16],
+            np.array(raw["friction"][0]["stuck"])[::16]]
+    assert len(r) == 16
+    for name, w in zip(names, want):
+        worst = np.abs(np.asarray(r[name], dtype=float) - w.astype(float)).max()
+        print(f"{name}: FMU against CLI {worst:.1e}")
+        assert worst <= 1e-9 * max(np.abs(w.astype(float)).max(), 1.0)
