@@ -162,6 +162,14 @@ fn rigid_family(seeds: std::ops::Range<u64>, steps: usize, checks_per_member: us
             labels.join(", "),
             runs[0].stop
         );
+        if std::env::var("PC_RIGID_EVENTS").is_ok() {
+            for b in &runs {
+                for e in b.events() {
+                    eprintln!("  {} {:.9} {}", e.event.unwrap().name(), e.parameter, e.detail);
+                }
+                eprintln!("  --");
+            }
+        }
     }
     (exact, reached, worst, compared, wrong)
 }
@@ -192,7 +200,8 @@ fn random_rigid_oscillators_give_the_same_exact_branch_at_k_and_2k() {
 #[ignore]
 fn random_rigid_family() {
     let count: u64 = std::env::var("PC_RIGID_FAMILY").ok().and_then(|s| s.parse().ok()).unwrap_or(40);
-    let (exact, reached, worst, compared, wrong) = rigid_family(100..100 + count, 256, 1);
+    let first: u64 = std::env::var("PC_RIGID_FAMILY_FROM").ok().and_then(|s| s.parse().ok()).unwrap_or(100);
+    let (exact, reached, worst, compared, wrong) = rigid_family(first..first + count, 256, 1);
     eprintln!(
         "random rigid family of {count}: {exact} exact to the end ({:.1} %), {reached} reached; worst k vs 2k event difference {worst:.1e}; stability vs long time integration: {wrong} of {compared} disagree",
         100.0 * exact as f64 / count as f64

@@ -11,8 +11,8 @@
 //! ([`RESEED`] of the range, growing until the polish accepts the grid's signature): the
 //! stretch between is not traced, and the grazing's detail says so.
 use super::family::{Family, Node, Signature};
-use super::{BRACKET, EventKind, Walk, bisect};
-use crate::analysis::polish::{self, Event};
+use super::{BRACKET, EventKind, NEW_PAIR, Walk, bisect, signature};
+use crate::analysis::polish::{self, Event, EventKind as Switch, Touch};
 use crate::periodic::{PeriodicProblem, PeriodicSolver};
 use crate::time::Discretization;
 
@@ -55,11 +55,11 @@ impl Walk<'_> {
             (polish::CLEARANCE, _) => {
                 let base = list.first().map_or(0.0, |l| l.0);
                 let at = base + (m.time / t - base).rem_euclid(1.0);
-                list.push((at, Event { contact: m.contact, kind: polish::EventKind::Impact { stick: false }, seed: 0.0 }));
+                list.push((at, Event { contact: m.contact, kind: Switch::Impact { stick: false }, seed: 0.0 }));
                 list.sort_by(|x, y| x.0.total_cmp(&y.0));
                 true
             }
-            ("impulse of the impact", Some(e)) if lo.orbit.events()[e].kind == (polish::EventKind::Impact { stick: false }) => {
+            ("impulse of the impact", Some(e)) if lo.orbit.events()[e].kind == (Switch::Impact { stick: false }) => {
                 list.remove(e);
                 // Located on the orbit without the impact, regular where the impacting one is singular.
                 if let Some(n) = self.fade(here, next, &lo, list.clone(), &what) {
@@ -67,12 +67,55 @@ impl Walk<'_> {
                 }
                 true
             }
+            // A pure impact starts to stick: a sticking arc of zero length after it, ending in a
+            // release (the orbit is the same), grows on the exact orbit.
+            (polish::HOLD, Some(e)) => {
+                list[e].1.kind = Switch::Impact { stick: true };
+                list.insert(e + 1, (list[e].0 + NEW_PAIR, Event { contact: m.contact, kind: Switch::Release, seed: 0.0 }));
+                if let Some(n) = self.begin_phase(&lo, &list, (e, e + 1), &what) {
+                    return Some(n);
+                }
+                false
+            }
+            // A stuck contact's force touches zero inside its arc: a flight of zero length there,
+            // from a release to a sticking impact (of zero impulse), grows on the exact orbit.
+            (polish::STUCK, None) => {
+                let touch = Touch { phase: 0, contact: m.contact, value: 0.0, time: m.time, closed: true };
+                let (sig, guess, pair) =
+                    signature::insert(&self.fam, &lo.orbit, &touch, (Switch::Release, Switch::Impact { stick: true }), NEW_PAIR, lo.w[lo.w.len() - 1]);
+                if let Some(n) = self.start_phase(&lo, sig, &guess, pair, &what) {
+                    return Some(n);
+                }
+                false
+            }
             _ => false,
         };
-        if changed && let Some(n) = self.restart(&lo, list, &what) {
-            return Some(n);
+        if changed {
+            let sig = Signature { events: list.iter().map(|l| l.1).collect(), always: lo.orbit.always_closed().to_vec() };
+            let guess = signature::guess(&self.fam, &lo.orbit, &list, lo.w[lo.w.len() - 1]);
+            if let Some(n) = self.restart(&lo, sig, guess, &what) {
+                return Some(n);
+            }
         }
         self.reseed(&lo, &what, to)
+    }
+
+    /// [`Self::start_phase`] for the time-ordered `list` (fractions of the period) of the orbit at `at`.
+    fn begin_phase(&mut self, at: &Node, list: &[(f64, Event)], pair: (usize, usize), what: &str) -> Option<Node> {
+        let sig = Signature { events: list.iter().map(|l| l.1).collect(), always: at.orbit.always_closed().to_vec() };
+        let guess = signature::guess(&self.fam, &at.orbit, list, at.w[at.w.len() - 1]);
+        self.start_phase(at, sig, &guess, pair, what)
+    }
+
+    /// The branch of signature `sig` (unknowns `guess`) whose phase between the events `pair`
+    /// begins at `at`, where it has zero length: its first point, the grazing recorded at `at`.
+    fn start_phase(&mut self, at: &Node, sig: Signature, guess: &[f64], pair: (usize, usize), what: &str) -> Option<Node> {
+        let before = self.fam.ne();
+        let first = self.open_phase(sig, guess, pair)?;
+        let detail = format!("{what}; events per period {before} -> {} (the new phase started on the exact orbit)", self.fam.ne());
+        self.push(at, Some(EventKind::Grazing), detail);
+        self.multipliers_across(at, &first);
+        Some(first)
     }
 
     /// An impact's impulse fades between `here` (positive) and `next` (negative): the grazing where
@@ -85,11 +128,7 @@ impl Walk<'_> {
     /// unstable impacting orbit from a fold ending at the grazing). `None` without a sign change.
     fn fade(&mut self, here: &Node, next: &Node, near: &Node, list: Vec<(f64, Event)>, what: &str) -> Option<Node> {
         let rho = self.fam.rho;
-        let t = near.orbit.period();
-        let t0 = list.first().map_or(0.0, |l| l.0 * t);
-        let mut guess: Vec<f64> = near.orbit.state(t0).iter().map(|y| y / self.fam.ys).collect();
-        guess.extend(list.iter().map(|l| l.0));
-        guess.push(0.0);
+        let guess = signature::guess(&self.fam, &near.orbit, &list, 0.0);
         let sig = Signature { events: list.iter().map(|l| l.1).collect(), always: near.orbit.always_closed().to_vec() };
         let before = self.fam.ne();
         let old = std::mem::replace(&mut self.fam.sig, sig);
@@ -107,18 +146,13 @@ impl Walk<'_> {
         }
     }
 
-    /// The branch of the signature `list` (events at fractions of the period) through the orbit
-    /// of `at` (a zero-velocity impact added or removed leaves the orbit as it is): corrected at
-    /// λ fixed, oriented towards the side where the orbit is admissible (λ's sense first).
-    fn restart(&mut self, at: &Node, list: Vec<(f64, Event)>, what: &str) -> Option<Node> {
+    /// The branch of the signature `sig` (unknowns `guess`) through the orbit of `at` (a
+    /// zero-velocity impact added or removed, a vanished sticking arc or flight, leaves the orbit
+    /// as it is): corrected at λ fixed, oriented towards the side where the orbit is admissible
+    /// (λ's sense first).
+    fn restart(&mut self, at: &Node, sig: Signature, guess: Vec<f64>, what: &str) -> Option<Node> {
         let rho = self.fam.rho;
         let lambda = at.lambda(rho);
-        let t = at.orbit.period();
-        let t0 = list.first().map_or(0.0, |l| l.0 * t);
-        let mut guess: Vec<f64> = at.orbit.state(t0).iter().map(|y| y / self.fam.ys).collect();
-        guess.extend(list.iter().map(|l| l.0));
-        guess.push(lambda / rho);
-        let sig = Signature { events: list.iter().map(|l| l.1).collect(), always: at.orbit.always_closed().to_vec() };
         let before = self.fam.ne();
         let old = std::mem::replace(&mut self.fam.sig, sig);
         let d = self.fam.dim();
@@ -148,14 +182,32 @@ impl Walk<'_> {
         }
     }
 
-    /// A phase between two events of one rigid contact has vanished at `here` (phase `e`).
+    /// A phase between two events of one rigid contact has vanished at `here` (phase `e`): a
+    /// sticking arc (the impact goes on as a pure one) or a flight from a release to a sticking
+    /// impact (the contact stays stuck) is removed on the exact orbit; other phases restart from
+    /// the grid LCP.
     pub(super) fn rigid_vanish(&mut self, here: &Node, e: usize, to: f64) -> Option<Node> {
-        let ev = self.fam.sig.events[e];
-        let what = format!(
-            "contact {}: its {} phase vanishes",
-            ev.contact,
-            if matches!(ev.kind, polish::EventKind::Impact { stick: true }) { "sticking" } else { "free" }
-        );
+        let ne = self.fam.ne();
+        let (ev, next) = (self.fam.sig.events[e], self.fam.sig.events[(e + 1) % ne]);
+        let what = format!("contact {}: its {} phase vanishes", ev.contact, if ev.kind == (Switch::Impact { stick: true }) { "sticking" } else { "free" });
+        let wl = here.w[here.w.len() - 1];
+        let change = match (ev.kind, next.kind) {
+            (Switch::Impact { stick: true }, Switch::Release) => {
+                let t = here.orbit.period();
+                let mut list: Vec<(f64, Event)> = here.orbit.events().iter().zip(here.orbit.times()).map(|(e, &s)| (s / t, *e)).collect();
+                list[e].1.kind = Switch::Impact { stick: false };
+                list.remove((e + 1) % ne);
+                let sig = Signature { events: list.iter().map(|l| l.1).collect(), always: here.orbit.always_closed().to_vec() };
+                Some((sig, signature::guess(&self.fam, &here.orbit, &list, wl)))
+            }
+            (Switch::Release, Switch::Impact { stick: true }) => signature::remove(&self.fam, &here.orbit, e, wl),
+            _ => None,
+        };
+        if let Some((sig, guess)) = change
+            && let Some(n) = self.restart(here, sig, guess, &what)
+        {
+            return Some(n);
+        }
         self.reseed(here, &what, to)
     }
 
