@@ -53,12 +53,37 @@ fn impact_oscillator_branches_match_the_closed_form() {
         eprintln!(
             "impact oscillator, gap {gap}: {} points, {compared} {regime:?} points vs closed form: amplitude {worst_amp:.1e} (relative), largest |μ| {worst_mu:.1e}; events {:?}",
             b.points.len(),
-            b.events().map(|e| (e.event.unwrap().name(), e.parameter)).collect::<Vec<_>>()
+            b.events().map(|e| (e.event.unwrap().name(), e.parameter, e.detail.as_str())).collect::<Vec<_>>()
         );
         assert!(compared >= 5, "only {compared} {regime:?} points");
+        if regime == RigidRegime::Sticking {
+            // The pure impact starts to stick on the exact orbit: the grazing where the closed
+            // form's sticking arc shrinks to nothing (its regime changes).
+            let onset = sticking_onset(&Oscillator::new(m, c, k, f, from), gap, from, to);
+            let at = b.events().map(|e| e.parameter).min_by(|x, y| (x - onset).abs().total_cmp(&(y - onset).abs())).unwrap();
+            eprintln!("sticking onset: walk {at:.10}, closed form {onset:.10}");
+            assert!((at - onset).abs() < 1e-6, "the sticking onset at Ω = {at}, the closed form's at {onset}");
+        }
         assert!(worst_amp < 1e-6, "amplitude off the closed form by {worst_amp:.1e}");
         assert!(worst_mu < 1e-4, "multiplier off the closed form's by {worst_mu:.1e}");
     }
+}
+
+/// The frequency in [a, b] where the closed form's orbit changes between a sticking arc and pure
+/// impacts (the sticking arc Ω t ∈ [Ω t_h, 2π + Ω t_d] shrinking to nothing), by bisection on its regime.
+fn sticking_onset(osc: &Oscillator, gap: f64, a: f64, b: f64) -> f64 {
+    let sticks = |w: f64| {
+        let o = Oscillator::new(osc.mass, osc.damping, osc.stiffness, osc.force, w);
+        RigidStopOrbit::solve(&o, gap).is_ok_and(|r| r.regime() == RigidRegime::Sticking)
+    };
+    let (mut lo, mut hi) = (a, b);
+    let s = sticks(lo);
+    assert!(s != sticks(hi), "no change of regime over [{a}, {b}]");
+    while hi - lo > 1e-12 {
+        let mid = 0.5 * (lo + hi);
+        if sticks(mid) == s { lo = mid } else { hi = mid }
+    }
+    0.5 * (lo + hi)
 }
 
 /// A random oscillator of 1–3 DOFs (a grounded chain: masses 0.5–2, springs 0.5–2, Rayleigh

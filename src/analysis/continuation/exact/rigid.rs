@@ -50,7 +50,8 @@ impl Walk<'_> {
         let what = format!("contact {}: the {} reaches zero", m.contact, m.what);
         // A new pure impact where the clearance touches zero; an impact whose impulse fades, removed.
         let t = lo.orbit.period();
-        let mut list: Vec<(f64, Event)> = lo.orbit.events().iter().zip(lo.orbit.times()).map(|(e, &s)| (s / t, *e)).collect();
+        let mut list = timed(&lo.orbit);
+        let land = if m.what == polish::STUCK { landing(&lo, m.contact, m.time) } else { None };
         let changed = match (m.what, m.event) {
             (polish::CLEARANCE, _) => {
                 let base = list.first().map_or(0.0, |l| l.0);
@@ -62,7 +63,8 @@ impl Walk<'_> {
             ("impulse of the impact", Some(e)) if lo.orbit.events()[e].kind == (Switch::Impact { stick: false }) => {
                 list.remove(e);
                 // Located on the orbit without the impact, regular where the impacting one is singular.
-                if let Some(n) = self.fade(here, next, &lo, list.clone(), &what) {
+                let rho = self.fam.rho;
+                if let Some(n) = self.fade((here.lambda(rho), next.lambda(rho)), &lo, list.clone(), &what) {
                     return Some(n);
                 }
                 true
@@ -79,6 +81,17 @@ impl Walk<'_> {
             }
             // A stuck contact's force touches zero inside its arc: a flight of zero length there,
             // from a release to a sticking impact (of zero impulse), grows on the exact orbit.
+            (polish::STUCK, None) if land.is_some() => {
+                let e = land.expect("guarded");
+                // The force touches zero where the sticking impact lands: the impact turns pure,
+                // and a flight of zero length leads to the sticking impact.
+                list[e].1.kind = Switch::Impact { stick: false };
+                list.insert(e + 1, (list[e].0 + NEW_PAIR, Event { contact: m.contact, kind: Switch::Impact { stick: true }, seed: 0.0 }));
+                if let Some(n) = self.begin_phase(&lo, &list, (e, e + 1), &what) {
+                    return Some(n);
+                }
+                false
+            }
             (polish::STUCK, None) => {
                 let touch = Touch { phase: 0, contact: m.contact, value: 0.0, time: m.time, closed: true };
                 let (sig, guess, pair) =
@@ -126,13 +139,12 @@ impl Walk<'_> {
     /// and λ(next); the branch goes on towards the side where that margin is ≥ 0, which reverses λ
     /// when the impacting orbit and the admissible contact-free one lie on the same side (the
     /// unstable impacting orbit from a fold ending at the grazing). `None` without a sign change.
-    fn fade(&mut self, here: &Node, next: &Node, near: &Node, list: Vec<(f64, Event)>, what: &str) -> Option<Node> {
-        let rho = self.fam.rho;
+    fn fade(&mut self, (la, lb): (f64, f64), near: &Node, list: Vec<(f64, Event)>, what: &str) -> Option<Node> {
         let guess = signature::guess(&self.fam, &near.orbit, &list, 0.0);
         let sig = Signature { events: list.iter().map(|l| l.1).collect(), always: near.orbit.always_closed().to_vec() };
         let before = self.fam.ne();
         let old = std::mem::replace(&mut self.fam.sig, sig);
-        let located = touch_point(&mut self.fam, &guess, here.lambda(rho), next.lambda(rho));
+        let located = touch_point(&mut self.fam, &guess, la, lb);
         match located {
             Some(n) => {
                 let detail = format!("{what}; events per period {before} -> {} (located on the orbit without the impact)", self.fam.ne());
@@ -187,28 +199,40 @@ impl Walk<'_> {
     /// impact (the contact stays stuck) is removed on the exact orbit; other phases restart from
     /// the grid LCP.
     pub(super) fn rigid_vanish(&mut self, here: &Node, e: usize, to: f64) -> Option<Node> {
-        let ne = self.fam.ne();
-        let (ev, next) = (self.fam.sig.events[e], self.fam.sig.events[(e + 1) % ne]);
+        let ev = self.fam.sig.events[e];
         let what = format!("contact {}: its {} phase vanishes", ev.contact, if ev.kind == (Switch::Impact { stick: true }) { "sticking" } else { "free" });
-        let wl = here.w[here.w.len() - 1];
-        let change = match (ev.kind, next.kind) {
-            (Switch::Impact { stick: true }, Switch::Release) => {
-                let t = here.orbit.period();
-                let mut list: Vec<(f64, Event)> = here.orbit.events().iter().zip(here.orbit.times()).map(|(e, &s)| (s / t, *e)).collect();
-                list[e].1.kind = Switch::Impact { stick: false };
-                list.remove((e + 1) % ne);
-                let sig = Signature { events: list.iter().map(|l| l.1).collect(), always: here.orbit.always_closed().to_vec() };
-                Some((sig, signature::guess(&self.fam, &here.orbit, &list, wl)))
-            }
-            (Switch::Release, Switch::Impact { stick: true }) => signature::remove(&self.fam, &here.orbit, e, wl),
-            _ => None,
-        };
-        if let Some((sig, guess)) = change
-            && let Some(n) = self.restart(here, sig, guess, &what)
-        {
+        if let Some(n) = self.merge(here, e, &what) {
             return Some(n);
         }
         self.reseed(here, &what, to)
+    }
+
+    /// The branch past `here` without its phase `e` (between two events of one rigid contact,
+    /// about to vanish), on the exact orbit; `None` for other phases or where that fails.
+    fn merge(&mut self, here: &Node, e: usize, what: &str) -> Option<Node> {
+        let ne = self.fam.ne();
+        let (ev, next) = (self.fam.sig.events[e], self.fam.sig.events[(e + 1) % ne]);
+        let wl = here.w[here.w.len() - 1];
+        let mut list = timed(&here.orbit);
+        let (sig, guess) = match (ev.kind, next.kind) {
+            (Switch::Impact { stick: true }, Switch::Release) => {
+                list[e].1.kind = Switch::Impact { stick: false };
+                list.remove((e + 1) % ne);
+                let sig = Signature { events: list.iter().map(|l| l.1).collect(), always: here.orbit.always_closed().to_vec() };
+                (sig, signature::guess(&self.fam, &here.orbit, &list, wl))
+            }
+            (Switch::Release, Switch::Impact { stick: true }) => signature::remove(&self.fam, &here.orbit, e, wl)?,
+            // A pure impact and the sticking impact after it merge: located on the orbit without
+            // the pure impact, where the force at its landing touches zero, a short way ahead.
+            (Switch::Impact { stick: false }, Switch::Impact { stick: true }) => {
+                list.remove(e);
+                let (rho, lambda) = (self.fam.rho, here.lambda(self.fam.rho));
+                let sense = here.tangent[here.tangent.len() - 1].signum();
+                return [1e-5, 1e-4, 1e-3].into_iter().find_map(|f| self.fade((lambda, lambda + sense * f * rho), here, list.clone(), what));
+            }
+            _ => return None,
+        };
+        self.restart(here, sig, guess, what)
     }
 
     /// The corrector stalls at `here` with the smallest step on an orbit with rigid contacts:
@@ -218,6 +242,17 @@ impl Walk<'_> {
     pub(super) fn rigid_stall(&mut self, here: &Node, to: f64) -> Option<Node> {
         let m = here.orbit.rigid_margin()?;
         let what = format!("the events merge (the corrector stalls; the smallest margin: contact {}'s {}, {:.1e})", m.contact, m.what, m.value);
+        // The shortest phase between two events of one contact: the one merging.
+        let (ne, n2) = (self.fam.ne(), here.w.len() - 1 - self.fam.ne());
+        let length = |e: usize| here.w[n2 + (e + 1) % ne] - here.w[n2 + e] + if e + 1 == ne { 1.0 } else { 0.0 };
+        let shortest = (0..ne)
+            .filter(|&e| ne >= 2 && self.fam.sig.events[e].contact == self.fam.sig.events[(e + 1) % ne].contact)
+            .min_by(|&a, &b| length(a).total_cmp(&length(b)));
+        if let Some(e) = shortest
+            && let Some(n) = self.merge(here, e, &what)
+        {
+            return Some(n);
+        }
         self.reseed(here, &what, to)
     }
 
@@ -255,6 +290,19 @@ impl Walk<'_> {
         }
         None
     }
+}
+
+/// The orbit's events with their times as fractions of the period.
+fn timed(orbit: &polish::PolishedOrbit) -> Vec<(f64, Event)> {
+    let t = orbit.period();
+    orbit.events().iter().zip(orbit.times()).map(|(e, &s)| (s / t, *e)).collect()
+}
+
+/// The sticking impact of contact `c` that lands at `time` (within 1e-9 of the period) on `n`'s orbit.
+fn landing(n: &Node, c: usize, time: f64) -> Option<usize> {
+    let t = n.orbit.period();
+    let near = |s: f64| ((s - time) / t + 0.5).rem_euclid(1.0) - 0.5;
+    n.orbit.events().iter().zip(n.orbit.times()).position(|(e, &s)| e.contact == c && e.kind == (Switch::Impact { stick: true }) && near(s).abs() < 1e-9)
 }
 
 /// The polished orbit of the grid LCP's solve at λ (on a [`REFINE`] times finer grid when the
