@@ -218,9 +218,10 @@ fn random_rigid_oscillators_give_the_same_exact_branch_at_k_and_2k() {
 }
 
 /// The whole random rigid family (opt-in: `PC_RIGID_FAMILY=40 cargo test --release --test suite
-/// rigid_branch:: -- --ignored`): at least 95 % reach the end on the exact orbit; prints the worst
-/// k vs 2k event disagreement and the stability labels at random points (one stable, one
-/// unstable per member) against long time integration.
+/// rigid_branch:: -- --ignored`; `PC_RIGID_FAMILY_FROM` the first seed, 100 by default;
+/// `PC_RIGID_EVENTS` prints every event): at least 95 % reach the end on the exact orbit; prints
+/// the worst k vs 2k event disagreement and the stability labels at random points (one stable,
+/// one unstable per member) against long time integration.
 #[test]
 #[ignore]
 fn random_rigid_family() {

@@ -13,8 +13,8 @@
 //! shrinking below 1e-6 of the period (steps land on it by quarters; the pair is removed and the
 //! branch goes on in the same direction of the parameter). Rigid contacts (plastic impacts,
 //! sticking arcs, releases; the monodromy is the relocated one-period map, rank-deficient at an
-//! impact): their signature changes are located on the exact orbit and the branch past them is
-//! started from the grid LCP ([`rigid`]).
+//! impact): their signature changes are located on the exact orbit and the branch goes on from
+//! there, from the grid LCP only where that fails ([`rigid`]).
 mod family;
 mod rigid;
 mod signature;

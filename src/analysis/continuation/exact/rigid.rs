@@ -1,15 +1,20 @@
 //! Changes of the event signature of an orbit with rigid contacts (impacts with e = 0, sticking
-//! arcs, releases): located on the exact orbit, then the new signature asked of the grid LCP.
+//! arcs, releases): located on the exact orbit, and the branch past them started there.
 //!
 //! A change shows as the orbit's rigid margin ([`PolishedOrbit::rigid_margin`]) crossing zero
 //! (a free contact's clearance touching zero: a new impact; a stuck contact's force touching
-//! zero: a release inside the arc; an impulse fading to zero; a pure impact starting to stick),
-//! or as a phase between two events of one rigid contact shrinking to nothing (a sticking arc
-//! or a flight between two impacts vanishing). The change is located by bisection on the arc of
-//! the old signature (to the bracket of the exact walk), and recorded as a grazing. The branch
-//! beyond it is started from the grid LCP's orbit, polished, a short way past the change
+//! zero: a release inside the arc, or a sticking impact landing where it is zero; an impulse
+//! fading to zero; a pure impact starting to stick), or as a phase between two events of one
+//! rigid contact shrinking to nothing (a sticking arc, a flight between two impacts or from a
+//! release to an impact vanishing). The change is located by bisection on the arc of the old
+//! signature (to the bracket of the exact walk), and recorded as a grazing. The new signature
+//! differs by an event or a phase of zero length, so the orbit is the same there: the branch
+//! goes on from it on the exact orbit. Where that fails (and for the changes not listed), the
+//! branch is started from the grid LCP's orbit, polished, a short way past the change
 //! ([`RESEED`] of the range, growing until the polish accepts the grid's signature): the
 //! stretch between is not traced, and the grazing's detail says so.
+//!
+//! [`PolishedOrbit::rigid_margin`]: crate::analysis::polish::PolishedOrbit::rigid_margin
 use super::family::{Family, Node, Signature};
 use super::{BRACKET, EventKind, NEW_PAIR, Walk, bisect, signature};
 use crate::analysis::polish::{self, Event, EventKind as Switch, Touch};
