@@ -69,7 +69,7 @@ impl Walk<'_> {
                 list.remove(e);
                 // Located on the orbit without the impact, regular where the impacting one is singular.
                 let rho = self.fam.rho;
-                if let Some(n) = self.fade((here.lambda(rho), next.lambda(rho)), &lo, list.clone(), &what) {
+                if let Some(n) = self.fade((here.lambda(rho), next.lambda(rho)), &lo, list.clone(), &what, "the impact") {
                     return Some(n);
                 }
                 true
@@ -144,7 +144,7 @@ impl Walk<'_> {
     /// and λ(next); the branch goes on towards the side where that margin is ≥ 0, which reverses λ
     /// when the impacting orbit and the admissible contact-free one lie on the same side (the
     /// unstable impacting orbit from a fold ending at the grazing). `None` without a sign change.
-    fn fade(&mut self, (la, lb): (f64, f64), near: &Node, list: Vec<(f64, Event)>, what: &str) -> Option<Node> {
+    fn fade(&mut self, (la, lb): (f64, f64), near: &Node, list: Vec<(f64, Event)>, what: &str, without: &str) -> Option<Node> {
         let guess = signature::guess(&self.fam, &near.orbit, &list, 0.0);
         let sig = Signature { events: list.iter().map(|l| l.1).collect(), always: near.orbit.always_closed().to_vec() };
         let before = self.fam.ne();
@@ -152,7 +152,7 @@ impl Walk<'_> {
         let located = touch_point(&mut self.fam, &guess, la, lb);
         match located {
             Some(n) => {
-                let detail = format!("{what}; events per period {before} -> {} (located on the orbit without the impact)", self.fam.ne());
+                let detail = format!("{what}; events per period {before} -> {} (located on the orbit without {without})", self.fam.ne());
                 self.push(&n, Some(EventKind::Grazing), detail);
                 Some(n)
             }
@@ -219,10 +219,19 @@ impl Walk<'_> {
         let (ev, next) = (self.fam.sig.events[e], self.fam.sig.events[(e + 1) % ne]);
         let wl = here.w[here.w.len() - 1];
         let mut list = timed(&here.orbit);
+        let (rho, lambda) = (self.fam.rho, here.lambda(self.fam.rho));
+        let sense = here.tangent[here.tangent.len() - 1].signum();
         let (sig, guess) = match (ev.kind, next.kind) {
+            // Located on the orbit with a pure impact, where the force that would hold its contact
+            // touches zero, a short way ahead; else that orbit's branch from here.
             (Switch::Impact { stick: true }, Switch::Release) => {
                 list[e].1.kind = Switch::Impact { stick: false };
                 list.remove((e + 1) % ne);
+                if let Some(n) =
+                    [1e-5, 1e-4, 1e-3].into_iter().find_map(|f| self.fade((lambda, lambda + sense * f * rho), here, list.clone(), what, "the sticking arc"))
+                {
+                    return Some(n);
+                }
                 let sig = Signature { events: list.iter().map(|l| l.1).collect(), always: here.orbit.always_closed().to_vec() };
                 (sig, signature::guess(&self.fam, &here.orbit, &list, wl))
             }
@@ -231,9 +240,7 @@ impl Walk<'_> {
             // the pure impact, where the force at its landing touches zero, a short way ahead.
             (Switch::Impact { stick: false }, Switch::Impact { stick: true }) => {
                 list.remove(e);
-                let (rho, lambda) = (self.fam.rho, here.lambda(self.fam.rho));
-                let sense = here.tangent[here.tangent.len() - 1].signum();
-                return [1e-5, 1e-4, 1e-3].into_iter().find_map(|f| self.fade((lambda, lambda + sense * f * rho), here, list.clone(), what));
+                return [1e-5, 1e-4, 1e-3].into_iter().find_map(|f| self.fade((lambda, lambda + sense * f * rho), here, list.clone(), what, "the impact"));
             }
             _ => return None,
         };
