@@ -53,12 +53,37 @@ fn impact_oscillator_branches_match_the_closed_form() {
         eprintln!(
             "impact oscillator, gap {gap}: {} points, {compared} {regime:?} points vs closed form: amplitude {worst_amp:.1e} (relative), largest |μ| {worst_mu:.1e}; events {:?}",
             b.points.len(),
-            b.events().map(|e| (e.event.unwrap().name(), e.parameter)).collect::<Vec<_>>()
+            b.events().map(|e| (e.event.unwrap().name(), e.parameter, e.detail.as_str())).collect::<Vec<_>>()
         );
         assert!(compared >= 5, "only {compared} {regime:?} points");
+        if regime == RigidRegime::Sticking {
+            // The pure impact starts to stick on the exact orbit: the grazing where the closed
+            // form's sticking arc shrinks to nothing (its regime changes).
+            let onset = sticking_onset(&Oscillator::new(m, c, k, f, from), gap, from, to);
+            let at = b.events().map(|e| e.parameter).min_by(|x, y| (x - onset).abs().total_cmp(&(y - onset).abs())).unwrap();
+            eprintln!("sticking onset: walk {at:.10}, closed form {onset:.10}");
+            assert!((at - onset).abs() < 1e-6, "the sticking onset at Ω = {at}, the closed form's at {onset}");
+        }
         assert!(worst_amp < 1e-6, "amplitude off the closed form by {worst_amp:.1e}");
         assert!(worst_mu < 1e-4, "multiplier off the closed form's by {worst_mu:.1e}");
     }
+}
+
+/// The frequency in [a, b] where the closed form's orbit changes between a sticking arc and pure
+/// impacts (the sticking arc Ω t ∈ [Ω t_h, 2π + Ω t_d] shrinking to nothing), by bisection on its regime.
+fn sticking_onset(osc: &Oscillator, gap: f64, a: f64, b: f64) -> f64 {
+    let sticks = |w: f64| {
+        let o = Oscillator::new(osc.mass, osc.damping, osc.stiffness, osc.force, w);
+        RigidStopOrbit::solve(&o, gap).is_ok_and(|r| r.regime() == RigidRegime::Sticking)
+    };
+    let (mut lo, mut hi) = (a, b);
+    let s = sticks(lo);
+    assert!(s != sticks(hi), "no change of regime over [{a}, {b}]");
+    while hi - lo > 1e-12 {
+        let mid = 0.5 * (lo + hi);
+        if sticks(mid) == s { lo = mid } else { hi = mid }
+    }
+    0.5 * (lo + hi)
 }
 
 /// A random oscillator of 1–3 DOFs (a grounded chain: masses 0.5–2, springs 0.5–2, Rayleigh
@@ -162,6 +187,14 @@ fn rigid_family(seeds: std::ops::Range<u64>, steps: usize, checks_per_member: us
             labels.join(", "),
             runs[0].stop
         );
+        if std::env::var("PC_RIGID_EVENTS").is_ok() {
+            for b in &runs {
+                for e in b.events() {
+                    eprintln!("  {} {:.9} {}", e.event.unwrap().name(), e.parameter, e.detail);
+                }
+                eprintln!("  --");
+            }
+        }
     }
     (exact, reached, worst, compared, wrong)
 }
@@ -185,14 +218,16 @@ fn random_rigid_oscillators_give_the_same_exact_branch_at_k_and_2k() {
 }
 
 /// The whole random rigid family (opt-in: `PC_RIGID_FAMILY=40 cargo test --release --test suite
-/// rigid_branch:: -- --ignored`): at least 95 % reach the end on the exact orbit; prints the worst
-/// k vs 2k event disagreement and the stability labels at random points (one stable, one
-/// unstable per member) against long time integration.
+/// rigid_branch:: -- --ignored`; `PC_RIGID_FAMILY_FROM` the first seed, 100 by default;
+/// `PC_RIGID_EVENTS` prints every event): at least 95 % reach the end on the exact orbit; prints
+/// the worst k vs 2k event disagreement and the stability labels at random points (one stable,
+/// one unstable per member) against long time integration.
 #[test]
 #[ignore]
 fn random_rigid_family() {
     let count: u64 = std::env::var("PC_RIGID_FAMILY").ok().and_then(|s| s.parse().ok()).unwrap_or(40);
-    let (exact, reached, worst, compared, wrong) = rigid_family(100..100 + count, 256, 1);
+    let first: u64 = std::env::var("PC_RIGID_FAMILY_FROM").ok().and_then(|s| s.parse().ok()).unwrap_or(100);
+    let (exact, reached, worst, compared, wrong) = rigid_family(first..first + count, 256, 1);
     eprintln!(
         "random rigid family of {count}: {exact} exact to the end ({:.1} %), {reached} reached; worst k vs 2k event difference {worst:.1e}; stability vs long time integration: {wrong} of {compared} disagree",
         100.0 * exact as f64 / count as f64

@@ -21,7 +21,7 @@ mod verify;
 pub use continued::Touch;
 pub use events::{Event, EventKind};
 pub use orbit::{OrbitParts, PolishedOrbit, user_value};
-pub use rigid::{CLEARANCE, RigidMargin};
+pub use rigid::{CLEARANCE, HOLD, RigidMargin, STUCK};
 
 use crate::periodic::PeriodicProblem;
 use crate::response::{EventRecord, PolishSummary, Response};

@@ -24,6 +24,11 @@ pub struct RigidMargin {
 
 /// [`RigidMargin::what`] of a free contact's clearance (a new impact where it touches zero).
 pub const CLEARANCE: &str = "clearance of the free contact";
+/// [`RigidMargin::what`] of a stuck contact's force (a release inside the arc where it touches zero).
+pub const STUCK: &str = "force of the stuck contact";
+/// [`RigidMargin::what`] of the force that would hold a pure impact's contact (it starts to stick
+/// where that force reaches zero).
+pub const HOLD: &str = "force that would hold the contact after its impact";
 
 impl PolishedOrbit {
     /// The smallest rigid margin of the orbit ([`RigidMargin`]); `None` without rigid contacts.
@@ -52,7 +57,7 @@ impl PolishedOrbit {
                     let closed: Vec<usize> = (0..model.contacts.len()).filter(|&i| self.phases[e].closed(i)).collect();
                     if let Some(hold) = Phase::new(model, &stuck, &closed) {
                         let z = hold.stuck_forces(&self.after[e], self.times[e]).into_iter().find(|(k, _)| *k == ev.contact).map_or(0.0, |(_, z)| z);
-                        keep(-z / fs, ev.contact, "force that would hold the contact after its impact", self.times[e], Some(e));
+                        keep(-z / fs, ev.contact, HOLD, self.times[e], Some(e));
                     }
                 }
             }
@@ -66,7 +71,7 @@ impl PolishedOrbit {
             for i in (0..model.contacts.len()).filter(|&i| model.contacts[i].is_rigid()) {
                 if stuck.contains(&i) {
                     let (v, t) = minimum(a, b, &|t| ph.stuck_forces(&ph.flow(a, y0, t), t).into_iter().find(|(k, _)| *k == i).map_or(0.0, |(_, z)| z));
-                    keep(v / fs, i, "force of the stuck contact", t, None);
+                    keep(v / fs, i, STUCK, t, None);
                 } else {
                     let (v, t) = minimum(a, b, &|t| self.clearance(i, &ph.flow(a, y0, t), t));
                     keep(v / xs, i, CLEARANCE, t, None);

@@ -13,8 +13,8 @@
 //! shrinking below 1e-6 of the period (steps land on it by quarters; the pair is removed and the
 //! branch goes on in the same direction of the parameter). Rigid contacts (plastic impacts,
 //! sticking arcs, releases; the monodromy is the relocated one-period map, rank-deficient at an
-//! impact): their signature changes are located on the exact orbit and the branch past them is
-//! started from the grid LCP ([`rigid`]).
+//! impact): their signature changes are located on the exact orbit and the branch goes on from
+//! there, from the grid LCP only where that fails ([`rigid`]).
 mod family;
 mod rigid;
 mod signature;
@@ -361,7 +361,8 @@ impl Walk<'_> {
         let touch = *lo.worst_touch()?;
         let before = self.fam.ne();
         let wl = lo.w[lo.w.len() - 1];
-        let (sig, guess, (ia, ib)) = signature::insert(&self.fam, &lo.orbit, &touch, NEW_PAIR, wl);
+        let kinds = if touch.closed { (Switch::Off, Switch::On) } else { (Switch::On, Switch::Off) };
+        let (sig, guess, pair) = signature::insert(&self.fam, &lo.orbit, &touch, kinds, NEW_PAIR, wl);
         let detail = format!(
             "contact {}: events per period {before} -> {} (a {} phase begins)",
             touch.contact,
@@ -369,27 +370,45 @@ impl Walk<'_> {
             if touch.closed { "open" } else { "closed" }
         );
         self.push(&lo, Some(EventKind::Grazing), detail);
-        self.fam.sig = sig;
+        let first = self.open_phase(sig, &guess, pair)?;
+        self.multipliers_across(&lo, &first);
+        Some(first)
+    }
+
+    /// The first point of the branch of signature `sig` whose phase between its events `ia` and
+    /// `ib` (one contact's) begins at a grazing: corrected from `guess` with that phase
+    /// [`NEW_PAIR`] and twice that long, its tangent along the secant (the phase growing). The
+    /// family keeps its old signature when the corrector fails.
+    fn open_phase(&mut self, sig: Signature, guess: &[f64], (ia, ib): (usize, usize)) -> Option<Node> {
+        let old = std::mem::replace(&mut self.fam.sig, sig);
         let d = self.fam.dim();
         let n2 = d - 1 - self.fam.ne();
         let mut normal = vec![0.0; d];
         normal[n2 + ib] = 1.0;
         normal[n2 + ia] = -1.0;
         let wrap = if ib < ia { 1.0 } else { 0.0 };
-        let w1 = self.fam.correct(&guess, &normal, NEW_PAIR - wrap)?;
-        let mut g2 = w1.clone();
-        g2[n2 + ia] -= 0.5 * NEW_PAIR;
-        g2[n2 + ib] += 0.5 * NEW_PAIR;
-        let w2 = self.fam.correct(&g2, &normal, 2.0 * NEW_PAIR - wrap)?;
-        let sec: Vec<f64> = w2.iter().zip(&w1).map(|(a, b)| a - b).collect();
-        let first = self.fam.node(w1, &sec)?;
-        // Multiplier events across the grazing itself (both orbits are the same there).
+        let first = self.fam.correct(guess, &normal, NEW_PAIR - wrap).and_then(|w1| {
+            let mut g2 = w1.clone();
+            g2[n2 + ia] -= 0.5 * NEW_PAIR;
+            g2[n2 + ib] += 0.5 * NEW_PAIR;
+            let w2 = self.fam.correct(&g2, &normal, 2.0 * NEW_PAIR - wrap)?;
+            let sec: Vec<f64> = w2.iter().zip(&w1).map(|(a, b)| a - b).collect();
+            self.fam.node(w1, &sec)
+        });
+        if first.is_none() {
+            self.fam.sig = old;
+        }
+        first
+    }
+
+    /// Multiplier events across a grazing, from `lo` (the old signature) to `first` (the new
+    /// one): both orbits are the same there.
+    fn multipliers_across(&mut self, lo: &Node, first: &Node) {
         for kind in [EventKind::PeriodDoubling, EventKind::NeimarkSacker] {
-            if side(&lo, kind) != side(&first, kind) {
-                self.push(&first, Some(kind), detail_of(kind, &first));
+            if side(lo, kind) != side(first, kind) {
+                self.push(first, Some(kind), detail_of(kind, first));
             }
         }
-        Some(first)
     }
 
     /// The events between two points of one signature, each located by bisection, in order.

@@ -1,18 +1,23 @@
 //! Changes of the event signature of an orbit with rigid contacts (impacts with e = 0, sticking
-//! arcs, releases): located on the exact orbit, then the new signature asked of the grid LCP.
+//! arcs, releases): located on the exact orbit, and the branch past them started there.
 //!
 //! A change shows as the orbit's rigid margin ([`PolishedOrbit::rigid_margin`]) crossing zero
 //! (a free contact's clearance touching zero: a new impact; a stuck contact's force touching
-//! zero: a release inside the arc; an impulse fading to zero; a pure impact starting to stick),
-//! or as a phase between two events of one rigid contact shrinking to nothing (a sticking arc
-//! or a flight between two impacts vanishing). The change is located by bisection on the arc of
-//! the old signature (to the bracket of the exact walk), and recorded as a grazing. The branch
-//! beyond it is started from the grid LCP's orbit, polished, a short way past the change
+//! zero: a release inside the arc, or a sticking impact landing where it is zero; an impulse
+//! fading to zero; a pure impact starting to stick), or as a phase between two events of one
+//! rigid contact shrinking to nothing (a sticking arc, a flight between two impacts or from a
+//! release to an impact vanishing). The change is located by bisection on the arc of the old
+//! signature (to the bracket of the exact walk), and recorded as a grazing. The new signature
+//! differs by an event or a phase of zero length, so the orbit is the same there: the branch
+//! goes on from it on the exact orbit. Where that fails (and for the changes not listed), the
+//! branch is started from the grid LCP's orbit, polished, a short way past the change
 //! ([`RESEED`] of the range, growing until the polish accepts the grid's signature): the
 //! stretch between is not traced, and the grazing's detail says so.
+//!
+//! [`PolishedOrbit::rigid_margin`]: crate::analysis::polish::PolishedOrbit::rigid_margin
 use super::family::{Family, Node, Signature};
-use super::{BRACKET, EventKind, Walk, bisect};
-use crate::analysis::polish::{self, Event};
+use super::{BRACKET, EventKind, NEW_PAIR, Walk, bisect, signature};
+use crate::analysis::polish::{self, Event, EventKind as Switch, Touch};
 use crate::periodic::{PeriodicProblem, PeriodicSolver};
 use crate::time::Discretization;
 
@@ -50,29 +55,85 @@ impl Walk<'_> {
         let what = format!("contact {}: the {} reaches zero", m.contact, m.what);
         // A new pure impact where the clearance touches zero; an impact whose impulse fades, removed.
         let t = lo.orbit.period();
-        let mut list: Vec<(f64, Event)> = lo.orbit.events().iter().zip(lo.orbit.times()).map(|(e, &s)| (s / t, *e)).collect();
+        let mut list = timed(&lo.orbit);
+        let land = if m.what == polish::STUCK { landing(&lo, m.contact, m.time) } else { None };
         let changed = match (m.what, m.event) {
             (polish::CLEARANCE, _) => {
                 let base = list.first().map_or(0.0, |l| l.0);
                 let at = base + (m.time / t - base).rem_euclid(1.0);
-                list.push((at, Event { contact: m.contact, kind: polish::EventKind::Impact { stick: false }, seed: 0.0 }));
+                list.push((at, Event { contact: m.contact, kind: Switch::Impact { stick: false }, seed: 0.0 }));
                 list.sort_by(|x, y| x.0.total_cmp(&y.0));
                 true
             }
-            ("impulse of the impact", Some(e)) if lo.orbit.events()[e].kind == (polish::EventKind::Impact { stick: false }) => {
+            ("impulse of the impact", Some(e)) if lo.orbit.events()[e].kind == (Switch::Impact { stick: false }) => {
                 list.remove(e);
                 // Located on the orbit without the impact, regular where the impacting one is singular.
-                if let Some(n) = self.fade(here, next, &lo, list.clone(), &what) {
+                let rho = self.fam.rho;
+                if let Some(n) = self.fade((here.lambda(rho), next.lambda(rho)), &lo, list.clone(), &what, "the impact") {
                     return Some(n);
                 }
                 true
             }
+            // A pure impact starts to stick: a sticking arc of zero length after it, ending in a
+            // release (the orbit is the same), grows on the exact orbit.
+            (polish::HOLD, Some(e)) => {
+                list[e].1.kind = Switch::Impact { stick: true };
+                list.insert(e + 1, (list[e].0 + NEW_PAIR, Event { contact: m.contact, kind: Switch::Release, seed: 0.0 }));
+                if let Some(n) = self.begin_phase(&lo, &list, (e, e + 1), &what) {
+                    return Some(n);
+                }
+                false
+            }
+            // A stuck contact's force touches zero inside its arc: a flight of zero length there,
+            // from a release to a sticking impact (of zero impulse), grows on the exact orbit.
+            (polish::STUCK, None) if land.is_some() => {
+                let e = land.expect("guarded");
+                // The force touches zero where the sticking impact lands: the impact turns pure,
+                // and a flight of zero length leads to the sticking impact.
+                list[e].1.kind = Switch::Impact { stick: false };
+                list.insert(e + 1, (list[e].0 + NEW_PAIR, Event { contact: m.contact, kind: Switch::Impact { stick: true }, seed: 0.0 }));
+                if let Some(n) = self.begin_phase(&lo, &list, (e, e + 1), &what) {
+                    return Some(n);
+                }
+                false
+            }
+            (polish::STUCK, None) => {
+                let touch = Touch { phase: 0, contact: m.contact, value: 0.0, time: m.time, closed: true };
+                let (sig, guess, pair) =
+                    signature::insert(&self.fam, &lo.orbit, &touch, (Switch::Release, Switch::Impact { stick: true }), NEW_PAIR, lo.w[lo.w.len() - 1]);
+                if let Some(n) = self.start_phase(&lo, sig, &guess, pair, &what) {
+                    return Some(n);
+                }
+                false
+            }
             _ => false,
         };
-        if changed && let Some(n) = self.restart(&lo, list, &what) {
-            return Some(n);
+        if changed {
+            let sig = Signature { events: list.iter().map(|l| l.1).collect(), always: lo.orbit.always_closed().to_vec() };
+            let guess = signature::guess(&self.fam, &lo.orbit, &list, lo.w[lo.w.len() - 1]);
+            if let Some(n) = self.restart(&lo, sig, guess, &what) {
+                return Some(n);
+            }
         }
         self.reseed(&lo, &what, to)
+    }
+
+    /// [`Self::start_phase`] for the time-ordered `list` (fractions of the period) of the orbit at `at`.
+    fn begin_phase(&mut self, at: &Node, list: &[(f64, Event)], pair: (usize, usize), what: &str) -> Option<Node> {
+        let sig = Signature { events: list.iter().map(|l| l.1).collect(), always: at.orbit.always_closed().to_vec() };
+        let guess = signature::guess(&self.fam, &at.orbit, list, at.w[at.w.len() - 1]);
+        self.start_phase(at, sig, &guess, pair, what)
+    }
+
+    /// The branch of signature `sig` (unknowns `guess`) whose phase between the events `pair`
+    /// begins at `at`, where it has zero length: its first point, the grazing recorded at `at`.
+    fn start_phase(&mut self, at: &Node, sig: Signature, guess: &[f64], pair: (usize, usize), what: &str) -> Option<Node> {
+        let before = self.fam.ne();
+        let first = self.open_phase(sig, guess, pair)?;
+        let detail = format!("{what}; events per period {before} -> {} (the new phase started on the exact orbit)", self.fam.ne());
+        self.push(at, Some(EventKind::Grazing), detail);
+        self.multipliers_across(at, &first);
+        Some(first)
     }
 
     /// An impact's impulse fades between `here` (positive) and `next` (negative): the grazing where
@@ -83,20 +144,15 @@ impl Walk<'_> {
     /// and λ(next); the branch goes on towards the side where that margin is ≥ 0, which reverses λ
     /// when the impacting orbit and the admissible contact-free one lie on the same side (the
     /// unstable impacting orbit from a fold ending at the grazing). `None` without a sign change.
-    fn fade(&mut self, here: &Node, next: &Node, near: &Node, list: Vec<(f64, Event)>, what: &str) -> Option<Node> {
-        let rho = self.fam.rho;
-        let t = near.orbit.period();
-        let t0 = list.first().map_or(0.0, |l| l.0 * t);
-        let mut guess: Vec<f64> = near.orbit.state(t0).iter().map(|y| y / self.fam.ys).collect();
-        guess.extend(list.iter().map(|l| l.0));
-        guess.push(0.0);
+    fn fade(&mut self, (la, lb): (f64, f64), near: &Node, list: Vec<(f64, Event)>, what: &str, without: &str) -> Option<Node> {
+        let guess = signature::guess(&self.fam, &near.orbit, &list, 0.0);
         let sig = Signature { events: list.iter().map(|l| l.1).collect(), always: near.orbit.always_closed().to_vec() };
         let before = self.fam.ne();
         let old = std::mem::replace(&mut self.fam.sig, sig);
-        let located = touch_point(&mut self.fam, &guess, here.lambda(rho), next.lambda(rho));
+        let located = touch_point(&mut self.fam, &guess, la, lb);
         match located {
             Some(n) => {
-                let detail = format!("{what}; events per period {before} -> {} (located on the orbit without the impact)", self.fam.ne());
+                let detail = format!("{what}; events per period {before} -> {} (located on the orbit without {without})", self.fam.ne());
                 self.push(&n, Some(EventKind::Grazing), detail);
                 Some(n)
             }
@@ -107,18 +163,13 @@ impl Walk<'_> {
         }
     }
 
-    /// The branch of the signature `list` (events at fractions of the period) through the orbit
-    /// of `at` (a zero-velocity impact added or removed leaves the orbit as it is): corrected at
-    /// λ fixed, oriented towards the side where the orbit is admissible (λ's sense first).
-    fn restart(&mut self, at: &Node, list: Vec<(f64, Event)>, what: &str) -> Option<Node> {
+    /// The branch of the signature `sig` (unknowns `guess`) through the orbit of `at` (a
+    /// zero-velocity impact added or removed, a vanished sticking arc or flight, leaves the orbit
+    /// as it is): corrected at λ fixed, oriented towards the side where the orbit is admissible
+    /// (λ's sense first).
+    fn restart(&mut self, at: &Node, sig: Signature, guess: Vec<f64>, what: &str) -> Option<Node> {
         let rho = self.fam.rho;
         let lambda = at.lambda(rho);
-        let t = at.orbit.period();
-        let t0 = list.first().map_or(0.0, |l| l.0 * t);
-        let mut guess: Vec<f64> = at.orbit.state(t0).iter().map(|y| y / self.fam.ys).collect();
-        guess.extend(list.iter().map(|l| l.0));
-        guess.push(lambda / rho);
-        let sig = Signature { events: list.iter().map(|l| l.1).collect(), always: at.orbit.always_closed().to_vec() };
         let before = self.fam.ne();
         let old = std::mem::replace(&mut self.fam.sig, sig);
         let d = self.fam.dim();
@@ -148,15 +199,52 @@ impl Walk<'_> {
         }
     }
 
-    /// A phase between two events of one rigid contact has vanished at `here` (phase `e`).
+    /// A phase between two events of one rigid contact has vanished at `here` (phase `e`): a
+    /// sticking arc (the impact goes on as a pure one) or a flight from a release to a sticking
+    /// impact (the contact stays stuck) is removed on the exact orbit; other phases restart from
+    /// the grid LCP.
     pub(super) fn rigid_vanish(&mut self, here: &Node, e: usize, to: f64) -> Option<Node> {
         let ev = self.fam.sig.events[e];
-        let what = format!(
-            "contact {}: its {} phase vanishes",
-            ev.contact,
-            if matches!(ev.kind, polish::EventKind::Impact { stick: true }) { "sticking" } else { "free" }
-        );
+        let what = format!("contact {}: its {} phase vanishes", ev.contact, if ev.kind == (Switch::Impact { stick: true }) { "sticking" } else { "free" });
+        if let Some(n) = self.merge(here, e, &what) {
+            return Some(n);
+        }
         self.reseed(here, &what, to)
+    }
+
+    /// The branch past `here` without its phase `e` (between two events of one rigid contact,
+    /// about to vanish), on the exact orbit; `None` for other phases or where that fails.
+    fn merge(&mut self, here: &Node, e: usize, what: &str) -> Option<Node> {
+        let ne = self.fam.ne();
+        let (ev, next) = (self.fam.sig.events[e], self.fam.sig.events[(e + 1) % ne]);
+        let wl = here.w[here.w.len() - 1];
+        let mut list = timed(&here.orbit);
+        let (rho, lambda) = (self.fam.rho, here.lambda(self.fam.rho));
+        let sense = here.tangent[here.tangent.len() - 1].signum();
+        let (sig, guess) = match (ev.kind, next.kind) {
+            // Located on the orbit with a pure impact, where the force that would hold its contact
+            // touches zero, a short way ahead; else that orbit's branch from here.
+            (Switch::Impact { stick: true }, Switch::Release) => {
+                list[e].1.kind = Switch::Impact { stick: false };
+                list.remove((e + 1) % ne);
+                if let Some(n) =
+                    [1e-5, 1e-4, 1e-3].into_iter().find_map(|f| self.fade((lambda, lambda + sense * f * rho), here, list.clone(), what, "the sticking arc"))
+                {
+                    return Some(n);
+                }
+                let sig = Signature { events: list.iter().map(|l| l.1).collect(), always: here.orbit.always_closed().to_vec() };
+                (sig, signature::guess(&self.fam, &here.orbit, &list, wl))
+            }
+            (Switch::Release, Switch::Impact { stick: true }) => signature::remove(&self.fam, &here.orbit, e, wl)?,
+            // A pure impact and the sticking impact after it merge: located on the orbit without
+            // the pure impact, where the force at its landing touches zero, a short way ahead.
+            (Switch::Impact { stick: false }, Switch::Impact { stick: true }) => {
+                list.remove(e);
+                return [1e-5, 1e-4, 1e-3].into_iter().find_map(|f| self.fade((lambda, lambda + sense * f * rho), here, list.clone(), what, "the impact"));
+            }
+            _ => return None,
+        };
+        self.restart(here, sig, guess, what)
     }
 
     /// The corrector stalls at `here` with the smallest step on an orbit with rigid contacts:
@@ -166,6 +254,17 @@ impl Walk<'_> {
     pub(super) fn rigid_stall(&mut self, here: &Node, to: f64) -> Option<Node> {
         let m = here.orbit.rigid_margin()?;
         let what = format!("the events merge (the corrector stalls; the smallest margin: contact {}'s {}, {:.1e})", m.contact, m.what, m.value);
+        // The shortest phase between two events of one contact: the one merging.
+        let (ne, n2) = (self.fam.ne(), here.w.len() - 1 - self.fam.ne());
+        let length = |e: usize| here.w[n2 + (e + 1) % ne] - here.w[n2 + e] + if e + 1 == ne { 1.0 } else { 0.0 };
+        let shortest = (0..ne)
+            .filter(|&e| ne >= 2 && self.fam.sig.events[e].contact == self.fam.sig.events[(e + 1) % ne].contact)
+            .min_by(|&a, &b| length(a).total_cmp(&length(b)));
+        if let Some(e) = shortest
+            && let Some(n) = self.merge(here, e, &what)
+        {
+            return Some(n);
+        }
         self.reseed(here, &what, to)
     }
 
@@ -203,6 +302,19 @@ impl Walk<'_> {
         }
         None
     }
+}
+
+/// The orbit's events with their times as fractions of the period.
+fn timed(orbit: &polish::PolishedOrbit) -> Vec<(f64, Event)> {
+    let t = orbit.period();
+    orbit.events().iter().zip(orbit.times()).map(|(e, &s)| (s / t, *e)).collect()
+}
+
+/// The sticking impact of contact `c` that lands at `time` (within 1e-9 of the period) on `n`'s orbit.
+fn landing(n: &Node, c: usize, time: f64) -> Option<usize> {
+    let t = n.orbit.period();
+    let near = |s: f64| ((s - time) / t + 0.5).rem_euclid(1.0) - 0.5;
+    n.orbit.events().iter().zip(n.orbit.times()).position(|(e, &s)| e.contact == c && e.kind == (Switch::Impact { stick: true }) && near(s).abs() < 1e-9)
 }
 
 /// The polished orbit of the grid LCP's solve at λ (on a [`REFINE`] times finer grid when the

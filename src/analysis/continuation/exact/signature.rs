@@ -1,16 +1,22 @@
 //! Changes of the event signature at a grazing: a contact's clearance touching zero between its
 //! events adds a pair of events there (contact on/off around the touch of an open contact,
-//! off/on inside a closed one); a phase shrinking to nothing between two events of one contact
-//! removes the pair.
+//! off/on inside a closed one; release/impact inside a rigid contact's sticking arc whose force
+//! touches zero); a phase shrinking to nothing between two events of one contact removes the pair.
 use super::family::{Family, Signature};
 use crate::analysis::polish::{Event, EventKind, PolishedOrbit, Touch};
 
-/// The signature of `orbit` with a pair of events `delta` (fraction of the period) apart around
-/// the touch: the new unknowns' guess (at λ/ρ `wl`) and the pair's indices (first, second) in the
-/// new time order.
-pub(super) fn insert(fam: &Family, orbit: &PolishedOrbit, touch: &Touch, delta: f64, wl: f64) -> (Signature, Vec<f64>, (usize, usize)) {
+/// The signature of `orbit` with a pair of events (`first`, `second`) `delta` (fraction of the
+/// period) apart around the touch: the new unknowns' guess (at λ/ρ `wl`) and the pair's indices
+/// in the new time order.
+pub(super) fn insert(
+    fam: &Family,
+    orbit: &PolishedOrbit,
+    touch: &Touch,
+    (first, second): (EventKind, EventKind),
+    delta: f64,
+    wl: f64,
+) -> (Signature, Vec<f64>, (usize, usize)) {
     let t = orbit.period();
-    let (first, second) = if touch.closed { (EventKind::Off, EventKind::On) } else { (EventKind::On, EventKind::Off) };
     let mut list: Vec<(f64, Event)> = orbit.events().iter().zip(orbit.times()).map(|(e, &s)| (s / t, *e)).collect();
     let base = list.first().map_or(touch.time / t - 0.5 * delta, |l| l.0);
     let wrap = |s: f64| base + (s - base).rem_euclid(1.0);
@@ -40,8 +46,8 @@ pub(super) fn remove(fam: &Family, orbit: &PolishedOrbit, phase: usize, wl: f64)
     let list: Vec<(f64, Event)> =
         orbit.events().iter().zip(orbit.times()).enumerate().filter(|(i, _)| *i != a && *i != b).map(|(_, (e, &s))| (s / t, *e)).collect();
     let mut always = orbit.always_closed().to_vec();
-    // The vanishing phase was open (off → on): without events the contact is closed all along.
-    if ea.kind == EventKind::Off && !list.iter().any(|l| l.1.contact == ea.contact) {
+    // The vanishing phase was open (off → on, release → impact): without events the contact is closed all along.
+    if matches!(ea.kind, EventKind::Off | EventKind::Release) && !list.iter().any(|l| l.1.contact == ea.contact) {
         always.push(ea.contact);
         always.sort_unstable();
     }
@@ -51,7 +57,7 @@ pub(super) fn remove(fam: &Family, orbit: &PolishedOrbit, phase: usize, wl: f64)
 
 /// Unknowns for the time-ordered `list` (fractions of the period): the state at the first
 /// event's time (at t = 0 without events; the state is continuous across compliant switches).
-fn guess(fam: &Family, orbit: &PolishedOrbit, list: &[(f64, Event)], wl: f64) -> Vec<f64> {
+pub(super) fn guess(fam: &Family, orbit: &PolishedOrbit, list: &[(f64, Event)], wl: f64) -> Vec<f64> {
     let t = orbit.period();
     let t0 = list.first().map_or(0.0, |l| l.0 * t);
     let mut w: Vec<f64> = orbit.state(t0).iter().map(|y| y / fam.ys).collect();
