@@ -99,38 +99,31 @@ pub(super) fn check_gross_slip(problem: &PeriodicProblem, asm: &Assembly, fft: &
 const HOMOTOPY_FIRST_STEP: f64 = 0.25;
 const HOMOTOPY_MIN_STEP: f64 = 1.0 / 256.0;
 
-/// The period's LCP of a rubbing model (`auto` or `shooting`): shooting alone first; when it
-/// misses, the μ-homotopy ([`friction_homotopy`]) gives a warm start for shooting; only then
-/// `auto`'s dense fallback (its projected cost is checked by the caller's policy). Why: the
-/// offset homotopy of cold shooting follows a path that folds and ends at a kink near the real
-/// blade's μ = 0.15 resonance (README "Friction"), where μ = 0 solves at once and the branch is
-/// smooth in μ.
+/// The period's LCP of a rubbing model (`auto` or `shooting`). Where shooting misses and no
+/// affordable dense fallback follows (`shooting` alone, or `auto` on an LCP whose dense Lemke is
+/// refused by its projected cost), the μ-homotopy ([`friction_homotopy`]) gives shooting a warm
+/// start. Why: near the real blade's μ = 0.15 resonance cold shooting's offset homotopy follows a
+/// path that folds and ends at a kink (README "Friction"), where μ = 0 solves at once.
 pub(super) fn solve_lcp(problem: &PeriodicProblem, fft: &PeriodFft, a: &BlockCirculant, q: &[f64], warm: Option<&[usize]>) -> Result<LcpSolution, SolveError> {
     let settings = problem.solver_settings();
     let rubbing = problem.model().rubbing.iter().any(|r| r.coefficient > 0.0);
-    // A warm-only try (a guarded sweep's quick one, and the homotopy's own steps) stays one try.
-    if !rubbing || settings.shooting_warm_only || !matches!(settings.method, LcpMethod::Auto | LcpMethod::Shooting) {
+    // A warm-only try (a guarded sweep's quick one, and the homotopy's own steps) stays one try;
+    // an affordable dense Lemke is the surer fallback.
+    let dense_next = settings.method == LcpMethod::Auto && crate::lcp::dense_fallback_allowed(q.len()).is_ok();
+    if !rubbing || settings.shooting_warm_only || dense_next || !matches!(settings.method, LcpMethod::Auto | LcpMethod::Shooting) {
         return problem.solve_lcp(a, q, warm);
     }
-    let shooting = |warm: Option<&[usize]>| {
-        let mut p = problem.clone();
-        p.set_solver_settings(SolverSettings { method: LcpMethod::Shooting, ..settings.clone() })?;
-        p.solve_lcp(a, q, warm)
-    };
-    let missed = match shooting(warm) {
+    let missed = match problem.solve_lcp(a, q, warm) {
         Ok(sol) => return Ok(sol),
         Err(e) => e,
     };
     progress(&format!("shooting missed ({missed}); μ-homotopy from μ = 0 next"));
-    let homotopy = friction_homotopy(problem, fft).and_then(|set| shooting(Some(&set)));
-    match (homotopy, settings.method) {
-        (Ok(sol), _) => Ok(sol),
-        (Err(e), LcpMethod::Shooting) => Err(annotate(e, &format!("shooting missed ({missed}), and so did the μ-homotopy from μ = 0"))),
-        (Err(e), _) => {
-            progress(&format!("shooting and the μ-homotopy missed ({e}); the dense fallback next"));
-            problem.solve_lcp(a, q, warm)
-        }
-    }
+    let homotopy = friction_homotopy(problem, fft).and_then(|set| {
+        let mut p = problem.clone();
+        p.set_solver_settings(SolverSettings { method: LcpMethod::Shooting, ..settings.clone() })?;
+        p.solve_lcp(a, q, Some(&set))
+    });
+    homotopy.map_err(|e| annotate(missed, &format!("the μ-homotopy from μ = 0 missed too ({e})")))
 }
 
 /// The μ-homotopy: solves the model without friction (the symmetric LCP, one answer), then
@@ -171,12 +164,12 @@ fn friction_homotopy(problem: &PeriodicProblem, fft: &PeriodFft) -> Result<Vec<u
     Ok(set)
 }
 
-/// `e` with `why` in front of its remedies (an LCP failure keeps its outcome and figures).
+/// `e` with `why` after its remedies (an LCP failure keeps its outcome and figures).
 fn annotate(e: SolveError, why: &str) -> SolveError {
     match e {
-        SolveError::Lcp { outcome, info, hint } => SolveError::Lcp { outcome, info, hint: format!("{why}; {hint}") },
-        SolveError::Limit(m) => SolveError::Limit(format!("{why}; {m}")),
-        SolveError::Invalid(m) => SolveError::Invalid(format!("{why}; {m}")),
+        SolveError::Lcp { outcome, info, hint } => SolveError::Lcp { outcome, info, hint: format!("{hint}; {why}") },
+        SolveError::Limit(m) => SolveError::Limit(format!("{m}; {why}")),
+        SolveError::Invalid(m) => SolveError::Invalid(format!("{m}; {why}")),
         other => other,
     }
 }
