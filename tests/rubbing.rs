@@ -284,3 +284,20 @@ fn a_sliding_direction_without_its_node_or_axis_is_refused_by_name() {
     let (a, b) = (by_dofs.to_problem("r.toml").unwrap().solve().unwrap(), by_dof.to_problem("r.toml").unwrap().solve().unwrap());
     assert_eq!(a.displacement, b.displacement);
 }
+
+/// The real rubbing blade's LCP (N = 17 408) ran 20 min in the dense fallback: `auto` now refuses
+/// it with the projected cost (N³ flops at 1e10/s: 17 408³/1e10 s = 8.8 min; 8·N² bytes =
+/// 2.26 GiB, by hand), and still allows it on the fine blade's N = 6144 (2.3 s projected).
+#[test]
+fn the_dense_fallback_is_a_projected_cost_decision() {
+    use periodic_contact::lcp::{DENSE_FALLBACK_MAX_S, dense_fallback_allowed, dense_lemke_seconds};
+    assert!((dense_lemke_seconds(17_408) - 527.5).abs() < 0.1, "{}", dense_lemke_seconds(17_408));
+    let refused = dense_fallback_allowed(17_408).expect_err("N = 17 408 must be refused");
+    for part in ["N = 17408", "≈ 9 min", "≈ 2.3 GiB"] {
+        assert!(refused.contains(part), "{part} missing from: {refused}");
+    }
+    assert!(dense_fallback_allowed(6144).is_ok());
+    // The limit sits between them: N³ = 1e10 · DENSE_FALLBACK_MAX_S.
+    let limit = (1e10 * DENSE_FALLBACK_MAX_S).cbrt() as usize;
+    assert!(dense_fallback_allowed(limit - 1).is_ok() && dense_fallback_allowed(limit + 2).is_err());
+}

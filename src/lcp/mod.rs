@@ -33,8 +33,8 @@ pub use lemke::{Lemke, LemkeSettings};
 pub use matrix::{BlockCirculant, DenseMatrix, LcpMatrix};
 pub use pivoting::{BlockPivoting, PivotingSettings};
 pub use policy::{
-    AUTO_LEMKE_MAX, DENSE_MAX, DENSE_MEMORY_MAX, GIB, LEMKE_AFTER_SHOOTING_MAX, LcpMethod, LcpMethodError, dense_memory, solve_circulant_lcp,
-    solve_periodic_lcp, solve_periodic_lcp_with,
+    AUTO_LEMKE_MAX, DENSE_FALLBACK_MAX_S, DENSE_MAX, DENSE_MEMORY_MAX, GIB, LEMKE_AFTER_SHOOTING_MAX, LEMKE_FLOPS_PER_S, LcpMethod, LcpMethodError,
+    dense_fallback_allowed, dense_lemke_seconds, dense_memory, progress, set_progress, solve_circulant_lcp, solve_periodic_lcp, solve_periodic_lcp_with,
 };
 pub use reference::solve_by_enumeration;
 pub use status::{LcpInfo, LcpOutcome, LcpSolution, LcpStep, WarmOutcome, residuals};

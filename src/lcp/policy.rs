@@ -65,6 +65,49 @@ pub fn dense_memory(n: usize) -> f64 {
     8.0 * (n as f64).powi(2)
 }
 
+/// Dense Lemke's speed on one core, flops per second, for its projected time: on the fine blade
+/// (N = 6144, ≈ N/2 pivots of 2N² flops: N³) it took 20 s (see `solve_periodic_lcp_with`).
+pub const LEMKE_FLOPS_PER_S: f64 = 1e10;
+
+/// After a failed shooting, `auto` runs dense Lemke only when it is projected to take at most
+/// this [s]; above, the failure is typed with the projected cost and the remedies. Why: on the
+/// rubbing real blade (N = 17 408) the fallback ran 20 min silently without finishing.
+pub const DENSE_FALLBACK_MAX_S: f64 = 120.0;
+
+/// Dense Lemke's projected seconds on an LCP of `n` unknowns: about N/2 pivots of 2N² flops.
+pub fn dense_lemke_seconds(n: usize) -> f64 {
+    (n as f64).powi(3) / LEMKE_FLOPS_PER_S
+}
+
+/// Whether `auto` may fall back on dense Lemke after shooting missed on an LCP of `n` unknowns:
+/// `Err` names the projected time and memory (the caller adds why shooting missed and remedies).
+pub fn dense_fallback_allowed(n: usize) -> Result<(), String> {
+    let (seconds, bytes) = (dense_lemke_seconds(n), dense_memory(n));
+    if seconds <= DENSE_FALLBACK_MAX_S && bytes <= DENSE_MEMORY_MAX {
+        return Ok(());
+    }
+    Err(format!(
+        "dense Lemke at N = {n} would take ≈ {:.0} min (N³ flops at {LEMKE_FLOPS_PER_S:.0e}/s; at most {DENSE_FALLBACK_MAX_S:.0} s in auto) and ≈ {:.1} GiB",
+        seconds / 60.0,
+        bytes / GIB
+    ))
+}
+
+static PROGRESS: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Turns on progress lines of long solves on stderr (the CLI does; a library caller, the C API
+/// and the FMU stay silent).
+pub fn set_progress(on: bool) {
+    PROGRESS.store(on, std::sync::atomic::Ordering::Relaxed);
+}
+
+/// Writes one progress line on stderr when [`set_progress`] turned them on.
+pub fn progress(line: &str) {
+    if PROGRESS.load(std::sync::atomic::Ordering::Relaxed) {
+        eprintln!("{line}");
+    }
+}
+
 /// The engine's policy for the period's LCP (A block-circulant, q), with the step map of the
 /// scheme when it has one. `auto`: shooting first when there is a step map (certified on (A, q)
 /// by FFT products), then, up to [`DENSE_MAX`], the block-circulant chain of
@@ -155,7 +198,15 @@ pub fn solve_periodic_lcp_with(
             // resonance): the certified reference next while it is cheap (N ≤
             // LEMKE_AFTER_SHOOTING_MAX: 0.1–0.6 s on the rigid blade at N = 3072, where block
             // pivoting took 8 s to end on a ray), else block pivoting first.
-            let fallback = || if q.len() <= LEMKE_AFTER_SHOOTING_MAX { lemke() } else { blind() };
+            let iterations = sol.info.pivots;
+            let fallback = || {
+                progress(&format!(
+                    "shooting missed on N = {} after {iterations} Newton iterations; dense fallback (projected ≈ {:.0} s)",
+                    q.len(),
+                    dense_lemke_seconds(q.len())
+                ));
+                if q.len() <= LEMKE_AFTER_SHOOTING_MAX { lemke() } else { blind() }
+            };
             (then(sol, &fallback), None)
         }
         _ => (blind(), None),

@@ -2,7 +2,9 @@
 //! private: every way in (constructor, updaters) runs the checks, so a `PeriodicProblem` is
 //! always ready to solve.
 use super::{Assembly, OutputMap, OutputSelection, PeriodFft, SolveError, SolverSettings, assembly, lcp_failure, limits, recovery};
-use crate::lcp::{BlockCirculant, DENSE_MAX, DENSE_MEMORY_MAX, GIB, LcpMethod, LcpOutcome, LcpSolution, dense_memory, solve_periodic_lcp_with};
+use crate::lcp::{
+    BlockCirculant, DENSE_MAX, DENSE_MEMORY_MAX, GIB, LcpMethod, LcpOutcome, LcpSolution, dense_fallback_allowed, dense_memory, solve_periodic_lcp_with,
+};
 use crate::model::{Contact, Model};
 use crate::response::Response;
 use crate::time::{Discretization, Pairing};
@@ -366,7 +368,7 @@ impl PeriodicProblem {
         let t_assembly = t_start.elapsed().as_secs_f64();
 
         let t_lcp = Instant::now();
-        let sol = self.solve_lcp(&a, &q, warm_start)?;
+        let sol = super::rubbing::solve_lcp(self, fft, &a, &q, warm_start)?;
         let t_lcp = t_lcp.elapsed().as_secs_f64();
         super::rubbing::check_gross_slip(self, asm, fft, &sol.z)?;
 
@@ -438,7 +440,7 @@ impl PeriodicProblem {
 
     /// Solves the LCP by the configured method; a failure is typed with its remedies.
     /// `auto` and `shooting` use the scheme's step map when it has one ([`super::state_space`]).
-    fn solve_lcp(&self, a: &BlockCirculant, q: &[f64], warm_start: Option<&[usize]>) -> Result<LcpSolution, SolveError> {
+    pub(super) fn solve_lcp(&self, a: &BlockCirculant, q: &[f64], warm_start: Option<&[usize]>) -> Result<LcpSolution, SolveError> {
         let method = self.solver.method;
         let step_map = match method {
             LcpMethod::Auto | LcpMethod::Shooting if !q.is_empty() => Some(super::state_space::step_map(self)),
@@ -460,8 +462,20 @@ impl PeriodicProblem {
             }
         }
         let step_map = step_map.and_then(Result::ok);
+        // auto's dense fallback after shooting only when its projected cost is affordable.
+        let refused = (method == LcpMethod::Auto && step_map.is_some()).then(|| dense_fallback_allowed(q.len()).err()).flatten();
+        let method = if refused.is_some() { LcpMethod::Shooting } else { method };
         let (sol, _state) = solve_periodic_lcp_with(a, q, step_map.as_ref(), method, self.solver.tolerance, warm_start, self.solver.shooting_warm_only);
-        if sol.outcome == LcpOutcome::Solved { Ok(sol) } else { Err(lcp_failure(sol)) }
+        match refused {
+            _ if sol.outcome == LcpOutcome::Solved => Ok(sol),
+            Some(cost) => Err(SolveError::Limit(format!(
+                "solver.method: shooting missed ({} after {} Newton iterations, residual {:.3e}); {cost}: set [solver] method = \"lemke\" to force it, or sweep towards this point from where it solves (warm starts)",
+                sol.outcome.name(),
+                sol.info.pivots,
+                sol.info.residual
+            ))),
+            None => Err(lcp_failure(sol)),
+        }
     }
 
     /// The LCP (A, q) of the period without solving it (for exports and studies).

@@ -3,7 +3,8 @@
 //! contact force on the structure is −(n − μ·sign(V)·t)ᵀ λ_a. The tangential rows are assembled
 //! as extra rows of B and folded into the contacts' columns: the LCP keeps its k·m unknowns and
 //! becomes non-symmetric (Ĝ_ab + c·Ĝ_a,t with c = −μ·sign(V)).
-use super::{Assembly, PeriodFft, PeriodicProblem, SolveError};
+use super::{Assembly, PeriodFft, PeriodicProblem, SolveError, SolverSettings};
+use crate::lcp::{BlockCirculant, LcpMethod, LcpSolution, progress};
 use crate::model::{Compliance, Contact, Model};
 use num_complex::Complex64 as C;
 use std::borrow::Cow;
@@ -92,4 +93,83 @@ pub(super) fn check_gross_slip(problem: &PeriodicProblem, asm: &Assembly, fft: &
         }
     }
     Ok(())
+}
+
+/// Steps of the μ-homotopy: the first step's share of μ, and the smallest before giving up.
+const HOMOTOPY_FIRST_STEP: f64 = 0.25;
+const HOMOTOPY_MIN_STEP: f64 = 1.0 / 256.0;
+
+/// The period's LCP of a rubbing model (`auto` or `shooting`). Where shooting misses and no
+/// affordable dense fallback follows (`shooting` alone, or `auto` on an LCP whose dense Lemke is
+/// refused by its projected cost), the μ-homotopy ([`friction_homotopy`]) gives shooting a warm
+/// start. Why: near the real blade's μ = 0.15 resonance cold shooting's offset homotopy follows a
+/// path that folds and ends at a kink (README "Friction"), where μ = 0 solves at once.
+pub(super) fn solve_lcp(problem: &PeriodicProblem, fft: &PeriodFft, a: &BlockCirculant, q: &[f64], warm: Option<&[usize]>) -> Result<LcpSolution, SolveError> {
+    let settings = problem.solver_settings();
+    let rubbing = problem.model().rubbing.iter().any(|r| r.coefficient > 0.0);
+    // A warm-only try (a guarded sweep's quick one, and the homotopy's own steps) stays one try;
+    // an affordable dense Lemke is the surer fallback.
+    let dense_next = settings.method == LcpMethod::Auto && crate::lcp::dense_fallback_allowed(q.len()).is_ok();
+    if !rubbing || settings.shooting_warm_only || dense_next || !matches!(settings.method, LcpMethod::Auto | LcpMethod::Shooting) {
+        return problem.solve_lcp(a, q, warm);
+    }
+    let missed = match problem.solve_lcp(a, q, warm) {
+        Ok(sol) => return Ok(sol),
+        Err(e) => e,
+    };
+    progress(&format!("shooting missed ({missed}); μ-homotopy from μ = 0 next"));
+    let homotopy = friction_homotopy(problem, fft).and_then(|set| {
+        let mut p = problem.clone();
+        p.set_solver_settings(SolverSettings { method: LcpMethod::Shooting, ..settings.clone() })?;
+        p.solve_lcp(a, q, Some(&set))
+    });
+    homotopy.map_err(|e| annotate(missed, &format!("the μ-homotopy from μ = 0 missed too ({e})")))
+}
+
+/// The μ-homotopy: solves the model without friction (the symmetric LCP, one answer), then
+/// raises every rubbing μ by steps to its value, each step shooting from the last step's active
+/// sets (Newton from them alone); a missed step is halved. Returns the active set at full μ.
+fn friction_homotopy(problem: &PeriodicProblem, fft: &PeriodFft) -> Result<Vec<usize>, SolveError> {
+    let model = problem.model();
+    let at = |share: f64, warm: Option<&[usize]>| -> Result<Vec<usize>, SolveError> {
+        let mut scaled = model.clone();
+        for r in &mut scaled.rubbing {
+            r.coefficient *= share;
+        }
+        if share == 0.0 {
+            scaled.rubbing.clear();
+        }
+        let mut p = problem.with_model(scaled, problem.discretization())?;
+        let method = if warm.is_some() { LcpMethod::Shooting } else { problem.solver_settings().method };
+        p.set_solver_settings(SolverSettings { method, shooting_warm_only: warm.is_some(), ..problem.solver_settings().clone() })?;
+        Ok(p.solve_with(fft, warm)?.active_set)
+    };
+    let mut set = at(0.0, None)?;
+    let (mut share, mut step) = (0.0, HOMOTOPY_FIRST_STEP);
+    let mu = model.rubbing.iter().fold(0.0f64, |v, r| v.max(r.coefficient));
+    while share < 1.0 {
+        let next = (share + step).min(1.0);
+        match at(next, Some(&set)) {
+            Ok(s) => {
+                progress(&format!("μ-homotopy: μ = {:.4} of {mu} solved (step {step:.4})", next * mu));
+                (set, share, step) = (s, next, (1.5 * step).min(HOMOTOPY_FIRST_STEP));
+            }
+            Err(e) if step <= HOMOTOPY_MIN_STEP => {
+                let why = format!("the μ-homotopy stalled at μ = {:.4} of {mu} (a step of {step:.2e}·μ missed; the branch may fold in μ)", share * mu);
+                return Err(annotate(e, &why));
+            }
+            Err(_) => step /= 2.0,
+        }
+    }
+    Ok(set)
+}
+
+/// `e` with `why` after its remedies (an LCP failure keeps its outcome and figures).
+fn annotate(e: SolveError, why: &str) -> SolveError {
+    match e {
+        SolveError::Lcp { outcome, info, hint } => SolveError::Lcp { outcome, info, hint: format!("{hint}; {why}") },
+        SolveError::Limit(m) => SolveError::Limit(format!("{m}; {why}")),
+        SolveError::Invalid(m) => SolveError::Invalid(format!("{m}; {why}")),
+        other => other,
+    }
 }

@@ -112,6 +112,8 @@ fn export_lcp(problem: &PeriodicProblem, path: &Path) -> Result<(), Failure> {
 }
 
 pub fn run(scene: &Path, files: Files, overrides: Overrides, flags: Refine) -> Result<(), Failure> {
+    // One solve may take minutes (shooting's homotopies, a dense fallback): say where it is.
+    periodic_contact::lcp::set_progress(true);
     let Files { output, export_lcp: export, hysteresis } = files;
     ensure_writable(output, "--output")?;
     if let Some(p) = export {
