@@ -324,10 +324,11 @@ impl StickSlipOrbit {
                 let j = self.jacobian(&u, &r);
                 let m = self.times.len();
                 let jtt = j.view((nr, nr), (m, m)).into_owned();
-                let schur = jtt.lu().solve(&j.view((nr, 0), (m, nr)).into_owned());
+                // No events: the monodromy is the flow's (and a 0 × 0 LU would not solve).
+                let schur = if m > 0 { jtt.lu().solve(&j.view((nr, 0), (m, nr)).into_owned()) } else { None };
                 let phi = j.view((0, 0), (nr, nr)) + DMatrix::identity(nr, nr);
                 self.monodromy = match schur {
-                    Some(s) if m > 0 => phi - j.view((0, nr), (nr, m)) * s,
+                    Some(s) => phi - j.view((0, nr), (nr, m)) * s,
                     _ => phi,
                 };
                 return Ok(());
@@ -470,6 +471,12 @@ pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<StickSlipOrbit,
     let Some(fr) = r.friction.first() else { return fail("the result has no friction output") };
     let flows = Flows::new(model)?;
     let (k, h, period) = (fr.stuck.len(), r.period / fr.stuck.len() as f64, r.period);
+    if flows.slip == 0.0 {
+        // No slip force: the free structure's linear orbit (the law holds at either velocity sign).
+        let mut orbit = StickSlipOrbit::new(flows.clone(), period, 0.0, Slide::Slip(1.0), vec![], vec![]);
+        orbit.converge()?;
+        return Ok(orbit);
+    }
     let all = runs(&fr.stuck, &fr.force);
     // The slider's constant of an orbit stuck all period: the LCP's mean of bᵀx (rigid) or of
     // the slider bᵀx − f/k_t (Jenkins).
