@@ -53,6 +53,11 @@ def golden(f, a, b, tol, sign):
 
 
 def exact_amplitude(n, omega):
+    if n == 0.0:
+        # No slip force: the free linear oscillator |P / (k − mω² + icω)| (the simulation
+        # chatters on a zero slip force).
+        d = friction_peer.DAMPER
+        return abs(d["F"][0] / (d["K"][0][0] - d["M"][0][0] * omega ** 2 + 1j * d["C"][0][0] * omega))
     case = dict(friction_peer.DAMPER, slip=MU * n)
     return float(friction_exact.solve(friction_peer.system(case, omega)).amplitude()[0])
 

@@ -49,7 +49,7 @@ pub struct LoadCurve {
 
 /// Golden section for the largest (`sign` = 1) or least (−1) of f on [a, b], to `tol`: the
 /// abscissa and f's value and payload there.
-fn golden<T>(mut f: impl FnMut(f64) -> Result<(f64, T), Error>, mut a: f64, mut b: f64, tol: f64, sign: f64) -> Result<(f64, f64, T), Error> {
+pub(super) fn golden<T>(mut f: impl FnMut(f64) -> Result<(f64, T), Error>, mut a: f64, mut b: f64, tol: f64, sign: f64) -> Result<(f64, f64, T), Error> {
     let g = (5f64.sqrt() - 1.0) / 2.0;
     let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
     let (mut fc, mut fd) = (f(c)?, f(d)?);
