@@ -126,3 +126,106 @@ fn bds1_error_estimate_within_10x_of_the_true_error_on_a_random_family() {
     }
     assert!(rows.len() >= 5, "the references converged");
 }
+
+#[test]
+fn polish_fits_orbits_whose_topology_the_lcp_misses_or_that_never_slip() {
+    // The 2-DOF chain at k = 512 where the LCP's phases are not the exact orbit's: Ω = 0.5949
+    // stops mid-swing twice a period (8 events; bds1's damping hides the short stops), found by
+    // marching the exact flows; Ω = 2.541 never slips (0 events), and the Jenkins damper under a
+    // load that holds it (μN = 1.5 > k_t·X): the stuck system's linear orbit. Against the
+    // event-driven simulation; a stuck orbit's position is unique only up to the slider's
+    // constant, so it is compared up to each DOF's mean.
+    use crate::friction::chain_oscillator;
+    let damper = oscillator(0.1, 0.8, 1.5, Some(2.0));
+    let cases = [(chain_oscillator(0.5948717948717949), 8), (chain_oscillator(2.541025641025641), 0), (damper, 0)];
+    for (o, events) in cases {
+        let n = o.mass.len();
+        let reference = FrictionOrbit::solve(&o, 1000, 1e-13, 20000).expect("reference orbit");
+        let outputs = OutputSelection { displacement: (0..n).collect(), velocity: vec![], acceleration: vec![], contacts: true };
+        let disc = Discretization { scheme: Scheme::Bds1, steps: 512, pairing: None };
+        let problem = PeriodicProblem::new(o.model(), disc, outputs, SolverSettings::default()).expect("problem");
+        let r = problem.solve().expect("solve");
+        let orbit = polish::friction::polish(&problem, &r).unwrap_or_else(|e| panic!("Ω = {}: {e}", o.omega));
+        let times: Vec<f64> = (0..257).map(|i| i as f64 * o.period() / 257.0).collect();
+        let mean = |f: &dyn Fn(f64) -> f64| if events == 0 { times.iter().map(|&t| f(t)).sum::<f64>() / times.len() as f64 } else { 0.0 };
+        let (mut err, mut scale) = (0.0f64, 0.0f64);
+        for d in 0..n {
+            let (ours, exact) = (|t: f64| orbit.state(t)[d], |t: f64| reference.displacement(t)[d]);
+            let (m_ours, m_exact) = (mean(&ours), mean(&exact));
+            scale = scale.max(reference.amplitude(d, 512));
+            err = times.iter().map(|&t| ((ours(t) - m_ours) - (exact(t) - m_exact)).abs()).fold(err, f64::max);
+        }
+        let holding = times.iter().map(|&t| orbit.contact(t).0.abs()).fold(0.0, f64::max);
+        println!(
+            "Ω = {:.4} (μN = {}): {} events (exact {events}), displacement error {:.2e} of the amplitude, stuck fraction {:.6} (exact {:.6}), max |f| {holding:.6} against μN {}",
+            o.omega,
+            o.slip_force,
+            orbit.times.len(),
+            err / scale,
+            orbit.stuck_fraction(),
+            reference.stuck_fraction,
+            o.slip_force
+        );
+        assert_eq!(orbit.times.len(), events);
+        assert!(err < 1e-8 * scale, "error {:.2e}", err / scale);
+        assert!((orbit.stuck_fraction() - reference.stuck_fraction).abs() < 1e-8);
+        assert!(holding <= o.slip_force * (1.0 + 1e-9), "|f| {holding} > μN");
+    }
+}
+
+#[test]
+#[ignore = "opt-in, 32 s at load 15 (about 150 LCP solves and polishes): cargo test --release --test suite friction_polish::peak_over -- --ignored --nocapture"]
+fn peak_over_frequency_at_a_normal_load_meets_closed_forms_and_the_simulation() {
+    // One point of the optimal-normal-load curve (`continue --peak-over`): the peak over
+    // ω ∈ [0.5, 2.5] of the Jenkins damper (m = k = 1, c = 0.1, k_t = 2, μ = 1) on the polished
+    // orbit, at k = 128. Free (N = 0) and stuck (N = 12 > k_t·X) it is the linear oscillator's
+    // resonance peak 1/(c·√(k_eff/m − c²/4m²)), k_eff = k and k + k_t; in between (N = 0.8) the
+    // event-driven simulation at the peak frequency found, and the peak a maximum there.
+    use periodic_contact::analysis::continuation::optimal_load::peak_at;
+    let (c, kt) = (0.1, 2.0);
+    let closed = |k_eff: f64| 1.0 / (c * (k_eff - c * c / 4.0).sqrt());
+    let problem = |slip: f64| {
+        let outputs = OutputSelection { displacement: vec![0], velocity: vec![], acceleration: vec![], contacts: true };
+        let disc = Discretization { scheme: Scheme::Bds1, steps: 128, pairing: None };
+        PeriodicProblem::new(oscillator(c, 1.0, slip, Some(kt)).model(), disc, outputs, SolverSettings::default()).expect("problem")
+    };
+    for (n, k_eff) in [(0.0, 1.0), (12.0, 1.0 + kt)] {
+        let p = peak_at(&problem(n), n, (0.5, 2.5), true).expect("peak");
+        let err = (p.amplitude[0] - closed(k_eff)).abs() / closed(k_eff);
+        println!(
+            "N = {n}: peak {:.12} at ω = {:.9} (closed form {:.12}), error {err:.2e}, polished {}",
+            p.amplitude[0],
+            p.frequency,
+            closed(k_eff),
+            p.polished
+        );
+        assert!(err < 1e-8 && p.polished && !p.at_end, "error {err:.2e}");
+    }
+    let n = 0.8;
+    let p = peak_at(&problem(n), n, (0.5, 2.5), true).expect("peak");
+    // The simulation's half peak-to-peak: 1024 samples, each extreme refined by golden section.
+    let exact = |w: f64| {
+        let o = FrictionOrbit::solve(&oscillator(c, w, n, Some(kt)), 1000, 1e-13, 20000).expect("reference orbit");
+        let (period, x) = (2.0 * std::f64::consts::PI / w, |t: f64| o.displacement(t)[0]);
+        let h = period / 1024.0;
+        let extreme = |sign: f64| {
+            let i = (0..1024).max_by(|&a, &b| (sign * x(a as f64 * h)).total_cmp(&(sign * x(b as f64 * h)))).unwrap_or(0);
+            let (mut lo, mut hi) = ((i as f64 - 1.0) * h, (i as f64 + 1.0) * h);
+            for _ in 0..80 {
+                let (a, b) = (hi - 0.618_033_988_75 * (hi - lo), lo + 0.618_033_988_75 * (hi - lo));
+                if sign * x(a) > sign * x(b) { hi = b } else { lo = a }
+            }
+            x(0.5 * (lo + hi))
+        };
+        0.5 * (extreme(1.0) - extreme(-1.0))
+    };
+    let (here, below, above) = (exact(p.frequency), exact(p.frequency - 1e-3), exact(p.frequency + 1e-3));
+    let err = (p.amplitude[0] - here).abs() / here;
+    println!(
+        "N = {n}: peak {:.12} at ω = {:.9}; the simulation there {here:.12} (error {err:.2e}), at ω ∓ 1e-3 {below:.12}, {above:.12}",
+        p.amplitude[0], p.frequency
+    );
+    assert!(err < 1e-8 && p.polished, "error {err:.2e}");
+    assert!(here > below && here > above, "not a maximum of the simulation's amplitude");
+    assert!(p.amplitude[0] < closed(1.0 + kt) && p.amplitude[0] < closed(1.0), "friction damps below both linear peaks");
+}

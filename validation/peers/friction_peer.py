@@ -14,10 +14,11 @@ peak); up to each DOF's mean where the exact orbit is stuck for the whole period
 then not unique). CPU: the CLI process's user+system time (getrusage of the child: start-up, scene parse,
 solve, JSON write); HB's time.process_time() over its H ladder 1, 3, 7, … (each solve seeded by
 the previous one, as HB is used). `--sweep P` adds the chain over P frequencies in [0.3, 2.6]:
-the plain LCP at k = `--sweep-steps` and the polish, against the exact simulation per point.
+the plain LCP at k = `--sweep-steps` and the polish, against the exact simulation per point;
+`--sweep-seed S` sweeps a chain drawn from seed S instead (masses, springs, dampers, μN).
 
     PC_CLI=target/release/periodic-contact validation/.venv/bin/python validation/peers/friction_peer.py \
-        [--sweep 40] [--out validation/peers/out]
+        [--sweep 40] [--sweep-seed S] [--out validation/peers/out]
 """
 from __future__ import annotations
 
@@ -187,14 +188,29 @@ def report(results, sweep):
     return "\n".join(lines) + "\n"
 
 
-def sweep_chain(points, steps, workdir, omegas=None):
+def random_chain(seed: int) -> tuple[dict, tuple[float, float]]:
+    """A chain drawn from `seed` (the "did not tune on" check): masses and springs in [0.5, 2],
+    dampers in [0.01, 0.08], μN in [0.1, 0.5] on m2, the load 1 on m1; the sweep range runs from
+    0.4·ω1 to 1.4·ω2 (the linear chain's modes with m2 free)."""
+    rng = np.random.default_rng(seed)
+    m1, m2, k1, k2 = rng.uniform(0.5, 2.0, 4)
+    c1, c2 = rng.uniform(0.01, 0.08, 2)
+    slip = float(rng.uniform(0.1, 0.5))
+    M, K = np.diag([m1, m2]), np.array([[k1 + k2, -k2], [-k2, k2]])
+    C = np.array([[c1 + c2, -c2], [-c2, c2]])
+    w = np.sqrt(np.sort(np.linalg.eigvals(np.linalg.solve(M, K)).real))
+    case = dict(M=M.tolist(), C=C.tolist(), K=K.tolist(), F=[1.0, 0.0], dof=1, slip=slip, kt=None)
+    return case, (0.4 * float(w[0]), 1.4 * float(w[1]))
+
+
+def sweep_chain(points, steps, workdir, omegas=None, case=CHAIN, span=(0.3, 2.6)):
     rows = []
-    for omega in np.linspace(0.3, 2.6, points) if omegas is None else omegas:
+    for omega in np.linspace(*span, points) if omegas is None else omegas:
         omega = float(omega)
-        exact, cpu = exact_orbit(CHAIN, omega)
+        exact, cpu = exact_orbit(case, omega)
         scale = float(exact.amplitude().max())
-        lcp = ours(CHAIN, omega, exact, scale, steps, False, workdir)
-        pol = ours(CHAIN, omega, exact, scale, steps, True, workdir)
+        lcp = ours(case, omega, exact, scale, steps, False, workdir)
+        pol = ours(case, omega, exact, scale, steps, True, workdir)
         rows.append({"omega": omega, "amplitude": exact.amplitude().tolist(), "stuck_fraction": exact.stuck_fraction(),
                      "events": len(exact.events()), "exact_cpu_s": cpu, "lcp": lcp, "polish": pol})
         print(f"sweep Ω {omega:.4f}: LCP {lcp['error']:.2e}, polish {pol['error']:.2e} ({pol['status']})", flush=True)
@@ -205,6 +221,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--sweep", type=int, default=0, help="chain sweep points (0: none)")
     ap.add_argument("--sweep-steps", type=int, default=512)
+    ap.add_argument("--sweep-seed", type=int, default=None, help="sweep a random chain drawn from this seed instead")
     ap.add_argument("--cases", default="damper,chain")
     ap.add_argument("--out", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "out"))
     a = ap.parse_args(argv)
@@ -216,8 +233,11 @@ def main(argv=None):
             for omega in omegas:
                 results.append(compare(name, case, omega, work))
                 print(f"{name} Ω {omega}: done", flush=True)
-        sweep = sweep_chain(a.sweep, a.sweep_steps, work) if a.sweep else []
+        case, span = (CHAIN, (0.3, 2.6)) if a.sweep_seed is None else random_chain(a.sweep_seed)
+        sweep = sweep_chain(a.sweep, a.sweep_steps, work, case=case, span=span) if a.sweep else []
     text = report(results, sweep)
+    if a.sweep and a.sweep_seed is not None:
+        text += f"\nrandom chain (seed {a.sweep_seed}): {json.dumps(case)}, Ω ∈ [{span[0]:.4f}, {span[1]:.4f}]\n"
     with open(os.path.join(a.out, "friction_peer.md"), "w") as f:
         f.write(text)
     with open(os.path.join(a.out, "friction_peer.json"), "w") as f:

@@ -73,23 +73,9 @@ pub(super) fn walk(
     let ends = least(&points[0]).min(least(&points[points.len() - 1]));
     if i > 0 && i + 1 < points.len() && least(&points[i]) < ends * (1.0 - 1e-9) {
         // Golden section on [λ_{i−1}, λ_{i+1}] (the sampled minimum's neighbours).
-        let g = (5f64.sqrt() - 1.0) / 2.0;
-        let (mut a, mut b) = (points[i - 1].parameter, points[i + 1].parameter);
-        let mut c = b - g * (b - a);
-        let mut d = a + g * (b - a);
-        let (mut pc, mut pd) = (solve_at(c)?, solve_at(d)?);
-        while (b - a).abs() > OPTIMUM_TOLERANCE * (to - from).abs() {
-            if least(&pc) < least(&pd) {
-                (b, d, pd) = (d, c, pc);
-                c = b - g * (b - a);
-                pc = solve_at(c)?;
-            } else {
-                (a, c, pc) = (c, d, pd);
-                d = a + g * (b - a);
-                pd = solve_at(d)?;
-            }
-        }
-        let mut best = if least(&pc) < least(&pd) { pc } else { pd };
+        let (a, b) = (points[i - 1].parameter, points[i + 1].parameter);
+        let f = |lambda: f64| solve_at(lambda).map(|p| (least(&p), p));
+        let (_, _, mut best) = super::optimal_load::golden(f, a, b, OPTIMUM_TOLERANCE * (to - from).abs(), -1.0)?;
         let dof = problem.outputs().displacement.first().map_or(String::new(), |d| format!(" of DOF {d}"));
         best.detail = format!("least amplitude{dof} (golden section to {OPTIMUM_TOLERANCE:e} of the range)");
         stop = format!("reached; least amplitude{dof} {:.6e} at {name} = {:.6e}", least(&best), best.parameter);

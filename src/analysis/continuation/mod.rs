@@ -19,6 +19,7 @@ mod exact_follow;
 mod floquet;
 mod follow;
 mod friction;
+pub mod optimal_load;
 pub mod output;
 mod parameter;
 mod switch;

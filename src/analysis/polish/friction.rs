@@ -23,6 +23,7 @@
 //! Zero multipliers are contractions, not a failure: the orbit is stable when the spectral
 //! radius of the monodromy is below 1, and they are reported as they are.
 use super::PolishFailure;
+mod settle;
 use crate::model::Model;
 use crate::periodic::PeriodicProblem;
 use crate::response::{EventRecord, Response};
@@ -281,10 +282,9 @@ impl StickSlipOrbit {
         j
     }
 
-    /// Seeds the state by the periodic fixed point of the (affine) one-period map at the seeded
-    /// times, then Newton on state and times.
-    fn converge(&mut self) -> Result<(), PolishFailure> {
-        let fail = |w: String| PolishFailure(format!("stick–slip polish: {w}; the LCP's orbit is kept"));
+    /// The unknowns at the seeded times with the state at the periodic fixed point of the
+    /// (affine) one-period map those times give.
+    fn seed(&self) -> Result<DVector<f64>, PolishFailure> {
         let nr = self.nr;
         let mut u = self.unknowns(&vec![0.0; nr]);
         let c0 = self.shoot(&u).0.rows(0, nr).into_owned();
@@ -295,7 +295,19 @@ impl StickSlipOrbit {
             a.set_column(i, &(self.shoot(&ui).0.rows(0, nr) - &c0));
         }
         // (Φ − I)u + c0 = 0 with a = Φ − I (the residual's linear part).
-        u.rows_mut(0, nr).copy_from(&a.lu().solve(&(-&c0)).ok_or_else(|| fail("the one-period map at the LCP's event times has a multiplier 1".into()))?);
+        let x = a.lu().solve(&(-&c0)).ok_or_else(|| {
+            PolishFailure("stick–slip polish: the one-period map at the LCP's event times has a multiplier 1; the LCP's orbit is kept".into())
+        })?;
+        u.rows_mut(0, nr).copy_from(&x);
+        Ok(u)
+    }
+
+    /// Seeds the state by the periodic fixed point of the (affine) one-period map at the seeded
+    /// times, then Newton on state and times.
+    fn converge(&mut self) -> Result<(), PolishFailure> {
+        let fail = |w: String| PolishFailure(format!("stick–slip polish: {w}; the LCP's orbit is kept"));
+        let nr = self.nr;
+        let mut u = self.seed()?;
         let scale = |u: &DVector<f64>| u.amax().max(f64::MIN_POSITIVE);
         for it in 1..=40 {
             let r0 = self.shoot(&u).0;
@@ -312,11 +324,12 @@ impl StickSlipOrbit {
                 let j = self.jacobian(&u, &r);
                 let m = self.times.len();
                 let jtt = j.view((nr, nr), (m, m)).into_owned();
-                let schur = jtt.lu().solve(&j.view((nr, 0), (m, nr)).into_owned());
+                // No events: the monodromy is the flow's (and a 0 × 0 LU would not solve).
+                let schur = if m > 0 { jtt.lu().solve(&j.view((nr, 0), (m, nr)).into_owned()) } else { None };
                 let phi = j.view((0, 0), (nr, nr)) + DMatrix::identity(nr, nr);
                 self.monodromy = match schur {
                     Some(s) => phi - j.view((0, nr), (nr, m)) * s,
-                    None => phi,
+                    _ => phi,
                 };
                 return Ok(());
             }
@@ -337,14 +350,16 @@ impl StickSlipOrbit {
         for (e, y0) in self.states.iter().enumerate() {
             let phase = if e == 0 { self.first } else { self.slides[e - 1] };
             let len = ends[e + 1] - ends[e];
-            for i in 1..64 {
-                let y = fl.flow(phase, y0, len * i as f64 / 64.0);
+            // Densely over a phase that fills the period (no event pins the orbit down).
+            let samples = if self.times.is_empty() { 4096 } else { 64 };
+            for i in 1..samples {
+                let y = fl.flow(phase, y0, len * i as f64 / samples as f64);
                 match phase {
                     Slide::Slip(s) if s * fl.velocity(&y) < -vtol => {
-                        return fail(format!("slip {s:+} reverses inside its phase at t = {:.6}", ends[e] + len * i as f64 / 64.0));
+                        return fail(format!("slip {s:+} reverses inside its phase at t = {:.6}", ends[e] + len * i as f64 / samples as f64));
                     }
                     Slide::Stick if fl.force(phase, &y).abs() > fl.slip + ftol => {
-                        return fail(format!("a stuck force exceeds μN at t = {:.6}", ends[e] + len * i as f64 / 64.0));
+                        return fail(format!("a stuck force exceeds μN at t = {:.6}", ends[e] + len * i as f64 / samples as f64));
                     }
                     _ => {}
                 }
@@ -456,9 +471,21 @@ pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<StickSlipOrbit,
     let Some(fr) = r.friction.first() else { return fail("the result has no friction output") };
     let flows = Flows::new(model)?;
     let (k, h, period) = (fr.stuck.len(), r.period / fr.stuck.len() as f64, r.period);
+    if flows.slip == 0.0 {
+        // No slip force: the free structure's linear orbit (the law holds at either velocity sign).
+        let mut orbit = StickSlipOrbit::new(flows.clone(), period, 0.0, Slide::Slip(1.0), vec![], vec![]);
+        orbit.converge()?;
+        return Ok(orbit);
+    }
     let all = runs(&fr.stuck, &fr.force);
-    if all.len() < 2 {
-        return fail("no stick or slip event (stuck all period: the orbit is linear and its mean holding force is not unique)");
+    // The slider's constant of an orbit stuck all period: the LCP's mean of bᵀx (rigid) or of
+    // the slider bᵀx − f/k_t (Jenkins).
+    let constant = fr.displacement.iter().zip(&fr.force).map(|(u, f)| u - flows.kt.map_or(0.0, |kt| f / kt)).sum::<f64>() / k as f64;
+    if all.is_empty() {
+        // No event in the LCP: stuck (or slipping one way) all period.
+        let phase = if fr.stuck[0] { Slide::Stick } else { Slide::Slip(fr.force[0].signum()) };
+        let orbit = StickSlipOrbit::new(flows.clone(), period, 0.0, phase, vec![], vec![]);
+        return settle::fit(orbit, constant).or_else(|e| settle::marched(&flows, period, None, constant).ok_or(e)?);
     }
     // Candidate topologies: as read, and (rigid Coulomb) with stick runs of one or two instants
     // taken for reversals, the LCP's trace of a continuous motion through v = 0.
@@ -481,6 +508,7 @@ pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<StickSlipOrbit,
         candidates.push(merged);
     }
     let mut last = PolishFailure(String::new());
+    let mut seeded = None;
     for runs in candidates {
         let nrun = runs.len();
         let len = |i: usize| (runs[(i + 1) % nrun].1 + k - runs[i].1) % k;
@@ -491,13 +519,19 @@ pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<StickSlipOrbit,
         let order: Vec<usize> = (1..=nrun).map(|i| (longest + i) % nrun).collect();
         let times = order.iter().map(|&i| start + (begin(i) - start).rem_euclid(period)).collect();
         let slides = order.iter().map(|&i| runs[i].0).collect();
-        let mut orbit = StickSlipOrbit::new(flows.clone(), period, start, runs[longest].0, slides, times);
-        match orbit.converge().and_then(|()| orbit.verify()) {
-            Ok(()) => return Ok(orbit),
+        let orbit = StickSlipOrbit::new(flows.clone(), period, start, runs[longest].0, slides, times);
+        if seeded.is_none() {
+            seeded = orbit.seed().ok().map(|u| (start, orbit.first, flows.augment(start, u.rows(0, orbit.nr).as_slice())));
+        }
+        match settle::fit(orbit, constant) {
+            Ok(o) => return Ok(o),
             Err(e) => last = e,
         }
     }
-    Err(last)
+    // The LCP's phases fit no exact orbit. Its short slips may be the trace of an orbit stuck
+    // all period (holding force near μN); else march the exact flows from the seeded state.
+    let stuck = StickSlipOrbit::new(flows.clone(), period, 0.0, Slide::Stick, vec![], vec![]);
+    settle::fit(stuck, constant).or_else(|_| settle::marched(&flows, period, seeded, constant).unwrap_or(Err(last)))
 }
 
 /// Replaces `r`'s series by the orbit's at the same instants, and its friction outputs (the

@@ -38,6 +38,15 @@ pub struct Args {
     /// (same CSV with a `branch` column, same events JSON and PNG).
     #[arg(long)]
     pub switch_at_pd: bool,
+    /// With `--param normal_force`: the optimal-normal-load curve instead of a branch, i.e. at
+    /// each load the peak over the frequencies A to B [rad/s] of the first displacement output
+    /// (`frequency:A:B`; a 24-point grid, the largest refined by golden section), and the load
+    /// of the least peak. CSV: load, peak frequency, amplitudes, polished.
+    #[arg(long, value_name = "frequency:A:B")]
+    pub peak_over: Option<String>,
+    /// With `--peak-over`: amplitudes of the stick–slip polish (exact) where it fits, else the LCP's.
+    #[arg(long)]
+    pub polish: bool,
     /// No PNG.
     #[arg(long)]
     pub no_plot: bool,
@@ -81,6 +90,12 @@ pub fn run(a: &Args) -> Result<(), Failure> {
         Some(s) => ContinuationSettings { max_step: s, exact_max_step: s, ..defaults },
         None => defaults,
     };
+    let peak_range = match &a.peak_over {
+        None if a.polish => return Err(Failure::input("--polish: only with --peak-over (the branch's points are the LCP's)".to_string())),
+        None => None,
+        Some(_) if param != Parameter::NormalForce => return Err(Failure::input(format!("--peak-over: only with --param normal_force (is {})", a.param))),
+        Some(s) => Some(peak_range(s)?),
+    };
     let bar = if a.quiet { ProgressBar::hidden() } else { ProgressBar::new(1000) };
     bar.set_style(ProgressStyle::with_template("{spinner} continue [{bar:40}] {msg}, {elapsed_precise} elapsed").unwrap().progress_chars("=> "));
     let (from, to) = (a.from, a.to);
@@ -88,6 +103,41 @@ pub fn run(a: &Args) -> Result<(), Failure> {
         bar.set_position((((v - from) / (to - from)).clamp(0.0, 1.0) * 1000.0) as u64);
         bar.set_message(format!("{} = {v:.6}", a.param));
     };
+    if let Some(range) = peak_range {
+        let curve =
+            continuation::optimal_load::optimal_load(problem, from, to, range, a.polish || built.polish, &settings, &on_point).map_err(Failure::from)?;
+        bar.finish_and_clear();
+        write_output(&a.output, &continuation::optimal_load::to_csv(&curve, problem, &built.labels))?;
+        let o = &curve.optimum;
+        let unit = |q| built.labels.unit(q);
+        use periodic_contact::model::Quantity;
+        eprintln!(
+            "continue: {} loads, {} solves in {:.3} s → {}; least peak {:.9e} {} at normal_force = {:.9e} {} (ω = {:.9e} {}, {}{})",
+            curve.points.len(),
+            curve.solves,
+            t_all.elapsed().as_secs_f64(),
+            a.output.display(),
+            o.amplitude[0],
+            unit(Quantity::Length),
+            o.normal_force,
+            unit(Quantity::Force),
+            o.frequency,
+            unit(Quantity::Frequency),
+            if curve.optimum_interior { "golden section" } else { "at an end of the load range" },
+            if o.polished { ", polished" } else { ", LCP amplitudes" }
+        );
+        if curve.points.iter().any(|p| p.at_end) {
+            eprintln!("warning: some peaks lie at an end of the frequency range (the CSV's at_range_end): widen --peak-over");
+        }
+        #[cfg(feature = "plots")]
+        if !a.no_plot {
+            let png = sibling(&a.output, "", "png");
+            let stem = a.scene.file_stem().map_or(String::new(), |s| s.to_string_lossy().to_string());
+            continuation::optimal_load::plot(&png, &curve, problem, &built.labels, &format!("{stem}: optimal normal load")).map_err(Failure::from)?;
+            eprintln!("optimal-normal-load curve → {}", png.display());
+        }
+        return Ok(());
+    }
     let (branches, failures) = if a.switch_at_pd {
         continuation::run_switching(problem, param, a.from, a.to, &settings, &on_point).map_err(Failure::from)?
     } else {
@@ -130,4 +180,16 @@ pub fn run(a: &Args) -> Result<(), Failure> {
         return Err(Failure::solver(format!("the continuation stopped before {} = {}: {}", a.param, a.to, branch.stop)));
     }
     Ok(())
+}
+
+/// `frequency:A:B` → (A, B).
+fn peak_range(s: &str) -> Result<(f64, f64), Failure> {
+    let bad = || Failure::input(format!("--peak-over: is \"{s}\", must be frequency:A:B with 0 < A < B (rad/s), e.g. frequency:0.5:2.5"));
+    let parts: Vec<&str> = s.split(':').collect();
+    let [what, a, b] = parts.as_slice() else { return Err(bad()) };
+    let (a, b): (f64, f64) = (a.parse().map_err(|_| bad())?, b.parse().map_err(|_| bad())?);
+    if *what != "frequency" || !(a > 0.0 && b > a && b.is_finite()) {
+        return Err(bad());
+    }
+    Ok((a, b))
 }
