@@ -115,7 +115,7 @@ fn den_hartog_oscillator_converges_at_first_order() {
 /// Hartog's oscillator the half-step pairing of cds is as large as O(h) but erratic in k (its
 /// error follows where the reversal falls in its step), while bds1's is a steady first-order term.
 /// Opt-in: `PERIODIC_CONTACT_FRICTION_HALF_STEPS=1 cargo test --release --test suite
-/// friction::half_step -- --ignored --nocapture` (about 15 s of Lemke on the half-step LCPs).
+/// friction::half_step -- --ignored --nocapture` (17 s at load 15).
 #[test]
 #[ignore]
 fn half_step_pairing_errors_are_erratic_in_k_and_bds1_errors_are_first_order() {
