@@ -37,8 +37,12 @@ pub struct ContactResponse {
 pub struct FrictionResponse {
     /// μ.
     pub coefficient: f64,
-    /// N (constant).
+    /// N (constant; 0 for a coupled contact, see `contact`).
     pub normal_force: f64,
+    /// Coupled normal–tangential friction: the index of the contact whose force λ_n (its
+    /// `contacts[i].force`) bounds |f| ≤ μ·λ_n at each instant; absent under a constant load.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact: Option<usize>,
     /// k_t of a Jenkins element; null for rigid Coulomb friction.
     pub stiffness: Option<f64>,
     /// Friction force f ∈ [−μN, μN] at each instant.

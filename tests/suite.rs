@@ -42,6 +42,8 @@ mod fmu_description;
 mod fmu_host;
 #[path = "friction.rs"]
 mod friction;
+#[path = "friction_coupled.rs"]
+mod friction_coupled;
 #[path = "friction_frontends.rs"]
 mod friction_frontends;
 #[path = "friction_polish.rs"]

@@ -60,18 +60,21 @@ pub fn plot_hysteresis(path: &std::path::Path, frictions: &[FrictionResponse], n
             None => "rigid Coulomb".to_string(),
         };
         let mu_n = f.coefficient * f.normal_force;
-        titles.push(format!("friction[{i}] on {dof} ({element}, μN = {mu_n}): {} {force}·{len} dissipated per cycle", energy_text(f.dissipated_energy)));
+        // A coupled contact's bound μλ_n varies over the period: no constant ±μN lines.
+        let bound = f.contact.map_or(format!("μN = {mu_n}"), |c| format!("slip force μ·λ_n of contact[{c}], μ = {}", f.coefficient));
+        titles.push(format!("friction[{i}] on {dof} ({element}, {bound}): {} {force}·{len} dissipated per cycle", energy_text(f.dissipated_energy)));
         axes.push((format!("relative displacement u of {dof} [{len}]"), format!("friction force f [{force}] (on the structure: −f)")));
         let points = friction_loop(f);
         let (lo, hi) = points.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| (l.min(p.0), h.max(p.0)));
+        let limit = |v: f64| if f.contact.is_some() { Vec::new() } else { vec![(lo, v), (hi, v)] };
         let stuck: Vec<(f64, f64)> = f.stuck.iter().zip(&points).filter(|(s, _)| **s).map(|(_, p)| *p).collect();
         let stuck_label = if stuck.is_empty() { String::new() } else { format!("stuck ({} of {} instants)", stuck.len(), f.stuck.len()) };
         curves.push((
             vec![
                 Series { label: "f against u over one period".into(), points, markers: false },
                 Series { label: stuck_label, points: stuck, markers: true },
-                Series { label: "slip force ±μN".into(), points: vec![(lo, mu_n), (hi, mu_n)], markers: false },
-                Series { label: String::new(), points: vec![(lo, -mu_n), (hi, -mu_n)], markers: false },
+                Series { label: if f.contact.is_some() { String::new() } else { "slip force ±μN".into() }, points: limit(mu_n), markers: false },
+                Series { label: String::new(), points: limit(-mu_n), markers: false },
             ],
             vec![
                 Look { colour: 0, line: Line::Solid, marker: None, hollow: false },

@@ -262,9 +262,15 @@ fn friction_outputs(b: &mut Variables, problem: &PeriodicProblem, labels: &Label
         };
         let slip = format!("{} {force}", f.slip_force());
         let kind = b.real(None, Quantity::Force, labels);
-        let what = format!(
-            "Friction force of friction contact {i} on {on}, {element}: acts on the structure as minus the force along the sliding direction; |force| <= mu*N ({slip} times normal_force_scale), = mu*N*sign(slip_velocity) while slipping"
-        );
+        let bound = match f.contact {
+            Some(c) => format!(
+                "|force| <= mu*lambda_n (mu = {}, lambda_n the force of contact {c}), = mu*lambda_n*sign(slip_velocity) while slipping, 0 while the contact is open",
+                f.coefficient
+            ),
+            None => format!("|force| <= mu*N ({slip} times normal_force_scale), = mu*N*sign(slip_velocity) while slipping"),
+        };
+        let what =
+            format!("Friction force of friction contact {i} on {on}, {element}: acts on the structure as minus the force along the sliding direction; {bound}");
         b.output(Variable::output(&format!("friction[{i}].force"), Continuous, kind, &what), Output::FrictionForce(i));
         let kind = b.real(None, Quantity::Velocity, labels);
         let what =

@@ -10,7 +10,8 @@
 //!   slider's velocity v − ḟ/k_t takes the place of v.
 use super::ModelError;
 
-/// A Coulomb friction contact under a constant normal load.
+/// A Coulomb friction contact under a constant normal load, or pressed by the normal force of a
+/// unilateral contact (coupled normal–tangential friction, src/formulation.md §9).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Friction {
     /// The sliding direction as a row of B: (model DOF, coefficient) terms.
@@ -21,22 +22,47 @@ pub struct Friction {
     pub normal_force: f64,
     /// Tangential stiffness k_t > 0 of a Jenkins element; `None`: rigid Coulomb.
     pub stiffness: Option<f64>,
+    /// Coupled: the index of the contact whose normal force λ_n presses the faces together (slip
+    /// force μ·λ_n at each instant; `normal_force` is then 0); `None`: the constant load N.
+    pub contact: Option<usize>,
 }
 
 impl Friction {
     /// A friction contact sliding along one DOF.
     pub fn on_dof(dof: usize, coefficient: f64, normal_force: f64, stiffness: Option<f64>) -> Self {
-        Friction { row: vec![(dof, 1.0)], coefficient, normal_force, stiffness }
+        Friction { row: vec![(dof, 1.0)], coefficient, normal_force, stiffness, contact: None }
     }
 
-    /// The slip force μN: the largest friction force the contact transmits.
+    /// A rigid Coulomb contact sliding along one DOF, pressed by the normal force of contact
+    /// `contact` (coupled normal–tangential friction).
+    pub fn coupled(dof: usize, coefficient: f64, contact: usize) -> Self {
+        Friction { row: vec![(dof, 1.0)], coefficient, normal_force: 0.0, stiffness: None, contact: Some(contact) }
+    }
+
+    /// The slip force μN of the constant normal load: the largest friction force the contact
+    /// transmits (0 for a coupled contact, whose bound μ·λ_n varies with its contact's force).
     pub fn slip_force(&self) -> f64 {
-        self.coefficient * self.normal_force
+        if self.contact.is_some() { 0.0 } else { self.coefficient * self.normal_force }
     }
 
-    /// Checks friction `i` of a model with `n` DOFs; fields are named as in the scene.
-    pub(super) fn check(&self, i: usize, n: usize) -> Result<(), ModelError> {
+    /// Checks friction `i` of a model with `n` DOFs and `contacts` contacts; fields are named as in
+    /// the scene.
+    pub(super) fn check(&self, i: usize, n: usize, contacts: usize) -> Result<(), ModelError> {
         let field = |f: &str| format!("friction[{i}].{f}");
+        if let Some(c) = self.contact {
+            if c >= contacts {
+                return Err(ModelError::new(
+                    field("contact"),
+                    format!("is {c}, the model has {contacts} contact(s): give the index of the [[contact]] whose normal force presses this friction contact"),
+                ));
+            }
+            if self.stiffness.is_some() || self.normal_force != 0.0 {
+                return Err(ModelError::new(
+                    field("contact"),
+                    "a coupled friction contact takes its normal force from the contact and is rigid Coulomb in this version: leave out normal_force and stiffness",
+                ));
+            }
+        }
         if self.row.is_empty() {
             return Err(ModelError::new(field("dof"), "is missing: a friction contact needs a sliding direction"));
         }

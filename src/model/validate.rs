@@ -246,7 +246,7 @@ impl Model {
             }
         }
         for (i, f) in self.frictions.iter().enumerate() {
-            f.check(i, n)?;
+            f.check(i, n, self.contacts.len())?;
         }
         for (i, r) in self.rubbing.iter().enumerate() {
             r.check(i, n, self.contacts.len())?;

@@ -152,6 +152,7 @@ pub fn friction_lcp(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, 
     let lay = Layout { k, mc: model.contacts.len(), mf: model.frictions.len() };
     let nn = k * (lay.mc + 2 * lay.mf);
     let slip: Vec<f64> = model.frictions.iter().map(|f| f.slip_force()).collect();
+    let coupled = super::friction_coupled::couplings(model);
     let mut data = vec![0.0; nn * nn];
     let mut q = vec![0.0; nn];
     let period = problem.period();
@@ -194,6 +195,10 @@ pub fn friction_lcp(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, 
                     // f = z₁ − μN: the constant part moves to q.
                     if b >= lay.mc {
                         q[r] -= v * slip[b - lay.mc];
+                        // Coupled: f = z₁ − μλ_n, so λ_n's column gains −μ times f's.
+                        if let Some((c, mu)) = coupled[b - lay.mc] {
+                            data[r * nn + lay.row(c, l)] -= mu * v;
+                        }
                     }
                 }
             }
@@ -208,6 +213,10 @@ pub fn friction_lcp(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, 
             data[r * nn + sl] = 1.0;
             data[sl * nn + r] = -1.0;
             q[sl] = 2.0 * mu_n;
+            // Coupled: the box is [−μλ_n, μλ_n], so w₂ = 2μλ_n − z₁.
+            if let Some((c, mu)) = coupled[t] {
+                data[sl * nn + lay.row(c, j)] = 2.0 * mu;
+            }
         }
     }
     (DenseMatrix::from_row_major(nn, data), q)
@@ -222,15 +231,16 @@ pub(super) fn solve(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, 
     debug_assert_eq!(m, lay.mc + lay.mf, "assembled with the friction rows");
     let nn = k * (lay.mc + 2 * lay.mf);
     let grid = FrictionGrid::new(problem.discretization().scheme, k, problem.period())?;
+    let coupled = super::friction_coupled::couplings(model);
     let method = problem.solver_settings().method;
     // Shooting where the dense LCP is refused (or asked for); the dense path keeps small N.
     let shoot = method == LcpMethod::Shooting || (method == LcpMethod::Auto && nn > FRICTION_DENSE_MAX);
     if grid.half_steps() {
         // The step map is bds1's; a Jenkins slider's velocity at a half step would be the central
         // difference (f_{j+1} − f_{j−1})/2h of the spring force, blind to f_j itself.
-        if shoot || model.frictions.iter().any(|f| f.stiffness.is_some()) {
+        if shoot || model.frictions.iter().any(|f| f.stiffness.is_some() || f.contact.is_some()) {
             return Err(SolveError::Invalid(format!(
-                "{HALF_STEPS_ENV}: the half-step friction pairing takes the dense LCP and rigid Coulomb contacts only; unset it, or use solver.method = \"lemke\" without friction.stiffness"
+                "{HALF_STEPS_ENV}: the half-step friction pairing takes the dense LCP and rigid Coulomb contacts under a constant normal load only; unset it, or use solver.method = \"lemke\" without friction.stiffness and friction.contact"
             )));
         }
     }
@@ -290,7 +300,7 @@ pub(super) fn solve(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, 
         let lcp_time = t_lcp.elapsed().as_secs_f64();
         sol.info.path = vec![LcpStep { method: LcpMethod::Lemke, size: nn, pivots: sol.info.pivots, outcome: sol.outcome, time_s: lcp_time }];
         if sol.outcome != LcpOutcome::Solved {
-            return Err(lcp_failure(sol));
+            return Err(if coupled.iter().any(Option::is_some) { super::friction_coupled::no_solution(problem, asm, sol) } else { lcp_failure(sol) });
         }
         let path = format!(
             "friction (N = {nn}: contacts and the box LCP of the friction rows, src/formulation.md §9): dense lexicographic Lemke, {} pivots, {lcp_time:.3} s → {}",
@@ -304,7 +314,9 @@ pub(super) fn solve(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, 
     let mut z = vec![0.0; k * m];
     let mut forces = vec![Vec::new(); lay.mf];
     for (t, f) in forces.iter_mut().enumerate() {
-        *f = (0..k).map(|j| sol.z[lay.row(lay.mc + t, j)] - slip[t]).collect();
+        // Coupled: f = z₁ − μλ_n at each instant.
+        let pressed = |j: usize| coupled[t].map_or(0.0, |(c, mu)| mu * sol.z[lay.row(c, j)]);
+        *f = (0..k).map(|j| sol.z[lay.row(lay.mc + t, j)] - slip[t] - pressed(j)).collect();
     }
     // What the structure feels at the instants (the half-step samples' mean under cds, galerkin).
     let felt: Vec<Vec<f64>> = forces.iter().map(|f| grid.felt(f)).collect();
@@ -388,7 +400,8 @@ fn friction_response(
     let f = &problem.model().frictions[t];
     let (k, m, nh) = (asm.k, asm.m, asm.k / 2 + 1);
     let a = lay.mc + t;
-    let mu_n = f.slip_force();
+    // The slip force at each instant: μN, or μλ_n of a coupled contact.
+    let bound: Vec<f64> = (0..k).map(|j| f.contact.map_or(f.slip_force(), |c| f.coefficient * sol.z[lay.row(c, j)])).collect();
     // The relay's velocity v = α − w₁ (src/formulation.md §9).
     let samples_velocity: Vec<f64> = (0..k).map(|j| sol.z[lay.slack(t, j)] - sol.w[lay.row(a, j)]).collect();
     // u = b xlin − Σ_b G_ab f_b, by the harmonics (z holds the forces felt at the instants).
@@ -396,7 +409,7 @@ fn friction_response(
     let u_hat: Vec<C> = (0..nh).map(|p| asm.bxlin_hat[p * m + a] - (0..m).map(|b| asm.g_hat[(p * m + a) * m + b] * z_hat[b][p]).sum::<C>()).collect();
     let displacement = fft.inverse(&u_hat);
     // Stuck: strictly inside the box (a slipping force sits on its bound to round-off).
-    let sample_stuck: Vec<bool> = samples.iter().map(|v| v.abs() < mu_n * (1.0 - 1e-9)).collect();
+    let sample_stuck: Vec<bool> = samples.iter().zip(&bound).map(|(v, b)| v.abs() < b * (1.0 - 1e-9)).collect();
     let (force, slip_velocity, stuck) = if grid.half_steps() {
         let before = |j: usize| (j + k - 1) % k;
         (
@@ -417,6 +430,7 @@ fn friction_response(
     Ok(FrictionResponse {
         coefficient: f.coefficient,
         normal_force: f.normal_force,
+        contact: f.contact,
         stiffness: f.stiffness,
         force,
         slip_velocity,

@@ -3,6 +3,7 @@
 mod assembly;
 mod cache;
 mod friction;
+mod friction_coupled;
 mod friction_shooting;
 pub mod limits;
 use crate::linalg::fft; // the crate's one FFT plan type, shared with lcp

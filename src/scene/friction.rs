@@ -1,4 +1,5 @@
-//! `[[friction]]`: Coulomb friction contacts under a constant normal load (src/formulation.md §9).
+//! `[[friction]]`: Coulomb friction contacts under a constant normal load or a contact's normal
+//! force (src/formulation.md §9).
 //!
 //! ```toml
 //! [[friction]]
@@ -10,9 +11,10 @@
 //! Rubbing in gross slip: `contact = i` with `sliding_velocity = V` (the counter-face of
 //! `[[contact]]` i slides at V along `dof`, or along `direction = [tx, ty, tz]` or
 //! `"tangential"` (the direction of rotation) at `node` or `dofs`, faster than the structure):
-//! the friction force is μ·λ_n along V, no normal_force; with [reduction] too. `contact` without
-//! `sliding_velocity` (coupled stick/slip), and `node` and `direction` under a normal load, are
-//! part of the interface but not yet solved: refused by name.
+//! the friction force is μ·λ_n along V, no normal_force; with [reduction] too. `contact = i`
+//! without `sliding_velocity`: coupled normal–tangential stick/slip, the slip force μ·λ_n of
+//! `[[contact]]` i at each instant (rigid Coulomb along `dof`, no normal_force). `node` and
+//! `direction` under a normal load are part of the interface but not yet solved: refused by name.
 use super::contacts::Resolver;
 use super::rotor::Rotor;
 use super::{BuildError, DofSpec, NodeSpec, NormalSpec, Scene};
@@ -38,18 +40,15 @@ pub struct FrictionSpec {
     pub normal_force: Option<f64>,
     /// Tangential stiffness k_t > 0 of a Jenkins element.
     pub stiffness: Option<f64>,
-    /// The normal force of `[[contact]]` i: with `sliding_velocity`, rubbing in gross slip.
+    /// The normal force of `[[contact]]` i: with `sliding_velocity`, rubbing in gross slip;
+    /// without, coupled normal–tangential stick/slip.
     pub contact: Option<usize>,
     /// The counter-face's sliding speed V along `dof` (rubbing in gross slip).
     pub sliding_velocity: Option<f64>,
 }
 
 /// Keys of the interface that this version refuses, with what they would do.
-const NOT_YET: [(&str, &str); 3] = [
-    ("contact", "coupled stick/slip normal–tangential friction (contact without sliding_velocity; give sliding_velocity = V for rubbing in gross slip)"),
-    ("node", "a friction contact on a named node"),
-    ("direction", "a sliding direction over several DOFs"),
-];
+const NOT_YET: [(&str, &str); 2] = [("node", "a friction contact on a named node"), ("direction", "a sliding direction over several DOFs")];
 
 impl Scene {
     /// The `[[friction]]` entries in the full (clamped) numbering: Coulomb contacts under a
@@ -95,7 +94,7 @@ impl FrictionSpec {
                 "needs contact = index: rubbing presses with the normal force of that [[contact]] (a constant normal_force with a sliding counter-face is not yet supported)",
             ));
         }
-        let given = [self.contact.is_some(), self.node.is_some() || self.dofs.is_some() || self.position.is_some(), self.direction.is_some()];
+        let given = [self.node.is_some() || self.dofs.is_some() || self.position.is_some(), self.direction.is_some()];
         if let Some(((key, what), _)) = NOT_YET.iter().zip(given).find(|(_, g)| *g) {
             return Err(BuildError::field(
                 format!("friction[{i}].{key}"),
@@ -108,6 +107,18 @@ impl FrictionSpec {
             return Err(BuildError::field(format!("friction[{i}]"), "needs dof = index (the sliding DOF)"));
         };
         let (_, full) = resolver.output_pair(&format!("friction[{i}].dof"), &DofSpec::Index(dof))?;
+        if let Some(contact) = self.contact {
+            let refused = [("normal_force", self.normal_force.is_some()), ("stiffness", self.stiffness.is_some())];
+            if let Some((key, _)) = refused.iter().find(|(_, g)| *g) {
+                return Err(BuildError::field(
+                    format!("friction[{i}].{key}"),
+                    format!(
+                        "is not taken by coupled friction (contact = {contact} without sliding_velocity) in this version: the normal force is the contact's, the friction rigid Coulomb"
+                    ),
+                ));
+            }
+            return Ok(Built::Load(Friction::coupled(full, self.coefficient, contact)));
+        }
         let Some(normal_force) = self.normal_force else {
             return Err(BuildError::field(format!("friction[{i}]"), "needs normal_force = N (a constant normal load ≥ 0)"));
         };
