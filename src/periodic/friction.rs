@@ -70,16 +70,26 @@ pub fn check_size(k: usize, mc: usize, mf: usize) -> Result<usize, SolveError> {
     Ok(n)
 }
 
-/// How the friction samples meet the scheme (src/formulation.md §9): f_j and the backward slip
-/// velocity (u_j − u_{j−1})/h at t_j, bds1's own derivative (implicit Euler, Moreau's
-/// time-stepping in the period): first order, and D = σ1 has Re ≥ 0, so A is positive
-/// semi-definite. Measured (tests/friction.rs): it converges at order 1 to Den Hartog's and the
-/// event-driven orbits. The half-step pairing of cds and galerkin (f, v at t_{j+1/2}, the structure
-/// feeling their mean) converged at order 2 but to an orbit 2e-3 off Den Hartog's, and an
-/// undamped cds LCP exhausted Lemke's budget: they are refused until that is understood.
+/// Set (to anything) to let cds and galerkin solve friction with the half-step pairing, for the
+/// measurements of src/formulation.md §9 "Why not a second-order pairing" only: it is refused
+/// otherwise, being no more accurate than bds1 in a way the error estimate can follow.
+pub const HALF_STEPS_ENV: &str = "PERIODIC_CONTACT_FRICTION_HALF_STEPS";
+
+/// How the friction samples meet the scheme (src/formulation.md §9).
+/// - bds1: f_j and the backward slip velocity (u_j − u_{j−1})/h at t_j, bds1's own derivative
+///   (implicit Euler, Moreau's time-stepping in the period); D = σ1 has Re ≥ 0. Measured
+///   (tests/friction.rs): a steady first-order lag dominates its error, so Richardson works.
+/// - cds and galerkin, half steps (only with [`HALF_STEPS_ENV`]): f_j acts on (t_j, t_{j+1}) and
+///   pairs with the slip velocity (u_{j+1} − u_j)/h there; the structure at t_j feels the mean
+///   (f_{j−1} + f_j)/2 (galerkin: linear hats for u, a piecewise-constant force). D·E = σ1 of
+///   cds, so A's form is Re(σ1 G) ≥ 0, identically 0 when undamped. Refused: the Coulomb force
+///   jumps at a reversal or a stop, a sample can switch only at a step, and the O(h) impulse
+///   error μN·h·(2ξ − 1) follows the event's place ξ in its step, erratically in k.
 pub struct FrictionGrid {
     /// Symbol of the slip velocity from the displacement at the instants, per harmonic.
     pub velocity: Vec<C>,
+    /// Symbol of the force the structure feels at the instants from the friction samples.
+    pub spread: Vec<C>,
 }
 
 impl FrictionGrid {
@@ -87,13 +97,34 @@ impl FrictionGrid {
         let h = period / k as f64;
         let nh = k / 2 + 1;
         let theta = |p: usize| 2.0 * std::f64::consts::PI * p as f64 / k as f64;
+        // 1 − cos θ = 2 sin²(θ/2): no cancellation in the low harmonics.
+        let versine = |p: usize| 2.0 * (theta(p) / 2.0).sin().powi(2);
         match scheme {
-            // (1 − z)/h with 1 − cos θ = 2 sin²(θ/2): no cancellation in the low harmonics.
-            Scheme::Bds1 => Ok(FrictionGrid { velocity: (0..nh).map(|p| C::new(2.0 * (theta(p) / 2.0).sin().powi(2), theta(p).sin()) / h).collect() }),
+            // (1 − z)/h, z = e^{−iθ} the one-step delay.
+            Scheme::Bds1 => Ok(FrictionGrid { velocity: (0..nh).map(|p| C::new(versine(p), theta(p).sin()) / h).collect(), spread: vec![C::ONE; nh] }),
+            // (z⁻¹ − 1)/h and (1 + z)/2.
+            Scheme::Cds | Scheme::Galerkin if std::env::var_os(HALF_STEPS_ENV).is_some() => Ok(FrictionGrid {
+                velocity: (0..nh).map(|p| C::new(-versine(p), theta(p).sin()) / h).collect(),
+                spread: (0..nh).map(|p| C::new(2.0 - versine(p), -theta(p).sin()) / 2.0).collect(),
+            }),
             other => Err(SolveError::Invalid(format!(
-                "discretization.scheme: is \"{other}\", but friction contacts are solved with bds1 only in this version (first order; src/formulation.md §9); set scheme = \"bds1\""
+                "discretization.scheme: is \"{other}\", but friction contacts are solved with bds1 only (first order, with an error the estimate follows): a second-order pairing's error follows where each reversal or stop falls between two instants, erratically in k (src/formulation.md §9); set scheme = \"bds1\""
             ))),
         }
+    }
+
+    /// Whether the friction samples sit at the half steps t_{j+1/2} (cds, galerkin).
+    pub fn half_steps(&self) -> bool {
+        self.spread.iter().any(|e| *e != C::ONE)
+    }
+
+    /// The force the structure feels at the instants from the friction samples `f`.
+    pub fn felt(&self, f: &[f64]) -> Vec<f64> {
+        if !self.half_steps() {
+            return f.to_vec();
+        }
+        let k = f.len();
+        (0..k).map(|j| 0.5 * (f[(j + k - 1) % k] + f[j])).collect()
     }
 }
 
@@ -143,8 +174,9 @@ pub fn friction_lcp(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, 
         // Columns: the response of row a to each row's force (−G for displacements, −D·G for
         // velocities, so +G and +D·G in w), a Jenkins element's D/k_t on its own row.
         for b in 0..m {
+            let spread = |p: usize| if b >= lay.mc { grid.spread[p] } else { C::ONE };
             for (p, v) in spec.iter_mut().enumerate() {
-                *v = asm.g_hat[(p * m + a) * m + b] * scale(p);
+                *v = asm.g_hat[(p * m + a) * m + b] * scale(p) * spread(p);
             }
             let mut ker = fft.inverse(&spec);
             // Jenkins: the slider's velocity is D(u − f/k_t).
@@ -203,6 +235,15 @@ pub(super) fn solve(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, 
     let method = problem.solver_settings().method;
     // Shooting where the dense LCP is refused (or asked for); the dense path keeps small N.
     let shoot = method == LcpMethod::Shooting || (method == LcpMethod::Auto && nn > FRICTION_DENSE_MAX);
+    if grid.half_steps() {
+        // The step map is bds1's; a Jenkins slider's velocity at a half step would be the central
+        // difference (f_{j+1} − f_{j−1})/2h of the spring force, blind to f_j itself.
+        if shoot || model.frictions.iter().any(|f| f.stiffness.is_some() || f.contact.is_some()) {
+            return Err(SolveError::Invalid(format!(
+                "{HALF_STEPS_ENV}: the half-step friction pairing takes the dense LCP and rigid Coulomb contacts under a constant normal load only; unset it, or use solver.method = \"lemke\" without friction.stiffness and friction.contact"
+            )));
+        }
+    }
     let (sol, t_assembly, lcp_time, path) = if shoot {
         let t_assembly = t_start.elapsed().as_secs_f64();
         let t_lcp = Instant::now();
@@ -277,18 +318,20 @@ pub(super) fn solve(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, 
         let pressed = |j: usize| coupled[t].map_or(0.0, |(c, mu)| mu * sol.z[lay.row(c, j)]);
         *f = (0..k).map(|j| sol.z[lay.row(lay.mc + t, j)] - slip[t] - pressed(j)).collect();
     }
+    // What the structure feels at the instants (the half-step samples' mean under cds, galerkin).
+    let felt: Vec<Vec<f64>> = forces.iter().map(|f| grid.felt(f)).collect();
     for j in 0..k {
         for a in 0..lay.mc {
             z[j * m + a] = sol.z[lay.row(a, j)];
         }
-        for (t, f) in forces.iter().enumerate() {
+        for (t, f) in felt.iter().enumerate() {
             z[j * m + lay.mc + t] = f[j];
         }
     }
     let rows = LcpSolution { outcome: sol.outcome, z, w: Vec::new(), info: sol.info.clone() };
     let t_rec = Instant::now();
     let mut response = recovery::recover(problem, asm, fft, &rows)?;
-    response.friction = (0..lay.mf).map(|t| friction_response(problem, asm, fft, (&rows.z, &forces[t]), &sol, &lay, t)).collect::<Result<_, _>>()?;
+    response.friction = (0..lay.mf).map(|t| friction_response(problem, (asm, fft, &grid), (&rows.z, &forces[t]), &sol, &lay, t)).collect::<Result<_, _>>()?;
     response.lcp.size = nn;
     response.lcp.path = path;
     // Warm starts are not used by this path: no active set to carry.
@@ -343,12 +386,13 @@ fn shooting_refused(dense: SolveError, why: &NoStepMap) -> SolveError {
     }
 }
 
-/// Force, slip velocity, stuck flags, tangential displacement and dissipated energy of friction `t`.
+/// Force, slip velocity, stuck flags, tangential displacement and dissipated energy of friction
+/// `t`, at the instants: with half-step samples (cds, galerkin) the force the structure feels
+/// there, the mean of the two slip velocities around t_j, and stuck where both samples stick.
 fn friction_response(
     problem: &PeriodicProblem,
-    asm: &Assembly,
-    fft: &PeriodFft,
-    (z, force): (&[f64], &[f64]),
+    (asm, fft, grid): (&Assembly, &PeriodFft, &FrictionGrid),
+    (z, samples): (&[f64], &[f64]),
     sol: &LcpSolution,
     lay: &Layout,
     t: usize,
@@ -358,17 +402,27 @@ fn friction_response(
     let a = lay.mc + t;
     // The slip force at each instant: μN, or μλ_n of a coupled contact.
     let bound: Vec<f64> = (0..k).map(|j| f.contact.map_or(f.slip_force(), |c| f.coefficient * sol.z[lay.row(c, j)])).collect();
-    let force = force.to_vec();
     // The relay's velocity v = α − w₁ (src/formulation.md §9).
-    let slip_velocity: Vec<f64> = (0..k).map(|j| sol.z[lay.slack(t, j)] - sol.w[lay.row(a, j)]).collect();
-    // u = b xlin − Σ_b G_ab f_b, by the harmonics.
+    let samples_velocity: Vec<f64> = (0..k).map(|j| sol.z[lay.slack(t, j)] - sol.w[lay.row(a, j)]).collect();
+    // u = b xlin − Σ_b G_ab f_b, by the harmonics (z holds the forces felt at the instants).
     let z_hat: Vec<Vec<C>> = (0..m).map(|b| fft.forward(&(0..k).map(|j| z[j * m + b]).collect::<Vec<_>>())).collect();
     let u_hat: Vec<C> = (0..nh).map(|p| asm.bxlin_hat[p * m + a] - (0..m).map(|b| asm.g_hat[(p * m + a) * m + b] * z_hat[b][p]).sum::<C>()).collect();
     let displacement = fft.inverse(&u_hat);
     // Stuck: strictly inside the box (a slipping force sits on its bound to round-off).
-    let stuck = force.iter().zip(&bound).map(|(v, b)| v.abs() < b * (1.0 - 1e-9)).collect();
+    let sample_stuck: Vec<bool> = samples.iter().zip(&bound).map(|(v, b)| v.abs() < b * (1.0 - 1e-9)).collect();
+    let (force, slip_velocity, stuck) = if grid.half_steps() {
+        let before = |j: usize| (j + k - 1) % k;
+        (
+            grid.felt(samples),
+            (0..k).map(|j| 0.5 * (samples_velocity[before(j)] + samples_velocity[j])).collect(),
+            (0..k).map(|j| sample_stuck[before(j)] && sample_stuck[j]).collect(),
+        )
+    } else {
+        (samples.to_vec(), samples_velocity.clone(), sample_stuck)
+    };
+    // ∮ f v dt over the samples: exact for the scheme (f and v constant over each step).
     let h = problem.period() / k as f64;
-    let dissipated_energy = h * force.iter().zip(&slip_velocity).map(|(f, v)| f * v).sum::<f64>();
+    let dissipated_energy = h * samples.iter().zip(&samples_velocity).map(|(f, v)| f * v).sum::<f64>();
     let all = force.iter().chain(&slip_velocity).chain(&displacement);
     if !all.clone().all(|v| v.is_finite()) || !dissipated_energy.is_finite() {
         return Err(SolveError::NonFinite(format!("friction {t}")));

@@ -16,7 +16,7 @@ mod tuning;
 
 pub use assembly::Assembly;
 pub use fft::PeriodFft;
-pub use friction::{FRICTION_DENSE_MAX, FrictionGrid, friction_lcp};
+pub use friction::{FRICTION_DENSE_MAX, FrictionGrid, HALF_STEPS_ENV, friction_lcp};
 pub use problem::{MAX_DENSE_FLOPS, MAX_LCP_SIZE, MAX_STEPS, MIN_STEPS, PeriodicProblem};
 pub use recovery::render_path as render_lcp_path;
 pub use rubbing::TangentialRow;
