@@ -88,7 +88,7 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
                 tmp[p] = v;
             }
             let bx = fft.inverse(&tmp);
-            let gap: Vec<f64> = time.iter().zip(&bx).map(|(&t, &b)| ca.gap_at(model.frequency, t) - b).collect();
+            let gap: Vec<f64> = ca.gap_samples(k, problem.period_multiple()).iter().zip(&bx).map(|(&g, &b)| g - b).collect();
             let force: Vec<f64> = (0..k).map(|j| sol.z[j * m + a]).collect();
             let gap = finite(gap, "contact gap", a)?;
             let normal_displacement = finite(bx, "contact normal displacement", a)?;

@@ -195,9 +195,10 @@ pub fn step_map(problem: &PeriodicProblem) -> Result<StepMapLcp, NoStepMap> {
         if let Compliance::Compliant { stiffness } = contact.compliance {
             flexibility[ci * m + ci] += 1.0 / stiffness;
         }
+        let gap = contact.gap_samples(k, problem.period_multiple());
         for j in 0..k {
             let at = (j + offsets[ci]) % k;
-            r[j * m + ci] = contact.gap_at(model.frequency, at as f64 * h) + gap_shift[at * m + ci];
+            r[j * m + ci] = gap[at] + gap_shift[at * m + ci];
         }
     }
     StepMapLcp::new(StepMapData { k, d, m, phi, carry, c, h: hm, gamma, flexibility, r }).map_err(|e| NoStepMap(e.to_string()))
