@@ -387,6 +387,7 @@ impl PeriodicProblem {
         let mut blocks = vec![0.0; k * m * m];
         let mut q = vec![0.0; k * m];
         let mut spec = vec![num_complex::Complex64::ZERO; nh];
+        let angles = crate::model::GridAngles::new(k);
         for (a, ca) in self.model.contacts.iter().enumerate() {
             let s = self.pairing_of(ca).offset();
             for b in 0..m {
@@ -402,7 +403,7 @@ impl PeriodicProblem {
                 *v = asm.bxlin_hat[p * m + a];
             }
             let bx = fft.inverse(&spec);
-            let gap = ca.gap_samples(k, self.period_multiple);
+            let gap = ca.gap_samples(&angles, self.period_multiple);
             for j in 0..k {
                 let jj = (j + s) % k;
                 q[j * m + a] = gap[jj] - bx[jj];
