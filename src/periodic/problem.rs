@@ -388,8 +388,8 @@ impl PeriodicProblem {
         let nh = k / 2 + 1;
         let mut blocks = vec![0.0; k * m * m];
         let mut q = vec![0.0; k * m];
-        let period = self.period();
         let mut spec = vec![num_complex::Complex64::ZERO; nh];
+        let angles = crate::model::GridAngles::new(k);
         for (a, ca) in self.model.contacts.iter().enumerate() {
             let s = self.pairing_of(ca).offset();
             for b in 0..m {
@@ -405,10 +405,10 @@ impl PeriodicProblem {
                 *v = asm.bxlin_hat[p * m + a];
             }
             let bx = fft.inverse(&spec);
+            let gap = ca.gap_samples(&angles, self.period_multiple);
             for j in 0..k {
                 let jj = (j + s) % k;
-                let t = jj as f64 * period / k as f64;
-                q[j * m + a] = ca.gap_at(self.model.frequency, t) - bx[jj];
+                q[j * m + a] = gap[jj] - bx[jj];
             }
             if let crate::model::Compliance::Compliant { stiffness } = ca.compliance {
                 blocks[a * m + a] += 1.0 / stiffness;
