@@ -32,7 +32,12 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 
 import numpy as np  # noqa: E402
 from scipy.linalg import expm  # noqa: E402
-from scipy.optimize import brentq, fsolve  # noqa: E402
+from scipy.optimize import fsolve  # noqa: E402
+
+try:  # the event-driven march is friction_exact's, on this file's flows
+    from .friction_exact import _march  # noqa: E402
+except ImportError:  # run as a script from validation/peers
+    from friction_exact import _march  # noqa: E402
 
 FREE, STICK, SLIP_UP, SLIP_DOWN = 0, 1, 2, 3
 NAMES = ("free", "stick", "slip+", "slip-")
@@ -145,53 +150,6 @@ class Flows:
         if phase == STICK:
             return self.r[0] @ y
         return (1.0 if phase == SLIP_UP else -1.0) * self.s.mu * (self.lam @ y)
-
-
-def _march(fl: Flows, t0: float, y: np.ndarray, phase: int, duration: float, record=False):
-    """Flow from (t0, y, phase) for `duration` on a grid of steps fl.h; returns the end state and
-    phase, and the segments [(start, phase, y)] if `record`."""
-    segs = [(t0, phase, y.copy())] if record else None
-    t = t0
-    steps = int(round(duration / fl.h))
-    events = 0
-    for i in range(steps):
-        end = t0 + (i + 1) * fl.h
-        while True:
-            full = abs((end - t) - fl.h) < 1e-15 * max(1.0, end)
-            y1 = fl.step_maps[phase] @ y if full else fl.flow(phase, y, end - t)
-            if fl.event(phase, y1) > 0:
-                y, t = y1, end
-                break
-            g = lambda tau: fl.event(phase, fl.flow(phase, y, tau))  # noqa: E731
-            tau_end = end - t
-            lo, hi = 0.0, tau_end
-            for j in range(1, 9):
-                tj = tau_end * j / 8
-                if g(tj) <= 0:
-                    hi = tj
-                    break
-                lo = tj
-            if lo > 0 or g(0.0) > 0:
-                tau = brentq(g, lo, hi, xtol=1e-16, rtol=8.9e-16, maxiter=200)
-            else:
-                # The phase starts on its event: bisect for the first point where it ends.
-                a, b = 0.0, hi
-                for _ in range(60):
-                    m = 0.5 * (a + b)
-                    if g(m) > 0:
-                        a = m
-                    else:
-                        b = m
-                tau = b
-            y = fl.flow(phase, y, tau)
-            t += tau
-            phase = fl.next_phase(phase, y)
-            events += 1
-            if record:
-                segs.append((t, phase, y.copy()))
-            if events > 50 * steps:
-                raise RuntimeError("the event-driven simulation chatters")
-    return y, phase, segs
 
 
 @dataclass

@@ -143,9 +143,10 @@ class Flows:
         return self.next_phase(SLIP_UP, y)
 
 
-def _march(fl: Flows, t0: float, y: np.ndarray, phase: int, duration: float, substeps: int, record=False):
+def _march(fl, t0: float, y: np.ndarray, phase: int, duration: float, record=False):
     """Flow from (t0, y, phase) for `duration` on a grid of `duration/fl.h` steps; returns the end
-    state and phase, and the segments [(start, phase, y)] if `record`."""
+    state and phase, and the segments [(start, phase, y)] if `record`. `fl` is any flows object with
+    `h`, `step_maps`, `flow`, `event` and `next_phase` (also coupled_exact.Flows)."""
     segs = [(t0, phase, y.copy())] if record else None
     t = t0
     steps = int(round(duration / fl.h))
@@ -161,7 +162,7 @@ def _march(fl: Flows, t0: float, y: np.ndarray, phase: int, duration: float, sub
             g = lambda tau: fl.event(phase, fl.flow(phase, y, tau))  # noqa: E731
             tau_end = end - t
             # The first sign change on (0, tau_end]: refine on a sub-grid (an event can start at 0).
-            lo = 0.0
+            lo, hi = 0.0, tau_end
             for j in range(1, 9):
                 tj = tau_end * j / 8
                 if g(tj) <= 0:
@@ -258,14 +259,14 @@ def solve(s: FrictionSystem, substeps: int = 400, march_tol: float = 1e-7, max_p
     prev = y.copy()
     periods = 0
     for periods in range(1, max_periods + 1):
-        y, phase, _ = _march(fl, 0.0, y, phase, T, substeps)
+        y, phase, _ = _march(fl, 0.0, y, phase, T)
         y[fl.ic], y[fl.isn] = 1.0, 0.0
         scale = max(np.abs(y[: 2 * n]).max(), 1e-300)
         if np.abs(y[: 2 * n] - prev[: 2 * n]).max() <= march_tol * scale:
             break
         prev = y.copy()
     # One recorded period; the shooting section: the middle of its longest phase.
-    _, _, segs = _march(fl, 0.0, y, phase, T, substeps, record=True)
+    _, _, segs = _march(fl, 0.0, y, phase, T, record=True)
     bounds = [sg[0] for sg in segs] + [T]
     i = int(np.argmax(np.diff(bounds)))
     t0 = 0.5 * (bounds[i] + bounds[i + 1])
@@ -276,7 +277,7 @@ def solve(s: FrictionSystem, substeps: int = 400, march_tol: float = 1e-7, max_p
     def period_map(z):
         yy = y0.copy()
         yy[:k] = z
-        end, p_end, _ = _march(fl, t0, yy, p0, T, substeps)
+        end, p_end, _ = _march(fl, t0, yy, p0, T)
         return end[:k], p_end
 
     def residual(z):
@@ -293,5 +294,5 @@ def solve(s: FrictionSystem, substeps: int = 400, march_tol: float = 1e-7, max_p
         raise RuntimeError(f"shooting did not converge: residual {res:.2e} ({msg})")
     y0 = y0.copy()
     y0[:k] = z
-    _, _, segs = _march(fl, t0, y0, p0, T, substeps, record=True)
+    _, _, segs = _march(fl, t0, y0, p0, T, record=True)
     return FrictionOrbit(fl, segs, t0, periods, res / scale)
