@@ -226,18 +226,26 @@ impl PolishedOrbit {
     /// Peak-to-peak / 2 of user DOF `dof`'s displacement over the period (through the output
     /// map when there is one): its extrema located as [`Self::touches`] locates minima.
     pub fn amplitude(&self, map: Option<&OutputMap>, dof: usize) -> Option<f64> {
+        self.amplitudes(map, &[dof])[0]
+    }
+
+    /// [`Self::amplitude`] of each of `dofs`, from one sampling of the period.
+    pub fn amplitudes(&self, map: Option<&OutputMap>, dofs: &[usize]) -> Vec<Option<f64>> {
         let n = self.model.n();
-        user_value(map, dof, &self.y0, 0, n)?;
         let sampled = self.sampled();
-        let jet = |e: usize, y: &DVector<f64>, t: f64, sign: f64, curvature: bool| {
-            let value = user_value(map, dof, y, 0, n).unwrap_or(0.0);
-            let slope = user_value(map, dof, y, n, n).unwrap_or(0.0);
-            let bend = if curvature { user_value(map, dof, &self.phases[e].acceleration(y, t), 0, n).unwrap_or(0.0) } else { 0.0 };
-            (sign * value, sign * slope, sign * bend)
+        let one = |dof: usize| {
+            user_value(map, dof, &self.y0, 0, n)?;
+            let jet = |e: usize, y: &DVector<f64>, t: f64, sign: f64, curvature: bool| {
+                let value = user_value(map, dof, y, 0, n).unwrap_or(0.0);
+                let slope = user_value(map, dof, y, n, n).unwrap_or(0.0);
+                let bend = if curvature { user_value(map, dof, &self.phases[e].acceleration(y, t), 0, n).unwrap_or(0.0) } else { 0.0 };
+                (sign * value, sign * slope, sign * bend)
+            };
+            let lo = sampled.smallest(self, &|e, y, t| jet(e, y, t, 1.0, false), &|e, y, t| jet(e, y, t, 1.0, true), &|_| false, true)?.0;
+            let hi = -sampled.smallest(self, &|e, y, t| jet(e, y, t, -1.0, false), &|e, y, t| jet(e, y, t, -1.0, true), &|_| false, true)?.0;
+            Some(0.5 * (hi - lo))
         };
-        let lo = sampled.smallest(self, &|e, y, t| jet(e, y, t, 1.0, false), &|e, y, t| jet(e, y, t, 1.0, true), &|_| false, true)?.0;
-        let hi = -sampled.smallest(self, &|e, y, t| jet(e, y, t, -1.0, false), &|e, y, t| jet(e, y, t, -1.0, true), &|_| false, true)?.0;
-        Some(0.5 * (hi - lo))
+        dofs.iter().map(|&d| one(d)).collect()
     }
 }
 
