@@ -156,136 +156,214 @@ impl PolishedOrbit {
         if e + 1 < self.events.len() { self.times[e + 1] } else { self.times[0] + self.period }
     }
 
-    /// The sample times of the period, phase by phase (each phase's start included, its end not):
-    /// (time, phase).
-    fn samples(&self) -> Vec<(f64, usize)> {
+    /// The period sampled phase by phase, each phase's samples equally spaced from its start
+    /// (one exponential e^{Ah} per phase, then a matrix-vector product per sample: the short
+    /// Taylor flows it replaces were most of the coarse blade's exact walk), with each phase's
+    /// state at its end (before the next event), so that every interval between samples lies
+    /// in one phase.
+    fn sampled(&self) -> Sampled {
         let ne = self.events.len();
-        let mut out = Vec::new();
+        let mut out = Sampled { samples: Vec::new(), states: Vec::new(), ends: Vec::new() };
         for e in 0..ne.max(1) {
-            let (a, b) = (self.times[e], if ne == 0 { self.times[0] + self.period } else { self.end_of(e) });
+            let (a, b) = (self.times[e], self.end_of(e));
             let count = (((b - a) * self.phases[e].speed_hint().max(self.model.frequency) * SAMPLES_PER_RADIAN).ceil() as usize).max(MIN_SAMPLES);
-            out.extend((0..count).map(|j| (a + (b - a) * j as f64 / count as f64, e)));
+            let h = (b - a) / count as f64;
+            let step = self.phases[e].exp(h);
+            let mut y = self.after[e].clone();
+            for j in 0..count {
+                let t = a + h * j as f64;
+                let next = if j + 1 == count { self.phases[e].flow(t, &y, b) } else { self.phases[e].flow_with(&step, t, &y, t + h) };
+                out.samples.push((t, e));
+                out.states.push(std::mem::replace(&mut y, next));
+            }
+            out.ends.push(y);
         }
         out
-    }
-
-    /// The states at the samples, each flowed from the one before in its phase (short flows).
-    fn sampled_states(&self, samples: &[(f64, usize)]) -> Vec<DVector<f64>> {
-        let mut out: Vec<DVector<f64>> = Vec::with_capacity(samples.len());
-        for (j, &(t, e)) in samples.iter().enumerate() {
-            let y = match j.checked_sub(1).map(|i| (samples[i], &out[i])) {
-                Some(((s, f), prev)) if f == e => self.phases[e].flow(s, prev, t),
-                _ => self.phases[e].flow(self.times[e], &self.after[e], t),
-            };
-            out.push(y);
-        }
-        out
-    }
-
-    /// The state at `t` (in [τ_0, τ_0 + T), as [`Self::locate`] gives it) flowed from the last
-    /// sample at or before it, which is in its phase (each phase's start is a sample).
-    fn state_near(&self, samples: &[(f64, usize)], states: &[DVector<f64>], t: f64) -> DVector<f64> {
-        let j = samples.partition_point(|s| s.0 <= t).saturating_sub(1);
-        let (s, e) = samples[j];
-        self.phases[e].flow(s, &states[j], t)
     }
 
     /// Each compliant contact's smallest local minimum of its signed clearance between its own
-    /// events ([`Touch`]): on samples of the whole period (cyclic), refined by golden section.
+    /// events ([`Touch`]). On the sampled period (cyclic): each interval between samples where
+    /// the slope turns from negative to non-negative holds a minimum; its cubic Hermite estimate
+    /// (values and slopes at both ends) ranks it, and those within [`REFINE_BAND`] of the
+    /// contact's range of the best estimate are refined by Newton on the slope ([`refine`]).
     /// A contact's own events, where its signed clearance comes down to 0 from both sides, are
-    /// not minima.
+    /// not minima: each interval is taken in its phase up to the phase's end (left limit).
     pub fn touches(&self) -> Vec<Touch> {
-        let samples = self.samples();
-        let states = self.sampled_states(&samples);
-        let len = samples.len();
+        let sampled = self.sampled();
         let mut out = Vec::new();
         for (i, c) in self.model.contacts.iter().enumerate() {
             if c.is_rigid() {
                 continue;
             }
+            let n = self.model.n();
             let sign = |e: usize| if self.phases[e].closed(i) { -1.0 } else { 1.0 };
-            let f = |t: f64| {
-                let (e, tt) = self.locate(t);
-                sign(e) * self.clearance(i, &self.state_near(&samples, &states, tt), tt)
+            // Signed clearance, its slope and curvature in state `y` at `t` of phase `e`.
+            let jet = |e: usize, y: &DVector<f64>, t: f64, curvature: bool| {
+                let s = sign(e);
+                let value = s * self.clearance(i, y, t);
+                let slope = s * (self.gap(i, t, 1) - c.along(|d| y[n + d]));
+                let bend = if curvature {
+                    let a = self.phases[e].acceleration(y, t);
+                    s * (self.gap(i, t, 2) - c.along(|d| a[d]))
+                } else {
+                    0.0
+                };
+                (value, slope, bend)
             };
-            let v: Vec<f64> = samples.iter().zip(&states).map(|(&(t, e), y)| sign(e) * self.clearance(i, y, t)).collect();
             let own = |j: usize| {
-                let (t, e) = samples[j];
+                let (t, e) = sampled.samples[j];
                 !self.events.is_empty() && t == self.times[e] && self.events[e].contact == i
             };
-            let mut best: Option<Touch> = None;
-            for j in 0..len {
-                let (l, r) = ((j + len - 1) % len, (j + 1) % len);
-                if own(j) || v[j] > v[l] || v[j] > v[r] {
-                    continue;
-                }
-                let t = samples[j].0;
-                let (tl, tr) = (t - (t - samples[l].0).rem_euclid(self.period), t + (samples[r].0 - t).rem_euclid(self.period));
-                let (time, value) = golden(tl, tr, &f);
-                if best.is_none_or(|b| value < b.value) {
-                    let (e, tt) = self.locate(time);
-                    best = Some(Touch { phase: e, contact: i, value, time: tt, closed: self.phases[e].closed(i) });
-                }
-            }
-            out.extend(best);
+            let best = sampled.smallest(self, &|e, y, t| jet(e, y, t, false), &|e, y, t| jet(e, y, t, true), &own, false);
+            out.extend(best.map(|(value, time)| {
+                let (e, tt) = self.locate(time);
+                Touch { phase: e, contact: i, value, time: tt, closed: self.phases[e].closed(i) }
+            }));
         }
         out
     }
 
     /// Peak-to-peak / 2 of user DOF `dof`'s displacement over the period (through the output
-    /// map when there is one): samples, each extremum refined by golden section.
+    /// map when there is one): its extrema located as [`Self::touches`] locates minima.
     pub fn amplitude(&self, map: Option<&OutputMap>, dof: usize) -> Option<f64> {
+        self.amplitudes(map, &[dof])[0]
+    }
+
+    /// [`Self::amplitude`] of each of `dofs`, from one sampling of the period.
+    pub fn amplitudes(&self, map: Option<&OutputMap>, dofs: &[usize]) -> Vec<Option<f64>> {
         let n = self.model.n();
-        user_value(map, dof, &self.y0, 0, n)?;
-        let samples = self.samples();
-        let states = self.sampled_states(&samples);
-        let x = |t: f64| {
-            let (_, tt) = self.locate(t);
-            user_value(map, dof, &self.state_near(&samples, &states, tt), 0, n).unwrap_or(0.0)
+        let sampled = self.sampled();
+        let one = |dof: usize| {
+            user_value(map, dof, &self.y0, 0, n)?;
+            let jet = |e: usize, y: &DVector<f64>, t: f64, sign: f64, curvature: bool| {
+                let value = user_value(map, dof, y, 0, n).unwrap_or(0.0);
+                let slope = user_value(map, dof, y, n, n).unwrap_or(0.0);
+                let bend = if curvature { user_value(map, dof, &self.phases[e].acceleration(y, t), 0, n).unwrap_or(0.0) } else { 0.0 };
+                (sign * value, sign * slope, sign * bend)
+            };
+            let lo = sampled.smallest(self, &|e, y, t| jet(e, y, t, 1.0, false), &|e, y, t| jet(e, y, t, 1.0, true), &|_| false, true)?.0;
+            let hi = -sampled.smallest(self, &|e, y, t| jet(e, y, t, -1.0, false), &|e, y, t| jet(e, y, t, -1.0, true), &|_| false, true)?.0;
+            Some(0.5 * (hi - lo))
         };
-        let xs: Vec<f64> = states.iter().map(|y| user_value(map, dof, y, 0, n).unwrap_or(0.0)).collect();
-        let len = xs.len();
-        let (mut hi, mut lo) = (f64::MIN, f64::MAX);
-        for j in 0..len {
-            let (l, r) = ((j + len - 1) % len, (j + 1) % len);
-            let t = samples[j].0;
-            let (tl, tr) = (t - (t - samples[l].0).rem_euclid(self.period), t + (samples[r].0 - t).rem_euclid(self.period));
-            hi = hi.max(xs[j]);
-            lo = lo.min(xs[j]);
-            if xs[j] >= xs[l] && xs[j] >= xs[r] {
-                hi = hi.max(-golden(tl, tr, &|t| -x(t)).1);
-            }
-            if xs[j] <= xs[l] && xs[j] <= xs[r] {
-                lo = lo.min(golden(tl, tr, &x).1);
-            }
-        }
-        Some(0.5 * (hi - lo))
+        dofs.iter().map(|&d| one(d)).collect()
     }
 }
 
-/// The minimum of `f` on [lo, hi] by golden section: (its time, its value).
-fn golden(mut lo: f64, mut hi: f64, f: &dyn Fn(f64) -> f64) -> (f64, f64) {
-    let g = 0.5 * (5f64.sqrt() - 1.0);
-    let (mut c, mut d) = (hi - g * (hi - lo), lo + g * (hi - lo));
-    let (mut fc, mut fd) = (f(c), f(d));
-    for _ in 0..80 {
-        if hi - lo <= 1e-13 * (1.0 + hi.abs()) {
-            break;
+/// A signal's value, slope and curvature at a state and time of a phase.
+type Jet<'a> = &'a dyn Fn(usize, &DVector<f64>, f64) -> (f64, f64, f64);
+
+/// Minima whose Hermite estimate lies within this fraction of the signal's sampled range of the
+/// best estimate are refined: the cubic Hermite error at 1/[`SAMPLES_PER_RADIAN`] radian of the
+/// fastest motion is (ωh)⁴/384 ≈ 1.6e-4 of that motion's amplitude (Burden & Faires §3.4), so the
+/// true smallest minimum is among them.
+const REFINE_BAND: f64 = 1e-2;
+
+/// The sampled period ([`PolishedOrbit::sampled`]).
+struct Sampled {
+    /// (time, phase) of each sample, and its state.
+    samples: Vec<(f64, usize)>,
+    states: Vec<DVector<f64>>,
+    /// Each phase's state at its end, flowed in the phase (before the next event).
+    ends: Vec<DVector<f64>>,
+}
+
+impl Sampled {
+    /// The smallest value of a signal over the period, and its time: the smallest interior
+    /// minimum between samples (refined), a kink at a phase start where the slope jumps from
+    /// negative to non-negative (an impact elsewhere) unless `own` says the sample is the
+    /// signal's own event, and the samples themselves when `samples_count`. `quick` gives value
+    /// and slope, `full` also the curvature (for Newton).
+    fn smallest(&self, orbit: &PolishedOrbit, quick: Jet, full: Jet, own: &dyn Fn(usize) -> bool, samples_count: bool) -> Option<(f64, f64)> {
+        let len = self.samples.len();
+        let phases = self.ends.len();
+        let mut best: Option<(f64, f64)> = None;
+        let keep = |best: &mut Option<(f64, f64)>, v: f64, t: f64| {
+            if best.is_none_or(|b| v < b.0) {
+                *best = Some((v, t));
+            }
+        };
+        let (mut vmin, mut vmax) = (f64::MAX, f64::MIN);
+        // Per interval: (Hermite estimate, its place in [0, 1], start sample, end time).
+        let mut candidates: Vec<(f64, f64, usize, f64)> = Vec::new();
+        for j in 0..len {
+            let (t0, e) = self.samples[j];
+            let (v0, d0, _) = quick(e, &self.states[j], t0);
+            let (t1, (v1, d1, _)) = match self.samples.get(j + 1) {
+                Some(&(t1, f)) if f == e => (t1, quick(e, &self.states[j + 1], t1)),
+                _ => {
+                    let b = orbit.end_of(e);
+                    (b, quick(e, &self.ends[e], b))
+                }
+            };
+            vmin = vmin.min(v0).min(v1);
+            vmax = vmax.max(v0).max(v1);
+            if samples_count {
+                keep(&mut best, v0, t0);
+            } else if (j == 0 || self.samples[j - 1].1 != e) && d0 >= 0.0 && !own(j) {
+                let before = (e + phases - 1) % phases;
+                let left = quick(before, &self.ends[before], orbit.end_of(before)).1;
+                if left < 0.0 {
+                    keep(&mut best, v0, t0);
+                }
+            }
+            if d0 < 0.0 && d1 >= 0.0 {
+                let (s, estimate) = hermite_min(v0, d0, v1, d1, t1 - t0);
+                candidates.push((estimate, s, j, t1));
+            }
         }
-        if fc < fd {
-            hi = d;
-            d = c;
-            fd = fc;
-            c = hi - g * (hi - lo);
-            fc = f(c);
+        let band = REFINE_BAND * (vmax - vmin);
+        let floor = candidates.iter().map(|c| c.0).fold(f64::MAX, f64::min);
+        for &(estimate, s, j, t1) in &candidates {
+            if estimate > floor + band || best.is_some_and(|b| estimate > b.0 + band) {
+                continue;
+            }
+            let (t0, e) = self.samples[j];
+            let y0 = &self.states[j];
+            let (t, v) = refine(t0, t1, t0 + s * (t1 - t0), &|t| full(e, &orbit.phases[e].flow(t0, y0, t), t));
+            keep(&mut best, v, t);
+        }
+        best
+    }
+}
+
+/// The minimum of the cubic Hermite interpolant on [0, h] with values v0, v1 and slopes
+/// d0 < 0 ≤ d1 at its ends (its slope's root by bisection): (its place in [0, 1], its value).
+fn hermite_min(v0: f64, d0: f64, v1: f64, d1: f64, h: f64) -> (f64, f64) {
+    // p(s) = v0 + b s + c s² + d s³ on s ∈ [0, 1].
+    let (b, c, d) = (h * d0, 3.0 * (v1 - v0) - h * (2.0 * d0 + d1), 2.0 * (v0 - v1) + h * (d0 + d1));
+    let (mut lo, mut hi) = (0.0, 1.0);
+    for _ in 0..50 {
+        let s = 0.5 * (lo + hi);
+        if b + 2.0 * c * s + 3.0 * d * s * s < 0.0 {
+            lo = s;
         } else {
-            lo = c;
-            c = d;
-            fc = fd;
-            d = lo + g * (hi - lo);
-            fd = f(d);
+            hi = s;
         }
     }
-    let t = 0.5 * (lo + hi);
-    (t, f(t))
+    let s = 0.5 * (lo + hi);
+    (s, v0 + s * (b + s * (c + s * d)))
+}
+
+/// The minimum of a signal on [lo, hi], whose slope is negative at lo and non-negative at hi:
+/// Newton on the slope from `start` (the Hermite estimate's place), a bisection step where
+/// Newton leaves the bracket or the curvature is not positive. (time, value).
+fn refine(mut lo: f64, mut hi: f64, start: f64, jet: &dyn Fn(f64) -> (f64, f64, f64)) -> (f64, f64) {
+    let (mut t, mut last) = (start, jet(start));
+    for _ in 0..60 {
+        let (_, slope, bend) = last;
+        if slope < 0.0 {
+            lo = t;
+        } else {
+            hi = t;
+        }
+        let newton = t - slope / bend;
+        let next = if bend > 0.0 && newton > lo && newton < hi { newton } else { 0.5 * (lo + hi) };
+        let done = (next - t).abs() <= 1e-13 * (1.0 + t.abs()) || hi - lo <= 1e-13 * (1.0 + hi.abs());
+        t = next;
+        last = jet(t);
+        if done {
+            break;
+        }
+    }
+    (t, last.0)
 }

@@ -144,7 +144,7 @@ impl Walk<'_> {
     fn push(&mut self, node: &Node, event: Option<EventKind>, detail: String) {
         let lambda = node.lambda(self.fam.rho);
         let map = self.problem.output_map();
-        let amplitude = self.problem.outputs().displacement.iter().map(|&d| node.orbit.amplitude(map, d).unwrap_or(f64::NAN)).collect();
+        let amplitude = node.orbit.amplitudes(map, &self.problem.outputs().displacement).into_iter().map(|a| a.unwrap_or(f64::NAN)).collect();
         let max_multiplier = floquet::largest(&node.mu);
         self.points.push(BranchPoint {
             parameter: lambda,
