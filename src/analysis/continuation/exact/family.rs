@@ -26,10 +26,8 @@ const MAX_ITERATIONS: usize = 12;
 /// Newton at its round-off floor: a step this small (scaled unknowns) and a defect below
 /// [`ROUND_OFF_DEFECT`] is a solution. The stiff phases' exponentials carry ~1e-11 relative
 /// round-off (the coarse blade's contact modes, ω_max/ω ≈ 270) into the velocity rows, where
-/// Newton then hovers at ‖F‖ of 1e-11 to 2e-10 with steps of 1e-11 (the stall at 2214 rad/s),
-/// and, the Jacobian worse conditioned towards a grazing, at ‖F‖ up to 8e-10 with steps of
-/// 1e-9 to 3e-9 (the stall at 2247.18 rad/s).
-const ROUND_OFF_STEP: f64 = 1e-8;
+/// Newton then hovers at ‖F‖ of 1e-11 to 2e-10 with steps of 1e-11 (the stall at 2214 rad/s).
+const ROUND_OFF_STEP: f64 = 1e-10;
 const ROUND_OFF_DEFECT: f64 = 1e-9;
 /// Central-difference step of the Jacobian (unknowns are O(1)).
 const DIFF: f64 = 1e-7;
@@ -183,10 +181,10 @@ impl Family {
             if !step.is_finite() || step > 1.0 {
                 return None;
             }
-            if step < ROUND_OFF_STEP {
+            if step < 1e-9 {
                 let f = self.residual(&w)?;
-                if (step < 1e-9 && f.amax() < TOLERANCE) || f.amax() < ROUND_OFF_DEFECT {
-                    // The Jacobian of the last iterate, at most 1e-8 away: the tangent's.
+                if f.amax() < TOLERANCE || (step < ROUND_OFF_STEP && f.amax() < ROUND_OFF_DEFECT) {
+                    // The Jacobian of the last iterate, 1e-9 away: the tangent's.
                     self.last_jacobian.replace(Some((w.clone(), jac)));
                     return Some(w);
                 }
