@@ -283,28 +283,25 @@ impl Sampled {
             }
         };
         let (mut vmin, mut vmax) = (f64::MAX, f64::MIN);
+        // Value and slope once per sample and per phase end (each is an interval's start and the
+        // interval before's end, and a phase's end also feeds the kink test after it).
+        let at: Vec<(f64, f64)> = self.samples.iter().zip(&self.states).map(|(&(t, e), y)| quick(e, y, t)).map(|(v, d, _)| (v, d)).collect();
+        let at_end: Vec<(f64, f64)> = self.ends.iter().enumerate().map(|(e, y)| quick(e, y, orbit.end_of(e))).map(|(v, d, _)| (v, d)).collect();
         // Per interval: (Hermite estimate, its place in [0, 1], start sample, end time).
         let mut candidates: Vec<(f64, f64, usize, f64)> = Vec::new();
         for j in 0..len {
             let (t0, e) = self.samples[j];
-            let (v0, d0, _) = quick(e, &self.states[j], t0);
-            let (t1, (v1, d1, _)) = match self.samples.get(j + 1) {
-                Some(&(t1, f)) if f == e => (t1, quick(e, &self.states[j + 1], t1)),
-                _ => {
-                    let b = orbit.end_of(e);
-                    (b, quick(e, &self.ends[e], b))
-                }
+            let (v0, d0) = at[j];
+            let (t1, (v1, d1)) = match self.samples.get(j + 1) {
+                Some(&(t1, f)) if f == e => (t1, at[j + 1]),
+                _ => (orbit.end_of(e), at_end[e]),
             };
             vmin = vmin.min(v0).min(v1);
             vmax = vmax.max(v0).max(v1);
-            if samples_count {
+            // A sample counts when asked, or as a kink at a phase start (slope − before, + after).
+            let kink = (j == 0 || self.samples[j - 1].1 != e) && d0 >= 0.0 && !own(j) && at_end[(e + phases - 1) % phases].1 < 0.0;
+            if samples_count || kink {
                 keep(&mut best, v0, t0);
-            } else if (j == 0 || self.samples[j - 1].1 != e) && d0 >= 0.0 && !own(j) {
-                let before = (e + phases - 1) % phases;
-                let left = quick(before, &self.ends[before], orbit.end_of(before)).1;
-                if left < 0.0 {
-                    keep(&mut best, v0, t0);
-                }
             }
             if d0 < 0.0 && d1 >= 0.0 {
                 let (s, estimate) = hermite_min(v0, d0, v1, d1, t1 - t0);
