@@ -86,6 +86,9 @@ pub const HALF_STEPS_ENV: &str = "PERIODIC_CONTACT_FRICTION_HALF_STEPS";
 ///   cds, so A's form is Re(σ1 G) ≥ 0, identically 0 when undamped. Refused: the Coulomb force
 ///   jumps at a reversal or a stop, a sample can switch only at a step, and the O(h) impulse
 ///   error μN·h·(2ξ − 1) follows the event's place ξ in its step, erratically in k.
+///   With [`super::EVENT_FITTED_ENV`] too, the steps around each slip end take a fitted law
+///   (`friction_events`) and converge at order 2 (measured); diagnostic, as the dense path is all
+///   that solves the half-step LCP.
 pub struct FrictionGrid {
     /// Symbol of the slip velocity from the displacement at the instants, per harmonic.
     pub velocity: Vec<C>,

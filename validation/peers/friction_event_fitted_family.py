@@ -1,6 +1,6 @@
 """Random family for the event-fitted half-step law (prototype): errors at k = 256/512/1024 against the
 event-driven exact orbit, the order, and the Richardson (order 2) estimate's ratio to the true error.
-Usage: python friction_event_fitted_family.py [seed] [draws]"""
+Usage: python friction_event_fitted_family.py [seed] [draws] [kinds, comma-separated, cycled]"""
 import sys
 import numpy as np
 from friction_event_fitted import system, solve
@@ -8,10 +8,11 @@ import friction_exact as fe
 
 seed = int(sys.argv[1]) if len(sys.argv) > 1 else 7
 draws = int(sys.argv[2]) if len(sys.argv) > 2 else 8
+kinds = (sys.argv[3] if len(sys.argv) > 3 else "den_hartog_c0,den_hartog_damped,chain,jenkins").split(",")
 rng = np.random.default_rng(seed)
 rows = []
 for i in range(draws):
-    kind = ["den_hartog_c0", "den_hartog_damped", "chain", "jenkins"][i % 4]
+    kind = kinds[i % len(kinds)]
     c = 0.0 if kind == "den_hartog_c0" else rng.uniform(0.02, 0.2)
     om = rng.uniform(0.4, 2.0) if kind != "chain" else rng.uniform(0.3, 1.6)
     sl = rng.uniform(0.1, 0.9)
