@@ -17,6 +17,7 @@
 //! (friction alone). The slip velocity is α − w₁.
 //!
 //! The matrix is dense: N = k·(m_c + 2·m_f) unknowns, at most [`FRICTION_DENSE_MAX`].
+use super::friction_events::{EVENT_FITTED_ENV, EventLaws, MAX_ROUNDS};
 use super::friction_shooting::{FrictionStepMap, coarse_start};
 use super::{Assembly, NoStepMap, PeriodFft, PeriodicProblem, SolveError, lcp_failure, recovery};
 use crate::lcp::{DenseMatrix, LcpInfo, LcpMethod, LcpOutcome, LcpSolution, LcpStep, Lemke, LemkeSettings, residuals};
@@ -85,6 +86,9 @@ pub const HALF_STEPS_ENV: &str = "PERIODIC_CONTACT_FRICTION_HALF_STEPS";
 ///   cds, so A's form is Re(σ1 G) ≥ 0, identically 0 when undamped. Refused: the Coulomb force
 ///   jumps at a reversal or a stop, a sample can switch only at a step, and the O(h) impulse
 ///   error μN·h·(2ξ − 1) follows the event's place ξ in its step, erratically in k.
+///   With [`super::EVENT_FITTED_ENV`] too, the steps around each slip end take a fitted law
+///   (`friction_events`) and converge at order 2 (measured); diagnostic, as the dense path is all
+///   that solves the half-step LCP.
 pub struct FrictionGrid {
     /// Symbol of the slip velocity from the displacement at the instants, per harmonic.
     pub velocity: Vec<C>,
@@ -296,14 +300,19 @@ pub(super) fn solve(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, 
         let t_lcp = Instant::now();
         let settings =
             LemkeSettings { certify_tol: problem.solver_settings().tolerance, max_pivots_per_dim: FRICTION_PIVOTS_PER_DIM, ..LemkeSettings::default() };
-        let mut sol = Lemke::new(settings).solve(&a, &q);
-        let lcp_time = t_lcp.elapsed().as_secs_f64();
-        sol.info.path = vec![LcpStep { method: LcpMethod::Lemke, size: nn, pivots: sol.info.pivots, outcome: sol.outcome, time_s: lcp_time }];
+        let mut sol = Lemke::new(settings.clone()).solve(&a, &q);
         if sol.outcome != LcpOutcome::Solved {
             return Err(if coupled.iter().any(Option::is_some) { super::friction_coupled::no_solution(problem, asm, sol) } else { lcp_failure(sol) });
         }
+        let mut rounds = 0;
+        if grid.half_steps() && std::env::var_os(EVENT_FITTED_ENV).is_some() {
+            (sol, rounds) = fit_events(problem, asm, (&a, &q), &lay, sol, &settings)?;
+        }
+        let lcp_time = t_lcp.elapsed().as_secs_f64();
+        sol.info.path = vec![LcpStep { method: LcpMethod::Lemke, size: nn, pivots: sol.info.pivots, outcome: sol.outcome, time_s: lcp_time }];
+        let fitted = if rounds > 0 { format!(", event-fitted half steps after {rounds} refits") } else { String::new() };
         let path = format!(
-            "friction (N = {nn}: contacts and the box LCP of the friction rows, src/formulation.md §9): dense lexicographic Lemke, {} pivots, {lcp_time:.3} s → {}",
+            "friction (N = {nn}: contacts and the box LCP of the friction rows, src/formulation.md §9): dense lexicographic Lemke, {} pivots{fitted}, {lcp_time:.3} s → {}",
             sol.info.pivots,
             sol.outcome.name()
         );
@@ -341,6 +350,68 @@ pub(super) fn solve(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, 
     response.timing_s.recovery = t_rec.elapsed().as_secs_f64();
     response.timing_s.total = t_start.elapsed().as_secs_f64();
     Ok(response)
+}
+
+/// Refits the event laws of the half-step samples (`friction_events`) from `sol` and solves again
+/// until they repeat; the answer's w₁ then holds −v̄ + α (the mean slip velocity, not the law's
+/// shifted one). Returns the last solution and the refits made.
+fn fit_events(
+    problem: &PeriodicProblem,
+    asm: &Assembly,
+    (a, q): (&DenseMatrix, &[f64]),
+    lay: &Layout,
+    mut sol: LcpSolution,
+    settings: &LemkeSettings,
+) -> Result<(LcpSolution, usize), SolveError> {
+    let (k, nn) = (lay.k, q.len());
+    let slip: Vec<f64> = problem.model().frictions.iter().map(|f| f.slip_force()).collect();
+    let h = problem.period() / k as f64;
+    let mut laws = EventLaws::none(k, lay.mf);
+    let mut rounds = 0;
+    // The samples' forces and mean slip velocities (k × mf), undoing the laws' shift v̄ − c − ε s.
+    let samples = |sol: &LcpSolution, laws: &EventLaws| -> (Vec<f64>, Vec<f64>) {
+        let (mut f, mut v) = (vec![0.0; k * lay.mf], vec![0.0; k * lay.mf]);
+        for (t, mu_n) in slip.iter().enumerate() {
+            for j in 0..k {
+                let (r, sl) = (lay.row(lay.mc + t, j), lay.slack(t, j));
+                f[j * lay.mf + t] = sol.z[r] - mu_n;
+                let (c, eps) = laws.at(t, j).unwrap_or((0.0, 0.0));
+                v[j * lay.mf + t] = sol.z[sl] - sol.w[r] + c + eps * f[j * lay.mf + t] / mu_n;
+            }
+        }
+        (f, v)
+    };
+    while rounds < MAX_ROUNDS {
+        let (f, v) = samples(&sol, &laws);
+        let next = EventLaws::fit(asm, lay.mc, &slip, (&f, &v), h);
+        if next.repeats(&laws, 1e-10) {
+            break;
+        }
+        laws = next;
+        rounds += 1;
+        let (mut data, mut q) = (a.as_slice().to_vec(), q.to_vec());
+        for (t, mu_n) in slip.iter().enumerate() {
+            for j in 0..k {
+                if let Some((c, eps)) = laws.at(t, j) {
+                    let r = lay.row(lay.mc + t, j);
+                    data[r * nn + r] += eps / mu_n;
+                    q[r] += c - eps;
+                }
+            }
+        }
+        sol = Lemke::new(settings.clone()).solve(&DenseMatrix::from_row_major(nn, data), &q);
+        if sol.outcome != LcpOutcome::Solved {
+            return Err(lcp_failure(sol));
+        }
+    }
+    let (_, v) = samples(&sol, &laws);
+    for t in 0..lay.mf {
+        for j in 0..k {
+            let (r, sl) = (lay.row(lay.mc + t, j), lay.slack(t, j));
+            sol.w[r] = sol.z[sl] - v[j * lay.mf + t];
+        }
+    }
+    Ok((sol, rounds))
 }
 
 /// The full friction LCP's certificate of the forces f (k × m_f, time-major) of a friction-only

@@ -4,6 +4,7 @@ mod assembly;
 mod cache;
 mod friction;
 mod friction_coupled;
+mod friction_events;
 mod friction_shooting;
 pub mod limits;
 use crate::linalg::fft; // the crate's one FFT plan type, shared with lcp
@@ -17,6 +18,7 @@ mod tuning;
 pub use assembly::Assembly;
 pub use fft::PeriodFft;
 pub use friction::{FRICTION_DENSE_MAX, FrictionGrid, HALF_STEPS_ENV, friction_lcp};
+pub use friction_events::EVENT_FITTED_ENV;
 pub use problem::{MAX_DENSE_FLOPS, MAX_LCP_SIZE, MAX_STEPS, MIN_STEPS, PeriodicProblem};
 pub use recovery::render_path as render_lcp_path;
 pub use rubbing::TangentialRow;
