@@ -135,7 +135,7 @@ fn polish_with_several_contacts_meets_the_event_driven_simulation() {
     let mut rows = Vec::new();
     for (name, model, reference) in cases {
         let period = 2.0 * std::f64::consts::PI / model.frequency;
-        let (mut r, orbit, problem) = polished(model, 512);
+        let (mut r, orbit, problem) = polished(model, 256);
         let orbit = orbit.unwrap_or_else(|e| panic!("{name}: {e}"));
         let scale = reference.x.iter().flat_map(|row| row.iter()).fold(0.0f64, |a, x| a.max(x.abs()));
         let err = reference

@@ -286,10 +286,11 @@ def regularised(sys_, orbit, eps, periods=40):
 
 def main():
     if len(sys.argv) > 1 and sys.argv[1] == "check":
-        for omega in (0.8, 1.2):
-            s = chain(omega)
+        for omega, slips in ((0.8, (0.25, 0.15)), (1.2, (0.25, 0.15)), (0.8, (0.6, 0.5))):
+            s = chain(omega, slips)
             o = steady(s)
-            print(f"chain Ω = {omega}: {len(o.events)} events, residual {o.residual:.1e}")
+            fr = [round(o.stuck_fraction(i), 4) for i in range(s.m)]
+            print(f"chain Ω = {omega}, μN = {slips}: {len(o.events)} events, stuck fractions {fr}, residual {o.residual:.1e}")
             for eps in (1e-2, 1e-3, 1e-4):
                 print(f"  DOP853, f = μN tanh(v/ε), ε = {eps:.0e}: max |x − x_exact| / max|x| = {regularised(s, o, eps):.2e}")
         return

@@ -432,6 +432,42 @@ impl MultiOrbit {
         fail(format_args!("Newton did not converge in 40 iterations, last correction {:.2e}", self.correction))
     }
 
+    /// The least and greatest friction force of contact `i` over 1024 points of the period.
+    fn force_range(&self, i: usize) -> (f64, f64) {
+        let f: Vec<f64> = (0..1024).map(|k| self.contact(i, self.start + k as f64 * self.period / 1024.0).0).collect();
+        (f.iter().copied().fold(f64::INFINITY, f64::min), f.iter().copied().fold(f64::NEG_INFINITY, f64::max))
+    }
+
+    /// Moves each pinned slider constant, by the constant force shift per unit constant (§9),
+    /// so that its contact's holding force stays within ±μN; returns whether any moved.
+    pub fn shift_pins(&mut self) -> Result<bool, PolishFailure> {
+        let mut moved = false;
+        for p in 0..self.pins.len() {
+            let (i, c) = self.pins[p];
+            let ((lo, hi), slip) = (self.force_range(i), self.flows.slip[i]);
+            if hi - lo >= 2.0 * slip {
+                return fail(format_args!("contact {i} stuck all period needs a holding force spanning {:.6e} > 2μN", hi - lo));
+            }
+            let shift = if hi > slip {
+                slip - hi
+            } else if lo < -slip {
+                -slip - lo
+            } else {
+                continue;
+            };
+            let mut probe = self.clone();
+            probe.pins[p].1 = c + 1.0;
+            probe.converge()?;
+            let per_unit = probe.force_range(i).0 - lo;
+            if per_unit != 0.0 {
+                self.pins[p].1 = c + shift / per_unit;
+                self.converge()?;
+                moved = true;
+            }
+        }
+        Ok(moved)
+    }
+
     fn ends(&self) -> Vec<f64> {
         std::iter::once(self.start).chain(self.times.iter().copied()).chain(std::iter::once(self.start + self.period)).collect()
     }

@@ -71,9 +71,22 @@ fn smoothed(s: &[Slide]) -> Vec<Slide> {
     out
 }
 
+/// Whether `s` sticks but for slips of at most three instants each.
+fn short_slips_only(s: &[Slide]) -> bool {
+    let k = s.len();
+    s.contains(&Slide::Stick)
+        && (0..k).all(|j| s[j] == Slide::Stick || (1..3).any(|d| s[(j + d) % k] == Slide::Stick) && (1..3).any(|d| s[(j + k - d) % k] == Slide::Stick))
+}
+
 /// Converges and verifies `orbit`.
 fn fit(mut orbit: MultiOrbit) -> Result<MultiOrbit, PolishFailure> {
     orbit.converge()?;
+    // A contact stuck all period: its constant moved into |f| ≤ μN (twice: the events move too).
+    for _ in 0..2 {
+        if !orbit.shift_pins()? {
+            break;
+        }
+    }
     orbit.verify()?;
     Ok(orbit)
 }
@@ -107,6 +120,12 @@ pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<MultiOrbit, Pol
     let merged: Vec<Vec<Slide>> = series.iter().zip(&fl.kt).map(|(s, kt)| if kt.is_none() { smoothed(s) } else { s.clone() }).collect();
     if merged != series {
         candidates.push(merged);
+    }
+    // A contact the LCP holds but for short slips (the trace of a holding force near μN) taken
+    // as stuck all period, the others as read.
+    let held: Vec<Vec<Slide>> = series.iter().map(|s| if short_slips_only(s) { vec![Slide::Stick; k] } else { s.clone() }).collect();
+    if held != series && held.iter().any(|s| s.iter().any(|&p| p != Slide::Stick)) {
+        candidates.push(held);
     }
     let mut last = PolishFailure(String::new());
     let mut seed = None;
