@@ -17,7 +17,10 @@ import tempfile
 
 import numpy as np
 
-import friction_multi_exact as fx
+try:
+    from peers import friction_multi_exact as fx
+except ImportError:  # run as a script from validation/peers
+    import friction_multi_exact as fx
 
 
 def draw(rng):
@@ -64,10 +67,8 @@ def scene(s, steps):
 fx.System.b_slip_kt = lambda s: zip(s.b, s.slip, s.kt)
 
 
-def main():
-    cases = int(sys.argv[1]) if len(sys.argv) > 1 else 30
-    seed = int(sys.argv[2]) if len(sys.argv) > 2 else 2026
-    cli = os.environ.get("PC_CLI", os.path.join(os.path.dirname(__file__), "..", "..", "target", "release", "periodic-contact"))
+def family(cases, seed, cli):
+    """[(error, description, status, reason, CLI CPU s)] per case, worst first."""
     rng = np.random.default_rng(seed)
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
@@ -106,6 +107,14 @@ def main():
             rows.append((err, desc, status, why, cpu))
             print(f"{desc}: {status}, error {err:.2e}, {why[:160]}", flush=True)
     rows.sort(key=lambda r: -r[0])
+    return rows
+
+
+def main():
+    cases = int(sys.argv[1]) if len(sys.argv) > 1 else 30
+    seed = int(sys.argv[2]) if len(sys.argv) > 2 else 2026
+    cli = os.environ.get("PC_CLI", os.path.join(os.path.dirname(__file__), "..", "..", "target", "release", "periodic-contact"))
+    rows = family(cases, seed, cli)
     ok = sum(1 for r in rows if r[2] == "polished" and r[0] <= 1e-8)
     print(f"\n{ok} of {len(rows)} polished to 1e-8 at k = 512 (seed {seed}); worst first:")
     for err, desc, status, why, cpu in rows:

@@ -14,8 +14,7 @@
 use super::super::PolishFailure;
 use super::Slide;
 use crate::model::Model;
-use crate::periodic::PeriodicProblem;
-use crate::response::{EventRecord, Response};
+use crate::response::EventRecord;
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64 as C;
 use std::cell::RefCell;
@@ -581,25 +580,4 @@ impl MultiOrbit {
 }
 
 mod topology;
-pub use topology::polish;
-
-/// Replaces `r`'s series by the orbit's at the same instants, and every contact's outputs.
-pub fn write(orbit: &MultiOrbit, problem: &PeriodicProblem, r: &mut Response) {
-    let n = orbit.flows.n;
-    let states: Vec<DVector<f64>> = r.time.iter().map(|&t| orbit.state(t)).collect();
-    let accs: Vec<DVector<f64>> = r
-        .time
-        .iter()
-        .map(|&t| {
-            let (mode, y) = orbit.at(t);
-            (&orbit.flows.mode(mode).a * y).rows(n, n).into_owned()
-        })
-        .collect();
-    super::super::orbit::write_kinematics(r, problem.output_map(), &states, &accs, n);
-    for (i, f) in r.friction.iter_mut().enumerate() {
-        for (j, &t) in r.time.iter().enumerate() {
-            (f.force[j], f.slip_velocity[j], f.displacement[j], f.stuck[j]) = orbit.contact(i, t);
-        }
-        f.dissipated_energy = orbit.dissipated_energy(i);
-    }
-}
+pub use topology::{polish, write};
