@@ -50,6 +50,11 @@ def draw(rng):
     return fx.System(M, C, K, F, omega, contacts)
 
 
+def parts(s):
+    """(direction, μN, k_t) per contact."""
+    return zip(s.b, s.slip, s.kt)
+
+
 def scene(s, steps):
     rows = lambda a: "[" + ", ".join("[" + ", ".join(repr(float(v)) for v in r) + "]" for r in a) + "]"  # noqa: E731
     out = f"[structure]\nmass = {rows(s.M)}\nstiffness = {rows(s.K)}\n\n[damping]\nmatrix = {rows(s.C)}\n\n"
@@ -57,14 +62,11 @@ def scene(s, steps):
     for d, a in enumerate(s.F):
         if a != 0.0:
             out += f"[[force]]\ndof = {d}\namplitude = {float(a)!r}\n\n"
-    for b, slip, kt in s.b_slip_kt():
+    for b, slip, kt in parts(s):
         out += f"[[friction]]\ndof = {int(np.argmax(b))}\ncoefficient = 1.0\nnormal_force = {slip!r}\n"
         out += f"stiffness = {kt!r}\n\n" if kt is not None else "\n"
     out += f"[discretization]\nscheme = \"bds1\"\nsteps = {steps}\n\n[output]\ndisplacement = {list(range(s.n))}\n"
     return out
-
-
-fx.System.b_slip_kt = lambda s: zip(s.b, s.slip, s.kt)
 
 
 def family(cases, seed, cli):
@@ -75,7 +77,7 @@ def family(cases, seed, cli):
         for c in range(cases):
             s = draw(rng)
             desc = (f"#{c} n={s.n} Ω={s.omega:.3f} contacts=" +
-                    ",".join(f"{int(np.argmax(b))}:{sl:.2f}{'' if kt is None else f'/kt{kt:.2f}'}" for b, sl, kt in s.b_slip_kt()))
+                    ",".join(f"{int(np.argmax(b))}:{sl:.2f}{'' if kt is None else f'/kt{kt:.2f}'}" for b, sl, kt in parts(s)))
             try:
                 ex = fx.steady(s)
             except Exception as e:  # noqa: BLE001
