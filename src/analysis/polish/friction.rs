@@ -23,6 +23,7 @@
 //! Zero multipliers are contractions, not a failure: the orbit is stable when the spectral
 //! radius of the monodromy is below 1, and they are reported as they are.
 use super::PolishFailure;
+pub mod multi;
 mod settle;
 use crate::model::Model;
 use crate::periodic::PeriodicProblem;

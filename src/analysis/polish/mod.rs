@@ -69,6 +69,17 @@ pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<PolishedOrbit, 
 /// with a warning and `polish.status = "fallback"`.
 pub fn apply(problem: &PeriodicProblem, r: &mut Response) -> Option<PolishedOrbit> {
     let t0 = Instant::now();
+    if problem.model().frictions.len() > 1 {
+        match friction::multi::polish(problem, r) {
+            Ok(orbit) => {
+                friction::multi::write(&orbit, problem, r);
+                let how = "stick–slip orbit of several friction contacts (exact flows between their merged events)";
+                record(r, how, orbit.event_records(), (orbit.iterations, orbit.residual, orbit.correction), t0);
+            }
+            Err(e) => fall_back(r, e, t0),
+        }
+        return None;
+    }
     if !problem.model().frictions.is_empty() {
         // The stick–slip orbit writes the samples; the front ends interpolate those.
         match friction::polish(problem, r) {
