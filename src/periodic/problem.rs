@@ -368,7 +368,9 @@ impl PeriodicProblem {
         let t_assembly = t_start.elapsed().as_secs_f64();
 
         let t_lcp = Instant::now();
-        let sol = super::rubbing::solve_lcp(self, fft, &a, &q, warm_start)?;
+        // A cold solve of a stiff model with rigid impacts starts from a coarse bds1 pilot's sets.
+        let pilot = warm_start.is_none().then(|| super::pilot::warm_start(self)).flatten();
+        let sol = super::rubbing::solve_lcp(self, fft, &a, &q, warm_start.or(pilot.as_deref()))?;
         let t_lcp = t_lcp.elapsed().as_secs_f64();
         super::rubbing::check_gross_slip(self, asm, fft, &sol.z)?;
 
