@@ -24,10 +24,10 @@ const PILOT_DIVISOR: usize = 8;
 /// The pilot grid's range of k.
 const PILOT_STEPS: (usize, usize) = (256, 2048);
 
-/// The active set of a bds1 solve on a coarser grid, carried to this problem's instants, when a
-/// cold solve of `problem` is worth a pilot (see the module); `None` otherwise, or when the pilot
-/// is refused or misses (the cold solve then runs as without it).
-pub(super) fn warm_start(problem: &PeriodicProblem) -> Option<Vec<usize>> {
+/// The active set of a bds1 solve on a coarser grid, carried to this problem's instants, and that
+/// grid's k, when a cold solve of `problem` is worth a pilot (see the module); `None` otherwise,
+/// or when the pilot is refused or misses (the cold solve then runs as without it).
+pub(super) fn warm_start(problem: &PeriodicProblem) -> Option<(Vec<usize>, usize)> {
     let disc = problem.discretization();
     let model = problem.model();
     let stiff_impacts = matches!(disc.scheme, Scheme::Cds | Scheme::Galerkin) && super::limits::ContactClass::of(model).rigid_massive > 0;
@@ -40,7 +40,7 @@ pub(super) fn warm_start(problem: &PeriodicProblem) -> Option<Vec<usize>> {
     let mut pilot = problem.clone();
     pilot.set_discretization(Discretization { scheme: Scheme::Bds1, steps, pairing: Some(Pairing::Same) }).ok()?;
     let r = pilot.solve_with(&PeriodFft::new(pilot.instants()), None).ok()?;
-    Some(carried_active_set(&r.active_set, model.contacts.len(), pilot.instants(), problem.instants()))
+    Some((carried_active_set(&r.active_set, model.contacts.len(), pilot.instants(), problem.instants()), steps))
 }
 
 /// An active set (indices j·m + c of instant j, row c of `rows`) of a grid of `from` instants,
