@@ -385,3 +385,36 @@ fn a_step_map_past_the_estimates_is_refused_with_its_figures() {
         assert!(why.contains(part), "{part:?} missing from: {why}");
     }
 }
+
+/// The bds1 pilot of a cold solve (`src/periodic/pilot.rs`): a Craig–Bampton-like pair, a body
+/// (mass 1, spring 1 to ground) and a light tip (mass 0.01) on a stiff spring (100: the tip's
+/// constraint mode at ≈ 100 rad/s against forcing at 0.8 rad/s), Rayleigh-damped (0.5 % on the
+/// tip mode), a rigid stop on the tip at half its contact-free reach; cds/forward at k = 2048
+/// (N = 2048). `auto` starts shooting from the pilot's sets, solves it without a fallback, and
+/// agrees with dense lexicographic Lemke's certified answer to 1e-9.
+#[test]
+fn a_piloted_cold_solve_of_a_stiff_rigid_model_agrees_with_lemke() {
+    let (n, k) = (2, 2048);
+    let mass = Matrix::from_rows(&[vec![1.0, 0.0], vec![0.0, 0.01]]);
+    let stiff = [vec![101.0, -100.0], vec![-100.0, 100.0]];
+    let damping: Vec<Vec<f64>> = (0..n).map(|i| (0..n).map(|j| 1e-4 * stiff[i][j] + if i == j { 0.02 * [1.0, 0.01][i] } else { 0.0 }).collect()).collect();
+    let structure = Structure { mass, stiffness: Matrix::from_rows(&stiff), damping: Some(Matrix::from_rows(&damping)) };
+    let force = Force { dof: 0, term: Harmonic { amplitude: 1.0, harmonic: 1, phase: 0.0 } };
+    let mut model = Model { structure, forces: vec![force], contacts: Vec::new(), frequency: 0.8, frictions: Vec::new(), rubbing: Vec::new() };
+    let outputs = OutputSelection { displacement: vec![0, 1], velocity: vec![], acceleration: vec![], contacts: true };
+    let disc = Discretization { scheme: Scheme::Cds, steps: k, pairing: Some(Pairing::Forward) };
+    let free = PeriodicProblem::new(model.clone(), disc, outputs.clone(), SolverSettings::default()).unwrap().solve().unwrap();
+    let reach = max_abs(&free.displacement["1"]);
+    model.contacts.push(Contact { row: vec![(1, 1.0)], gap: 0.5 * reach, compliance: Compliance::Rigid, motion: Vec::new() });
+    let p = PeriodicProblem::new(model, disc, outputs, SolverSettings::default()).unwrap();
+    let piloted = p.solve().unwrap();
+    let lemke = with(&p, LcpMethod::Lemke).solve().unwrap();
+    let d = difference(&piloted, &lemke);
+    eprintln!(
+        "{}; residual {:.1e}; lemke {} pivots, {:.2} s; difference {d:.1e}",
+        piloted.lcp.path, piloted.lcp.residual, lemke.lcp.pivots, lemke.timing_s.lcp
+    );
+    assert!(piloted.lcp.path.contains("bds1 pilot") && !piloted.lcp.path.contains("fallback"), "{}", piloted.lcp.path);
+    assert!(piloted.contacts[0].force.iter().any(|&f| f > 0.0), "the stop is never reached");
+    assert!(d <= AGREE, "the piloted solve differs from lemke by {d:.3e}");
+}

@@ -92,26 +92,9 @@ pub fn estimate(problem: &PeriodicProblem, r: &Response) -> Accuracy {
         // period map then starts on the right pieces, where a cold start's offset homotopy
         // fails on stiff blades (the fine blade's 2k solve fell back to minutes of dense Lemke).
         let mut session = PeriodicSolver::new(second.clone());
-        session.set_warm_start(&carried_active_set(&r.active_set, r.lcp.size / instants.max(1), instants, second.instants()));
+        session.set_warm_start(&crate::periodic::carried_active_set(&r.active_set, r.lcp.size / instants.max(1), instants, second.instants()));
         session.solve()
     })
-}
-
-/// An active set (indices j·m + c of instant j, row c of `rows`) of a grid of `from` instants,
-/// carried to a grid of `to` instants over the same period: instant j of the new grid takes the
-/// set of instant ⌊j·from/to⌋ (k → 2k: instants 2j and 2j + 1 take j; k → k/2: j takes 2j).
-/// A warm start for the same orbit sampled at other instants (the estimate, a sweep's k/2 grid).
-pub(crate) fn carried_active_set(active: &[usize], rows: usize, from: usize, to: usize) -> Vec<usize> {
-    if rows == 0 || from == 0 {
-        return Vec::new();
-    }
-    let mut on = vec![false; from * rows];
-    for &i in active {
-        if let Some(a) = on.get_mut(i) {
-            *a = true;
-        }
-    }
-    (0..to * rows).filter(|&i| on[(i / rows) * from / to * rows + i % rows]).collect()
 }
 
 /// [`estimate`] with the second solve made by `solve_second` (given the problem at k/2 or 2k):
@@ -171,7 +154,7 @@ fn short(e: &SolveError) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::carried_active_set;
+    use crate::periodic::carried_active_set;
 
     #[test]
     fn an_active_set_moves_to_the_doubled_and_the_halved_grid() {

@@ -364,7 +364,7 @@ fn second_solve(session: &mut Option<(PeriodicSolver, Option<f64>)>, problem: &P
     }
     let m = problem.model().contacts.len();
     let k_first = first.lcp.size / m.max(1);
-    let carried = accuracy::carried_active_set(&first.active_set, m, k_first, solver.problem().instants());
+    let carried = crate::periodic::carried_active_set(&first.active_set, m, k_first, solver.problem().instants());
     solver.set_warm_start(&carried);
     let (r, _) = solve_guarded(solver, *last, f, true);
     *last = r.as_ref().ok().map(|_| f);
