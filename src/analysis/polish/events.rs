@@ -86,7 +86,9 @@ pub fn from_response(model: &Model, r: &Response, offsets: &[usize]) -> (Vec<Eve
             let s = offsets[i] as f64;
             for (a, b) in runs {
                 let len = (b + k - a) % k + 1;
-                let stick = len >= STICK_RUN;
+                // A contact on a massless DOF cannot bounce off (no impulse): its run is always a
+                // closing, a held arc and a release.
+                let stick = len >= STICK_RUN || model.contact_is_massless(c);
                 // The impulse of step a acts at about t_{a+s} (its paired instant), half a step earlier.
                 events.push(Event { contact: i, kind: EventKind::Impact { stick }, seed: t(a as f64 + s - 0.5) });
                 if stick {
