@@ -51,7 +51,7 @@ fn block_errors(p: &PeriodicProblem, orbit: &PolishedOrbit, nudge: f64) -> (f64,
     (err[0] / size[0], err[1] / size[1], jac.ncols() - n2)
 }
 
-fn check(name: &str, p: &PeriodicProblem) {
+pub(crate) fn check(name: &str, p: &PeriodicProblem) {
     let r = p.solve().unwrap();
     let orbit = polish::polish(p, &r).unwrap();
     assert!(orbit.events().len() >= 2, "{name}: the contact is touched");

@@ -60,6 +60,8 @@ mod hard_cases;
 mod lcp;
 #[path = "linear.rs"]
 mod linear;
+#[path = "massless_polish.rs"]
+mod massless_polish;
 #[path = "polish.rs"]
 mod polish;
 #[path = "props.rs"]

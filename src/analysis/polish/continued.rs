@@ -53,11 +53,11 @@ impl PolishedOrbit {
     /// the variational equations of ẏ = A y + b(t) between events, ∂y(t₁)/∂y(t₀) = e^{A(t₁−t₀)},
     /// ∂y(t₁)/∂t₀ = −e^{A(t₁−t₀)} f(t₀, y(t₀)), ∂y(t₁)/∂t₁ = f(t₁, y(t₁)) (f the phase's vector
     /// field; Hairer, Nørsett & Wanner I, §I.14), chained through the events with identity
-    /// saltation (compliant switches, see [`Self::flow_product`]). `None` with a stuck contact
-    /// or an impact or release event, or where [`Self::shooting_residual`] gives none.
+    /// saltation (compliant switches, rigid contacts on massless DOFs: see
+    /// [`Self::identity_saltation`]). `None` with an impact on a massive DOF or a stuck contact
+    /// on one, or where [`Self::shooting_residual`] gives none.
     pub fn shooting_jacobian(&self, y0: &[f64], times: &[f64]) -> Option<(DVector<f64>, DMatrix<f64>)> {
-        let compliant = self.events.iter().all(|e| matches!(e.kind, EventKind::On | EventKind::Off));
-        if !compliant || !self.phases.iter().all(|p| p.all_free()) {
+        if !self.identity_saltation() {
             return None;
         }
         let (n, ne) = (self.model.n(), self.events.len());
@@ -81,6 +81,7 @@ impl PolishedOrbit {
             let (t0, t1) = if ne == 0 { (0.0, self.period) } else { (tau[e], if e + 1 < ne { tau[e + 1] } else { tau[0] + self.period }) };
             let ex = self.phases[e].exp(t1 - t0);
             let ym = self.phases[e].flow_with(&ex, t0, &y, t1);
+            let ex = self.phases[e].transition(&ex);
             dy = &ex * dy;
             if ne > 0 {
                 let next = (e + 1) % ne;
@@ -90,11 +91,24 @@ impl PolishedOrbit {
                     dy[(r, n2 + next)] += f1[r];
                 }
                 let c = self.events[next].contact;
-                res[n2 + next] = self.clearance(c, &ym, t1);
-                for col in 0..n2 + ne {
-                    jac[(n2 + next, col)] = -self.model.contacts[c].along(|d| dy[(d, col)]);
+                if self.events[next].kind == EventKind::Release {
+                    // The held force z(y, t) is affine in y: its y-gradient times a column is
+                    // z(column) − z(0); its explicit t-derivative by central differences.
+                    let z = |y: &DVector<f64>, t: f64| self.phases[e].stuck_forces(y, t).into_iter().find(|(k, _)| *k == c).map_or(0.0, |(_, z)| z);
+                    let (zero, h) = (DVector::zeros(n2), 1e-7 * self.period);
+                    let z0 = z(&zero, t1);
+                    res[n2 + next] = z(&ym, t1);
+                    for col in 0..n2 + ne {
+                        jac[(n2 + next, col)] = z(&dy.column(col).into_owned(), t1) - z0;
+                    }
+                    jac[(n2 + next, n2 + next)] += (z(&ym, t1 + h) - z(&ym, t1 - h)) / (2.0 * h);
+                } else {
+                    res[n2 + next] = self.clearance(c, &ym, t1);
+                    for col in 0..n2 + ne {
+                        jac[(n2 + next, col)] = -self.model.contacts[c].along(|d| dy[(d, col)]);
+                    }
+                    jac[(n2 + next, n2 + next)] += self.gap(c, t1, 1);
                 }
-                jac[(n2 + next, n2 + next)] += self.gap(c, t1, 1);
             }
             y = ym;
         }
@@ -138,7 +152,7 @@ impl PolishedOrbit {
     /// Bifurcations of Non-Smooth Mechanical Systems", §7.1). `None` with a stuck contact or an
     /// impact (its velocity reset is not the identity: the relocated one-period map then).
     pub(super) fn flow_product(&self) -> Option<DMatrix<f64>> {
-        if !self.phases.iter().all(|p| p.all_free()) || self.events.iter().any(|e| matches!(e.kind, super::EventKind::Impact { .. })) {
+        if !self.identity_saltation() {
             return None;
         }
         let n2 = 2 * self.model.n();
@@ -146,9 +160,23 @@ impl PolishedOrbit {
         let mut m = DMatrix::identity(n2, n2);
         for e in 0..ne.max(1) {
             let span = if ne == 0 { self.period } else { self.end_of(e) - self.times[e] };
-            m = self.phases[e].exp(span) * m;
+            m = self.phases[e].transition(&self.phases[e].exp(span)) * m;
         }
         Some(m)
+    }
+
+    /// Every event's saltation matrix is the identity: compliant switches (see
+    /// [`Self::flow_product`]), and rigid contacts on massless DOFs closing and releasing. Such a
+    /// contact's force is zero at both (clearance 0 when it closes, force 0 when it releases), so
+    /// the condensed massless DOFs are the same either side and the massive vector field is
+    /// continuous. An impact on a massive DOF resets velocities (not the identity).
+    fn identity_saltation(&self) -> bool {
+        let massless = |i: usize| self.model.contact_is_massless(&self.model.contacts[i]);
+        let events = self.events.iter().all(|e| match e.kind {
+            EventKind::On | EventKind::Off => true,
+            EventKind::Impact { .. } | EventKind::Release => massless(e.contact),
+        });
+        events && self.phases.iter().all(|p| p.stuck_contacts().all(massless))
     }
 
     /// The time phase `e` ends (the next event's, event 0's a period later).

@@ -87,6 +87,19 @@ pub fn from_response(model: &Model, r: &Response, offsets: &[usize]) -> (Vec<Eve
             for (a, b) in runs {
                 let len = (b + k - a) % k + 1;
                 let stick = len >= STICK_RUN;
+                if model.contact_is_massless(c) {
+                    // A massless contact's force and clearance are continuous: the closing and the
+                    // release are seeded between instants by linear extrapolation of the clearance
+                    // before the run and of the force at its end (many contacts of one blade close
+                    // and release within one step: equal seeds would leave their order to Newton).
+                    let (g, f) = (&rc.gap, &rc.force);
+                    let (a1, a2, b1) = ((a + k - 1) % k, (a + k - 2) % k, (b + k - 1) % k);
+                    let close = if g[a2] > g[a1] && g[a1] > 0.0 { (g[a1] / (g[a2] - g[a1])).min(1.0) } else { 0.5 };
+                    let open = if f[b1] > f[b] && len > 1 { (f[b] / (f[b1] - f[b])).min(1.0) } else { 0.5 };
+                    events.push(Event { contact: i, kind: EventKind::Impact { stick: true }, seed: t(a1 as f64 + s + close) });
+                    events.push(Event { contact: i, kind: EventKind::Release, seed: t(b as f64 + s + open) });
+                    continue;
+                }
                 // The impulse of step a acts at about t_{a+s} (its paired instant), half a step earlier.
                 events.push(Event { contact: i, kind: EventKind::Impact { stick }, seed: t(a as f64 + s - 0.5) });
                 if stick {

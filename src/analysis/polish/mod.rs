@@ -35,10 +35,11 @@ pub struct PolishFailure(pub String);
 /// Polishes the orbit of `r` (solved from `problem`).
 pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<PolishedOrbit, PolishFailure> {
     let model = problem.model();
-    let massless = model.massless_dofs();
-    if !massless.is_empty() {
+    let damped: Vec<usize> =
+        model.massless_dofs().into_iter().filter(|&d| (0..model.n()).any(|j| model.structure.damping.as_ref().is_some_and(|c| c.get(d, j) != 0.0))).collect();
+    if !damped.is_empty() {
         return Err(PolishFailure(format!(
-            "DOFs {massless:?} are massless (a massless boundary, src/formulation.md §4.1): the polish's exact flows need every DOF to carry mass; the LCP's orbit is kept"
+            "DOFs {damped:?} are massless but damped: the polish condenses massless DOFs statically (src/formulation.md §4.1 gives them no damping); the LCP's orbit is kept"
         )));
     }
     if problem.period_multiple() != 1 {

@@ -139,6 +139,11 @@ impl PolishedOrbit {
     /// v⁺ = v⁻ − M⁻¹Bᵀ P with B v⁺ = ġ (src/formulation.md §5's forward increment, in one instant).
     fn impact(&self, i: usize, stuck: &[usize], y: &DVector<f64>, t: f64) -> Option<(DVector<f64>, f64)> {
         let n = self.model.n();
+        if self.model.contact_is_massless(&self.model.contacts[i]) {
+            // A rigid contact on a massless DOF closes without impulse (no mass to stop): the DOF
+            // follows the obstacle from here, the massive state is continuous.
+            return Some((y.clone(), 0.0));
+        }
         let mut set: Vec<usize> = stuck.to_vec();
         if !set.contains(&i) {
             set.push(i);

@@ -6,6 +6,9 @@
 //! free coordinates obey Nᵀ M N x_f'' + Nᵀ C N x_f' + Nᵀ K N x_f = Nᵀ (f − M x_c'' − C x_c' − K x_c),
 //! x_c = B_Sᵀ gap_S, whose flow is the periodic particular solution plus e^{Aτ} applied to the rest
 //! (the matrix exponential of the first-order form, as in src/formulation.md §6.2 for one DOF).
+//! Massless free coordinates x_b (a massless boundary, src/formulation.md §4.1: no mass, no
+//! damping) answer statically, K_ba x_a + K_bb x_b = g_b(t): they are condensed, the closed
+//! compliant springs on them included, and the state that flows is the massive [x_a; v_a] only.
 use crate::model::{Compliance, Model};
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64 as C;
@@ -18,7 +21,7 @@ pub(super) type Harmonics = Vec<(u32, DVector<C>)>;
 pub(super) struct Phase {
     pub n: usize,
     omega: f64,
-    /// The free coordinates' basis N (n × n_f, orthonormal columns) and the stuck contacts.
+    /// The massive free coordinates' basis N_a (n × n_a, orthonormal columns) and the stuck contacts.
     free: DMatrix<f64>,
     stuck: Vec<usize>,
     /// Rows of B of the stuck contacts, dense (|stuck| × n).
@@ -40,8 +43,13 @@ pub(super) struct Phase {
     /// ‖Â‖₁, which sets the Taylor substeps of a short flow ([`Phase::flow`]).
     a_norm: f64,
     mff_inv: DMatrix<f64>,
-    /// Particular periodic solution of the free state [x_f; v_f].
+    /// Particular periodic solution of the massive free state [x_a; v_a].
     part: Harmonics,
+    /// The massless free coordinates' basis N_b (n × n_b), their static condensation
+    /// x_b = S x_a + (particular part), S = −K_bb⁻¹ K_ba, and their particular solution X_b.
+    slave: DMatrix<f64>,
+    slave_map: DMatrix<f64>,
+    slave_part: Harmonics,
 }
 
 /// The longest span ‖Â τ‖₁ that [`Phase::flow`] takes by the Taylor action rather than the
@@ -124,52 +132,88 @@ impl Phase {
             }
         }
         let b_stuck = DMatrix::from_fn(stuck.len(), n, |r, d| model.contacts[stuck[r]].row.iter().find(|e| e.0 == d).map_or(0.0, |e| e.1));
-        let free = null_basis(model, stuck);
-        let nf = free.ncols();
-        let sub = |a: &DMatrix<f64>| free.transpose() * a * &free;
-        let mff_inv = if nf == 0 { DMatrix::zeros(0, 0) } else { sub(&m).try_inverse()? };
+        let all = null_basis(model, stuck);
+        let ff = |a: &DMatrix<f64>| all.transpose() * a * &all;
+        let (m_ff, c_ff, k_ff) = (ff(&m), ff(&c), ff(&k));
+        // Massless free coordinates (a massless boundary, src/formulation.md §4.1): no mass and
+        // no damping, condensed statically; a column mixing mass and no mass is not supported.
+        let massless: Vec<usize> = (0..all.ncols()).filter(|&j| m_ff.column(j).iter().all(|v| *v == 0.0)).collect();
+        let massive: Vec<usize> = (0..all.ncols()).filter(|j| !massless.contains(j)).collect();
+        if massless.iter().any(|&j| c_ff.column(j).iter().any(|v| *v != 0.0)) {
+            return None;
+        }
+        let (free, slave) = (all.select_columns(&massive), all.select_columns(&massless));
+        let (nf, nb) = (massive.len(), massless.len());
+        let k_bb = k_ff.select_rows(&massless).select_columns(&massless);
+        let k_ba = k_ff.select_rows(&massless).select_columns(&massive);
+        let slave_map = if nb == 0 { DMatrix::zeros(0, nf) } else { -k_bb.lu().solve(&k_ba)? };
+        // K_aa − K_ab K_bb⁻¹ K_ba: the massive coordinates' condensed stiffness (Guyan's, exact
+        // here since the condensed DOFs carry no inertia).
+        let k_cond = k_ff.select_rows(&massive).select_columns(&massive) + k_ff.select_rows(&massive).select_columns(&massless) * &slave_map;
+        let sub = |a: &DMatrix<f64>| a.select_rows(&massive).select_columns(&massive);
+        let mff_inv = if nf == 0 { DMatrix::zeros(0, 0) } else { sub(&m_ff).try_inverse()? };
         let mut a = DMatrix::zeros(2 * nf, 2 * nf);
         let mut speed = 1.0;
         if nf > 0 {
-            let mk = -&mff_inv * sub(&k);
+            let mk = -&mff_inv * &k_cond;
             let norm = mk.row_iter().map(|r| r.iter().map(|v| v.abs()).sum::<f64>()).fold(0.0, f64::max);
             speed = if norm > 0.0 && norm.is_finite() { norm.sqrt() } else { 1.0 };
             a.view_mut((0, nf), (nf, nf)).fill_with_identity();
             a.view_mut((nf, 0), (nf, nf)).copy_from(&mk);
-            a.view_mut((nf, nf), (nf, nf)).copy_from(&(-&mff_inv * sub(&c)));
+            a.view_mut((nf, nf), (nf, nf)).copy_from(&(-&mff_inv * sub(&c_ff)));
         }
-        // Free forcing per harmonic: f_f − (−(pω)² M_f· + ipω C_f· + K_f·) x_presc.
+        // Free forcing per harmonic: g = Nᵀ(f − (−(pω)² M + ipω C + K) x_presc); the free
+        // coordinates' periodic answer X solves (−(pω)² M_ff + ipω C_ff + K_ff) X = g.
         let mut ps: Vec<u32> = force.iter().chain(&presc).map(|(p, _)| *p).collect();
         ps.sort_unstable();
         ps.dedup();
-        let mut part = Vec::new();
-        let ac = a.map(|v| C::new(v, 0.0));
+        let (mut part, mut slave_part) = (Vec::new(), Vec::new());
+        let cplx = |a: &DMatrix<f64>, s: f64| a.map(|v| C::new(s * v, 0.0));
         for p in ps {
             let w = p as f64 * omega;
             let fp = force.iter().find(|(q, _)| *q == p).map_or_else(|| DVector::zeros(n), |(_, v)| v.clone());
             let xp = presc.iter().find(|(q, _)| *q == p).map_or_else(|| DVector::zeros(n), |(_, v)| v.clone());
-            let dyn_op = m.map(|v| C::new(-w * w * v, 0.0)) + c.map(|v| C::new(0.0, w * v)) + k.map(|v| C::new(v, 0.0));
-            let rhs = fp - dyn_op * xp;
-            let g = free.map(|v| C::new(v, 0.0)).transpose() * rhs;
-            let acc = mff_inv.map(|v| C::new(v, 0.0)) * g;
-            let mut b = DVector::zeros(2 * nf);
-            if nf > 0 {
-                b.rows_mut(nf, nf).copy_from(&acc);
-            }
-            let op = DMatrix::from_diagonal_element(2 * nf, 2 * nf, C::new(0.0, w)) - &ac;
-            let y = if nf == 0 { b } else { op.lu().solve(&b)? };
-            if !y.iter().all(|v| v.re.is_finite() && v.im.is_finite()) {
+            let dyn_op = cplx(&m, -w * w) + c.map(|v| C::new(0.0, w * v)) + cplx(&k, 1.0);
+            let g = cplx(&all, 1.0).transpose() * (fp - dyn_op * xp);
+            let op = cplx(&m_ff, -w * w) + c_ff.map(|v| C::new(0.0, w * v)) + cplx(&k_ff, 1.0);
+            let x = if g.is_empty() { g } else { op.lu().solve(&g)? };
+            if !x.iter().all(|v| v.re.is_finite() && v.im.is_finite()) {
                 return None;
             }
+            let xa = x.select_rows(&massive);
+            let mut y = DVector::zeros(2 * nf);
+            y.rows_mut(0, nf).copy_from(&xa);
+            y.rows_mut(nf, nf).copy_from(&(xa * C::new(0.0, w)));
             part.push((p, y));
+            slave_part.push((p, x.select_rows(&massless)));
         }
-        // The particular solution above uses the unbalanced A; the exponential the balanced one.
+        // A was built in [x; v]; the exponential takes the balanced one (see `exp`).
         if nf > 0 {
             a.view_mut((0, nf), (nf, nf)).scale_mut(speed);
             a.view_mut((nf, 0), (nf, nf)).scale_mut(1.0 / speed);
         }
         let a_norm = a.column_iter().map(|c| c.iter().map(|v| v.abs()).sum::<f64>()).fold(0.0, f64::max);
-        Some(Phase { n, omega, free, stuck: stuck.to_vec(), b_stuck, closed: closed.to_vec(), m, c, k, force, presc, a, speed, a_norm, mff_inv, part })
+        Some(Phase {
+            n,
+            omega,
+            free,
+            stuck: stuck.to_vec(),
+            b_stuck,
+            closed: closed.to_vec(),
+            m,
+            c,
+            k,
+            force,
+            presc,
+            a,
+            speed,
+            a_norm,
+            mff_inv,
+            part,
+            slave,
+            slave_map,
+            slave_part,
+        })
     }
 
     /// Whether compliant contact `i` is closed in this phase.
@@ -180,11 +224,6 @@ impl Phase {
     /// The phase's fastest rate [rad/s] (the balancing speed, ≥ its ω_max): for sampling.
     pub fn speed_hint(&self) -> f64 {
         self.speed
-    }
-
-    /// No contact is stuck: the exponential acts on the whole state [x; v].
-    pub fn all_free(&self) -> bool {
-        self.stuck.is_empty()
     }
 
     pub fn stuck_contacts(&self) -> impl Iterator<Item = usize> + '_ {
@@ -205,7 +244,7 @@ impl Phase {
         e
     }
 
-    /// [Nᵀ x; Nᵀ v] of the full state [x; v].
+    /// [N_aᵀ x; N_aᵀ v] of the full state [x; v]: the massive free coordinates.
     fn free_state(&self, y: &DVector<f64>) -> DVector<f64> {
         let (n, nf) = (self.n, self.free.ncols());
         let mut out = DVector::zeros(2 * nf);
@@ -215,7 +254,7 @@ impl Phase {
     }
 
     /// The full state [x; v] at `t1`, from the full state `y0` at `t0` (stuck DOFs of `y0` are
-    /// ignored: they follow the obstacle); `e` is `self.exp(t1 − t0)`.
+    /// ignored: they follow the obstacle; so are massless DOFs: condensed); `e` is `self.exp(t1 − t0)`.
     pub fn flow_with(&self, e: &DMatrix<f64>, t0: f64, y0: &DVector<f64>, t1: f64) -> DVector<f64> {
         let nf2 = 2 * self.free.ncols();
         let p0 = eval(&self.part, self.omega, t0, 0, nf2);
@@ -264,32 +303,74 @@ impl Phase {
         u
     }
 
-    /// [x_c + N x_f; v_c + N v_f].
+    /// [x_c + N_a x_a + N_b x_b; v_c + N_a v_a + N_b v_b], the massless coordinates condensed:
+    /// x_b = X_b(t) + S (x_a − X_a(t)) (the particular solution and S = −K_bb⁻¹ K_ba).
     fn assemble(&self, yf: &DVector<f64>, t: f64) -> DVector<f64> {
         let (n, nf) = (self.n, self.free.ncols());
         let mut y = DVector::zeros(2 * n);
-        let x = eval(&self.presc, self.omega, t, 0, n) + &self.free * yf.rows(0, nf);
-        let v = eval(&self.presc, self.omega, t, 1, n) + &self.free * yf.rows(nf, nf);
+        let mut x = eval(&self.presc, self.omega, t, 0, n) + &self.free * yf.rows(0, nf);
+        let mut v = eval(&self.presc, self.omega, t, 1, n) + &self.free * yf.rows(nf, nf);
+        if self.slave.ncols() > 0 {
+            let (nb, pa) = (self.slave.ncols(), eval(&self.part, self.omega, t, 0, 2 * nf));
+            let xb = eval(&self.slave_part, self.omega, t, 0, nb) + &self.slave_map * (yf.rows(0, nf) - pa.rows(0, nf));
+            let vb = eval(&self.slave_part, self.omega, t, 1, nb) + &self.slave_map * (yf.rows(nf, nf) - pa.rows(nf, nf));
+            x += &self.slave * xb;
+            v += &self.slave * vb;
+        }
         y.rows_mut(0, n).copy_from(&x);
         y.rows_mut(n, n).copy_from(&v);
         y
     }
 
-    /// Acceleration of every DOF in state `y` at `t`.
+    /// `y` with its stuck DOFs on the obstacle and its massless DOFs condensed from its massive
+    /// ones at `t`, as the flow takes it (a Newton iterate's entries there are free unknowns,
+    /// and a state just before a massless contact closes has that DOF off the obstacle).
+    fn condensed(&self, y: &DVector<f64>, t: f64) -> DVector<f64> {
+        if self.slave.ncols() == 0 && self.stuck.is_empty() { y.clone() } else { self.assemble(&self.free_state(y), t) }
+    }
+
+    /// The derivative of the full state at the phase's end by the full state at its start,
+    /// 2n × 2n, from `e` = `self.exp(τ)`: L e R with R = diag(N_aᵀ, N_aᵀ) and
+    /// L = diag(N_a + N_b S, N_a + N_b S) (stuck DOFs follow the obstacle, massless ones their
+    /// condensation: neither carries state). `e` itself when every DOF is free and massive.
+    pub fn transition(&self, e: &DMatrix<f64>) -> DMatrix<f64> {
+        let (n, nf) = (self.n, self.free.ncols());
+        if self.stuck.is_empty() && self.slave.ncols() == 0 {
+            return e.clone();
+        }
+        let lift = &self.free + &self.slave * &self.slave_map;
+        let mut out = DMatrix::zeros(2 * n, 2 * n);
+        for (r, c) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
+            let block = &lift * e.view((r * nf, c * nf), (nf, nf)) * self.free.transpose();
+            out.view_mut((r * n, c * n), (n, n)).copy_from(&block);
+        }
+        out
+    }
+
+    /// Acceleration of every DOF in state `y` at `t` (its massless DOFs condensed first).
     pub fn acceleration(&self, y: &DVector<f64>, t: f64) -> DVector<f64> {
         let n = self.n;
+        let y = self.condensed(y, t);
         let (x, v) = (y.rows(0, n).into_owned(), y.rows(n, n).into_owned());
         let acc = eval(&self.presc, self.omega, t, 2, n);
         let rhs = eval(&self.force, self.omega, t, 0, n) - &self.c * &v - &self.k * &x - &self.m * &acc;
         let af = &self.mff_inv * (self.free.transpose() * rhs);
-        acc + &self.free * af
+        let mut out = acc + &self.free * &af;
+        if self.slave.ncols() > 0 {
+            // ẍ_b = Ẍ_b(t) + S (ẍ_a − Ẍ_a(t)).
+            let nf = self.free.ncols();
+            let pa = eval(&self.part, self.omega, t, 1, 2 * nf);
+            out += &self.slave * (eval(&self.slave_part, self.omega, t, 2, self.slave.ncols()) + &self.slave_map * (af - pa.rows(nf, nf)));
+        }
+        out
     }
 
     /// Compressive force of each stuck contact (contact index, force) in state `y` at `t`:
     /// z = B_S (f − M a − C v − K x) (the residual is B_Sᵀ z, and B_S B_Sᵀ = I).
     pub fn stuck_forces(&self, y: &DVector<f64>, t: f64) -> Vec<(usize, f64)> {
         let n = self.n;
-        let acc = self.acceleration(y, t);
+        let y = self.condensed(y, t);
+        let acc = self.acceleration(&y, t);
         let (x, v) = (y.rows(0, n).into_owned(), y.rows(n, n).into_owned());
         let r = eval(&self.force, self.omega, t, 0, n) - &self.m * acc - &self.c * v - &self.k * x;
         let z = &self.b_stuck * r;

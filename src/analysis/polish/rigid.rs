@@ -48,7 +48,10 @@ impl PolishedOrbit {
             }
         };
         for (e, (&p, ev)) in self.impulses.iter().zip(&self.events).enumerate() {
-            if let EventKind::Impact { stick } = ev.kind {
+            // A massless contact closes without impulse: its margins are its clearance and force.
+            if let EventKind::Impact { stick } = ev.kind
+                && !model.contact_is_massless(&model.contacts[ev.contact])
+            {
                 keep(p * model.frequency / fs, ev.contact, "impulse of the impact", self.times[e], Some(e));
                 if !stick {
                     // The force that would hold the contact just after a pure impact (≤ 0 for a pure impact).

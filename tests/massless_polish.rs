@@ -1,0 +1,100 @@
+//! The event-fitted polish on models with a massless DOF (a massless boundary, src/formulation.md
+//! §4.1), against closed forms: a mass on a spring k1 with a massless contact point behind a
+//! spring k2. The point answers statically, so the mass sees the 1-DOF stop of
+//! `exact::CompliantStopOrbit` (src/formulation.md §6.2) with the series stiffness
+//! k_c k2 / (k_c + k2) against a compliant stop k_c, and with k2 itself against a rigid stop (the
+//! point then rests on the obstacle: no impact, a held arc and a release). The same model as
+//! validation/test_exact_flow.py::test_massless_contact_point_is_a_series_spring.
+use periodic_contact::analysis::polish;
+use periodic_contact::exact::{CompliantStopOrbit, Oscillator};
+use periodic_contact::model::{Compliance, Contact, Force, Harmonic, Matrix, Model, Structure};
+use periodic_contact::periodic::{OutputSelection, PeriodicProblem, SolverSettings};
+use periodic_contact::time::{Discretization, Scheme};
+
+const M: f64 = 1.0;
+const C: f64 = 0.05;
+const K1: f64 = 1.0;
+const K2: f64 = 30.0;
+const G0: f64 = 1.0;
+const F: f64 = 1.0;
+const OMEGA: f64 = 1.3;
+
+/// The mass (DOF 0) on k1, the massless point (DOF 1) behind k2, the stop on the point.
+fn point_model(compliance: Compliance) -> Model {
+    let rows = |a: [[f64; 2]; 2]| Matrix::from_rows(&a.iter().map(|r| r.to_vec()).collect::<Vec<_>>());
+    Model {
+        structure: Structure { mass: rows([[M, 0.0], [0.0, 0.0]]), stiffness: rows([[K1 + K2, -K2], [-K2, K2]]), damping: Some(rows([[C, 0.0], [0.0, 0.0]])) },
+        forces: vec![Force { dof: 0, term: Harmonic { amplitude: F, harmonic: 1, phase: 0.0 } }],
+        contacts: vec![Contact::on_dof(1, 1.0, G0, compliance)],
+        frequency: OMEGA,
+        frictions: Vec::new(),
+        rubbing: Vec::new(),
+    }
+}
+
+/// Polishes the cds answer at k = 256 and returns the largest errors of the mass and of the
+/// point against the closed form (over its peak-to-peak), the events and the orbit.
+fn check(compliance: Compliance, stop_stiffness: f64, point: impl Fn(f64) -> f64) -> (f64, f64, usize, polish::PolishedOrbit) {
+    let exact = CompliantStopOrbit::solve(&Oscillator::new(M, C, K1, F, OMEGA), stop_stiffness, G0, None).unwrap();
+    assert!(exact.has_contact());
+    let outputs = OutputSelection { displacement: vec![0, 1], velocity: vec![0], acceleration: vec![], contacts: true };
+    let disc = Discretization { scheme: Scheme::Cds, steps: 256, pairing: None };
+    let p = PeriodicProblem::new(point_model(compliance), disc, outputs, SolverSettings::default()).unwrap();
+    let mut r = p.solve().unwrap();
+    let orbit = polish::apply(&p, &mut r);
+    let s = r.polish.clone().unwrap();
+    assert_eq!(s.status, "polished", "fell back: {}", s.reason);
+    let (mut ex, mut ep) = (0.0f64, 0.0f64);
+    for (j, &t) in r.time.iter().enumerate() {
+        let (x, v, _) = exact.eval(t);
+        ex = ex.max((r.displacement["0"][j] - x).abs()).max((r.velocity["0"][j] - v).abs() / OMEGA);
+        ep = ep.max((r.displacement["1"][j] - point(x)).abs());
+    }
+    let ptp = exact.peak_to_peak();
+    // The monodromy of the massive state [x_0; v_0] is the closed form's (the massless DOF adds
+    // two zero multipliers): every switch's saltation is the identity (src/analysis/polish/continued.rs).
+    let orbit = orbit.expect("polished");
+    let mut got: Vec<num_complex::Complex64> = orbit.monodromy().complex_eigenvalues().iter().copied().filter(|z| z.norm() > 1e-9).collect();
+    let mut want = exact.floquet_multipliers().to_vec();
+    let key = |c: &num_complex::Complex64| (c.norm(), c.im);
+    got.sort_by(|a, b| key(a).partial_cmp(&key(b)).unwrap());
+    want.sort_by(|a, b| key(a).partial_cmp(&key(b)).unwrap());
+    eprintln!("massless point, {compliance:?}: mass {:.2e}, point {:.2e} of ptp; events {:?}; multipliers {got:?} vs {want:?}", ex / ptp, ep / ptp, s.events);
+    assert_eq!(got.len(), 2, "two nonzero multipliers: {got:?}");
+    for (g, w) in got.iter().zip(&want) {
+        assert!((g - w).norm() < 1e-7 * w.norm().max(1e-3), "multiplier {g} vs closed form {w}");
+    }
+    (ex / ptp, ep / ptp, s.events.len(), orbit)
+}
+
+#[test]
+fn a_massless_point_on_a_compliant_stop_is_the_series_spring_orbit() {
+    let kc = 15.0;
+    // In contact the point sits where the springs balance: k2 (p − x) + k_c (p − g0) = 0.
+    let (ex, ep, events, _) = check(Compliance::Compliant { stiffness: kc }, kc * K2 / (kc + K2), |x| if x > G0 { (K2 * x + kc * G0) / (K2 + kc) } else { x });
+    assert_eq!(events, 2, "contact on, off");
+    assert!(ex < 1e-12 && ep < 1e-12, "mass {ex:.2e}, point {ep:.2e}");
+}
+
+#[test]
+fn a_massless_point_on_a_rigid_stop_is_the_stop_spring_orbit() {
+    let (ex, ep, events, orbit) = check(Compliance::Rigid, K2, |x| x.min(G0));
+    assert_eq!(events, 2, "closing (no impulse), release");
+    assert!(ex < 1e-12 && ep < 1e-12, "mass {ex:.2e}, point {ep:.2e}");
+    // The closing carries no impulse and the held arc a compressive force k2 (x − g0).
+    assert!(orbit.event_records().iter().all(|e| e.impulse == 0.0));
+}
+
+/// The exact walk's variational Jacobian (its state columns lifted through the condensation,
+/// a held arc's release row from the affine held force) against central differences of the
+/// shooting residual (tests/exact_jacobian.rs), on the compliant and the rigid point.
+#[test]
+fn variational_jacobian_matches_central_differences_with_a_massless_point() {
+    for (name, compliance) in [("massless point, compliant stop", Compliance::Compliant { stiffness: 15.0 }), ("massless point, rigid stop", Compliance::Rigid)]
+    {
+        let outputs = OutputSelection { displacement: vec![0], velocity: vec![], acceleration: vec![], contacts: true };
+        let disc = Discretization { scheme: Scheme::Cds, steps: 256, pairing: None };
+        let p = PeriodicProblem::new(point_model(compliance), disc, outputs, SolverSettings::default()).unwrap();
+        crate::exact_jacobian::check(name, &p);
+    }
+}
