@@ -39,6 +39,6 @@ pub use policy::{
 pub use reference::solve_by_enumeration;
 pub use status::{LcpInfo, LcpOutcome, LcpSolution, LcpStep, WarmOutcome, residuals};
 pub use structured::{
-    CirculantOperator, DenseLu, MAX_PAIRS, ShootingOutcome, ShootingSettings, ShootingSolution, StepMapData, StepMapError, StepMapLcp, dense_product,
-    solve_shooting,
+    CirculantOperator, DenseLu, MAX_PAIRS, ShootingOutcome, ShootingReach, ShootingSettings, ShootingSolution, StepMapData, StepMapError, StepMapLcp,
+    dense_product, solve_shooting,
 };

@@ -1,7 +1,7 @@
 //! The LCP policy: which method solves a block-circulant LCP, and the fallbacks (`auto`).
 //! Shared by the engine and by `periodic-contact lcp`, so it knows nothing of mechanics.
 use super::status::{evaluate, recheck_exactly};
-use super::structured::{ShootingOutcome, ShootingSettings, StepMapLcp, solve_shooting};
+use super::structured::{ShootingOutcome, ShootingReach, ShootingSettings, StepMapLcp, solve_shooting};
 use super::{BlockCirculant, BlockPivoting, CirculantOperator, LcpOutcome, LcpSolution, LcpStep, Lemke, LemkeSettings, PivotingSettings, WarmOutcome};
 use std::time::Instant;
 
@@ -121,11 +121,11 @@ pub fn solve_periodic_lcp(
     tolerance: f64,
     warm_start: Option<&[usize]>,
 ) -> (LcpSolution, Option<Vec<f64>>) {
-    solve_periodic_lcp_with(a, q, step_map, method, tolerance, warm_start, false)
+    solve_periodic_lcp_with(a, q, step_map, method, tolerance, warm_start, ShootingReach::FULL)
 }
 
-/// [`solve_periodic_lcp`]; `warm_only`: shooting with a warm start stops where Newton from it
-/// misses ([`ShootingSettings::warm_only`]).
+/// [`solve_periodic_lcp`]; `reach`: what shooting may try beyond Newton from the warm start
+/// ([`ShootingReach`]: a guarded sweep's quick tries).
 pub fn solve_periodic_lcp_with(
     a: &BlockCirculant,
     q: &[f64],
@@ -133,7 +133,7 @@ pub fn solve_periodic_lcp_with(
     method: LcpMethod,
     tolerance: f64,
     warm_start: Option<&[usize]>,
-    warm_only: bool,
+    reach: ShootingReach,
 ) -> (LcpSolution, Option<Vec<f64>>) {
     if q.is_empty() {
         return (LcpSolution { outcome: LcpOutcome::Solved, z: vec![], w: vec![], info: Default::default() }, None);
@@ -190,7 +190,8 @@ pub fn solve_periodic_lcp_with(
             // bounds each try.
             let defaults = ShootingSettings::default();
             let max_work = if method == LcpMethod::Auto && dense_ok { defaults.max_work.max(0.5 * (q.len() as f64).powi(3)) } else { defaults.max_work };
-            let (sol, state) = shooting(a, q, sm, tolerance, warm_start, &ShootingSettings { max_work, warm_only, ..defaults });
+            let (sol, state) =
+                shooting(a, q, sm, tolerance, warm_start, &ShootingSettings { max_work, warm_only: reach.warm_only, homotopy: reach.homotopy, ..defaults });
             if sol.outcome == LcpOutcome::Solved || method == LcpMethod::Shooting || !dense_ok {
                 return (sol, state);
             }

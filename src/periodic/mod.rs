@@ -87,11 +87,14 @@ pub struct SolverSettings {
     /// Shooting from a warm start stops where Newton from it misses, without the contact-free
     /// start and the offset homotopy (a guarded sweep's quick tries; default off).
     pub shooting_warm_only: bool,
+    /// Shooting may follow the offset homotopy when Newton misses (default on; off for a
+    /// guarded sweep's cold try inside a run of failed points).
+    pub shooting_homotopy: bool,
 }
 
 impl Default for SolverSettings {
     fn default() -> Self {
-        SolverSettings { method: LcpMethod::Auto, tolerance: 1e-9, parallel: true, shooting_warm_only: false }
+        SolverSettings { method: LcpMethod::Auto, tolerance: 1e-9, parallel: true, shooting_warm_only: false, shooting_homotopy: true }
     }
 }
 

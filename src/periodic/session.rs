@@ -195,9 +195,20 @@ impl PeriodicSolver {
     /// start alone (no contact-free start nor offset homotopy: those are the cold try's). The
     /// answer's active set becomes the next warm start, as in [`Self::solve`].
     pub fn solve_by_shooting(&mut self, warm: bool) -> Result<Response, SolveError> {
+        self.solve_by_shooting_with(warm, true)
+    }
+
+    /// [`Self::solve_by_shooting`]; `homotopy` off: a cold try ends where Newton from the
+    /// contact-free orbit misses (no offset homotopy, which can cost seconds).
+    pub fn solve_by_shooting_with(&mut self, warm: bool, homotopy: bool) -> Result<Response, SolveError> {
         let settings = self.problem.solver_settings().clone();
         let guess = self.warm_start.clone().filter(|_| warm && self.warm_starts);
-        let quick = super::SolverSettings { method: crate::lcp::LcpMethod::Shooting, shooting_warm_only: guess.is_some(), ..settings.clone() };
+        let quick = super::SolverSettings {
+            method: crate::lcp::LcpMethod::Shooting,
+            shooting_warm_only: guess.is_some(),
+            shooting_homotopy: homotopy,
+            ..settings.clone()
+        };
         self.problem.set_solver_settings(quick)?;
         let result = self.solve_cached(guess.as_deref());
         self.problem.set_solver_settings(settings)?;

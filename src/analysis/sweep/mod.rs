@@ -14,6 +14,7 @@
 //! and one chunk (`--threads 1 --chunks-per-thread 1`).
 #[cfg(feature = "reference")]
 pub mod marching;
+mod refine;
 pub mod spectrum;
 
 use crate::analysis::{accuracy, continuation};
@@ -35,11 +36,16 @@ pub struct SweepSettings {
     /// Estimate every point's error ([`crate::analysis::accuracy`]): a second, warm-started
     /// sweep at k/2 (or 2k where k/2 breaks the scheme's limit) beside the first.
     pub estimate: bool,
+    /// Refine every point whose estimate exceeds this (relative to the peak-to-peak amplitude):
+    /// k → 2k while it does, up to `max_steps` ([`refine`]). Needs `estimate`.
+    pub tolerance: Option<f64>,
+    /// The largest k of a refinement.
+    pub max_steps: usize,
 }
 
 impl Default for SweepSettings {
     fn default() -> Self {
-        SweepSettings { warm_start: true, threads: 0, chunks_per_thread: 4, estimate: false }
+        SweepSettings { warm_start: true, threads: 0, chunks_per_thread: 4, estimate: false, tolerance: None, max_steps: 4096 }
     }
 }
 
@@ -58,6 +64,8 @@ pub struct SweepPoint {
     /// Fraction of the instants with a force, per contact.
     pub contact_fraction: Vec<f64>,
     pub lcp_size: usize,
+    /// Instants per period of the point's answer (the scene's k, or a refinement's).
+    pub steps: usize,
     /// Pivots (or block exchanges plus pivots) of the point's final solve.
     pub pivots: usize,
     /// The solve started from the previous point's active set.
@@ -96,6 +104,7 @@ impl SweepPoint {
             max_force: r.contacts.iter().map(|c| c.force.iter().copied().fold(0.0, f64::max)).collect(),
             contact_fraction: (0..r.contacts.len()).map(|i| r.contact_fraction(i)).collect(),
             lcp_size: r.lcp.size,
+            steps: problem.discretization().steps,
             pivots: r.lcp.pivots,
             warm_start_used: false,
             cold_fallback: false,
@@ -168,6 +177,7 @@ pub fn run(
                 let mut solver = session.clone();
                 // The second grid of the error estimates, warm-started along the chunk too.
                 let mut second: Option<(PeriodicSolver, Option<f64>)> = None;
+                let mut levels = refine::Levels::new();
                 let mut out = Vec::with_capacity(hi - lo);
                 let mut last: Option<(f64, Response)> = None;
                 // Guarded: the last solved frequency, kept past a failure with its active sets
@@ -181,7 +191,12 @@ pub fn run(
                     let t = Instant::now();
                     let mut substeps = 0;
                     let mut r = if guarded {
-                        let (r, n) = solve_guarded(&mut solver, last_solved, f, true);
+                        // Inside a run of failures (past a fold) the cold try stops before the
+                        // offset homotopy: there it missed after 70–100 kinks (2–5 s each), while
+                        // the branch beyond (2473 rad/s) is reached by Newton from the
+                        // contact-free orbit; the refill then follows it back over the run.
+                        let cold = if last.is_none() && last_solved.is_some() { ColdTry::WithoutHomotopy } else { ColdTry::Full };
+                        let (r, n) = solve_guarded(&mut solver, last_solved, f, cold);
                         substeps = n;
                         r
                     } else {
@@ -206,6 +221,7 @@ pub fn run(
                     point.cold_fallback = solver.last_start() == WarmStart::ColdFallback;
                     if let Ok(r) = &r {
                         estimate(&mut point, &solver, r, &mut second, settings);
+                        refine::refine(&mut point, solver.problem(), r, &mut levels, settings);
                     }
                     point.time_s = t.elapsed().as_secs_f64();
                     match r {
@@ -242,9 +258,9 @@ pub fn refill(template: &PeriodicProblem, points: &mut [SweepPoint], settings: &
         return;
     }
     let mut solver = PeriodicSolver::new(template.clone());
-    let mut second = None;
+    let (mut second, mut levels) = (None, refine::Levels::new());
     for reverse in [true, false] {
-        refill_pass(&mut solver, &mut second, settings, points, reverse);
+        refill_pass(&mut solver, (&mut second, &mut levels), settings, points, reverse);
     }
 }
 
@@ -266,7 +282,7 @@ fn estimate(point: &mut SweepPoint, solver: &PeriodicSolver, r: &Response, secon
 /// down to those points in a few Newton iterations each. A point still missed keeps its failure.
 fn refill_pass(
     solver: &mut PeriodicSolver,
-    second: &mut Option<(PeriodicSolver, Option<f64>)>,
+    (second, levels): (&mut Option<(PeriodicSolver, Option<f64>)>, &mut refine::Levels),
     settings: &SweepSettings,
     points: &mut [SweepPoint],
     reverse: bool,
@@ -281,13 +297,14 @@ fn refill_pass(
         let t = Instant::now();
         let f = points[i].frequency;
         solver.set_warm_start(&points[j].active_set);
-        let (r, substeps) = solve_guarded(solver, Some(points[j].frequency), f, false);
+        let (r, substeps) = solve_guarded(solver, Some(points[j].frequency), f, ColdTry::No);
         let before = points[i].time_s;
         match r {
             Ok(r) => {
                 let mut point = SweepPoint::from_response(solver.problem(), f, &r);
                 (point.substeps, point.warm_start_used) = (substeps, true);
                 estimate(&mut point, solver, &r, second, settings);
+                refine::refine(&mut point, solver.problem(), &r, levels, settings);
                 point.time_s = before + t.elapsed().as_secs_f64();
                 points[i] = point;
                 neighbour = Some(i);
@@ -295,6 +312,15 @@ fn refill_pass(
             Err(_) => points[i].time_s = before + t.elapsed().as_secs_f64(),
         }
     }
+}
+
+/// The last try of [`solve_guarded`]: none, cold shooting, or cold shooting without its offset
+/// homotopy (Newton from the contact-free orbit alone).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum ColdTry {
+    No,
+    Full,
+    WithoutHomotopy,
 }
 
 /// Halvings of the ω step when a sub-step misses: down to 1/16 of the sweep's step.
@@ -307,8 +333,8 @@ const SUBSTEP_HALVINGS: u32 = 4;
 /// warm-started from the previous); then cold shooting. Never the dense fallback: a point still
 /// missed is a typed failure naming the cause and the remedy, and the sweep goes on. Each try
 /// is bounded by shooting's work budget. Returns the answer and the sub-steps solved before it.
-/// `cold`: end with cold shooting (else a miss after the sub-steps is the failure).
-fn solve_guarded(solver: &mut PeriodicSolver, last: Option<f64>, f: f64, cold: bool) -> (Result<Response, SolveError>, usize) {
+/// `cold`: how to end ([`ColdTry`]; `No`: a miss after the sub-steps is the failure).
+fn solve_guarded(solver: &mut PeriodicSolver, last: Option<f64>, f: f64, cold: ColdTry) -> (Result<Response, SolveError>, usize) {
     let at = |solver: &mut PeriodicSolver, w: f64, warm: bool| solver.update_frequency(w).and_then(|()| solver.solve_by_shooting(warm));
     let had_warm = solver.warm_start().is_some();
     let first = match at(solver, f, true) {
@@ -332,13 +358,18 @@ fn solve_guarded(solver: &mut PeriodicSolver, last: Option<f64>, f: f64, cold: b
         }
     }
     // Cold shooting, unless the first try already was.
-    let cold = if had_warm && cold { at(solver, f, false) } else { Err(first) };
-    match cold {
+    let last_try = match cold {
+        ColdTry::Full if had_warm => at(solver, f, false),
+        ColdTry::WithoutHomotopy => solver.update_frequency(f).and_then(|()| solver.solve_by_shooting_with(false, false)),
+        _ => Err(first),
+    };
+    match last_try {
         Ok(r) => (Ok(r), substeps),
         Err(SolveError::Lcp { outcome, info, .. }) => {
-            let from = last.map_or_else(|| "no solved point before it".to_string(), |f0| format!("{substeps} ω sub-steps from {f0} rad/s"));
+            let how = if cold == ColdTry::WithoutHomotopy { " (without the offset homotopy: the point before failed too)" } else { "" };
+            let from = last.map_or_else(|| "no solved point just before it".to_string(), |f0| format!("{substeps} ω sub-steps from {f0} rad/s"));
             let hint = format!(
-                "shooting missed ω = {f} rad/s from the last point's active sets, after {from}, and cold; the sweep skips the dense fallback above N = {LEMKE_AFTER_SHOOTING_MAX} (block pivoting then Lemke: minutes); remedies: more --points (a smaller ω step), or `periodic-contact solve SCENE --frequency {f}` for this point alone (it runs the dense fallback)"
+                "shooting missed ω = {f} rad/s from the last point's active sets, after {from}, and cold{how}; the sweep skips the dense fallback above N = {LEMKE_AFTER_SHOOTING_MAX} (block pivoting then Lemke: minutes); remedies: more --points (a smaller ω step), or `periodic-contact solve SCENE --frequency {f}` for this point alone (it runs the dense fallback)"
             );
             (Err(SolveError::Lcp { outcome, info, hint }), substeps)
         }
@@ -366,7 +397,7 @@ fn second_solve(session: &mut Option<(PeriodicSolver, Option<f64>)>, problem: &P
     let k_first = first.lcp.size / m.max(1);
     let carried = crate::periodic::carried_active_set(&first.active_set, m, k_first, solver.problem().instants());
     solver.set_warm_start(&carried);
-    let (r, _) = solve_guarded(solver, *last, f, true);
+    let (r, _) = solve_guarded(solver, *last, f, ColdTry::Full);
     *last = r.as_ref().ok().map(|_| f);
     r
 }
@@ -414,7 +445,7 @@ pub fn to_csv(param: &str, values: &[f64], problem: &PeriodicProblem, points: &[
     let contact_dofs = contact_labels(problem);
     head.extend(contact_dofs.iter().enumerate().map(|(i, d)| format!("max_force_c{i}_dof{d} {kn}")));
     head.extend(contact_dofs.iter().enumerate().map(|(i, d)| format!("contact_fraction_c{i}_dof{d}")));
-    head.extend(["lcp_size", "pivots", "warm_start_used", "cold_fallback", "solver", "substeps", "time_s", "status"].map(String::from));
+    head.extend(["lcp_size", "steps", "pivots", "warm_start_used", "cold_fallback", "solver", "substeps", "time_s", "status"].map(String::from));
     let estimated = points.iter().any(|p| !p.estimate_method.is_empty());
     if estimated {
         head.push("error_estimate_relative".into());
@@ -434,6 +465,7 @@ pub fn to_csv(param: &str, values: &[f64], problem: &PeriodicProblem, points: &[
         row.extend((0..nc).map(|i| num(p.max_force.get(i))));
         row.extend((0..nc).map(|i| num(p.contact_fraction.get(i))));
         row.push(p.lcp_size.to_string());
+        row.push(p.steps.to_string());
         row.push(p.pivots.to_string());
         row.push(u8::from(p.warm_start_used).to_string());
         row.push(u8::from(p.cold_fallback).to_string());

@@ -61,6 +61,14 @@ pub struct Args {
     /// last column, relative to the peak-to-peak amplitude; the worst is printed).
     #[arg(long)]
     pub estimate: bool,
+    /// Refine each point whose error estimate exceeds this fraction of its peak-to-peak
+    /// amplitude: solved again at 2k (warm-started from its answer), while it does and up to
+    /// --max-steps; implies --estimate. The CSV's `steps` column gives each point's k.
+    #[arg(long)]
+    pub tolerance: Option<f64>,
+    /// The largest k of a refinement (--tolerance).
+    #[arg(long, default_value_t = 4096)]
+    pub max_steps: usize,
     /// Log amplitude axis in the frequency-response PNGs (suggested when the contact and linear
     /// peaks differ by more than 10×).
     #[arg(long)]
@@ -144,7 +152,17 @@ pub fn run(a: &Args) -> Result<(), Failure> {
         ),
         None => eprintln!("{file}: {} DOFs, set-up {:.3} s", built.full.n(), built.timings.total),
     }
-    let settings = SweepSettings { warm_start: !a.cold, threads: a.threads, chunks_per_thread: a.chunks_per_thread, estimate: a.estimate };
+    if let Some(t) = a.tolerance.filter(|t| !(t.is_finite() && *t > 0.0 && *t < 1.0)) {
+        return Err(Failure::input(format!("--tolerance: {t} is not a fraction of the amplitude in (0, 1); e.g. --tolerance 1e-3")));
+    }
+    let settings = SweepSettings {
+        warm_start: !a.cold,
+        threads: a.threads,
+        chunks_per_thread: a.chunks_per_thread,
+        estimate: a.estimate || a.tolerance.is_some(),
+        tolerance: a.tolerance,
+        max_steps: a.max_steps,
+    };
     let bar = if a.quiet { ProgressBar::hidden() } else { ProgressBar::new(a.points as u64) };
     bar.set_style(
         ProgressStyle::with_template("{spinner} sweep [{bar:40}] {pos}/{len} points, {elapsed_precise} elapsed, ETA {eta} {msg}")
@@ -188,7 +206,7 @@ pub fn run(a: &Args) -> Result<(), Failure> {
         fallback,
         a.output.display()
     );
-    if a.estimate {
+    if settings.estimate {
         let worst = points
             .iter()
             .filter(|p| p.error.is_none())
@@ -201,6 +219,14 @@ pub fn run(a: &Args) -> Result<(), Failure> {
                 w.frequency, w.estimate_method
             );
         }
+    }
+    if let Some(tol) = a.tolerance {
+        let met = points.iter().filter(|p| p.estimate_relative.is_some_and(|e| e <= tol)).count();
+        let mut ks: Vec<usize> = points.iter().filter(|p| p.error.is_none()).map(|p| p.steps).collect();
+        ks.sort_unstable();
+        ks.dedup();
+        let per_k: Vec<String> = ks.iter().map(|&k| format!("{} at k = {k}", points.iter().filter(|p| p.error.is_none() && p.steps == k).count())).collect();
+        eprintln!("  tolerance {tol:e}: met at {met} of {} points; {} (refined up to --max-steps {})", points.len(), per_k.join(", "), a.max_steps);
     }
     for (i, d) in problem.outputs().displacement.iter().enumerate() {
         let nl = sweep::peak(&points, |p| p.amplitude[i]);

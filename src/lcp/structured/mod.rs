@@ -24,6 +24,6 @@ mod step_map;
 
 pub use circulant::CirculantOperator;
 pub use jacobian::product as dense_product;
-pub use shooting::{ShootingOutcome, ShootingSettings, ShootingSolution, solve_shooting};
+pub use shooting::{ShootingOutcome, ShootingReach, ShootingSettings, ShootingSolution, solve_shooting};
 pub use step_lcp::MAX_PAIRS;
 pub use step_map::{DenseLu, StepMapData, StepMapError, StepMapLcp};

@@ -44,6 +44,23 @@ pub struct ShootingSettings {
     /// homotopy): a guarded sweep's quick try, which has other routes (ω sub-steps, a neighbour
     /// on the other side) cheaper than a homotopy of hundreds of kinks.
     pub warm_only: bool,
+    /// Without a warm start (or past it), follow the offset homotopy when Newton from the
+    /// contact-free orbit misses. Off: a guarded sweep's cold try inside a run of failed points
+    /// (issue 23: there it met 70–100 kinks and missed, 2–5 s each).
+    pub homotopy: bool,
+}
+
+/// What a shooting solve may try beyond Newton from its warm start ([`ShootingSettings`]'s
+/// `warm_only` and `homotopy`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ShootingReach {
+    pub warm_only: bool,
+    pub homotopy: bool,
+}
+
+impl ShootingReach {
+    /// Everything: warm Newton, the contact-free start, the offset homotopy.
+    pub const FULL: ShootingReach = ShootingReach { warm_only: false, homotopy: true };
 }
 
 impl Default for ShootingSettings {
@@ -56,6 +73,7 @@ impl Default for ShootingSettings {
             max_work: 6e9,
             work_iterations: 40.0,
             warm_only: false,
+            homotopy: true,
         }
     }
 }
@@ -317,6 +335,9 @@ fn shoot(nt: &mut Newton<'_>, warm: Option<&[u64]>) -> ShootingSolution {
         Ok(it) => return done(nt, it, 0, "free"),
         Err(best) => best,
     };
+    if !settings.homotopy {
+        return fail(nt, ShootingOutcome::NotConverged, best, 0);
+    }
     // 2. Homotopy in the offset: δ₀ makes the contact-free orbit feasible; the path (s, δ) is
     // followed by pseudo-arclength down to δ = 0, through its folds (coexisting orbits).
     let delta0 = -free_march.min_w * (1.0 + 1e-6) + f64::MIN_POSITIVE;
