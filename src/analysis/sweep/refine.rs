@@ -39,7 +39,7 @@ pub(super) fn refine(point: &mut SweepPoint, problem: &PeriodicProblem, first: &
             levels.push(PeriodicSolver::new(p).with_warm_starts(settings.warm_start));
         }
         let solver = &mut levels[level];
-        let carried = accuracy::carried_active_set(&prev.active_set, m, prev.lcp.size / m, solver.problem().instants());
+        let carried = crate::periodic::carried_active_set(&prev.active_set, m, prev.lcp.size / m, solver.problem().instants());
         solver.set_warm_start(&carried);
         let r =
             if guarded(solver.problem()) { solve_guarded(solver, None, f, ColdTry::No).0 } else { solver.update_frequency(f).and_then(|()| solver.solve()) };
