@@ -322,16 +322,7 @@ impl StickSlipOrbit {
                 self.residual = r.amax();
                 self.times = u.rows(nr, self.times.len()).iter().copied().collect();
                 self.states = states;
-                let j = self.jacobian(&u, &r);
-                let m = self.times.len();
-                let jtt = j.view((nr, nr), (m, m)).into_owned();
-                // No events: the monodromy is the flow's (and a 0 × 0 LU would not solve).
-                let schur = if m > 0 { jtt.lu().solve(&j.view((nr, 0), (m, nr)).into_owned()) } else { None };
-                let phi = j.view((0, 0), (nr, nr)) + DMatrix::identity(nr, nr);
-                self.monodromy = match schur {
-                    Some(s) => phi - j.view((0, nr), (nr, m)) * s,
-                    _ => phi,
-                };
+                self.monodromy = event_condensed_monodromy(&self.jacobian(&u, &r), nr, self.times.len());
                 return Ok(());
             }
         }
@@ -533,6 +524,18 @@ pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<StickSlipOrbit,
     // all period (holding force near μN); else march the exact flows from the seeded state.
     let stuck = StickSlipOrbit::new(flows.clone(), period, 0.0, Slide::Stick, vec![], vec![]);
     settle::fit(stuck, constant).or_else(|_| settle::marched(&flows, period, seeded, constant).unwrap_or(Err(last)))
+}
+
+/// The monodromy of a shooting Jacobian [[Φ − I, J_xt], [J_tx, J_tt]] over the state and `m`
+/// event times: the event times eliminated (Schur complement), Φ − J_xt J_tt⁻¹ J_tx.
+pub(super) fn event_condensed_monodromy(j: &DMatrix<f64>, nr: usize, m: usize) -> DMatrix<f64> {
+    let phi = j.view((0, 0), (nr, nr)) + DMatrix::identity(nr, nr);
+    // No events: the monodromy is the flow's (and a 0 × 0 LU would not solve).
+    let schur = if m > 0 { j.view((nr, nr), (m, m)).into_owned().lu().solve(&j.view((nr, 0), (m, nr)).into_owned()) } else { None };
+    match schur {
+        Some(s) => phi - j.view((0, nr), (nr, m)) * s,
+        None => phi,
+    }
 }
 
 /// Replaces `r`'s series by the orbit's at the same instants, and its friction outputs (the

@@ -417,14 +417,7 @@ impl MultiOrbit {
                 self.residual = r.amax();
                 self.times = u.rows(nr, self.times.len()).iter().copied().collect();
                 self.states = states;
-                let j = self.jacobian(&u, &r);
-                let m = self.times.len();
-                let phi = j.view((0, 0), (nr, nr)) + DMatrix::identity(nr, nr);
-                let schur = if m > 0 { j.view((nr, nr), (m, m)).into_owned().lu().solve(&j.view((nr, 0), (m, nr)).into_owned()) } else { None };
-                self.monodromy = match schur {
-                    Some(s) => phi - j.view((0, nr), (nr, m)) * s,
-                    None => phi,
-                };
+                self.monodromy = super::event_condensed_monodromy(&self.jacobian(&u, &r), nr, self.times.len());
                 return Ok(());
             }
         }
