@@ -75,31 +75,9 @@ impl Flows {
         let fr = &model.frictions[0];
         let mut b = DVector::zeros(n);
         fr.row.iter().for_each(|&(d, c)| b[d] += c);
-        let s = &model.structure;
-        let m = super::phase::dense(&s.mass, n);
-        let c = s.damping.as_ref().map_or_else(|| DMatrix::zeros(n, n), |d| super::phase::dense(d, n));
-        let k = super::phase::dense(&s.stiffness, n);
-        let minv = m.try_inverse().ok_or_else(|| fail("the mass matrix is singular"))?;
-        let mut harmonics: Vec<u32> = model.forces.iter().map(|f| f.term.harmonic).filter(|&p| p > 0).collect();
-        harmonics.sort_unstable();
-        harmonics.dedup();
-        let dim = 2 * n + 2 + 2 * harmonics.len();
+        // ỹ = (x, v, the slider s0, cos/sin of each harmonic, 1).
+        let ForcedStructure { minv, g, harmonics, dim } = forced_structure(model, 1).ok_or_else(|| fail("the mass matrix is singular"))?;
         let (is0, ione) = (2 * n, dim - 1);
-        // G ỹ = F(t) − Kx − Cv (n × dim).
-        let mut g = DMatrix::zeros(n, dim);
-        g.view_mut((0, 0), (n, n)).copy_from(&(-&k));
-        g.view_mut((0, n), (n, n)).copy_from(&(-&c));
-        for f in &model.forces {
-            let amp = C::from_polar(f.term.amplitude, f.term.phase);
-            match harmonics.iter().position(|&p| p == f.term.harmonic) {
-                // Re(a e^{iθ}) = Re a cos θ − Im a sin θ.
-                Some(h) => {
-                    g[(f.dof, is0 + 1 + 2 * h)] += amp.re;
-                    g[(f.dof, is0 + 2 + 2 * h)] -= amp.im;
-                }
-                None => g[(f.dof, ione)] += amp.re,
-            }
-        }
         let mb = &minv * &b;
         let med = b.dot(&mb);
         let kt = fr.stiffness;
@@ -524,6 +502,44 @@ pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<StickSlipOrbit,
     // all period (holding force near μN); else march the exact flows from the seeded state.
     let stuck = StickSlipOrbit::new(flows.clone(), period, 0.0, Slide::Stick, vec![], vec![]);
     settle::fit(stuck, constant).or_else(|_| settle::marched(&flows, period, seeded, constant).unwrap_or(Err(last)))
+}
+
+/// The structure's dense M⁻¹ and its forced dynamics G ỹ = F(t) − Kx − Cv (n × dim) on an
+/// augmented state ỹ = (x, v, `extra` friction unknowns, cos and sin of each forcing harmonic, 1),
+/// shared by the one- and several-contact polish. `None` when M is singular.
+pub(super) struct ForcedStructure {
+    pub minv: DMatrix<f64>,
+    pub g: DMatrix<f64>,
+    pub harmonics: Vec<u32>,
+    pub dim: usize,
+}
+
+pub(super) fn forced_structure(model: &Model, extra: usize) -> Option<ForcedStructure> {
+    let n = model.n();
+    let s = &model.structure;
+    let minv = super::phase::dense(&s.mass, n).try_inverse()?;
+    let c = s.damping.as_ref().map_or_else(|| DMatrix::zeros(n, n), |d| super::phase::dense(d, n));
+    let k = super::phase::dense(&s.stiffness, n);
+    let mut harmonics: Vec<u32> = model.forces.iter().map(|f| f.term.harmonic).filter(|&p| p > 0).collect();
+    harmonics.sort_unstable();
+    harmonics.dedup();
+    let dim = 2 * n + extra + 2 * harmonics.len() + 1;
+    let (ih, ione) = (2 * n + extra, dim - 1);
+    let mut g = DMatrix::zeros(n, dim);
+    g.view_mut((0, 0), (n, n)).copy_from(&(-&k));
+    g.view_mut((0, n), (n, n)).copy_from(&(-&c));
+    for f in &model.forces {
+        let amp = C::from_polar(f.term.amplitude, f.term.phase);
+        match harmonics.iter().position(|&p| p == f.term.harmonic) {
+            // Re(a e^{iθ}) = Re a cos θ − Im a sin θ.
+            Some(h) => {
+                g[(f.dof, ih + 2 * h)] += amp.re;
+                g[(f.dof, ih + 1 + 2 * h)] -= amp.im;
+            }
+            None => g[(f.dof, ione)] += amp.re,
+        }
+    }
+    Some(ForcedStructure { minv, g, harmonics, dim })
 }
 
 /// The monodromy of a shooting Jacobian [[Φ − I, J_xt], [J_tx, J_tt]] over the state and `m`

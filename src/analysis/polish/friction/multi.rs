@@ -57,31 +57,10 @@ fn key(mode: &[Slide]) -> Vec<usize> {
 impl MultiFlows {
     pub fn new(model: &Model) -> Result<Self, PolishFailure> {
         let n = model.n();
-        let s = &model.structure;
-        let m = super::super::phase::dense(&s.mass, n);
-        let c = s.damping.as_ref().map_or_else(|| DMatrix::zeros(n, n), |d| super::super::phase::dense(d, n));
-        let k = super::super::phase::dense(&s.stiffness, n);
-        let Some(minv) = m.try_inverse() else { return fail("the mass matrix is singular") };
-        let mut harmonics: Vec<u32> = model.forces.iter().map(|f| f.term.harmonic).filter(|&p| p > 0).collect();
-        harmonics.sort_unstable();
-        harmonics.dedup();
-        let nc = model.frictions.len();
-        let dim = 2 * n + nc + 1 + 2 * harmonics.len();
-        let (ih, ione) = (2 * n + nc, dim - 1);
-        let mut g = DMatrix::zeros(n, dim);
-        g.view_mut((0, 0), (n, n)).copy_from(&(-&k));
-        g.view_mut((0, n), (n, n)).copy_from(&(-&c));
-        for f in &model.forces {
-            let amp = C::from_polar(f.term.amplitude, f.term.phase);
-            match harmonics.iter().position(|&p| p == f.term.harmonic) {
-                // Re(a e^{iθ}) = Re a cos θ − Im a sin θ.
-                Some(h) => {
-                    g[(f.dof, ih + 2 * h)] += amp.re;
-                    g[(f.dof, ih + 1 + 2 * h)] -= amp.im;
-                }
-                None => g[(f.dof, ione)] += amp.re,
-            }
-        }
+        // ỹ = (x, v, each contact's slider, cos/sin of each harmonic, 1).
+        let Some(super::ForcedStructure { minv, g, harmonics, dim }) = super::forced_structure(model, model.frictions.len()) else {
+            return fail("the mass matrix is singular");
+        };
         let b = model
             .frictions
             .iter()
