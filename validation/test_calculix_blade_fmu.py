@@ -1,13 +1,13 @@
-"""A blade assembled by CalculiX, packaged as an FMU, run under fmpy.simulate_fmu and under libcosim
-(issue 23): both give the CLI's displacements at the k instants to 1e-9 of each output's
-peak-to-peak amplitude.
+"""A blade assembled by CalculiX, packaged as an FMU, run under fmpy.simulate_fmu and under libcosim,
+and solved through the C API by ctypes (issue 23): all three give the CLI's displacements at the k
+instants to 1e-9 of each output's peak-to-peak amplitude.
 
 - test_coarse_calculix_blade_fmu (default run, ccx needed, skipped with the reason without it):
   the generator's coarse blade written as a deck by `periodic-contact deck` (24 x 8 x 2 C3D8I,
   5 400 DOFs), assembled by `ccx`, massless-boundary reduction, rigid radial contacts on the 9 tip
   nodes, the two-lobe Gaussian casing of examples/real-blade/blade.toml, cds k = 512, block
   pivoting. The whole
-  chain deck -> ccx -> CLI -> FMU -> fmpy + libcosim.
+  chain deck -> ccx -> CLI + C API -> FMU -> fmpy + libcosim.
 - test_real_blade_fmu (opt-in: PC_REAL_BLADE_FMU=1, about a minute): examples/real-blade/blade.toml
   itself (66 480 DOFs, 2 x 65 MB of matrices, generated into examples/real-blade/job/ by deck + ccx
   when absent), its matrix files referenced by an absolute path, so packaged to external/.
@@ -105,8 +105,8 @@ def _timed_fmu_run(fmu, k, period):
 
 
 def _fmu_equals_cli(cli, scene, name, timed):
-    """CLI solve, FMU packaging, fmpy.simulate_fmu and libcosim over one period at T/k: every
-    output displacement equals the CLI's at the k instants to 1e-9 of its peak-to-peak amplitude.
+    """CLI solve, the C API through ctypes, FMU packaging, fmpy.simulate_fmu and libcosim over one
+    period at T/k: every output displacement equals the CLI's at the k instants to 1e-9 of its peak-to-peak amplitude.
     With `timed`, a further run through fmpy's FMI calls times them. Returns the measured figures."""
     folder = os.path.dirname(scene)
     out = os.path.join(folder, f"{name}.json")
@@ -126,6 +126,9 @@ def _fmu_equals_cli(cli, scene, name, timed):
     dofs = [int(d) for d in raw["displacement"]]
     want = {d: np.asarray(raw["displacement"][str(d)]) for d in dofs}
     t0 = time.perf_counter()
+    c_api = engine.capi_displacements(cli, scene, [str(d) for d in dofs], k)
+    figures["c_api_s"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
     sim = fmpy.simulate_fmu(fmu, start_time=0.0, stop_time=period, output_interval=period / k, output=[f"displacement[{d}]" for d in dofs])
     figures["fmpy_simulate_s"] = time.perf_counter() - t0
     assert len(sim) == k + 1, f"{name}: {len(sim)} rows for {k} steps"
@@ -139,6 +142,7 @@ def _fmu_equals_cli(cli, scene, name, timed):
         assert scale > 0.0
         errs[f"fmpy {d}"] = float(np.max(np.abs(np.asarray(sim[f"displacement[{d}]"][:k]) - x))) / scale
         errs[f"libcosim {d}"] = float(np.max(np.abs(lc.values[f"x{d}"] - x[j % k]))) / scale
+        errs[f"C API {d}"] = float(np.max(np.abs(c_api[str(d)] - x))) / scale
     if timed:
         figures.update(_timed_fmu_run(fmu, k, period))
     figures["worst_relative_difference"] = max(errs.values())

@@ -280,7 +280,11 @@ def summary(h: Hysteresis) -> str:
     lines = [f"continued folds: upper {h.fold_upper:.6f}, lower {h.fold_lower:.6f} rad/s; stops: "
              + "; ".join(b.stop for b in h.branches) + "; uncertified rows dropped: "
              + ", ".join(str(b.uncertified) for b in h.branches)]
-    for name, run in (("up", h.up), ("down", h.down)):
+    for name, run, fold in (("up", h.up, h.fold_upper), ("down", h.down, h.fold_lower)):
+        # Each jump against the continuation's fold, relative: the fold the FMU logs (10 digits) and
+        # the farther end of the step it jumps in.
+        lines.append(f"run-{name} jumps against the continued fold {fold!r}: " + ", ".join(
+            f"logged fold {abs(j[1] - fold) / fold:.1e}, jump step {max(abs(j[2] - fold), abs(j[3] - fold)) / fold:.1e}" for j in run.jumps))
         w, a, tol = envelope(run, with_tolerance=True)
         d, _, interp = on_stable_branch(w, a, h.branches)
         tol = tol + interp

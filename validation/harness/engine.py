@@ -13,6 +13,7 @@ Contracts (fixed by the lead):
 """
 from __future__ import annotations
 
+import ctypes
 import json
 import os
 import subprocess
@@ -159,6 +160,45 @@ def build_fmu(cli: str, scene_text: str, workdir: str, name: str) -> str:
     if not os.path.exists(fmu):
         raise EngineError(f"periodic-contact fmu {name}: exit 0 but {fmu} was not written")
     return fmu
+
+
+def capi_displacements(cli: str, scene: str, keys, k: int) -> dict[str, np.ndarray]:
+    """The C API (libperiodic_contact.so beside the CLI) through ctypes, as a Python user calls it:
+    pc_problem_from_scene_file, pc_problem_solve, pc_result_displacement of each key at the k instants."""
+    c = ctypes
+    lib = c.CDLL(os.path.join(os.path.dirname(cli), "libperiodic_contact.so"))
+    lib.pc_last_error.restype = c.c_char_p
+    lib.pc_problem_from_scene_file.restype = c.c_void_p
+    lib.pc_problem_from_scene_file.argtypes = [c.c_char_p]
+    lib.pc_problem_solve.restype = c.c_void_p
+    lib.pc_problem_solve.argtypes = [c.c_void_p]
+    lib.pc_result_steps.restype = c.c_size_t
+    lib.pc_result_steps.argtypes = [c.c_void_p]
+    lib.pc_result_displacement.argtypes = [c.c_void_p, c.c_size_t, c.POINTER(c.c_double), c.c_size_t]
+    lib.pc_result_free.argtypes = [c.c_void_p]
+    lib.pc_problem_free.argtypes = [c.c_void_p]
+    p = lib.pc_problem_from_scene_file(scene.encode())
+    if not p:
+        raise EngineError(f"pc_problem_from_scene_file({scene}): {lib.pc_last_error().decode()}")
+    try:
+        r = lib.pc_problem_solve(p)
+        if not r:
+            raise EngineError(f"pc_problem_solve({scene}): {lib.pc_last_error().decode()}")
+        try:
+            if lib.pc_result_steps(r) != k:
+                raise EngineError(f"{scene}: the C API solved on {lib.pc_result_steps(r)} instants, the CLI on {k}")
+            out = {}
+            for key in keys:
+                x = (c.c_double * k)()
+                status = lib.pc_result_displacement(r, int(key), x, k)
+                if status != 0:
+                    raise EngineError(f"pc_result_displacement({key}): {lib.pc_last_error().decode()}")
+                out[key] = np.frombuffer(x, dtype=float).copy()
+            return out
+        finally:
+            lib.pc_result_free(r)
+    finally:
+        lib.pc_problem_free(p)
 
 
 # ----------------------------------------------------------------------------- FMU
