@@ -42,9 +42,10 @@ FRONT_ENDS = ("C API", "fmpy", "libcosim")
 ALL = os.environ.get("PC_FRONTENDS_ALL", "") not in ("", "0")
 
 # Scenes whose cells are not all in the default run: the front ends the default run does use
-# (CPU per solve measured with /usr/bin/time at load 7-11). Each front end solves once more.
+# (CPU per solve measured with /usr/bin/time at load 7-11). Each front end solves once more; the
+# default run keeps the CLI, C API and Rust host of the fine blade in tests/frontends.rs.
 SLOW = {
-    "fmu/scenes/blade-casing.toml": ("fmpy",),  # the fine blade, 30 000 DOFs: tens of s per solve
+    "fmu/scenes/blade-casing.toml": ("fmpy",),  # the fine blade, 30 000 DOFs: 12-25 s wall per solve at load 15-17
     "examples/rubbing/blade-coarse-mu0.toml": (),  # 7.4 s CPU per solve (3352 pivots at k = 2048)
     "examples/rubbing/blade-coarse-plain.toml": (),  # 7.8 s CPU per solve (bit for bit mu0's orbit)
     # The real blade (66 480 DOFs read from CalculiX's job and reduced at each instantiation).
