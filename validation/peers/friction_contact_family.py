@@ -34,21 +34,7 @@ except ImportError:  # run as a script from validation/peers
 
 
 def draw(rng):
-    n = int(rng.integers(2, 4))
-    m = rng.uniform(0.5, 1.5, n)
-    k = rng.uniform(0.5, 2.0, n)
-    K = np.zeros((n, n))
-    K[0, 0] += k[0]
-    for i in range(1, n):
-        K[i - 1, i - 1] += k[i]
-        K[i, i] += k[i]
-        K[i - 1, i] -= k[i]
-        K[i, i - 1] -= k[i]
-    M = np.diag(m)
-    C = rng.uniform(0.01, 0.05) * M + rng.uniform(0.005, 0.03) * K
-    F = np.zeros(n)
-    F[0] = 1.0
-    F[n - 1] += rng.uniform(-0.5, 0.5)
+    n, M, C, K, F = fm.structure(rng)
     omega = float(rng.uniform(0.3, 2.0))
     contacts = []
     for d in sorted(rng.choice(n, size=int(rng.integers(1, 3)), replace=False)):
