@@ -48,6 +48,8 @@ mod friction_coupled;
 mod friction_frontends;
 #[path = "friction_polish.rs"]
 mod friction_polish;
+#[path = "friction_polish_contact.rs"]
+mod friction_polish_contact;
 #[path = "friction_polish_multi.rs"]
 mod friction_polish_multi;
 #[path = "friction_shooting.rs"]

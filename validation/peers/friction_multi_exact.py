@@ -63,7 +63,7 @@ class System:
         r[:, self.ic] = self.F
         forces = np.zeros((self.m, dim))
         stuck = []
-        for i, ph in enumerate(mode):
+        for i, ph in enumerate(mode[:self.m]):
             b = self.b[i]
             if ph != STICK:
                 r[:, self.i1] -= b * ph * self.slip[i]
@@ -76,6 +76,7 @@ class System:
                 forces[i, 2 * n + i] = -kt
             else:
                 stuck.append(i)
+        self.more_forces(mode, r)
         s = len(stuck)
         saddle = np.zeros((n + s, n + s))
         saddle[:n, :n] = self.M
@@ -92,6 +93,13 @@ class System:
         A[self.isn, self.ic] = self.omega
         self.cache[mode] = (A, forces, stuck)
         return self.cache[mode]
+
+    def more_forces(self, mode, r):
+        """Adds forces of further mode entries (after the m contacts) to r; none here."""
+
+    def rest_mode(self):
+        """The mode the march from rest starts in."""
+        return tuple([STICK] * self.m)
 
     def force(self, mode, i, y):
         return self.build(mode)[1][i] @ y
@@ -156,7 +164,7 @@ class System:
             if key not in self.cache:
                 self.cache[key] = expm(A * dh)
             yn = self.cache[key] @ y
-            ended = [i for i in range(self.m) if self.g(mode, i, yn) < 0]
+            ended = [i for i in range(len(mode)) if self.g(mode, i, yn) < 0]
             if not ended:
                 t, y = t + dh, yn
                 continue
@@ -185,7 +193,7 @@ class System:
 def steady(sys_, substeps=2000, periods=800, tol=1e-13):
     """The periodic orbit: march from rest until a period's events repeat, then shooting."""
     T = sys_.period
-    mode = tuple([STICK] * sys_.m)
+    mode = sys_.rest_mode()
     y = sys_.augment(0.0, np.zeros(2 * sys_.n))
     prev = None
     t = 0.0

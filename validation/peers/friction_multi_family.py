@@ -23,7 +23,8 @@ except ImportError:  # run as a script from validation/peers
     import friction_multi_exact as fx
 
 
-def draw(rng):
+def structure(rng):
+    """A chain of 2–3 masses: (n, M, C, K, F), forced on the first mass (and the last)."""
     n = int(rng.integers(2, 4))
     m = rng.uniform(0.5, 1.5, n)
     k = rng.uniform(0.5, 2.0, n)  # k[0] to ground, k[i] between i−1 and i
@@ -39,6 +40,11 @@ def draw(rng):
     F = np.zeros(n)
     F[0] = 1.0
     F[n - 1] += rng.uniform(-0.5, 0.5)
+    return n, M, C, K, F
+
+
+def draw(rng):
+    n, M, C, K, F = structure(rng)
     dofs = rng.choice(n, size=int(rng.integers(2, n + 1)), replace=False)
     contacts = []
     for d in sorted(dofs):

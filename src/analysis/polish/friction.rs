@@ -31,12 +31,15 @@ use crate::response::{EventRecord, Response};
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64 as C;
 
-/// A phase of the contact.
+/// A phase of the contact, or of a compliant stop among several friction contacts (multi.rs).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Slide {
     Stick,
     /// Slip with the sign of the sliding velocity bᵀv (the force is sign·μN).
     Slip(f64),
+    /// A compliant unilateral stop open (no force) or closed (its spring pushes back).
+    Open,
+    Closed,
 }
 
 impl Slide {
@@ -45,6 +48,8 @@ impl Slide {
             Slide::Stick => 0,
             Slide::Slip(s) if s > 0.0 => 1,
             Slide::Slip(_) => 2,
+            Slide::Open => 3,
+            Slide::Closed => 4,
         }
     }
 }
@@ -100,7 +105,7 @@ impl Flows {
                         }
                         a[(n + i, is0)] += mb[i] * kt;
                     }
-                    (Slide::Stick, None) => {}
+                    (Slide::Stick, None) | (Slide::Open | Slide::Closed, _) => {}
                 }
             }
             for (h, &q) in harmonics.iter().enumerate() {
@@ -136,6 +141,7 @@ impl Flows {
         match phase {
             Slide::Stick => self.stick_force.dot(y),
             Slide::Slip(s) => s * self.slip,
+            Slide::Open | Slide::Closed => 0.0,
         }
     }
 
@@ -157,7 +163,7 @@ impl Flows {
         match (from, to) {
             (Slide::Slip(_), _) => self.velocity(y),
             (Slide::Stick, Slide::Slip(s)) => self.stick_force.dot(y) - s * self.slip,
-            (Slide::Stick, Slide::Stick) => unreachable!("phases alternate"),
+            _ => unreachable!("phases alternate between stick and slip"),
         }
     }
 

@@ -70,11 +70,13 @@ pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<PolishedOrbit, 
 /// with a warning and `polish.status = "fallback"`.
 pub fn apply(problem: &PeriodicProblem, r: &mut Response) -> Option<PolishedOrbit> {
     let t0 = Instant::now();
-    if problem.model().frictions.len() > 1 {
+    // Several friction contacts, or friction with compliant stops: one mode per contact and stop.
+    let model = problem.model();
+    if model.frictions.len() > 1 || (!model.frictions.is_empty() && !model.contacts.is_empty()) {
         match friction::multi::polish(problem, r) {
             Ok(orbit) => {
                 friction::multi::write(&orbit, problem, r);
-                let how = "stick–slip orbit of several friction contacts (exact flows between their merged events)";
+                let how = "stick–slip orbit of friction contacts and compliant stops (exact flows between their merged events)";
                 record(r, how, orbit.event_records(), (orbit.iterations, orbit.residual, orbit.correction), t0);
             }
             Err(e) => fall_back(r, e, t0),

@@ -10,7 +10,9 @@
 //! phase sequence comes from the LCP's per-contact stuck flags and force signs (as read; rigid
 //! stick runs of ≤ 2 instants taken for reversals), else from an event-driven march of the exact
 //! flows; Newton on the state and the event times; contacts stuck all period are pinned at the
-//! LCP's slider constants (their orbit is unique only up to those, §9).
+//! LCP's slider constants (their orbit is unique only up to those, §9). Compliant unilateral
+//! stops ([`stops`]) are further entries of a mode, after the friction contacts: one event list,
+//! one Newton, one monodromy for both.
 use super::super::PolishFailure;
 use super::Slide;
 use crate::model::Model;
@@ -44,6 +46,8 @@ pub struct MultiFlows {
     b: Vec<DVector<f64>>,
     slip: Vec<f64>,
     kt: Vec<Option<f64>>,
+    /// The compliant stops, mode entries `b.len()..`.
+    stops: Vec<stops::Stop>,
     minv: DMatrix<f64>,
     /// G ỹ = F(t) − Kx − Cv.
     g: DMatrix<f64>,
@@ -78,14 +82,21 @@ impl MultiFlows {
             b,
             slip: model.frictions.iter().map(|f| f.slip_force()).collect(),
             kt: model.frictions.iter().map(|f| f.stiffness).collect(),
+            stops: stops::Stop::from_model(model)?,
             minv,
             g,
             cache: Rc::default(),
         })
     }
 
+    /// The friction contacts (the first entries of a mode).
     pub fn contacts(&self) -> usize {
         self.b.len()
+    }
+
+    /// The entries of a mode: friction contacts, then stops.
+    pub fn elements(&self) -> usize {
+        self.b.len() + self.stops.len()
     }
 
     /// The stuck rigid contacts' directions as columns, and W = (BᵀM⁻¹B)⁻¹BᵀM⁻¹.
@@ -108,6 +119,12 @@ impl MultiFlows {
         let mut h = self.g.clone();
         let mut force = vec![DVector::zeros(dim); mode.len()];
         for (i, &phase) in mode.iter().enumerate() {
+            if i >= self.b.len() {
+                if phase == Slide::Closed {
+                    force[i] = self.stops[i - self.b.len()].close(&mut h, ione);
+                }
+                continue;
+            }
             let b = &self.b[i];
             match (phase, self.kt[i]) {
                 (Slide::Slip(s), _) => {
@@ -123,7 +140,7 @@ impl MultiFlows {
                     force[i].rows_mut(0, n).copy_from(&(b * kt));
                     force[i][is0 + i] = -kt;
                 }
-                (Slide::Stick, None) => {}
+                (Slide::Stick, None) | (Slide::Open | Slide::Closed, _) => {}
             }
         }
         let mut acc = h.clone();
@@ -138,7 +155,7 @@ impl MultiFlows {
         let mut a = DMatrix::zeros(dim, dim);
         a.view_mut((0, n), (n, n)).fill_with_identity();
         a.view_mut((n, 0), (n, dim)).copy_from(&(&self.minv * acc));
-        let ih = is0 + mode.len();
+        let ih = is0 + self.b.len();
         for (j, &q) in self.harmonics.iter().enumerate() {
             let w = q as f64 * self.omega;
             a[(ih + 2 * j, ih + 1 + 2 * j)] = -w;
@@ -182,9 +199,10 @@ impl MultiFlows {
     /// The event function of contact `i` leaving its phase in `mode` for `to` (0 at the event).
     fn event(&self, mode: &[Slide], i: usize, to: Slide, y: &DVector<f64>) -> f64 {
         match (mode[i], to) {
+            (Slide::Open | Slide::Closed, _) => self.stops[i - self.b.len()].penetration(y),
             (Slide::Slip(_), _) => self.velocity(i, y),
             (Slide::Stick, Slide::Slip(s)) => self.force(mode, i, y) - s * self.slip[i],
-            (Slide::Stick, Slide::Stick) => f64::NAN,
+            (Slide::Stick, _) => f64::NAN,
         }
     }
 
@@ -214,6 +232,8 @@ impl MultiFlows {
     /// The phase contact `i` takes when its phase in `mode` ends at state `y`.
     pub fn next(&self, mode: &[Slide], i: usize, y: &DVector<f64>) -> Slide {
         match mode[i] {
+            Slide::Open => Slide::Closed,
+            Slide::Closed => Slide::Open,
             Slide::Stick => Slide::Slip(self.force(mode, i, y).signum()),
             Slide::Slip(_) if self.kt[i].is_some() => Slide::Stick,
             Slide::Slip(_) => {
@@ -231,6 +251,8 @@ impl MultiFlows {
         match mode[i] {
             Slide::Slip(s) => s * self.velocity(i, y) < 0.0,
             Slide::Stick => self.force(mode, i, y).abs() > self.slip[i],
+            Slide::Open => self.stops[i - self.b.len()].penetration(y) > 0.0,
+            Slide::Closed => self.stops[i - self.b.len()].penetration(y) < 0.0,
         }
     }
 }
@@ -458,6 +480,9 @@ impl MultiOrbit {
             .map(|(i, y)| fl.velocity(i, &y).abs())
             .fold(f64::MIN_POSITIVE, f64::max);
         let vtol = 1e-9 * vscale;
+        // A stop's clearance is checked against the largest |x| or gap.
+        let xscale = (0..64).map(|k| self.state(self.start + k as f64 * self.period / 64.0).rows(0, fl.n).amax()).fold(0.0, f64::max);
+        let ptol = 1e-9 * fl.stops.iter().fold(xscale, |m, s| m.max(s.gap.abs())).max(f64::MIN_POSITIVE);
         let samples = if self.times.is_empty() { 4096 } else { 64 };
         for (e, y0) in self.states.iter().enumerate() {
             let (mode, len) = (&self.modes[e], ends[e + 1] - ends[e]);
@@ -465,8 +490,15 @@ impl MultiOrbit {
                 let t = len * k as f64 / samples as f64;
                 let y = fl.flow(mode, y0, t);
                 for (i, &phase) in mode.iter().enumerate() {
-                    let ftol = 1e-9 * fl.slip[i].max(f64::MIN_POSITIVE);
+                    let ftol = 1e-9 * fl.slip.get(i).copied().unwrap_or(0.0).max(f64::MIN_POSITIVE);
                     match phase {
+                        Slide::Open | Slide::Closed if fl.stops[i - fl.contacts()].breaks(phase, &y, ptol) => {
+                            return fail(format_args!(
+                                "the fitted orbit's stop {} is {phase:?} against its clearance at t = {:.6}",
+                                i - fl.contacts(),
+                                ends[e] + t
+                            ));
+                        }
                         Slide::Slip(s) if s * fl.velocity(i, &y) < -vtol => {
                             return fail(format_args!("the fitted orbit's contact {i} reverses inside a slip at t = {:.6}", ends[e] + t));
                         }
@@ -481,7 +513,7 @@ impl MultiOrbit {
         // A rigid onset of sticking must hold; a reversal must not.
         for (e, &(i, to)) in self.events.iter().enumerate() {
             let (before, y) = (&self.modes[e], &self.states[e + 1]);
-            if fl.kt[i].is_some() || before[i] == Slide::Stick {
+            if i >= fl.contacts() || fl.kt[i].is_some() || before[i] == Slide::Stick {
                 continue;
             }
             let mut stuck = before.clone();
@@ -540,16 +572,20 @@ impl MultiOrbit {
         (0..self.events.len())
             .map(|e| {
                 let (i, to) = self.events[e];
+                let contact = if i < self.flows.contacts() { i } else { i - self.flows.contacts() };
                 let kind = match (self.modes[e][i], to) {
+                    (_, Slide::Closed) => "contact_on",
+                    (_, Slide::Open) => "contact_off",
                     (Slide::Stick, _) => "slip",
                     (_, Slide::Stick) => "stick",
                     _ => "reversal",
                 };
-                EventRecord { time: self.times[e].rem_euclid(self.period), contact: i, kind: kind.into(), impulse: 0.0 }
+                EventRecord { time: self.times[e].rem_euclid(self.period), contact, kind: kind.into(), impulse: 0.0 }
             })
             .collect()
     }
 }
 
+pub mod stops;
 mod topology;
 pub use topology::{polish, write};

@@ -31,6 +31,8 @@ fn next(fl: &Flows, from: Slide, y: &DVector<f64>) -> Slide {
             let held = fl.stick_force.dot(&fl.enter(from, Slide::Stick, y.clone()));
             if held.abs() <= fl.slip { Slide::Stick } else { Slide::Slip(held.signum()) }
         }
+        // One contact alone has no stop.
+        Slide::Open | Slide::Closed => from,
     }
 }
 
@@ -39,6 +41,7 @@ fn ended(fl: &Flows, phase: Slide, y: &DVector<f64>) -> bool {
     match phase {
         Slide::Slip(s) => s * fl.velocity(y) < 0.0,
         Slide::Stick => fl.stick_force.dot(y).abs() > fl.slip,
+        Slide::Open | Slide::Closed => false,
     }
 }
 

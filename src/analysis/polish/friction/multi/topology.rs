@@ -94,20 +94,24 @@ fn fit(mut orbit: MultiOrbit) -> Result<MultiOrbit, PolishFailure> {
 /// Fits the stick–slip orbit of the several friction contacts of `problem` to the LCP's `r`.
 pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<MultiOrbit, PolishFailure> {
     let model = problem.model();
-    if !model.contacts.is_empty() || !model.rubbing.is_empty() {
-        return fail("several friction contacts are fitted without unilateral or rubbing contacts in this version");
+    if !model.rubbing.is_empty() {
+        return fail("friction contacts are fitted without rubbing contacts in this version");
     }
     if model.frictions.iter().any(|f| f.contact.is_some()) {
         return fail("a coupled normal–tangential contact has no constant slip force to fit");
     }
-    if r.friction.len() != model.frictions.len() {
-        return fail("the result has no friction outputs");
+    if r.friction.len() != model.frictions.len() || r.contacts.len() != model.contacts.len() {
+        return fail("the result has no friction or contact outputs ([output] contacts = false)");
     }
     let fl = MultiFlows::new(model)?;
     let (k, period) = (r.friction[0].stuck.len(), r.period);
     let h = period / k as f64;
-    let series: Vec<Vec<Slide>> =
+    let mut series: Vec<Vec<Slide>> =
         r.friction.iter().map(|f| f.stuck.iter().zip(&f.force).map(|(&st, &x)| if st { Slide::Stick } else { Slide::Slip(x.signum()) }).collect()).collect();
+    // The stops' phases follow the friction contacts' in a mode.
+    series.extend(super::stops::series(r));
+    // Every friction contact stuck, the stops as the LCP has them at instant 0.
+    let all_stuck: Mode = (0..fl.elements()).map(|i| if i < fl.contacts() { Slide::Stick } else { series[i][0] }).collect();
     // The slider constants of contacts stuck all period: the LCP's mean of bᵀx (rigid) or of
     // the slider bᵀx − f/k_t (Jenkins).
     let constants: Vec<f64> = r
@@ -117,7 +121,7 @@ pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<MultiOrbit, Pol
         .map(|(f, kt)| f.displacement.iter().zip(&f.force).map(|(u, x)| u - kt.map_or(0.0, |kt| x / kt)).sum::<f64>() / k as f64)
         .collect();
     let mut candidates = vec![series.clone()];
-    let merged: Vec<Vec<Slide>> = series.iter().zip(&fl.kt).map(|(s, kt)| if kt.is_none() { smoothed(s) } else { s.clone() }).collect();
+    let merged: Vec<Vec<Slide>> = series.iter().enumerate().map(|(i, s)| if fl.kt.get(i) == Some(&None) { smoothed(s) } else { s.clone() }).collect();
     if merged != series {
         candidates.push(merged);
     }
@@ -139,11 +143,11 @@ pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<MultiOrbit, Pol
             Err(e) => last = e,
         }
     }
-    let stuck = MultiOrbit::new(fl.clone(), period, 0.0, vec![Slide::Stick; fl.contacts()], vec![], vec![], &constants);
+    let stuck = MultiOrbit::new(fl.clone(), period, 0.0, all_stuck.clone(), vec![], vec![], &constants);
     if let Ok(o) = fit(stuck) {
         return Ok(o);
     }
-    let seed = seed.unwrap_or_else(|| (0.0, vec![Slide::Stick; fl.contacts()], fl.augment(0.0, &[])));
+    let seed = seed.unwrap_or_else(|| (0.0, all_stuck, fl.augment(0.0, &[])));
     match settle(&fl, period, seed) {
         Some((before, evs)) => {
             fit(assemble(&fl, period, &evs, before, &constants)).map_err(|e| PolishFailure(format!("{}; as read from the LCP: {}", e.0, last.0)))
@@ -160,7 +164,7 @@ fn settle(fl: &MultiFlows, period: f64, (t0, mut mode, y): (f64, Mode, DVector<f
     let mut y = fl.project(&mode, y);
     let mut t = t0;
     let mut previous: Option<Vec<Switch>> = None;
-    let any_ended = |mode: &Mode, y: &DVector<f64>| (0..fl.contacts()).find(|&i| fl.ended(mode, i, y));
+    let any_ended = |mode: &Mode, y: &DVector<f64>| (0..fl.elements()).find(|&i| fl.ended(mode, i, y));
     // Bisections that barely advance (a grazing slip) are bounded too.
     let mut budget = 4 * STEPS * MAX_PERIODS;
     for p in 0..MAX_PERIODS {
