@@ -15,15 +15,23 @@ use crate::time::Discretization;
 pub(super) type Levels = Vec<PeriodicSolver>;
 
 /// Refines `point`, the answer `first` of `problem` (the chunk's first grid at the point's
-/// frequency), while its estimate exceeds the tolerance and the doubled k stays within
-/// `settings.max_steps`. The point keeps its coarser answer where a refined solve fails (a
-/// large LCP's refined try is Newton from the carried set alone, [`solve_guarded`]); the
-/// failure is noted in its `estimate_method`.
-pub(super) fn refine(point: &mut SweepPoint, problem: &PeriodicProblem, first: &Response, levels: &mut Levels, settings: &SweepSettings) {
+/// frequency; `below`, its estimate's k/2 answer when there is one), while its estimate exceeds
+/// the tolerance and the doubled k stays within `settings.max_steps`. The point keeps its
+/// coarser answer where a refined solve fails (a large LCP's refined try is Newton from the
+/// carried set alone, [`solve_guarded`]); the failure is noted in its `estimate_method`.
+pub(super) fn refine(
+    point: &mut SweepPoint,
+    problem: &PeriodicProblem,
+    first: &Response,
+    below: Option<Response>,
+    levels: &mut Levels,
+    settings: &SweepSettings,
+) {
     let Some(tolerance) = settings.tolerance else { return };
     let f = point.frequency;
     let m = problem.model().contacts.len().max(1);
-    let mut coarse: Option<Response> = None;
+    // The two grids below the next one, coarse to fine: Richardson and the observed order.
+    let (mut third, mut coarse): (Option<Response>, Option<Response>) = (below, None);
     for level in 0.. {
         let prev = coarse.as_ref().unwrap_or(first);
         let steps = problem.discretization().steps << (level + 1);
@@ -50,24 +58,20 @@ pub(super) fn refine(point: &mut SweepPoint, problem: &PeriodicProblem, first: &
                 return;
             }
         };
-        // Richardson between this grid and the one below: the coarser answer is at hand.
-        let a = accuracy::estimate_with(solver.problem(), &r, &mut |p| {
-            if p.discretization().steps == steps / 2 {
-                Ok(prev.clone())
-            } else {
-                Err(SolveError::Invalid(format!("no answer at k = {}", p.discretization().steps)))
-            }
-        });
-        if a.relative.is_none() {
+        // Richardson between this grid and the one below, the observed order from the one
+        // below that: both answers are at hand.
+        let a = accuracy::estimate_from(solver.problem(), &r, prev, third.as_ref().filter(|t| t.steps * 4 == steps), &format!("k/2 = {}", steps / 2));
+        let Some(relative) = settings.measure.of(&a) else {
             point.estimate_method.push_str(&format!("; refined to k = {steps} without an estimate ({}), k = {} kept", a.method, steps / 2));
             return;
-        }
+        };
         let mut refined = SweepPoint::from_response(solver.problem(), f, &r);
-        (refined.estimate_relative, refined.estimate_method) = (a.relative, a.method);
+        (refined.estimate_relative, refined.estimate_method) = (Some(relative), a.method);
         (refined.substeps, refined.warm_start_used, refined.cold_fallback) = (point.substeps, point.warm_start_used, point.cold_fallback);
         // The first grid's active set stays: it warm-starts the neighbours (`refill`).
         (refined.time_s, refined.active_set) = (point.time_s, std::mem::take(&mut point.active_set));
         *point = refined;
+        third = Some(coarse.take().unwrap_or_else(|| first.clone()));
         coarse = Some(r);
     }
 }
