@@ -17,7 +17,7 @@ pub mod marching;
 mod refine;
 pub mod spectrum;
 
-use crate::analysis::{accuracy, continuation};
+use crate::analysis::continuation;
 use crate::model::{Labels, Quantity};
 use crate::periodic::limits::AmplitudeMeasure;
 use crate::periodic::{LEMKE_AFTER_SHOOTING_MAX, LcpMethod, PeriodicProblem, PeriodicSolver, SolveError, Tuning, WarmStart};
@@ -187,7 +187,7 @@ pub fn run(
             .map(|&(lo, hi)| {
                 let mut solver = session.clone();
                 // The second grid of the error estimates, warm-started along the chunk too.
-                let mut second: Coarser = Vec::new();
+                let mut second: refine::Coarser = Vec::new();
                 let mut levels = refine::Levels::new();
                 let mut out = Vec::with_capacity(hi - lo);
                 let mut last: Option<(f64, Response)> = None;
@@ -231,7 +231,7 @@ pub fn run(
                     point.warm_start_used = r.is_ok() && solver.last_start() == WarmStart::Used;
                     point.cold_fallback = solver.last_start() == WarmStart::ColdFallback;
                     if let Ok(r) = &r {
-                        let below = estimate(&mut point, &solver, r, &mut second, settings);
+                        let below = refine::estimate(&mut point, &solver, r, &mut second, settings);
                         refine::refine(&mut point, solver.problem(), r, below, &mut levels, settings);
                     }
                     point.time_s = t.elapsed().as_secs_f64();
@@ -269,44 +269,10 @@ pub fn refill(template: &PeriodicProblem, points: &mut [SweepPoint], settings: &
         return;
     }
     let mut solver = PeriodicSolver::new(template.clone());
-    let (mut second, mut levels) = (Coarser::new(), refine::Levels::new());
+    let (mut second, mut levels) = (refine::Coarser::new(), refine::Levels::new());
     for reverse in [true, false] {
         refill_pass(&mut solver, (&mut second, &mut levels), settings, points, reverse);
     }
-}
-
-/// The chunk's sessions of the estimates' coarser grids (k/2 and k/4, or 2k), each with the
-/// frequency it last solved.
-type Coarser = Vec<(PeriodicSolver, Option<f64>)>;
-
-/// The point's error estimate ([`SweepSettings::estimate`]): a second solve on the other grid and
-/// a third at k/4 for the observed order ([`accuracy::estimate_from`]), in the chunk's sessions
-/// for those grids. Returns the k/2 answer (the refinement's third grid).
-fn estimate(point: &mut SweepPoint, solver: &PeriodicSolver, r: &Response, second: &mut Coarser, settings: &SweepSettings) -> Option<Response> {
-    if !settings.estimate {
-        return None;
-    }
-    let (grid, note) = match accuracy::second_grid(solver.problem(), r) {
-        Ok(g) => g,
-        Err(a) => {
-            (point.estimate_relative, point.estimate_method) = (settings.measure.of(&a), a.method);
-            return None;
-        }
-    };
-    let half = match second_solve(second, &grid, r, settings.warm_start, ColdTry::Full) {
-        Ok(h) => h,
-        Err(e) => {
-            point.estimate_method = format!("none: the second solve at {note} failed: {}", e.to_string().split(':').next().unwrap_or_default());
-            return None;
-        }
-    };
-    let coarser = grid.instants() < solver.problem().instants();
-    // Newton from the carried set alone: a k/4 grid near its stability limit can miss, and
-    // then the estimate has two grids (a cold try there cost seconds per point).
-    let quarter = coarser.then(|| accuracy::third_grid(&grid)).flatten().and_then(|g| second_solve(second, &g, r, settings.warm_start, ColdTry::No).ok());
-    let a = accuracy::estimate_from(solver.problem(), r, &half, quarter.as_ref(), &note);
-    (point.estimate_relative, point.estimate_method) = (settings.measure.of(&a), a.method);
-    coarser.then_some(half)
 }
 
 /// Retries a guarded sweep's failed points from their nearest solved neighbour in the sweep's
@@ -318,7 +284,7 @@ fn estimate(point: &mut SweepPoint, solver: &PeriodicSolver, r: &Response, secon
 /// down to those points in a few Newton iterations each. A point still missed keeps its failure.
 fn refill_pass(
     solver: &mut PeriodicSolver,
-    (second, levels): (&mut Coarser, &mut refine::Levels),
+    (second, levels): (&mut refine::Coarser, &mut refine::Levels),
     settings: &SweepSettings,
     points: &mut [SweepPoint],
     reverse: bool,
@@ -339,7 +305,7 @@ fn refill_pass(
             Ok(r) => {
                 let mut point = SweepPoint::from_response(solver.problem(), f, &r);
                 (point.substeps, point.warm_start_used) = (substeps, true);
-                let below = estimate(&mut point, solver, &r, second, settings);
+                let below = refine::estimate(&mut point, solver, &r, second, settings);
                 refine::refine(&mut point, solver.problem(), &r, below, levels, settings);
                 point.time_s = before + t.elapsed().as_secs_f64();
                 points[i] = point;
@@ -411,35 +377,6 @@ fn solve_guarded(solver: &mut PeriodicSolver, last: Option<f64>, f: f64, cold: C
         }
         Err(e) => (Err(e), substeps),
     }
-}
-
-/// The second solve of a point's error estimate, in the chunk's session for that grid (made on
-/// the first point, or again when the grid changes), with the frequency it last solved. On a
-/// large LCP ([`guarded`]) it starts from the active set of `first`, the point's answer on the
-/// first grid, carried to this grid (the same orbit at other instants: a closer guess than this
-/// grid's last point) and never runs the dense fallback ([`solve_guarded`]).
-fn second_solve(sessions: &mut Coarser, problem: &PeriodicProblem, first: &Response, warm: bool, cold: ColdTry) -> Result<Response, SolveError> {
-    let steps = problem.discretization().steps;
-    let i = match sessions.iter().position(|s| s.0.problem().discretization().steps == steps) {
-        Some(i) => i,
-        None => {
-            sessions.push((PeriodicSolver::new(problem.clone()).with_warm_starts(warm), None));
-            sessions.len() - 1
-        }
-    };
-    let (solver, last) = &mut sessions[i];
-    let f = problem.model().frequency;
-    if !(warm && guarded(solver.problem())) {
-        solver.update_frequency(f)?;
-        return solver.solve();
-    }
-    let m = problem.model().contacts.len();
-    let k_first = first.lcp.size / m.max(1);
-    let carried = crate::periodic::carried_active_set(&first.active_set, m, k_first, solver.problem().instants());
-    solver.set_warm_start(&carried);
-    let (r, _) = solve_guarded(solver, *last, f, cold);
-    *last = r.as_ref().ok().map(|_| f);
-    r
 }
 
 /// Whether a sweep guards this problem's points ([`solve_guarded`]): `auto` on an LCP above

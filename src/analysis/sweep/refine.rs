@@ -76,6 +76,69 @@ pub(super) fn refine(
     }
 }
 
+/// The chunk's sessions of the estimates' coarser grids (k/2 and k/4, or 2k), each with the
+/// frequency it last solved.
+pub(super) type Coarser = Vec<(PeriodicSolver, Option<f64>)>;
+
+/// The point's error estimate ([`SweepSettings::estimate`]): a second solve on the other grid and
+/// a third at k/4 for the observed order ([`accuracy::estimate_from`]), in the chunk's sessions
+/// for those grids. Returns the k/2 answer (the refinement's third grid).
+pub(super) fn estimate(point: &mut SweepPoint, solver: &PeriodicSolver, r: &Response, second: &mut Coarser, settings: &SweepSettings) -> Option<Response> {
+    if !settings.estimate {
+        return None;
+    }
+    let (grid, note) = match accuracy::second_grid(solver.problem(), r) {
+        Ok(g) => g,
+        Err(a) => {
+            (point.estimate_relative, point.estimate_method) = (settings.measure.of(&a), a.method);
+            return None;
+        }
+    };
+    let half = match second_solve(second, &grid, r, settings.warm_start, ColdTry::Full) {
+        Ok(h) => h,
+        Err(e) => {
+            point.estimate_method = format!("none: the second solve at {note} failed: {}", e.to_string().split(':').next().unwrap_or_default());
+            return None;
+        }
+    };
+    let coarser = grid.instants() < solver.problem().instants();
+    // Newton from the carried set alone: a k/4 grid near its stability limit can miss, and
+    // then the estimate has two grids (a cold try there cost seconds per point).
+    let quarter = coarser.then(|| accuracy::third_grid(&grid)).flatten().and_then(|g| second_solve(second, &g, r, settings.warm_start, ColdTry::No).ok());
+    let a = accuracy::estimate_from(solver.problem(), r, &half, quarter.as_ref(), &note);
+    (point.estimate_relative, point.estimate_method) = (settings.measure.of(&a), a.method);
+    coarser.then_some(half)
+}
+
+/// The second solve of a point's error estimate, in the chunk's session for that grid (made on
+/// the first point, or again when the grid changes), with the frequency it last solved. On a
+/// large LCP ([`guarded`]) it starts from the active set of `first`, the point's answer on the
+/// first grid, carried to this grid (the same orbit at other instants: a closer guess than this
+/// grid's last point) and never runs the dense fallback ([`solve_guarded`]).
+fn second_solve(sessions: &mut Coarser, problem: &PeriodicProblem, first: &Response, warm: bool, cold: ColdTry) -> Result<Response, SolveError> {
+    let steps = problem.discretization().steps;
+    let i = match sessions.iter().position(|s| s.0.problem().discretization().steps == steps) {
+        Some(i) => i,
+        None => {
+            sessions.push((PeriodicSolver::new(problem.clone()).with_warm_starts(warm), None));
+            sessions.len() - 1
+        }
+    };
+    let (solver, last) = &mut sessions[i];
+    let f = problem.model().frequency;
+    if !(warm && guarded(solver.problem())) {
+        solver.update_frequency(f)?;
+        return solver.solve();
+    }
+    let m = problem.model().contacts.len();
+    let k_first = first.lcp.size / m.max(1);
+    let carried = crate::periodic::carried_active_set(&first.active_set, m, k_first, solver.problem().instants());
+    solver.set_warm_start(&carried);
+    let (r, _) = solve_guarded(solver, *last, f, cold);
+    *last = r.as_ref().ok().map(|_| f);
+    r
+}
+
 fn first_clause(e: &SolveError) -> String {
     let s = e.to_string();
     s.split(':').next().unwrap_or(&s).to_string()
