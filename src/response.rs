@@ -179,6 +179,9 @@ pub struct Accuracy {
     pub estimate: Option<f64>,
     /// `estimate` divided by the largest peak-to-peak amplitude of the displacement outputs.
     pub relative: Option<f64>,
+    /// The largest over the displacement outputs of each one's estimate divided by its own
+    /// peak-to-peak amplitude (≥ `relative`: a small output counts as much as the largest).
+    pub relative_own: Option<f64>,
     /// How it was obtained, e.g. "richardson: k/2 = 256, order 2 (cds, forward, rigid contact with sticking)".
     pub method: String,
 }

@@ -73,13 +73,22 @@ pub fn solve_to_tolerance(problem: &mut PeriodicProblem, target: &AccuracyTarget
             }
         };
         r.accuracy = accuracy::estimate_with(problem, &r, &mut neighbour);
+        // With k/2 and k/4 at hand (the earlier levels), the observed order enters the estimate.
+        let below = |n: usize| solved.iter().find(|s| s.steps * n == r.steps);
+        if let (Some(half), Some(quarter), Ok((second, note))) = (below(2), below(4), accuracy::second_grid(problem, &r))
+            && second.instants() == half.steps
+            && r.accuracy.estimate.is_some()
+        {
+            r.accuracy = accuracy::estimate_from(problem, &r, half, Some(quarter), &note);
+        }
         let seconds = t0.elapsed().as_secs_f64();
-        let estimate = r.accuracy.relative;
+        let estimate = target.measure.of(&r.accuracy);
         let order = accuracy::expected_order(problem, &r).0.unwrap_or(1.0);
         let previous = tried.last().filter(|t| t.steps * 2 == k).and_then(|t| t.estimate);
         let bound = estimate.map(|e| envelope(e, k, order, &tried));
         tried.push(SchemeTrial { steps: k, estimate, bound, seconds });
-        solved.retain(|s| s.steps > r.steps / 2);
+        // k/2 stays for the next level's observed order.
+        solved.retain(|s| s.steps > r.steps / 4);
         solved.push(r.clone());
         untrusted = distrust(problem, &r, estimate, previous, order);
         best = Some(r);

@@ -80,6 +80,39 @@ pub struct AccuracyTarget {
     /// The refinement stops when the next solve is projected to take longer than this [s]
     /// (`[discretization] time_budget`).
     pub time_budget: f64,
+    /// What the tolerance is relative to (`[discretization] tolerance_of`).
+    pub measure: AmplitudeMeasure,
+}
+
+/// What a relative error estimate divides by when compared with a tolerance
+/// (`[discretization] tolerance_of`, `sweep --tolerance-of`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum AmplitudeMeasure {
+    /// The largest peak-to-peak amplitude of the displacement outputs (`"largest"`, the default):
+    /// an output that barely moves (a node near the root) does not ask for unbounded accuracy.
+    #[default]
+    Largest,
+    /// Each output's own peak-to-peak amplitude (`"own"`): the small outputs (the real blade's
+    /// radial tip outputs, 1/11 of the largest) are held to the same relative accuracy.
+    Own,
+}
+
+impl AmplitudeMeasure {
+    /// The scene's and the CLI's spelling.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "largest" => Some(Self::Largest),
+            "own" => Some(Self::Own),
+            _ => None,
+        }
+    }
+    /// The estimate of `a` in this measure.
+    pub fn of(self, a: &crate::response::Accuracy) -> Option<f64> {
+        match self {
+            Self::Largest => a.relative,
+            Self::Own => a.relative_own,
+        }
+    }
 }
 
 /// Default `[discretization] tolerance` with `scheme = "auto"`: 1e-3 of the peak-to-peak
@@ -96,7 +129,7 @@ pub const AUTO_FIRST_STEPS: usize = 128;
 
 impl Default for AccuracyTarget {
     fn default() -> Self {
-        AccuracyTarget { tolerance: AUTO_TOLERANCE, max_steps: AUTO_MAX_STEPS, time_budget: AUTO_TIME_BUDGET }
+        AccuracyTarget { tolerance: AUTO_TOLERANCE, max_steps: AUTO_MAX_STEPS, time_budget: AUTO_TIME_BUDGET, measure: AmplitudeMeasure::Largest }
     }
 }
 

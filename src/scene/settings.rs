@@ -3,7 +3,7 @@
 use super::{BuildError, DiscretizationSpec, SolverSpec, StepsSpec};
 use crate::lcp::LcpMethod;
 use crate::periodic::SolverSettings;
-use crate::periodic::limits::AccuracyTarget;
+use crate::periodic::limits::{AccuracyTarget, AmplitudeMeasure};
 use crate::time::{Discretization, Pairing, Scheme};
 
 /// `[discretization]`: the scheme, the steps per period and the optional pairing; `true` when
@@ -86,7 +86,12 @@ pub fn period_multiple(spec: &DiscretizationSpec) -> Result<usize, BuildError> {
 /// (each checked); `None` for a named scheme, which must not carry them.
 pub fn accuracy_target(spec: &DiscretizationSpec) -> Result<Option<AccuracyTarget>, BuildError> {
     if spec.scheme != "auto" {
-        let given = [("tolerance", spec.tolerance.is_some()), ("max_steps", spec.max_steps.is_some()), ("time_budget", spec.time_budget.is_some())];
+        let given = [
+            ("tolerance", spec.tolerance.is_some()),
+            ("max_steps", spec.max_steps.is_some()),
+            ("time_budget", spec.time_budget.is_some()),
+            ("tolerance_of", spec.tolerance_of.is_some()),
+        ];
         if let Some((key, _)) = given.iter().find(|(_, g)| *g) {
             return Err(BuildError::field(
                 format!("discretization.{key}"),
@@ -127,6 +132,14 @@ pub fn accuracy_target(spec: &DiscretizationSpec) -> Result<Option<AccuracyTarge
             return Err(BuildError::field("discretization.time_budget", format!("is {b}, must be a positive number of seconds")));
         }
         t.time_budget = b;
+    }
+    if let Some(m) = &spec.tolerance_of {
+        t.measure = AmplitudeMeasure::parse(m).ok_or_else(|| {
+            BuildError::field(
+                "discretization.tolerance_of",
+                format!("is \"{m}\", must be \"largest\" (the largest output's peak-to-peak amplitude) or \"own\" (each output's own)"),
+            )
+        })?;
     }
     Ok(Some(t))
 }

@@ -290,6 +290,9 @@ pub struct DiscretizationSpec {
     pub max_steps: Option<i64>,
     /// With `scheme = "auto"`: stop refining when the next solve is projected past this [s].
     pub time_budget: Option<f64>,
+    /// With `scheme = "auto"`: what `tolerance` is relative to, `"largest"` (default) or `"own"`
+    /// (`periodic::limits::AmplitudeMeasure`).
+    pub tolerance_of: Option<String>,
 }
 
 /// `steps = 512` or `steps = "auto"`; anything else is kept to be refused naming the field.
@@ -329,6 +332,7 @@ impl Default for DiscretizationSpec {
             tolerance: None,
             max_steps: None,
             time_budget: None,
+            tolerance_of: None,
             period_multiple: None,
         }
     }

@@ -17,8 +17,9 @@ pub mod marching;
 mod refine;
 pub mod spectrum;
 
-use crate::analysis::{accuracy, continuation};
+use crate::analysis::continuation;
 use crate::model::{Labels, Quantity};
+use crate::periodic::limits::AmplitudeMeasure;
 use crate::periodic::{LEMKE_AFTER_SHOOTING_MAX, LcpMethod, PeriodicProblem, PeriodicSolver, SolveError, Tuning, WarmStart};
 use crate::response::Response;
 use rayon::prelude::*;
@@ -41,11 +42,21 @@ pub struct SweepSettings {
     pub tolerance: Option<f64>,
     /// The largest k of a refinement.
     pub max_steps: usize,
+    /// What `tolerance` and the points' `estimate_relative` are relative to.
+    pub measure: AmplitudeMeasure,
 }
 
 impl Default for SweepSettings {
     fn default() -> Self {
-        SweepSettings { warm_start: true, threads: 0, chunks_per_thread: 4, estimate: false, tolerance: None, max_steps: 4096 }
+        SweepSettings {
+            warm_start: true,
+            threads: 0,
+            chunks_per_thread: 4,
+            estimate: false,
+            tolerance: None,
+            max_steps: 4096,
+            measure: AmplitudeMeasure::Largest,
+        }
     }
 }
 
@@ -176,7 +187,7 @@ pub fn run(
             .map(|&(lo, hi)| {
                 let mut solver = session.clone();
                 // The second grid of the error estimates, warm-started along the chunk too.
-                let mut second: Option<(PeriodicSolver, Option<f64>)> = None;
+                let mut second: refine::Coarser = Vec::new();
                 let mut levels = refine::Levels::new();
                 let mut out = Vec::with_capacity(hi - lo);
                 let mut last: Option<(f64, Response)> = None;
@@ -220,8 +231,8 @@ pub fn run(
                     point.warm_start_used = r.is_ok() && solver.last_start() == WarmStart::Used;
                     point.cold_fallback = solver.last_start() == WarmStart::ColdFallback;
                     if let Ok(r) = &r {
-                        estimate(&mut point, &solver, r, &mut second, settings);
-                        refine::refine(&mut point, solver.problem(), r, &mut levels, settings);
+                        let below = refine::estimate(&mut point, &solver, r, &mut second, settings);
+                        refine::refine(&mut point, solver.problem(), r, below, &mut levels, settings);
                     }
                     point.time_s = t.elapsed().as_secs_f64();
                     match r {
@@ -258,18 +269,9 @@ pub fn refill(template: &PeriodicProblem, points: &mut [SweepPoint], settings: &
         return;
     }
     let mut solver = PeriodicSolver::new(template.clone());
-    let (mut second, mut levels) = (None, refine::Levels::new());
+    let (mut second, mut levels) = (refine::Coarser::new(), refine::Levels::new());
     for reverse in [true, false] {
         refill_pass(&mut solver, (&mut second, &mut levels), settings, points, reverse);
-    }
-}
-
-/// The point's error estimate ([`SweepSettings::estimate`]): a second solve on the other grid,
-/// in the chunk's session for that grid.
-fn estimate(point: &mut SweepPoint, solver: &PeriodicSolver, r: &Response, second: &mut Option<(PeriodicSolver, Option<f64>)>, settings: &SweepSettings) {
-    if settings.estimate {
-        let a = accuracy::estimate_with(solver.problem(), r, &mut |p| second_solve(second, p, r, settings.warm_start));
-        (point.estimate_relative, point.estimate_method) = (a.relative, a.method);
     }
 }
 
@@ -282,7 +284,7 @@ fn estimate(point: &mut SweepPoint, solver: &PeriodicSolver, r: &Response, secon
 /// down to those points in a few Newton iterations each. A point still missed keeps its failure.
 fn refill_pass(
     solver: &mut PeriodicSolver,
-    (second, levels): (&mut Option<(PeriodicSolver, Option<f64>)>, &mut refine::Levels),
+    (second, levels): (&mut refine::Coarser, &mut refine::Levels),
     settings: &SweepSettings,
     points: &mut [SweepPoint],
     reverse: bool,
@@ -303,8 +305,8 @@ fn refill_pass(
             Ok(r) => {
                 let mut point = SweepPoint::from_response(solver.problem(), f, &r);
                 (point.substeps, point.warm_start_used) = (substeps, true);
-                estimate(&mut point, solver, &r, second, settings);
-                refine::refine(&mut point, solver.problem(), &r, levels, settings);
+                let below = refine::estimate(&mut point, solver, &r, second, settings);
+                refine::refine(&mut point, solver.problem(), &r, below, levels, settings);
                 point.time_s = before + t.elapsed().as_secs_f64();
                 points[i] = point;
                 neighbour = Some(i);
@@ -375,31 +377,6 @@ fn solve_guarded(solver: &mut PeriodicSolver, last: Option<f64>, f: f64, cold: C
         }
         Err(e) => (Err(e), substeps),
     }
-}
-
-/// The second solve of a point's error estimate, in the chunk's session for that grid (made on
-/// the first point, or again when the grid changes), with the frequency it last solved. On a
-/// large LCP ([`guarded`]) it starts from the active set of `first`, the point's answer on the
-/// first grid, carried to this grid (the same orbit at other instants: a closer guess than this
-/// grid's last point) and never runs the dense fallback ([`solve_guarded`]).
-fn second_solve(session: &mut Option<(PeriodicSolver, Option<f64>)>, problem: &PeriodicProblem, first: &Response, warm: bool) -> Result<Response, SolveError> {
-    let steps = problem.discretization().steps;
-    let (solver, last) = match session {
-        Some(s) if s.0.problem().discretization().steps == steps => s,
-        _ => session.insert((PeriodicSolver::new(problem.clone()).with_warm_starts(warm), None)),
-    };
-    let f = problem.model().frequency;
-    if !(warm && guarded(solver.problem())) {
-        solver.update_frequency(f)?;
-        return solver.solve();
-    }
-    let m = problem.model().contacts.len();
-    let k_first = first.lcp.size / m.max(1);
-    let carried = crate::periodic::carried_active_set(&first.active_set, m, k_first, solver.problem().instants());
-    solver.set_warm_start(&carried);
-    let (r, _) = solve_guarded(solver, *last, f, ColdTry::Full);
-    *last = r.as_ref().ok().map(|_| f);
-    r
 }
 
 /// Whether a sweep guards this problem's points ([`solve_guarded`]): `auto` on an LCP above

@@ -15,15 +15,23 @@ use crate::time::Discretization;
 pub(super) type Levels = Vec<PeriodicSolver>;
 
 /// Refines `point`, the answer `first` of `problem` (the chunk's first grid at the point's
-/// frequency), while its estimate exceeds the tolerance and the doubled k stays within
-/// `settings.max_steps`. The point keeps its coarser answer where a refined solve fails (a
-/// large LCP's refined try is Newton from the carried set alone, [`solve_guarded`]); the
-/// failure is noted in its `estimate_method`.
-pub(super) fn refine(point: &mut SweepPoint, problem: &PeriodicProblem, first: &Response, levels: &mut Levels, settings: &SweepSettings) {
+/// frequency; `below`, its estimate's k/2 answer when there is one), while its estimate exceeds
+/// the tolerance and the doubled k stays within `settings.max_steps`. The point keeps its
+/// coarser answer where a refined solve fails (a large LCP's refined try is Newton from the
+/// carried set alone, [`solve_guarded`]); the failure is noted in its `estimate_method`.
+pub(super) fn refine(
+    point: &mut SweepPoint,
+    problem: &PeriodicProblem,
+    first: &Response,
+    below: Option<Response>,
+    levels: &mut Levels,
+    settings: &SweepSettings,
+) {
     let Some(tolerance) = settings.tolerance else { return };
     let f = point.frequency;
     let m = problem.model().contacts.len().max(1);
-    let mut coarse: Option<Response> = None;
+    // The two grids below the next one, coarse to fine: Richardson and the observed order.
+    let (mut third, mut coarse): (Option<Response>, Option<Response>) = (below, None);
     for level in 0.. {
         let prev = coarse.as_ref().unwrap_or(first);
         let steps = problem.discretization().steps << (level + 1);
@@ -50,26 +58,85 @@ pub(super) fn refine(point: &mut SweepPoint, problem: &PeriodicProblem, first: &
                 return;
             }
         };
-        // Richardson between this grid and the one below: the coarser answer is at hand.
-        let a = accuracy::estimate_with(solver.problem(), &r, &mut |p| {
-            if p.discretization().steps == steps / 2 {
-                Ok(prev.clone())
-            } else {
-                Err(SolveError::Invalid(format!("no answer at k = {}", p.discretization().steps)))
-            }
-        });
-        if a.relative.is_none() {
+        // Richardson between this grid and the one below, the observed order from the one
+        // below that: both answers are at hand.
+        let a = accuracy::estimate_from(solver.problem(), &r, prev, third.as_ref().filter(|t| t.steps * 4 == steps), &format!("k/2 = {}", steps / 2));
+        let Some(relative) = settings.measure.of(&a) else {
             point.estimate_method.push_str(&format!("; refined to k = {steps} without an estimate ({}), k = {} kept", a.method, steps / 2));
             return;
-        }
+        };
         let mut refined = SweepPoint::from_response(solver.problem(), f, &r);
-        (refined.estimate_relative, refined.estimate_method) = (a.relative, a.method);
+        (refined.estimate_relative, refined.estimate_method) = (Some(relative), a.method);
         (refined.substeps, refined.warm_start_used, refined.cold_fallback) = (point.substeps, point.warm_start_used, point.cold_fallback);
         // The first grid's active set stays: it warm-starts the neighbours (`refill`).
         (refined.time_s, refined.active_set) = (point.time_s, std::mem::take(&mut point.active_set));
         *point = refined;
+        third = Some(coarse.take().unwrap_or_else(|| first.clone()));
         coarse = Some(r);
     }
+}
+
+/// The chunk's sessions of the estimates' coarser grids (k/2 and k/4, or 2k), each with the
+/// frequency it last solved.
+pub(super) type Coarser = Vec<(PeriodicSolver, Option<f64>)>;
+
+/// The point's error estimate ([`SweepSettings::estimate`]): a second solve on the other grid and
+/// a third at k/4 for the observed order ([`accuracy::estimate_from`]), in the chunk's sessions
+/// for those grids. Returns the k/2 answer (the refinement's third grid).
+pub(super) fn estimate(point: &mut SweepPoint, solver: &PeriodicSolver, r: &Response, second: &mut Coarser, settings: &SweepSettings) -> Option<Response> {
+    if !settings.estimate {
+        return None;
+    }
+    let (grid, note) = match accuracy::second_grid(solver.problem(), r) {
+        Ok(g) => g,
+        Err(a) => {
+            (point.estimate_relative, point.estimate_method) = (settings.measure.of(&a), a.method);
+            return None;
+        }
+    };
+    let half = match second_solve(second, &grid, r, settings.warm_start, ColdTry::Full) {
+        Ok(h) => h,
+        Err(e) => {
+            point.estimate_method = format!("none: the second solve at {note} failed: {}", e.to_string().split(':').next().unwrap_or_default());
+            return None;
+        }
+    };
+    let coarser = grid.instants() < solver.problem().instants();
+    // Newton from the carried set alone: a k/4 grid near its stability limit can miss, and
+    // then the estimate has two grids (a cold try there cost seconds per point).
+    let quarter = coarser.then(|| accuracy::third_grid(&grid)).flatten().and_then(|g| second_solve(second, &g, r, settings.warm_start, ColdTry::No).ok());
+    let a = accuracy::estimate_from(solver.problem(), r, &half, quarter.as_ref(), &note);
+    (point.estimate_relative, point.estimate_method) = (settings.measure.of(&a), a.method);
+    coarser.then_some(half)
+}
+
+/// The second solve of a point's error estimate, in the chunk's session for that grid (made on
+/// the first point, or again when the grid changes), with the frequency it last solved. On a
+/// large LCP ([`guarded`]) it starts from the active set of `first`, the point's answer on the
+/// first grid, carried to this grid (the same orbit at other instants: a closer guess than this
+/// grid's last point) and never runs the dense fallback ([`solve_guarded`]).
+fn second_solve(sessions: &mut Coarser, problem: &PeriodicProblem, first: &Response, warm: bool, cold: ColdTry) -> Result<Response, SolveError> {
+    let steps = problem.discretization().steps;
+    let i = match sessions.iter().position(|s| s.0.problem().discretization().steps == steps) {
+        Some(i) => i,
+        None => {
+            sessions.push((PeriodicSolver::new(problem.clone()).with_warm_starts(warm), None));
+            sessions.len() - 1
+        }
+    };
+    let (solver, last) = &mut sessions[i];
+    let f = problem.model().frequency;
+    if !(warm && guarded(solver.problem())) {
+        solver.update_frequency(f)?;
+        return solver.solve();
+    }
+    let m = problem.model().contacts.len();
+    let k_first = first.lcp.size / m.max(1);
+    let carried = crate::periodic::carried_active_set(&first.active_set, m, k_first, solver.problem().instants());
+    solver.set_warm_start(&carried);
+    let (r, _) = solve_guarded(solver, *last, f, cold);
+    *last = r.as_ref().ok().map(|_| f);
+    r
 }
 
 fn first_clause(e: &SolveError) -> String {

@@ -3,6 +3,7 @@
 use crate::{Failure, ensure_writable, write_output};
 use indicatif::{ProgressBar, ProgressStyle};
 use periodic_contact::model::Quantity;
+use periodic_contact::periodic::limits::AmplitudeMeasure;
 use periodic_contact::scene::Scene;
 use periodic_contact::sweep::{self, SweepSettings, marching::MarchOptions};
 use std::path::{Path, PathBuf};
@@ -69,6 +70,10 @@ pub struct Args {
     /// The largest k of a refinement (--tolerance).
     #[arg(long, default_value_t = 4096)]
     pub max_steps: usize,
+    /// What --tolerance and the estimates are relative to: "largest" (the largest output's
+    /// peak-to-peak amplitude) or "own" (each output's own).
+    #[arg(long, default_value = "largest")]
+    pub tolerance_of: String,
     /// Log amplitude axis in the frequency-response PNGs (suggested when the contact and linear
     /// peaks differ by more than 10×).
     #[arg(long)]
@@ -155,7 +160,10 @@ pub fn run(a: &Args) -> Result<(), Failure> {
     if let Some(t) = a.tolerance.filter(|t| !(t.is_finite() && *t > 0.0 && *t < 1.0)) {
         return Err(Failure::input(format!("--tolerance: {t} is not a fraction of the amplitude in (0, 1); e.g. --tolerance 1e-3")));
     }
+    let measure = AmplitudeMeasure::parse(&a.tolerance_of)
+        .ok_or_else(|| Failure::input(format!("--tolerance-of: \"{}\" is neither \"largest\" nor \"own\"", a.tolerance_of)))?;
     let settings = SweepSettings {
+        measure,
         warm_start: !a.cold,
         threads: a.threads,
         chunks_per_thread: a.chunks_per_thread,
