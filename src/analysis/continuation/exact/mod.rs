@@ -90,9 +90,9 @@ pub(super) fn walk(
 /// The walk's first point: `orbit` (at λ = `from`) closed as a function of the parameter, its
 /// tangent towards `to`; λ scaled by `rho` in the unknowns.
 fn begin<'a>(problem: &'a PeriodicProblem, param: Parameter, from: f64, to: f64, rho: f64, orbit: &PolishedOrbit) -> Result<(Walk<'a>, Node), Error> {
-    let ys = orbit.initial_state().iter().fold(0.0f64, |m, y| m.max(y.abs())).max(1e-300);
     let sig = Signature { events: orbit.events().to_vec(), always: orbit.always_closed().to_vec() };
-    let fam = Family::new(problem.model(), param, rho, ys, sig);
+    let mut fam = Family::new(problem.model(), param, rho, 1.0, sig);
+    fam.ys = fam.scale_of(orbit.initial_state());
     let d = fam.dim();
     let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
     let w0 = fam
@@ -305,8 +305,27 @@ impl Walk<'_> {
                 return done(self, stop, false, true);
             }
             here = next;
+            self.rescale(&mut here);
             ds = (step * 1.5).min(settings.exact_max_step);
         }
+    }
+
+    /// The state scale follows the orbit: set to `node`'s largest state component when that has
+    /// moved by more than 2× from it (`node`'s unknowns and tangent re-expressed). With the scale
+    /// of the first point, the coarse blade's resonant orbits (20× larger) made each arclength
+    /// step a twentieth of the orbit's change it allows at the start, and the corrector's
+    /// round-off 20× larger in the scaled unknowns.
+    fn rescale(&mut self, node: &mut Node) {
+        let n2 = node.w.len() - 1 - self.fam.ne();
+        let scale = node.w[..n2].iter().fold(0.0f64, |m, w| m.max(w.abs()));
+        if !(scale > 0.0 && scale.is_finite()) || (0.5..=2.0).contains(&scale) {
+            return;
+        }
+        self.fam.ys *= scale;
+        node.w[..n2].iter_mut().for_each(|w| *w /= scale);
+        node.tangent[..n2].iter_mut().for_each(|t| *t /= scale);
+        let norm = node.tangent.iter().map(|t| t * t).sum::<f64>().sqrt();
+        node.tangent.iter_mut().for_each(|t| *t /= norm);
     }
 
     /// Phases between two events of one contact that shrink along the tangent: (phase, length,
