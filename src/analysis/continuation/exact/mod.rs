@@ -33,6 +33,13 @@ const NEW_PAIR: f64 = 1e-5;
 const BRACKET: f64 = 1e-12;
 /// Successive tangents at a larger angle than arccos(this) mean a step too long.
 const MIN_COS: f64 = 0.9;
+/// A corrected point farther than this × the step from the predictor is on another part of the
+/// branch: the corrector jumped (the coarse blade: from the upper branch at 2655.19 rad/s onto the
+/// near-parallel middle branch at 2605.14, tangents still at cos 0.93, so the walk turned back
+/// with no fold). On this part the distance is ≈ ½·step·angle ≤ 0.23·step (angle ≤
+/// arccos(MIN_COS)); the 19 jumps of one whole run were 0.68 to 11.5 steps away (Allgower & Georg
+/// 1990, §6.1: the corrector's distance to the predictor bounds the step).
+const MAX_DRIFT: f64 = 0.5;
 /// A touch counts as a crossing below −this × the state scale (round-off of the flows).
 const TOUCH_TOL: f64 = 1e-10;
 
@@ -215,8 +222,9 @@ impl Walk<'_> {
             let pred: Vec<f64> = here.w.iter().zip(&here.tangent).map(|(w, t)| w + step * t).collect();
             let target: f64 = here.tangent.iter().zip(&pred).map(|(t, p)| t * p).sum();
             let next = self.fam.correct(&pred, &here.tangent, target).and_then(|w| self.fam.node(w, &here.tangent));
+            let drift = |n: &Node| n.w.iter().zip(&pred).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt();
             let next = match next {
-                Some(n) if dot(&n.tangent, &here.tangent) >= MIN_COS || step <= settings.min_step => n,
+                Some(n) if (dot(&n.tangent, &here.tangent) >= MIN_COS || step <= settings.min_step) && drift(&n) <= MAX_DRIFT * step => n,
                 _ => {
                     ds = step / 2.0;
                     if ds < settings.min_step {
