@@ -182,7 +182,8 @@ fn one_walk_turns_at_both_folds_of_the_demo() {
     // wiggle back up in ω reads |μ| < 1: measured down to 0.0072 below the tip).
     let middle: Vec<&continuation::BranchPoint> =
         b.points[folds[0]..folds[1]].iter().filter(|q| q.certified && q.parameter < at[0] - 0.009 && q.parameter > at[1] + 0.0045).collect();
-    assert!(middle.len() > 20 && middle.iter().all(|q| !q.stable && q.max_multiplier > 1.0), "{} middle points", middle.len());
+    // (12 such points since the exact walk's state scale follows the orbit: longer steps.)
+    assert!(middle.len() >= 10 && middle.iter().all(|q| !q.stable && q.max_multiplier > 1.0), "{} middle points", middle.len());
     // Past the lower fold, off the stop: the linear orbit, stable with |μ| = e^(−cT/2).
     let free: Vec<&continuation::BranchPoint> = b.points[folds[1]..].iter().filter(|q| q.certified && q.parameter > grazing + 0.01).collect();
     assert!(free.len() > 5);

@@ -33,6 +33,13 @@ const NEW_PAIR: f64 = 1e-5;
 const BRACKET: f64 = 1e-12;
 /// Successive tangents at a larger angle than arccos(this) mean a step too long.
 const MIN_COS: f64 = 0.9;
+/// A corrected point farther than this × the step from the predictor is on another part of the
+/// branch: the corrector jumped (the coarse blade: from the upper branch at 2655.19 rad/s onto the
+/// near-parallel middle branch at 2605.14, tangents still at cos 0.93, so the walk turned back
+/// with no fold). On this part the distance is ≈ ½·step·angle ≤ 0.23·step (angle ≤
+/// arccos(MIN_COS)); the 19 jumps of one whole run were 0.68 to 11.5 steps away (Allgower & Georg
+/// 1990, §6.1: the corrector's distance to the predictor bounds the step).
+const MAX_DRIFT: f64 = 0.5;
 /// A touch counts as a crossing below −this × the state scale (round-off of the flows).
 const TOUCH_TOL: f64 = 1e-10;
 
@@ -90,9 +97,9 @@ pub(super) fn walk(
 /// The walk's first point: `orbit` (at λ = `from`) closed as a function of the parameter, its
 /// tangent towards `to`; λ scaled by `rho` in the unknowns.
 fn begin<'a>(problem: &'a PeriodicProblem, param: Parameter, from: f64, to: f64, rho: f64, orbit: &PolishedOrbit) -> Result<(Walk<'a>, Node), Error> {
-    let ys = orbit.initial_state().iter().fold(0.0f64, |m, y| m.max(y.abs())).max(1e-300);
     let sig = Signature { events: orbit.events().to_vec(), always: orbit.always_closed().to_vec() };
-    let fam = Family::new(problem.model(), param, rho, ys, sig);
+    let mut fam = Family::new(problem.model(), param, rho, 1.0, sig);
+    fam.ys = fam.scale_of(orbit.initial_state());
     let d = fam.dim();
     let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
     let w0 = fam
@@ -215,8 +222,9 @@ impl Walk<'_> {
             let pred: Vec<f64> = here.w.iter().zip(&here.tangent).map(|(w, t)| w + step * t).collect();
             let target: f64 = here.tangent.iter().zip(&pred).map(|(t, p)| t * p).sum();
             let next = self.fam.correct(&pred, &here.tangent, target).and_then(|w| self.fam.node(w, &here.tangent));
+            let drift = |n: &Node| n.w.iter().zip(&pred).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt();
             let next = match next {
-                Some(n) if dot(&n.tangent, &here.tangent) >= MIN_COS || step <= settings.min_step => n,
+                Some(n) if (dot(&n.tangent, &here.tangent) >= MIN_COS || step <= settings.min_step) && drift(&n) <= MAX_DRIFT * step => n,
                 _ => {
                     ds = step / 2.0;
                     if ds < settings.min_step {
@@ -305,8 +313,27 @@ impl Walk<'_> {
                 return done(self, stop, false, true);
             }
             here = next;
+            self.rescale(&mut here);
             ds = (step * 1.5).min(settings.exact_max_step);
         }
+    }
+
+    /// The state scale follows the orbit: set to `node`'s largest state component when that has
+    /// moved by more than 2× from it (`node`'s unknowns and tangent re-expressed). With the scale
+    /// of the first point, the coarse blade's resonant orbits (20× larger) made each arclength
+    /// step a twentieth of the orbit's change it allows at the start, and the corrector's
+    /// round-off 20× larger in the scaled unknowns.
+    fn rescale(&mut self, node: &mut Node) {
+        let n2 = node.w.len() - 1 - self.fam.ne();
+        let scale = node.w[..n2].iter().fold(0.0f64, |m, w| m.max(w.abs()));
+        if !(scale > 0.0 && scale.is_finite()) || (0.5..=2.0).contains(&scale) {
+            return;
+        }
+        self.fam.ys *= scale;
+        node.w[..n2].iter_mut().for_each(|w| *w /= scale);
+        node.tangent[..n2].iter_mut().for_each(|t| *t /= scale);
+        let norm = node.tangent.iter().map(|t| t * t).sum::<f64>().sqrt();
+        node.tangent.iter_mut().for_each(|t| *t /= norm);
     }
 
     /// Phases between two events of one contact that shrink along the tangent: (phase, length,

@@ -60,7 +60,7 @@ pub(super) fn remove(fam: &Family, orbit: &PolishedOrbit, phase: usize, wl: f64)
 pub(super) fn guess(fam: &Family, orbit: &PolishedOrbit, list: &[(f64, Event)], wl: f64) -> Vec<f64> {
     let t = orbit.period();
     let t0 = list.first().map_or(0.0, |l| l.0 * t);
-    let mut w: Vec<f64> = orbit.state(t0).iter().map(|y| y / fam.ys).collect();
+    let mut w = fam.scaled(orbit.state(t0).as_slice());
     w.extend(list.iter().map(|l| l.0));
     w.push(wl);
     w
