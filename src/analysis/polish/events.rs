@@ -1,8 +1,10 @@
 //! The event sequence of an orbit, read from the LCP's solution: a rigid contact's run of forced
 //! instants is an impact followed by a sticking arc and a release (or a pure impact when the run
 //! is short); a compliant contact's run of penetrating instants is contact on, then off.
+use super::orbit::PolishedOrbit;
 use crate::model::Model;
 use crate::response::Response;
+use nalgebra::DVector;
 
 /// What happens at an event.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -193,5 +195,47 @@ fn after(kind: EventKind) -> bool {
         EventKind::Impact { stick } => stick,
         EventKind::Release | EventKind::Off => false,
         EventKind::On => true,
+    }
+}
+
+/// Events of different contacts passing each other in the polish's Newton (orbit.rs).
+impl PolishedOrbit {
+    /// Whether events `a` and `b` may pass each other in Newton: two contacts whose switches
+    /// have identity saltation (the contact force is zero there: compliant contacts and rigid
+    /// ones on massless DOFs), so that the orbit is continuous in their times through the swap.
+    /// The real blade's 17 tips close and release within one step of each other, in an order the
+    /// LCP's grid cannot tell.
+    pub(super) fn may_pass(&self, a: &Event, b: &Event) -> bool {
+        let smooth = |e: &Event| {
+            let c = &self.model.contacts[e.contact];
+            !c.is_rigid() || self.model.contact_is_massless(c)
+        };
+        a.contact != b.contact && smooth(a) && smooth(b)
+    }
+
+    /// The orbit with the events of the unknowns `u` sorted by their times, and `u` in that
+    /// order, when only events that [`Self::may_pass`] have passed each other and event 0 stays
+    /// first within one period; the phases of unchanged contact sets are reused.
+    pub(super) fn reordered(&self, u: &DVector<f64>) -> Option<(Self, DVector<f64>)> {
+        let n2 = 2 * self.model.n();
+        let ne = self.events.len();
+        let tau: Vec<f64> = u.iter().skip(n2).copied().collect();
+        if ne < 3 || tau[1..].iter().any(|&t| t <= tau[0] || t >= tau[0] + self.period) {
+            return None;
+        }
+        let mut order: Vec<usize> = (0..ne).collect();
+        order[1..].sort_by(|&a, &b| tau[a].total_cmp(&tau[b]));
+        for (x, &a) in order.iter().enumerate() {
+            if order[x + 1..].iter().any(|&b| b < a && !self.may_pass(&self.events[a], &self.events[b])) {
+                return None;
+            }
+        }
+        let events: Vec<Event> = order.iter().map(|&e| Event { seed: tau[e], ..self.events[e] }).collect();
+        let orbit = Self::reusing(&self.model, events, &self.always, &self.phases).ok()?;
+        let mut v = u.clone();
+        for (x, &e) in order.iter().enumerate() {
+            v[n2 + x] = tau[e];
+        }
+        Some((orbit, v))
     }
 }

@@ -88,7 +88,7 @@ impl PolishedOrbit {
     }
 
     /// [`Self::new`], taking from `reuse` the phases whose contact sets it already holds.
-    fn reusing(model: &Model, evs: Vec<Event>, always: &[usize], reuse: &[Phase]) -> Result<Self, PolishFailure> {
+    pub(super) fn reusing(model: &Model, evs: Vec<Event>, always: &[usize], reuse: &[Phase]) -> Result<Self, PolishFailure> {
         let sets = events::phase_sets(model, &evs, always);
         let mut phases = Vec::new();
         let empty = vec![always.to_vec()];
@@ -251,7 +251,7 @@ impl PolishedOrbit {
     /// In raw units the velocity of a stiff DOF (a Craig–Bampton constraint mode, a closed
     /// contact spring: ω_d ≈ 6e5 rad/s on the coarse blade) outweighs every clearance, and the
     /// line search then refuses Newton steps that are right (the coarse blade's stall).
-    fn weights(&self) -> DVector<f64> {
+    pub(super) fn weights(&self) -> DVector<f64> {
         let (n, s) = (self.model.n(), &self.model.structure);
         let rate = |d: usize| (s.stiffness.get(d, d) / s.mass.get(d, d)).abs().sqrt().max(self.model.frequency);
         let ne = self.events.len();
@@ -268,46 +268,7 @@ impl PolishedOrbit {
         })
     }
 
-    /// Whether events `a` and `b` may pass each other in Newton: two contacts whose switches
-    /// have identity saltation (the contact force is zero there: compliant contacts and rigid
-    /// ones on massless DOFs), so that the orbit is continuous in their times through the swap.
-    /// The real blade's 17 tips close and release within one step of each other, in an order the
-    /// LCP's grid cannot tell.
-    fn may_pass(&self, a: &Event, b: &Event) -> bool {
-        let smooth = |e: &Event| {
-            let c = &self.model.contacts[e.contact];
-            !c.is_rigid() || self.model.contact_is_massless(c)
-        };
-        a.contact != b.contact && smooth(a) && smooth(b)
-    }
-
-    /// The orbit with the events of the unknowns `u` sorted by their times, and `u` in that
-    /// order, when only events that [`Self::may_pass`] have passed each other and event 0 stays
-    /// first within one period; the phases of unchanged contact sets are reused.
-    fn reordered(&self, u: &DVector<f64>) -> Option<(Self, DVector<f64>)> {
-        let n2 = 2 * self.model.n();
-        let ne = self.events.len();
-        let tau: Vec<f64> = u.iter().skip(n2).copied().collect();
-        if ne < 3 || tau[1..].iter().any(|&t| t <= tau[0] || t >= tau[0] + self.period) {
-            return None;
-        }
-        let mut order: Vec<usize> = (0..ne).collect();
-        order[1..].sort_by(|&a, &b| tau[a].total_cmp(&tau[b]));
-        for (x, &a) in order.iter().enumerate() {
-            if order[x + 1..].iter().any(|&b| b < a && !self.may_pass(&self.events[a], &self.events[b])) {
-                return None;
-            }
-        }
-        let events: Vec<Event> = order.iter().map(|&e| Event { seed: tau[e], ..self.events[e] }).collect();
-        let orbit = Self::reusing(&self.model, events, &self.always, &self.phases).ok()?;
-        let mut v = u.clone();
-        for (x, &e) in order.iter().enumerate() {
-            v[n2 + x] = tau[e];
-        }
-        Some((orbit, v))
-    }
-
-    fn ordered(&self, u: &DVector<f64>) -> bool {
+    pub(super) fn ordered(&self, u: &DVector<f64>) -> bool {
         let n2 = 2 * self.model.n();
         let tau: Vec<f64> = u.iter().skip(n2).copied().collect();
         tau.windows(2).all(|w| w[0] < w[1]) && tau.last().is_none_or(|&l| l < tau[0] + self.period)
@@ -487,17 +448,6 @@ impl PolishedOrbit {
     /// The section's time: the first event's (0 without events).
     pub fn section_time(&self) -> f64 {
         self.times[0]
-    }
-
-    /// The force scale of the sign checks ([`super::verify`], [`Self::rigid_margin`]): the largest
-    /// load, impulse × ω, or stuck contact's force at the events. The held forces count because a
-    /// casing-driven blade has no load, and its rigid contacts on massless DOFs no impulse: without
-    /// them the scale was f64::MIN_POSITIVE and a −2e-12 N round-off read as −1e296.
-    pub(super) fn force_scale(&self) -> f64 {
-        let loads: f64 = self.model.forces.iter().map(|f| f.term.amplitude.abs()).sum();
-        let held =
-            self.after.iter().zip(&self.times).zip(&self.phases).flat_map(|((y, &t), ph)| ph.stuck_forces(y, t)).fold(0.0f64, |m, (_, z)| m.max(z.abs()));
-        self.impulses.iter().fold(loads.max(held), |m, p| m.max(p.abs() * self.model.frequency)).max(f64::MIN_POSITIVE)
     }
 
     /// Events with their times in [0, T) and impulses.

@@ -111,3 +111,16 @@ pub(super) fn check(o: &PolishedOrbit) -> Result<(), PolishFailure> {
     }
     Ok(())
 }
+
+impl PolishedOrbit {
+    /// The force scale of the sign checks ([`super::verify`], [`Self::rigid_margin`]): the largest
+    /// load, impulse × ω, or stuck contact's force at the events. The held forces count because a
+    /// casing-driven blade has no load, and its rigid contacts on massless DOFs no impulse: without
+    /// them the scale was f64::MIN_POSITIVE and a −2e-12 N round-off read as −1e296.
+    pub(super) fn force_scale(&self) -> f64 {
+        let loads: f64 = self.model.forces.iter().map(|f| f.term.amplitude.abs()).sum();
+        let held =
+            self.after.iter().zip(&self.times).zip(&self.phases).flat_map(|((y, &t), ph)| ph.stuck_forces(y, t)).fold(0.0f64, |m, (_, z)| m.max(z.abs()));
+        self.impulses.iter().fold(loads.max(held), |m, p| m.max(p.abs() * self.model.frequency)).max(f64::MIN_POSITIVE)
+    }
+}
