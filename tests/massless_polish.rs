@@ -9,6 +9,8 @@ use periodic_contact::analysis::polish;
 use periodic_contact::exact::{CompliantStopOrbit, Oscillator};
 use periodic_contact::model::{Compliance, Contact, Force, Harmonic, Matrix, Model, Structure};
 use periodic_contact::periodic::{OutputSelection, PeriodicProblem, SolverSettings};
+use periodic_contact::response::Response;
+use periodic_contact::scene::Scene;
 use periodic_contact::time::{Discretization, Scheme};
 
 const M: f64 = 1.0;
@@ -97,4 +99,74 @@ fn variational_jacobian_matches_central_differences_with_a_massless_point() {
         let p = PeriodicProblem::new(point_model(compliance), disc, outputs, SolverSettings::default()).unwrap();
         crate::exact_jacobian::check(name, &p);
     }
+}
+
+/// The coarse two-lobe blade (fmu/scenes/blade-two-lobes.toml) reduced with a massless boundary,
+/// solved by cds at k steps: its 17 radial tips compliant as in the scene, or rigid with the
+/// casing as the only excitation (the real blade's case: no load, no impulse).
+fn coarse_blade(rigid: bool, steps: usize) -> PeriodicProblem {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fmu/scenes/blade-two-lobes.toml");
+    let text = std::fs::read_to_string(path)
+        .unwrap()
+        .replace("method = \"craig-bampton\"", "method = \"massless-boundary\"")
+        .replace("scheme = \"bds2\"", "scheme = \"cds\"");
+    let text = text.replace("steps = 256", &format!("steps = {steps}"));
+    let drop = |l: &str| {
+        rigid
+            && (l.starts_with("stiffness = 1e7")
+                || l == "[[force]]"
+                || l.starts_with("node = \"MC\"")
+                || l.starts_with("axis = \"y\"")
+                || l.starts_with("amplitude = 1.0"))
+    };
+    let text: String = text.lines().filter(|l| !drop(l)).map(|l| format!("{l}\n")).collect();
+    Scene::parse(&text, "blade.toml").unwrap().to_problem("blade.toml").unwrap()
+}
+
+/// The largest difference of the displacement outputs of `a` and `b` at the coarser grid's
+/// instants, over `b`'s largest peak-to-peak amplitude.
+fn difference(a: &Response, b: &Response) -> f64 {
+    let k = a.steps.min(b.steps);
+    let (sa, sb) = (a.steps / k, b.steps / k);
+    let ptp = b.displacement.values().map(|x| Response::peak_to_peak(x)).fold(0.0, f64::max);
+    a.displacement.iter().flat_map(|(key, x)| (0..k).map(move |j| (x[j * sa] - b.displacement[key][j * sb]).abs())).fold(0.0, f64::max) / ptp
+}
+
+#[test]
+fn the_coarse_blade_with_rigid_tips_on_its_massless_boundary_polishes_to_the_limit_of_the_lcp() {
+    // Its tips close and release within one step of each other in an order the grid cannot
+    // tell: Newton lets them pass (was: "events merge or reorder"); the scale of the force checks
+    // is the held forces (was f64::MIN_POSITIVE without a load: −1e296 of a round-off).
+    let p = coarse_blade(true, 512);
+    let lcp = p.solve().unwrap();
+    let mut r = lcp.clone();
+    polish::apply(&p, &mut r).expect("polished");
+    let s = r.polish.clone().unwrap();
+    assert_eq!(s.status, "polished", "fell back: {}", s.reason);
+    // The LCP at k and 2k against the exact orbit: cds's order 2 (4× per doubling).
+    let fine = coarse_blade(true, 1024).solve().unwrap();
+    let (e1, e2) = (difference(&lcp, &r), difference(&fine, &r));
+    eprintln!(
+        "coarse rigid massless blade: {} events, residual {:.1e}; LCP vs polish {e1:.3e} (k = 512), {e2:.3e} (1024), order {:.2}",
+        s.events.len(),
+        s.residual,
+        (e1 / e2).log2()
+    );
+    assert!(s.events.len() >= 34, "every tip closes and releases: {} events", s.events.len());
+    assert!((e1 / e2).log2() > 1.6 && (e1 / e2).log2() < 2.4, "order {:.2}: {e1:.3e}, {e2:.3e}", (e1 / e2).log2());
+}
+
+#[test]
+fn the_coarse_blade_with_compliant_tips_on_its_massless_boundary_polishes_from_k_256() {
+    // README "Massless DOFs": this stalled from cds at k = 256 ("events merge or reorder").
+    let p = coarse_blade(false, 256);
+    let lcp = p.solve().unwrap();
+    let mut r = lcp.clone();
+    polish::apply(&p, &mut r).expect("polished");
+    let s = r.polish.clone().unwrap();
+    assert_eq!(s.status, "polished", "fell back: {}", s.reason);
+    let fine = coarse_blade(false, 512).solve().unwrap();
+    let (e1, e2) = (difference(&lcp, &r), difference(&fine, &r));
+    eprintln!("coarse compliant massless blade: {} events; LCP vs polish {e1:.3e} (k = 256), {e2:.3e} (512), order {:.2}", s.events.len(), (e1 / e2).log2());
+    assert!((e1 / e2).log2() > 1.6 && (e1 / e2).log2() < 2.4, "order {:.2}: {e1:.3e}, {e2:.3e}", (e1 / e2).log2());
 }

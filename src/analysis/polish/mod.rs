@@ -59,7 +59,19 @@ pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<PolishedOrbit, 
     }
     let offsets: Vec<usize> = (0..model.contacts.len()).map(|i| problem.pairing_at(i).offset()).collect();
     let (evs, always) = events::from_response(model, r, &offsets);
-    let orbit = PolishedOrbit::solve(model, evs, &always)?;
+    let evs = events::isolated_first(evs, model.period());
+    let orbit = match PolishedOrbit::solve(model, evs.clone(), &always) {
+        Ok(orbit) => orbit,
+        Err(e) => {
+            // Once more without the runs of at most two steps at a near-grazing (events.rs).
+            let span = 2.5 * model.period() / r.steps as f64;
+            let fewer = events::without_short_runs(model, &evs, span, model.period());
+            if fewer.len() == evs.len() {
+                return Err(e);
+            }
+            PolishedOrbit::solve(model, events::isolated_first(fewer, model.period()), &always).map_err(|_| e)?
+        }
+    };
     verify::check(&orbit)?;
     Ok(orbit)
 }

@@ -216,6 +216,12 @@ impl Phase {
         })
     }
 
+    /// Whether this is the phase of the stuck contacts `stuck` and the closed compliant ones
+    /// `closed` (both ascending): a reordered orbit reuses it.
+    pub fn is_for(&self, stuck: &[usize], closed: &[usize]) -> bool {
+        self.stuck == stuck && self.closed == closed
+    }
+
     /// Whether compliant contact `i` is closed in this phase.
     pub fn closed(&self, i: usize) -> bool {
         self.closed.contains(&i)

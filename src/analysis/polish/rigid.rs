@@ -93,8 +93,7 @@ impl PolishedOrbit {
         }
         // The scales of verify.rs: the largest normal displacement and the largest force met.
         let xs = self.after.iter().flat_map(|y| model.contacts.iter().map(move |c| c.along(|d| y[d]).abs())).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
-        let loads: f64 = model.forces.iter().map(|f| f.term.amplitude.abs()).sum();
-        let fs = self.impulses.iter().fold(loads, |m, p| m.max(p.abs() * model.frequency)).max(f64::MIN_POSITIVE);
+        let fs = self.force_scale();
         let mut best = RigidMargin { value: f64::INFINITY, contact: 0, what: "", time: 0.0, event: None };
         let mut keep = |value: f64, contact: usize, what: &'static str, time: f64, event: Option<usize>| {
             if value < best.value {

@@ -15,11 +15,9 @@ const SAMPLES: usize = 200;
 /// Relative tolerance of the sign checks (of the clearance scale, of the force scale).
 const TOL: f64 = 1e-9;
 
-/// The smallest value of `f` over [a, b]: dense samples, then golden section around each
-/// sampled local minimum.
-pub(super) fn minimum(a: f64, b: f64, f: &dyn Fn(f64) -> f64) -> (f64, f64) {
-    let ts: Vec<f64> = (0..=SAMPLES).map(|i| a + (b - a) * i as f64 / SAMPLES as f64).collect();
-    let vs: Vec<f64> = ts.iter().map(|&t| f(t)).collect();
+/// The smallest value of `f` over [a, b]: at the dense samples `ts` (values `vs`), then by
+/// golden section around each sampled local minimum.
+pub(super) fn minimum(ts: &[f64], vs: &[f64], f: &dyn Fn(f64) -> f64) -> (f64, f64) {
     let mut best = (vs[0], ts[0]);
     for i in 0..ts.len() {
         if vs[i] < best.0 {
@@ -47,8 +45,7 @@ pub(super) fn check(o: &PolishedOrbit) -> Result<(), PolishFailure> {
     let ne = o.events.len().max(1);
     // Scales: the largest normal displacement of a contact and the largest force met.
     let xs = o.after.iter().flat_map(|y| model.contacts.iter().map(move |c| c.along(|d| y[d]).abs())).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
-    let loads: f64 = model.forces.iter().map(|f| f.term.amplitude.abs()).sum();
-    let fs = o.impulses.iter().fold(loads, |m, p| m.max(p.abs() * model.frequency)).max(f64::MIN_POSITIVE);
+    let fs = o.force_scale();
     for (e, &p) in o.impulses.iter().enumerate() {
         if p < -TOL * fs / model.frequency {
             return Err(PolishFailure(format!("the impact of contact[{}] at t = {:.6} would pull (impulse {p:.3e})", o.events[e].contact, o.times[e])));
@@ -59,18 +56,30 @@ pub(super) fn check(o: &PolishedOrbit) -> Result<(), PolishFailure> {
         let ph: &Phase = &o.phases[e];
         let y0 = &o.after[e];
         let state = |t: f64| ph.flow(a, y0, t);
+        // The samples' states once for every contact: one exponential, then a product per sample.
+        let ts: Vec<f64> = (0..=SAMPLES).map(|j| a + (b - a) * j as f64 / SAMPLES as f64).collect();
+        let step = ph.exp((b - a) / SAMPLES as f64);
+        let mut ys = vec![ph.flow(a, y0, a)];
+        for w in ts.windows(2) {
+            let next = ph.flow_with(&step, w[0], ys.last().expect("one"), w[1]);
+            ys.push(next);
+        }
+        let forces: Vec<Vec<(usize, f64)>> = ys.iter().zip(&ts).map(|(y, &t)| ph.stuck_forces(y, t)).collect();
         let stuck: Vec<usize> = ph.stuck_contacts().collect();
         for (i, c) in model.contacts.iter().enumerate() {
-            let (v, t, what) = if stuck.contains(&i) {
-                let (v, t) = minimum(a, b, &|t| ph.stuck_forces(&state(t), t).into_iter().find(|(k, _)| *k == i).map_or(0.0, |(_, z)| z));
+            let (v, t, what) = if let Some(s) = stuck.iter().position(|&k| k == i) {
+                let vs: Vec<f64> = forces.iter().map(|z| z[s].1).collect();
+                let (v, t) = minimum(&ts, &vs, &|t| ph.stuck_forces(&state(t), t)[s].1);
                 (v / fs, t, "force")
             } else if c.is_rigid() {
-                let (v, t) = minimum(a, b, &|t| o.clearance(i, &state(t), t));
+                let vs: Vec<f64> = ys.iter().zip(&ts).map(|(y, &t)| o.clearance(i, y, t)).collect();
+                let (v, t) = minimum(&ts, &vs, &|t| o.clearance(i, &state(t), t));
                 (v / xs, t, "clearance")
             } else {
                 let closed = o.phases[e].closed(i);
                 let sign = if closed { -1.0 } else { 1.0 };
-                let (v, t) = minimum(a, b, &|t| sign * o.clearance(i, &state(t), t));
+                let vs: Vec<f64> = ys.iter().zip(&ts).map(|(y, &t)| sign * o.clearance(i, y, t)).collect();
+                let (v, t) = minimum(&ts, &vs, &|t| sign * o.clearance(i, &state(t), t));
                 (v / xs, t, if closed { "penetration of the closed compliant contact" } else { "clearance of the open compliant contact" })
             };
             if v < -TOL {
@@ -101,4 +110,17 @@ pub(super) fn check(o: &PolishedOrbit) -> Result<(), PolishFailure> {
         }
     }
     Ok(())
+}
+
+impl PolishedOrbit {
+    /// The force scale of the sign checks ([`super::verify`], [`Self::rigid_margin`]): the largest
+    /// load, impulse × ω, or stuck contact's force at the events. The held forces count because a
+    /// casing-driven blade has no load, and its rigid contacts on massless DOFs no impulse: without
+    /// them the scale was f64::MIN_POSITIVE and a −2e-12 N round-off read as −1e296.
+    pub(super) fn force_scale(&self) -> f64 {
+        let loads: f64 = self.model.forces.iter().map(|f| f.term.amplitude.abs()).sum();
+        let held =
+            self.after.iter().zip(&self.times).zip(&self.phases).flat_map(|((y, &t), ph)| ph.stuck_forces(y, t)).fold(0.0f64, |m, (_, z)| m.max(z.abs()));
+        self.impulses.iter().fold(loads.max(held), |m, p| m.max(p.abs() * self.model.frequency)).max(f64::MIN_POSITIVE)
+    }
 }
