@@ -244,11 +244,13 @@ pub fn estimate_from(problem: &PeriodicProblem, r: &Response, second: &Response,
             let d_half = differences(second, third);
             let (fine, coarse) = (largest(&d), largest(&d_half));
             let rho = if fine > 0.0 { coarse / fine } else { f64::INFINITY };
-            let used = rho.clamp(2.0, gain);
+            // Observed order below 1 is pre-asymptotic in either direction (compliant galerkin at
+            // k = 128 falls 15× to the next grid): the two-grid estimate at the scheme's order.
+            let used = if rho < 2.0 { gain } else { rho.min(gain) };
             let e = d.iter().zip(&d_half).map(|(d, dh)| (d / (used - 1.0)).max(dh / (gain * (gain - 1.0)))).collect();
             let q = rho.log2();
             let says = if rho < 2.0 {
-                format!(", observed order {q:.2} from k/4 = {} (below 1, not established: the plain difference)", third.steps)
+                format!(", observed order {q:.2} from k/4 = {} (below 1, pre-asymptotic: not used)", third.steps)
             } else if rho < gain {
                 format!(", observed order {q:.2} from k/4 = {} (used)", third.steps)
             } else {
