@@ -54,7 +54,7 @@ fn block_errors(p: &PeriodicProblem, orbit: &PolishedOrbit, nudge: f64) -> (f64,
 pub(crate) fn check(name: &str, p: &PeriodicProblem) {
     let r = p.solve().unwrap();
     let orbit = polish::polish(p, &r).unwrap();
-    assert!(orbit.events().len() >= 2, "{name}: the contact is touched");
+    assert!(!orbit.events().is_empty(), "{name}: the contact is touched");
     for nudge in [0.0, 1e-3] {
         let t0 = Instant::now();
         let (state, time, ne) = block_errors(p, &orbit, nudge);

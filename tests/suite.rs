@@ -78,6 +78,8 @@ mod results;
 mod rigid_blade;
 #[path = "rigid_branch.rs"]
 mod rigid_branch;
+#[path = "rigid_jacobian.rs"]
+mod rigid_jacobian;
 #[path = "rubbing.rs"]
 mod rubbing;
 #[path = "scheme_auto.rs"]

@@ -49,72 +49,40 @@ impl PolishedOrbit {
         self.residual_of(&u)
     }
 
-    /// [`Self::shooting_residual`] and its Jacobian in (y0, times), from one flow of the period:
-    /// the variational equations of ẏ = A y + b(t) between events, ∂y(t₁)/∂y(t₀) = e^{A(t₁−t₀)},
-    /// ∂y(t₁)/∂t₀ = −e^{A(t₁−t₀)} f(t₀, y(t₀)), ∂y(t₁)/∂t₁ = f(t₁, y(t₁)) (f the phase's vector
-    /// field; Hairer, Nørsett & Wanner I, §I.14), chained through the events with identity
-    /// saltation (compliant switches, rigid contacts on massless DOFs: see
-    /// [`Self::identity_saltation`]). `None` with an impact on a massive DOF or a stuck contact
-    /// on one, or where [`Self::shooting_residual`] gives none.
+    /// [`Self::shooting_residual`] and its Jacobian in (y0, times), from one flow of the period
+    /// and its variation ([`Self::variation`] in rigid.rs: exact flows between events, each
+    /// event's state map, plastic impacts' velocity resets included; event 0's time enters as
+    /// phase 0's start and as its return a period later). `None` when the times are not
+    /// increasing within one period, or where a flow or a reset fails.
     pub fn shooting_jacobian(&self, y0: &[f64], times: &[f64]) -> Option<(DVector<f64>, DMatrix<f64>)> {
-        if !self.identity_saltation() {
-            return None;
-        }
-        let (n, ne) = (self.model.n(), self.events.len());
-        let n2 = 2 * n;
-        let tau: &[f64] = if ne == 0 { &[] } else { times };
-        if tau.windows(2).any(|w| w[0] >= w[1]) || tau.last().is_some_and(|&l| l >= tau[0] + self.period) {
+        let (n2, ne) = (2 * self.model.n(), self.events.len());
+        let tau: &[f64] = if ne == 0 { &[0.0] } else { times };
+        if tau.windows(2).any(|w| w[0] >= w[1]) || (ne > 0 && tau[ne - 1] >= tau[0] + self.period) {
             return None;
         }
         let start = DVector::from_column_slice(y0);
+        let v = self.variation(&start, tau, tau[0] + self.period)?;
         let mut res = DVector::zeros(n2 + ne);
+        res.rows_mut(0, n2).copy_from(&(&v.end - &start));
+        res.rows_mut(n2, ne).copy_from(&v.conditions);
         let mut jac = DMatrix::zeros(n2 + ne, n2 + ne);
-        let mut y = start.clone();
-        let mut dy = DMatrix::identity(n2, n2 + ne);
-        let field = |e: usize, y: &DVector<f64>, t: f64| {
-            let mut f = DVector::zeros(n2);
-            f.rows_mut(0, n).copy_from(&y.rows(n, n));
-            f.rows_mut(n, n).copy_from(&self.phases[e].acceleration(y, t));
-            f
-        };
-        for e in 0..ne.max(1) {
-            let (t0, t1) = if ne == 0 { (0.0, self.period) } else { (tau[e], if e + 1 < ne { tau[e + 1] } else { tau[0] + self.period }) };
-            let ex = self.phases[e].exp(t1 - t0);
-            let ym = self.phases[e].flow_with(&ex, t0, &y, t1);
-            let ex = self.phases[e].transition(&ex);
-            dy = &ex * dy;
-            if ne > 0 {
-                let next = (e + 1) % ne;
-                let (f0, f1) = (&ex * field(e, &y, t0), field(e, &ym, t1));
-                for r in 0..n2 {
-                    dy[(r, n2 + e)] -= f0[r];
-                    dy[(r, n2 + next)] += f1[r];
-                }
-                let c = self.events[next].contact;
-                if self.events[next].kind == EventKind::Release {
-                    // The held force z(y, t) is affine in y: its y-gradient times a column is
-                    // z(column) − z(0); its explicit t-derivative by central differences.
-                    let z = |y: &DVector<f64>, t: f64| self.phases[e].stuck_forces(y, t).into_iter().find(|(k, _)| *k == c).map_or(0.0, |(_, z)| z);
-                    let (zero, h) = (DVector::zeros(n2), 1e-7 * self.period);
-                    let z0 = z(&zero, t1);
-                    res[n2 + next] = z(&ym, t1);
-                    for col in 0..n2 + ne {
-                        jac[(n2 + next, col)] = z(&dy.column(col).into_owned(), t1) - z0;
-                    }
-                    jac[(n2 + next, n2 + next)] += (z(&ym, t1 + h) - z(&ym, t1 - h)) / (2.0 * h);
-                } else {
-                    res[n2 + next] = self.clearance(c, &ym, t1);
-                    for col in 0..n2 + ne {
-                        jac[(n2 + next, col)] = -self.model.contacts[c].along(|d| dy[(d, col)]);
-                    }
-                    jac[(n2 + next, n2 + next)] += self.gap(c, t1, 1);
-                }
-            }
-            y = ym;
+        jac.view_mut((0, 0), (n2, n2 + ne)).copy_from(&v.d_end.columns(0, n2 + ne));
+        jac.view_mut((n2, 0), (ne, n2 + ne)).copy_from(&v.d_conditions.columns(0, n2 + ne));
+        for r in 0..n2 {
+            jac[(r, r)] -= 1.0;
         }
-        res.rows_mut(0, n2).copy_from(&(&y - &start));
-        jac.view_mut((0, 0), (n2, n2 + ne)).copy_from(&(dy - DMatrix::identity(n2, n2 + ne)));
-        res.iter().all(|v| v.is_finite()).then_some((res, jac))
+        if ne > 0 {
+            // τ_0 is also event 0's return time.
+            let back = v.d_end.column(n2 + ne).into_owned();
+            let cond = v.d_conditions.column(n2 + ne).into_owned();
+            for r in 0..n2 {
+                jac[(r, n2)] += back[r];
+            }
+            for r in 0..ne {
+                jac[(n2 + r, n2)] += cond[r];
+            }
+        }
+        Some((res, jac))
     }
 
     /// This orbit at the solution (`y0`, `times`) of [`Self::shooting_residual`]: the states after

@@ -146,7 +146,7 @@ impl PolishedOrbit {
 
     /// Plastic impact of contact `i` at `t`, the contacts `stuck` staying on their obstacles:
     /// v⁺ = v⁻ − M⁻¹Bᵀ P with B v⁺ = ġ (src/formulation.md §5's forward increment, in one instant).
-    fn impact(&self, i: usize, stuck: &[usize], y: &DVector<f64>, t: f64) -> Option<(DVector<f64>, f64)> {
+    pub(super) fn impact(&self, i: usize, stuck: &[usize], y: &DVector<f64>, t: f64) -> Option<(DVector<f64>, f64)> {
         let n = self.model.n();
         if self.model.contact_is_massless(&self.model.contacts[i]) {
             // A rigid contact on a massless DOF closes without impulse (no mass to stop): the DOF
@@ -157,13 +157,12 @@ impl PolishedOrbit {
         if !set.contains(&i) {
             set.push(i);
         }
-        let m_inv = phase::dense(&self.model.structure.mass, n).try_inverse()?;
-        let b = DMatrix::from_fn(set.len(), n, |r, d| self.model.contacts[set[r]].row.iter().find(|e| e.0 == d).map_or(0.0, |e| e.1));
+        let (b, m_inv_bt, s_inv) = self.reset(&set)?;
         let v = y.rows(n, n).into_owned();
         let rhs = &b * &v - DVector::from_fn(set.len(), |r, _| self.gap(set[r], t, 1));
-        let p = (&b * &m_inv * b.transpose()).lu().solve(&rhs)?;
+        let p = s_inv * rhs;
         let mut out = y.clone();
-        let dv = &m_inv * b.transpose() * &p;
+        let dv = m_inv_bt * &p;
         for d in 0..n {
             out[n + d] -= dv[d];
         }
@@ -367,57 +366,9 @@ impl PolishedOrbit {
         self.impulses = shot.impulses;
         self.monodromy = match self.flow_product() {
             Some(m) => m,
-            None => self.stroboscopic().ok_or_else(|| fail("the monodromy could not be formed (an event condition is singular in its time: grazing)"))?,
+            None => self.event_monodromy().ok_or_else(|| fail("the monodromy could not be formed (an event condition is singular in its time: grazing)"))?,
         };
         Ok(())
-    }
-
-    /// The one-period map at the fixed time s = times[0] (just after event 0), z ↦ y(s + T),
-    /// its events relocated for every z: with w the other event times and event 0's return,
-    /// G(z, w) = 0, and dy/dz = ∂y/∂z − ∂y/∂w·G_w⁻¹·G_z (finite differences, central, 1e-7
-    /// relative).
-    fn stroboscopic(&self) -> Option<DMatrix<f64>> {
-        let n2 = 2 * self.model.n();
-        let ne = self.events.len();
-        let (s, t) = (self.times[0], self.period);
-        let parts = |z: &DVector<f64>, w: &[f64]| -> Option<(DVector<f64>, Vec<f64>)> {
-            if ne == 0 {
-                return Some((self.phases[0].flow(s, z, s + t), vec![]));
-            }
-            let tau: Vec<f64> = std::iter::once(s).chain(w[..ne - 1].iter().copied()).collect();
-            let shot = self.shoot_to(z, &tau, w[ne - 1])?;
-            Some((self.phases[0].flow(w[ne - 1], &shot.end, s + t), shot.conditions))
-        };
-        let w0: Vec<f64> = self.times.iter().skip(1).copied().chain(std::iter::once(s + t)).take(ne).collect();
-        let ys = self.y0.amax().max(1e-300);
-        let (mut yz, mut gz) = (DMatrix::zeros(n2, n2), DMatrix::zeros(ne, n2));
-        for c in 0..n2 {
-            let h = 1e-7 * ys;
-            let (mut up, mut dn) = (self.y0.clone(), self.y0.clone());
-            up[c] += h;
-            dn[c] -= h;
-            let ((a, ga), (b, gb)) = (parts(&up, &w0)?, parts(&dn, &w0)?);
-            yz.set_column(c, &((a - b) / (2.0 * h)));
-            for r in 0..ne {
-                gz[(r, c)] = (ga[r] - gb[r]) / (2.0 * h);
-            }
-        }
-        if ne == 0 {
-            return Some(yz);
-        }
-        let (mut yw, mut gw) = (DMatrix::zeros(n2, ne), DMatrix::zeros(ne, ne));
-        for c in 0..ne {
-            let h = 1e-7 * t;
-            let (mut up, mut dn) = (w0.clone(), w0.clone());
-            up[c] += h;
-            dn[c] -= h;
-            let ((a, ga), (b, gb)) = (parts(&self.y0, &up)?, parts(&self.y0, &dn)?);
-            yw.set_column(c, &((a - b) / (2.0 * h)));
-            for r in 0..ne {
-                gw[(r, c)] = (ga[r] - gb[r]) / (2.0 * h);
-            }
-        }
-        Some(yz - yw * gw.lu().solve(&gz)?)
     }
 
     /// Newton iterations, final residual (max norm of periodicity and event conditions) and the
@@ -434,7 +385,8 @@ impl PolishedOrbit {
 
     /// The monodromy matrix (2n×2n, state [x; v]): the derivative of the one-period map at the
     /// fixed time [`Self::section_time`] (just after the first event), the events relocated
-    /// (finite differences, step 1e-7 relative). Its eigenvalues are the orbit's Floquet
+    /// (the phases' exponentials and the events' saltation: [`Self::flow_product`], else the
+    /// variational flow of `rigid.rs`). Its eigenvalues are the orbit's Floquet
     /// multipliers (a plastic impact adds zeros).
     pub fn monodromy(&self) -> &DMatrix<f64> {
         &self.monodromy

@@ -8,7 +8,7 @@
 use super::events::EventKind;
 use super::orbit::PolishedOrbit;
 use super::phase::Phase;
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
 
 /// Samples per radian of the phase's fastest rate (its balancing speed, ≥ ω_max). A plastic
 /// impact rings the stiff modes: on the coarse blade the tip comes back to the casing 9e-6 s
@@ -135,5 +135,204 @@ impl PolishedOrbit {
             }
         }
         Some(best)
+    }
+}
+
+/// One period flowed with its first-order variation: the state after event 0's return, the
+/// event conditions, and their derivatives by the columns (y0, τ_0 as phase 0's start,
+/// τ_1 … τ_{ne−1}, the return time of event 0) (2n + ne + 1 columns).
+pub(super) struct Variation {
+    pub end: DVector<f64>,
+    pub conditions: DVector<f64>,
+    pub d_end: DMatrix<f64>,
+    pub d_conditions: DMatrix<f64>,
+}
+
+/// A plastic impact's velocity reset (src/formulation.md §5 in one instant) on the contacts `set`
+/// (the stuck ones and the impacting one): v⁺ = v⁻ − W (B v⁻ − ġ_set(t)), W = M⁻¹Bᵀ(BM⁻¹Bᵀ)⁻¹,
+/// the impulses (BM⁻¹Bᵀ)⁻¹(B v⁻ − ġ). (B, M⁻¹Bᵀ, (BM⁻¹Bᵀ)⁻¹); `None` with a singular M or BM⁻¹Bᵀ.
+pub(super) type Reset = (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>);
+
+impl PolishedOrbit {
+    pub(super) fn reset(&self, set: &[usize]) -> Option<Reset> {
+        let n = self.model.n();
+        let m_inv = super::phase::dense(&self.model.structure.mass, n).try_inverse()?;
+        let b = DMatrix::from_fn(set.len(), n, |r, d| self.model.contacts[set[r]].row.iter().find(|e| e.0 == d).map_or(0.0, |e| e.1));
+        let m_inv_bt = m_inv * b.transpose();
+        let s_inv = (&b * &m_inv_bt).try_inverse()?;
+        Some((b, m_inv_bt, s_inv))
+    }
+
+    /// [`Self::shoot_to`] with its variation (the variational equations of ẏ = A y + b(t) between
+    /// events, Hairer, Nørsett & Wanner I, §I.14: ∂y(t₁)/∂y(t₀) = Φ, ∂y(t₁)/∂t₀ = −Φ f(t₀, y(t₀)),
+    /// ∂y(t₁)/∂t₁ = f(t₁, y(t₁)), Φ the phase's transition, which drops the stuck and massless
+    /// DOFs; chained through each event's state map: the identity at compliant switches,
+    /// releases and massless closings, the affine velocity reset of [`Self::reset`] at a plastic
+    /// impact, whose time dependence enters through ġ(t)). With the event times left free this is
+    /// the saltation product of Leine & Nijmeijer, "Dynamics and Bifurcations of Non-Smooth
+    /// Mechanical Systems", §7.1. `None` where a flow or a reset fails.
+    pub(super) fn variation(&self, y0: &DVector<f64>, tau: &[f64], ret: f64) -> Option<Variation> {
+        let (n, ne) = (self.model.n(), self.events.len());
+        let (n2, cols) = (2 * n, 2 * n + ne + 1);
+        let field = |e: usize, y: &DVector<f64>, t: f64| {
+            let mut f = DVector::zeros(n2);
+            f.rows_mut(0, n).copy_from(&y.rows(n, n));
+            f.rows_mut(n, n).copy_from(&self.phases[e].acceleration(y, t));
+            f
+        };
+        let mut y = y0.clone();
+        let mut dy = DMatrix::identity(n2, cols);
+        let (mut g, mut dg) = (DVector::zeros(ne), DMatrix::zeros(ne, cols));
+        for e in 0..ne.max(1) {
+            let ph = &self.phases[e];
+            let (t0, t1) = if ne == 0 { (0.0, self.period) } else { (tau[e], if e + 1 < ne { tau[e + 1] } else { ret }) };
+            let ex = ph.exp(t1 - t0);
+            let ym = ph.flow_with(&ex, t0, &y, t1);
+            let phi = ph.transition(&ex);
+            dy = &phi * dy;
+            if ne == 0 {
+                y = ym;
+                break;
+            }
+            let (next, end_col) = ((e + 1) % ne, if e + 1 < ne { n2 + e + 1 } else { n2 + ne });
+            let f0 = &phi * field(e, &y, t0);
+            let f1 = field(e, &ym, t1);
+            for r in 0..n2 {
+                dy[(r, n2 + e)] -= f0[r];
+                dy[(r, end_col)] += f1[r];
+            }
+            let ev = self.events[next];
+            let c = ev.contact;
+            if ev.kind == EventKind::Release {
+                // The held force z(y, t) is affine in y: its y-gradient times a column is
+                // z(column) − z(0); its explicit t-derivative by central differences.
+                let z = |y: &DVector<f64>, t: f64| ph.stuck_forces(y, t).into_iter().find(|(k, _)| *k == c).map(|(_, z)| z);
+                let (zero, h) = (DVector::zeros(n2), 1e-7 * self.period);
+                let z0 = z(&zero, t1)?;
+                g[next] = z(&ym, t1)?;
+                for col in 0..cols {
+                    dg[(next, col)] = z(&dy.column(col).into_owned(), t1)? - z0;
+                }
+                dg[(next, end_col)] += (z(&ym, t1 + h)? - z(&ym, t1 - h)?) / (2.0 * h);
+            } else {
+                g[next] = self.clearance(c, &ym, t1);
+                for col in 0..cols {
+                    dg[(next, col)] = -self.model.contacts[c].along(|d| dy[(d, col)]);
+                }
+                dg[(next, end_col)] += self.gap(c, t1, 1);
+            }
+            y = match ev.kind {
+                EventKind::Impact { .. } if !self.model.contact_is_massless(&self.model.contacts[c]) => {
+                    let mut set: Vec<usize> = ph.stuck_contacts().collect();
+                    if !set.contains(&c) {
+                        set.push(c);
+                    }
+                    let (b, m_inv_bt, s_inv) = self.reset(&set)?;
+                    // v⁺ = v⁻ − W (B v⁻ − ġ(t)): dv⁺ = (I − W B) dv⁻ + W g̈(t) dt.
+                    let w = m_inv_bt * s_inv;
+                    let dv = dy.rows(n, n).into_owned();
+                    let jump = &w * (&b * &dv);
+                    dy.rows_mut(n, n).copy_from(&(dv - jump));
+                    let gdd = DVector::from_iterator(set.len(), set.iter().map(|&k| self.gap(k, t1, 2)));
+                    let wg = &w * gdd;
+                    for r in 0..n {
+                        dy[(n + r, end_col)] += wg[r];
+                    }
+                    let v = ym.rows(n, n).into_owned();
+                    let gd = DVector::from_iterator(set.len(), set.iter().map(|&k| self.gap(k, t1, 1)));
+                    let mut out = ym;
+                    let v_new = &v - &w * (&b * &v - gd);
+                    out.rows_mut(n, n).copy_from(&v_new);
+                    out
+                }
+                _ => ym,
+            };
+        }
+        let all = y.iter().chain(g.iter()).chain(dy.iter()).chain(dg.iter()).all(|v| v.is_finite());
+        all.then_some(Variation { end: y, conditions: g, d_end: dy, d_conditions: dg })
+    }
+
+    /// The monodromy of a solved orbit with events whose state maps are not the identity: the
+    /// derivative of the one-period map at the fixed time s = times[0], z ↦ y(s + T), its events
+    /// relocated (with w = (τ_1 … τ_{ne−1}, event 0's return) and G(z, w) = 0 the event
+    /// conditions: dy/dz = Y_z − Y_w G_w⁻¹ G_z) from [`Self::variation`]. `None` where G_w is
+    /// singular (an event condition tangent in its time: a grazing).
+    pub(super) fn event_monodromy(&self) -> Option<DMatrix<f64>> {
+        let (n2, ne) = (2 * self.model.n(), self.events.len());
+        let (s, t) = (self.times[0], self.period);
+        let v = self.variation(&self.y0, &self.times, s + t)?;
+        if ne == 0 {
+            return Some(v.d_end.columns(0, n2).into_owned());
+        }
+        // Past the return, phase 0 runs on to s + T: a flow of zero length (its projection) whose
+        // start moves with the return time.
+        let ph = &self.phases[0];
+        let proj = ph.transition(&ph.exp(0.0));
+        let mut f = DVector::zeros(n2);
+        let n = n2 / 2;
+        f.rows_mut(0, n).copy_from(&v.end.rows(n, n));
+        f.rows_mut(n, n).copy_from(&ph.acceleration(&v.end, s + t));
+        let y_z = &proj * v.d_end.columns(0, n2);
+        let mut y_w = &proj * v.d_end.columns(n2 + 1, ne);
+        let back = &proj * f;
+        for r in 0..n2 {
+            y_w[(r, ne - 1)] -= back[r];
+        }
+        let g_z = v.d_conditions.columns(0, n2).into_owned();
+        let g_w = v.d_conditions.columns(n2 + 1, ne).into_owned();
+        let m = y_z - y_w * g_w.lu().solve(&g_z)?;
+        m.iter().all(|x| x.is_finite()).then_some(m)
+    }
+}
+
+impl PolishedOrbit {
+    /// The one-period map at the section time s = times[0] by event-driven simulation: from the
+    /// state `z` just after event 0 at s, each phase is flowed to the root of its next event's
+    /// condition (the clearance at an impact or a compliant switch, the held force at a release;
+    /// secant iteration from the orbit's own event time, to 1e-15 of the period), the event's
+    /// state map applied, and the last phase flowed on to s + T. The reference for the
+    /// [`Self::monodromy`] (its differences); `None` where a root is not found.
+    pub fn return_map(&self, z: &[f64]) -> Option<DVector<f64>> {
+        let ne = self.events.len();
+        let (s, t) = (self.times[0], self.period);
+        let mut y = DVector::from_column_slice(z);
+        if ne == 0 {
+            return Some(self.phases[0].flow(s, &y, s + t));
+        }
+        let mut start = s;
+        for e in 0..ne {
+            let ph = &self.phases[e];
+            let next = (e + 1) % ne;
+            let ev = self.events[next];
+            let condition = |at: f64| {
+                let ym = ph.flow(start, &y, at);
+                match ev.kind {
+                    EventKind::Release => ph.stuck_forces(&ym, at).into_iter().find(|(k, _)| *k == ev.contact).map_or(f64::NAN, |(_, z)| z),
+                    _ => self.clearance(ev.contact, &ym, at),
+                }
+            };
+            let nominal = if e + 1 < ne { self.times[e + 1] } else { s + t };
+            let (mut a, mut b) = (nominal, nominal + 1e-6 * t);
+            let (mut ga, mut gb) = (condition(a), condition(b));
+            for _ in 0..60 {
+                if gb == ga || (b - a).abs() < 1e-15 * t {
+                    break;
+                }
+                let c = b - gb * (b - a) / (gb - ga);
+                (a, ga) = (b, gb);
+                b = c;
+                gb = condition(b);
+            }
+            if !gb.is_finite() || (b - a).abs() > 1e-12 * t {
+                return None;
+            }
+            let ym = ph.flow(start, &y, b);
+            y = match ev.kind {
+                EventKind::Impact { .. } => self.impact(ev.contact, &ph.stuck_contacts().collect::<Vec<_>>(), &ym, b)?.0,
+                _ => ym,
+            };
+            start = b;
+        }
+        Some(self.phases[0].flow(start, &y, s + t))
     }
 }

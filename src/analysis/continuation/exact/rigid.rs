@@ -242,10 +242,18 @@ impl Walk<'_> {
             }
             (Switch::Release, Switch::Impact { stick: true }) => signature::remove(&self.fam, &here.orbit, e, wl)?,
             // A pure impact and the sticking impact after it merge: located on the orbit without
-            // the pure impact, where the force at its landing touches zero, a short way ahead.
+            // the pure impact, where the force at its landing touches zero, a short way ahead;
+            // else that orbit's branch from here (the coarse blade at 2215.5 rad/s: the flight
+            // between them 2.5e-6 of the period when the corrector stalls, and no zero ahead).
             (Switch::Impact { stick: false }, Switch::Impact { stick: true }) => {
                 list.remove(e);
-                return [1e-5, 1e-4, 1e-3].into_iter().find_map(|f| self.fade((lambda, lambda + sense * f * rho), here, list.clone(), what, "the impact"));
+                if let Some(n) =
+                    [1e-5, 1e-4, 1e-3].into_iter().find_map(|f| self.fade((lambda, lambda + sense * f * rho), here, list.clone(), what, "the impact"))
+                {
+                    return Some(n);
+                }
+                let sig = Signature { events: list.iter().map(|l| l.1).collect(), always: here.orbit.always_closed().to_vec() };
+                (sig, signature::guess(&self.fam, &here.orbit, &list, wl))
             }
             _ => return None,
         };
