@@ -1,5 +1,5 @@
 //! Event-fitted laws for the half-step friction pairing (src/formulation.md §9 "Event-fitted half
-//! steps"): a diagnostic, opt-in by [`EVENT_FITTED_ENV`] on top of the half steps' switch.
+//! steps"): cds's and galerkin's friction law at each slip end (off with [`RELAY_HALF_STEPS_ENV`]).
 //!
 //! The half-step sample f_j is the mean force over (t_j, t_(j+1)) and pairs with the mean slip
 //! velocity v̄_j. Where the slip ends inside a step the exact mean force lies inside the box while

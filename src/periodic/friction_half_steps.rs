@@ -1,7 +1,7 @@
 //! The half-step friction pairing of cds and galerkin as a step map, with the event-fitted laws
 //! (src/formulation.md §9 "Event-fitted half steps", "Friction by shooting").
 //!
-//! The scheme's row at t_j, N₀u_(j+1) + N₁u_j + N₂u_(j−1) = F(t_j) − B_fᵀ(f_(j−1) + f_j)/2
+//! The scheme's row at t_j, N₀u_(j+1) + N₁u_j + N₂u_(j−1) = Σ_i a0_i F(t_(j+1−i)) − B_fᵀ(f_(j−1) + f_j)/2
 //! (N_i = a2_i M/h² + a1_i C/h + a0_i K: cds a0 = (0, 1, 0), galerkin (1, 4, 1)/6), steps from the
 //! state y = (u_(j−1), u_j, f_(j−1)): with W = N₀⁻¹ the prediction without f_j is
 //! u⁰ = W(F(t_j) − N₁u_j − N₂u_(j−1) − B_fᵀf_(j−1)/2), and the sample's mean slip velocity
@@ -162,11 +162,14 @@ impl HalfStepMap {
             rows[(n + i, n + dof)] -= dir / h;
         }
         let t: Vec<f64> = (0..mf * mf).map(|il| dofs[il / mf].1 * wbt[(dofs[il / mf].0, il % mf)] / h).collect();
-        let loads = super::state_space::force_samples(model, k, h);
+        // The load as the scheme weighs it, Σ_i a0_i F(t_(j+1−i)) (galerkin: the hats' (1, 4, 1)/6,
+        // the assembly's w_p F̂_p; cds: F(t_j)); the friction force enters unweighted, as contacts.
+        let samples = super::state_space::force_samples(model, k, h);
+        let load = |j: usize, l: usize| (0..3).map(|i| a0[i] * samples[((j + k + 1 - i) % k) * n + l]).sum::<f64>();
         let mut forcing = vec![0.0; k * n];
         for j in 0..k {
             for r in 0..n {
-                forcing[j * n + r] = (0..n).map(|l| w[(r, l)] * loads[j * n + l]).sum();
+                forcing[j * n + r] = (0..n).map(|l| w[(r, l)] * load(j, l)).sum();
             }
         }
         // z = e^{−iπ} = −1 in N₀z⁻¹ + N₁ + N₂z.
