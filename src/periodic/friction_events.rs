@@ -25,7 +25,7 @@ pub const RELAY_HALF_STEPS_ENV: &str = "PERIODIC_CONTACT_FRICTION_RELAY_HALF_STE
 /// The receptance of each friction row (after `mc` contact rows) at the Nyquist harmonic.
 pub(super) fn nyquist(asm: &Assembly, mc: usize, mf: usize) -> Vec<f64> {
     let (k, m) = (asm.k, asm.m);
-    (0..mf).map(|t| if k % 2 == 0 { asm.g_hat[((k / 2) * m + mc + t) * m + mc + t].re } else { 0.0 }).collect()
+    (0..mf).map(|t| if k.is_multiple_of(2) { asm.g_hat[((k / 2) * m + mc + t) * m + mc + t].re } else { 0.0 }).collect()
 }
 
 /// Refits of the laws at most. Why: measured (validation/peers/friction_event_fitted.py) they
@@ -73,7 +73,7 @@ impl EventLaws {
         for (t, (&mu_n, &g_nyquist)) in slip.iter().zip(nyquist).enumerate() {
             // cds: G(π) = 1/(k_s − 4m/h²), so 1/m = −4G(π)/h² up to O(h²); a massless or
             // statically condensed row has G(π) ≥ 0 and no finite g: the relay stays (μN = 0 too).
-            if k % 2 != 0 || g_nyquist >= 0.0 || mu_n <= 0.0 {
+            if !k.is_multiple_of(2) || g_nyquist >= 0.0 || mu_n <= 0.0 {
                 continue;
             }
             let g = -4.0 * g_nyquist / (h * h) * mu_n;
