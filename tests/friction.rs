@@ -111,53 +111,90 @@ fn den_hartog_oscillator_converges_at_first_order() {
     }
 }
 
-/// The event-fitted half steps (src/formulation.md §9 "Event-fitted half steps"): each slip end's
-/// step takes the law v̄ = c + ε s fitted from the previous solve, which restores order 2 on Den
-/// Hartog's oscillator. Against the event-driven simulation at the instants (max |x_j − x(t_j)|,
-/// relative to the amplitude) and Den Hartog's closed-form amplitude. The Python prototype
-/// (validation/peers/friction_event_fitted.py, same scheme) gave max errors 2.6e-4 → 6.7e-5
-/// (Ω = 0.6) and 4.7e-4 → 1.1e-4 (Ω = 1.7) at k = 128 → 256. Opt-in (dense Lemke on the half-step
-/// LCP takes ~10⁴–10⁵ pivots at k = 256): `PERIODIC_CONTACT_FRICTION_HALF_STEPS=1
-/// PERIODIC_CONTACT_FRICTION_EVENT_FITTED=1 cargo test --release --test suite friction::event_fitted
-/// -- --ignored --nocapture`.
+/// max_j |x_j − x(t_j)| over DOF `dof` against the event-driven orbit, relative to `scale`.
+fn error_at_instants(r: &Response, orbit: &FrictionOrbit, period: f64, dof: usize, scale: f64) -> f64 {
+    let x = &r.displacement[&dof.to_string()];
+    let h = period / x.len() as f64;
+    x.iter().enumerate().map(|(j, v)| (v - orbit.displacement(j as f64 * h)[dof]).abs()).fold(0.0, f64::max) / scale
+}
+
+/// cds's default friction, the event-fitted half steps by shooting (src/formulation.md §9
+/// "Event-fitted half steps"): each slip end's step takes the law v̄ = c + ε s fitted from the
+/// previous orbit, which restores order 2. Against the event-driven simulation at the instants
+/// (max |x_j − x(t_j)| over the amplitude) and Den Hartog's closed form; Richardson at order 2
+/// from k = 256 to 512 (|x_2j(512) − x_j(256)|/3) against the true error at 512. Den Hartog c = 0
+/// (continuous motion, the closed form), damped with stops, and the 2-DOF chain (friction on m2).
+/// Measured (this test, load 20): Den Hartog Ω = 0.6, μN = 0.3: 6.77e-5 → 1.98e-5 (k = 256 → 512,
+/// order 1.78, estimate/true 0.92); Ω = 1.7, μN = 0.2: 1.11e-4 → 2.56e-5 (2.11, 1.11); damped
+/// c = 0.1, Ω = 0.7, μN = 0.6: 1.49e-4 → 6.0e-5 (1.31, 0.71); the others in README "Friction".
 #[test]
-#[ignore]
-fn event_fitted_half_steps_converge_at_second_order_on_den_hartog() {
-    assert!(std::env::var_os(HALF_STEPS_ENV).is_some() && std::env::var_os(EVENT_FITTED_ENV).is_some(), "set {HALF_STEPS_ENV}=1 and {EVENT_FITTED_ENV}=1");
-    for (omega, slip) in [(0.6, 0.3), (1.7, 0.2)] {
-        let osc = oscillator(0.0, omega, slip, None);
-        let exact = den_hartog_amplitude(1.0, 1.0, 1.0, slip, omega).unwrap();
+fn event_fitted_half_steps_are_second_order_and_within_1e_3_at_k_512() {
+    // The 2-DOF chain of validation/peers/friction_half_steps_family.py (seed 11, rounded).
+    let chain = FrictionOscillator {
+        mass: vec![vec![1.0, 0.0], vec![0.0, 1.0]],
+        damping: vec![vec![0.057, 0.0], vec![0.0, 0.057]],
+        stiffness: vec![vec![2.0, -1.0], vec![-1.0, 1.0]],
+        force: vec![0.0, 1.0],
+        omega: 1.02,
+        dof: 1,
+        slip_force: 0.487,
+        tangential_stiffness: None,
+    };
+    let cases = [
+        ("Den Hartog", oscillator(0.0, 0.6, 0.3, None)),
+        ("Den Hartog", oscillator(0.0, 1.7, 0.2, None)),
+        ("c = 0 with stops", oscillator(0.0, 1.438, 0.818, None)),
+        ("damped", oscillator(0.1, 0.7, 0.6, None)),
+        ("chain", chain),
+    ];
+    for (name, osc) in cases {
         let orbit = FrictionOrbit::solve(&osc, 2000, 1e-11, 20000).expect("orbit");
-        let errors: Vec<(f64, f64)> = [128, 256]
-            .iter()
-            .map(|&k| {
-                let r = solve_by(osc.model(), Scheme::Cds, k);
-                let x = &r.displacement["0"];
-                let h = osc.period() / k as f64;
-                let max = x.iter().enumerate().map(|(j, v)| (v - orbit.displacement(j as f64 * h)[0]).abs()).fold(0.0, f64::max) / exact;
-                println!("Den Hartog Ω = {omega}, μN = {slip}, k = {k}: {}", r.lcp.path);
-                (max, (amplitude(&r, 0) - exact) / exact)
+        let dof = osc.dof;
+        let exact = orbit.amplitude(dof, 4000);
+        // Continuous motion at c = 0: Den Hartog's closed form, and order 2 (measured 1.78, 2.11).
+        let closed = den_hartog_amplitude(1.0, 1.0, 1.0, osc.slip_force, osc.omega).ok().filter(|_| osc.damping[0][0] == 0.0);
+        if let Some(x) = closed {
+            assert!((x - exact).abs() < 1e-6 * x);
+        }
+        let runs: Vec<Response> = [256, 512].iter().map(|&k| solve_by(osc.model(), Scheme::Cds, k)).collect();
+        let e: Vec<f64> = runs.iter().map(|r| error_at_instants(r, &orbit, osc.period(), dof, exact)).collect();
+        let order = (e[0] / e[1]).log2();
+        // Richardson, order 2, at the common instants, over the DOFs.
+        let estimate = (0..osc.mass.len())
+            .map(|d| {
+                let (c, f) = (&runs[0].displacement[&d.to_string()], &runs[1].displacement[&d.to_string()]);
+                c.iter().enumerate().map(|(j, v)| (f[2 * j] - v).abs()).fold(0.0, f64::max) / 3.0
             })
-            .collect();
-        let order = (errors[0].0 / errors[1].0).log2();
+            .fold(0.0, f64::max);
+        let truth = (0..osc.mass.len()).map(|d| error_at_instants(&runs[1], &orbit, osc.period(), d, 1.0)).fold(0.0, f64::max);
         println!(
-            "  max error at the instants {:.3e} → {:.3e} (order {order:.2}); amplitude {:.3e} → {:.3e}",
-            errors[0].0, errors[1].0, errors[0].1, errors[1].1
+            "{name} c = {}, Ω = {}, μN = {} (stuck {:.3}): {:.3e} → {:.3e} (order {order:.2}); estimate/true at 512 {:.2}; {}",
+            osc.damping[0][0],
+            osc.omega,
+            osc.slip_force,
+            orbit.stuck_fraction,
+            e[0],
+            e[1],
+            estimate / truth,
+            runs[1].lcp.path
         );
-        assert!(errors[1].0 < 2e-4, "k = 256: {:.3e}", errors[1].0);
-        assert!(order > 1.7, "order {order:.2}");
+        assert!(runs[1].lcp.path.contains("event-fitted laws"), "{}", runs[1].lcp.path);
+        assert!(e[1] < 1e-3, "k = 512: {:.3e}", e[1]);
+        // The order with stops or damping wanders (0.94–2.57 over the family, README "Friction").
+        assert!(closed.is_none() || order > 1.6, "order {order:.2}");
+        assert!((0.1..10.0).contains(&(estimate / truth)), "estimate {estimate:.3e} against {truth:.3e}");
     }
 }
 
-/// Why friction is bds1 only (src/formulation.md §9 "Why not a second-order pairing"): on Den
-/// Hartog's oscillator the half-step pairing of cds is as large as O(h) but erratic in k (its
-/// error follows where the reversal falls in its step), while bds1's is a steady first-order term.
-/// Opt-in: `PERIODIC_CONTACT_FRICTION_HALF_STEPS=1 cargo test --release --test suite
-/// friction::half_step -- --ignored --nocapture` (17 s at load 15).
+/// Why the half steps need the event laws (src/formulation.md §9 "Why not a second-order
+/// pairing"): on Den Hartog's oscillator the relay half steps of cds are as large as O(h) but
+/// erratic in k (the error follows where the reversal falls in its step), while bds1's is a steady
+/// first-order term. Opt-in: `PERIODIC_CONTACT_FRICTION_RELAY_HALF_STEPS=1 cargo test --release
+/// --test suite friction::half_step -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn half_step_pairing_errors_are_erratic_in_k_and_bds1_errors_are_first_order() {
-    assert!(std::env::var_os(HALF_STEPS_ENV).is_some(), "set {HALF_STEPS_ENV}=1: the half-step pairing is refused without it");
+    assert!(std::env::var_os(RELAY_HALF_STEPS_ENV).is_some(), "set {RELAY_HALF_STEPS_ENV}=1: the half steps take the event laws without it");
     let steps = [200, 220, 240, 256, 280, 300, 320];
     for (omega, slip) in [(0.6, 0.3), (1.7, 0.2)] {
         let exact = den_hartog_amplitude(1.0, 1.0, 1.0, slip, omega).unwrap();
@@ -264,9 +301,13 @@ fn scene_friction_solves_and_refuses_what_is_not_yet_supported() {
     }
     let e = Scene::parse(&SCENE.replacen("normal_force = 1.0", "normal_force = -1.0", 1), "f.toml").unwrap().to_problem("f.toml").unwrap_err().to_string();
     assert!(e.contains("friction[0].normal_force") && e.contains("-1"), "{e}");
-    let p = Scene::parse(&SCENE.replacen("\"bds1\"", "\"cds\"", 1), "f.toml").unwrap().to_problem("f.toml").unwrap();
+    // cds takes rigid Coulomb (the event-fitted half steps); a Jenkins element needs bds1.
+    let cds = SCENE.replacen("\"bds1\"", "\"cds\"", 1);
+    let r = Scene::parse(&cds, "f.toml").unwrap().to_problem("f.toml").unwrap().solve().unwrap();
+    assert!((amplitude(&r, 0) - exact).abs() < 1e-3 * exact, "cds {}", amplitude(&r, 0));
+    let p = Scene::parse(&cds.replacen("normal_force = 1.0", "normal_force = 1.0\nstiffness = 2.0", 1), "f.toml").unwrap().to_problem("f.toml").unwrap();
     let e = p.solve().unwrap_err().to_string();
-    assert!(e.contains("discretization.scheme") && e.contains("bds1"), "{e}");
+    assert!(e.contains("discretization.scheme") && e.contains("bds1") && e.contains("Jenkins"), "{e}");
 }
 
 /// A friction element driven through a displacement amplitude X: a unit mass on a spring k_s =

@@ -17,8 +17,9 @@
 //! (friction alone). The slip velocity is α − w₁.
 //!
 //! The matrix is dense: N = k·(m_c + 2·m_f) unknowns, at most [`FRICTION_DENSE_MAX`].
-use super::friction_events::{EVENT_FITTED_ENV, EventLaws, MAX_ROUNDS};
-use super::friction_shooting::{FrictionStepMap, coarse_start};
+use super::friction_events::{EventLaws, MAX_ROUNDS, RELAY_HALF_STEPS_ENV, nyquist};
+use super::friction_half_steps::HalfStepMap;
+use super::friction_shooting::{FrictionStepMap, ShotFailure, coarse_start};
 use super::{Assembly, NoStepMap, PeriodFft, PeriodicProblem, SolveError, lcp_failure, recovery};
 use crate::lcp::{DenseMatrix, LcpInfo, LcpMethod, LcpOutcome, LcpSolution, LcpStep, Lemke, LemkeSettings, residuals};
 use crate::model::{Compliance, Contact, Model};
@@ -71,24 +72,18 @@ pub fn check_size(k: usize, mc: usize, mf: usize) -> Result<usize, SolveError> {
     Ok(n)
 }
 
-/// Set (to anything) to let cds and galerkin solve friction with the half-step pairing, for the
-/// measurements of src/formulation.md §9 "Why not a second-order pairing" only: it is refused
-/// otherwise, being no more accurate than bds1 in a way the error estimate can follow.
-pub const HALF_STEPS_ENV: &str = "PERIODIC_CONTACT_FRICTION_HALF_STEPS";
-
 /// How the friction samples meet the scheme (src/formulation.md §9).
 /// - bds1: f_j and the backward slip velocity (u_j − u_{j−1})/h at t_j, bds1's own derivative
 ///   (implicit Euler, Moreau's time-stepping in the period); D = σ1 has Re ≥ 0. Measured
 ///   (tests/friction.rs): a steady first-order lag dominates its error, so Richardson works.
-/// - cds and galerkin, half steps (only with [`HALF_STEPS_ENV`]): f_j acts on (t_j, t_{j+1}) and
-///   pairs with the slip velocity (u_{j+1} − u_j)/h there; the structure at t_j feels the mean
-///   (f_{j−1} + f_j)/2 (galerkin: linear hats for u, a piecewise-constant force). D·E = σ1 of
-///   cds, so A's form is Re(σ1 G) ≥ 0, identically 0 when undamped. Refused: the Coulomb force
-///   jumps at a reversal or a stop, a sample can switch only at a step, and the O(h) impulse
-///   error μN·h·(2ξ − 1) follows the event's place ξ in its step, erratically in k.
-///   With [`super::EVENT_FITTED_ENV`] too, the steps around each slip end take a fitted law
-///   (`friction_events`) and converge at order 2 (measured); diagnostic, as the dense path is all
-///   that solves the half-step LCP.
+/// - cds and galerkin, half steps: f_j acts on (t_j, t_{j+1}) and pairs with the mean slip
+///   velocity (u_{j+1} − u_j)/h there; the structure at t_j feels (f_{j−1} + f_j)/2 (galerkin:
+///   linear hats for u, a piecewise-constant force). D·E = σ1 of cds, so A's form is
+///   Re(σ1 G) ≥ 0. On the relay alone the O(h) impulse error μN·h·(2ξ − 1) follows the event's
+///   place ξ in its step, erratically in k; so the steps around each slip end take a fitted law
+///   (`friction_events`, unless [`RELAY_HALF_STEPS_ENV`]) and converge at order 2 (measured,
+///   README "Friction"). Solved by the half-step map (`friction_half_steps`) by default: dense
+///   Lemke's path on this LCP is degenerate (E(π) = 0).
 pub struct FrictionGrid {
     /// Symbol of the slip velocity from the displacement at the instants, per harmonic.
     pub velocity: Vec<C>,
@@ -107,12 +102,12 @@ impl FrictionGrid {
             // (1 − z)/h, z = e^{−iθ} the one-step delay.
             Scheme::Bds1 => Ok(FrictionGrid { velocity: (0..nh).map(|p| C::new(versine(p), theta(p).sin()) / h).collect(), spread: vec![C::ONE; nh] }),
             // (z⁻¹ − 1)/h and (1 + z)/2.
-            Scheme::Cds | Scheme::Galerkin if std::env::var_os(HALF_STEPS_ENV).is_some() => Ok(FrictionGrid {
+            Scheme::Cds | Scheme::Galerkin => Ok(FrictionGrid {
                 velocity: (0..nh).map(|p| C::new(-versine(p), theta(p).sin()) / h).collect(),
                 spread: (0..nh).map(|p| C::new(2.0 - versine(p), -theta(p).sin()) / 2.0).collect(),
             }),
             other => Err(SolveError::Invalid(format!(
-                "discretization.scheme: is \"{other}\", but friction contacts are solved with bds1 only (first order, with an error the estimate follows): a second-order pairing's error follows where each reversal or stop falls between two instants, erratically in k (src/formulation.md §9); set scheme = \"bds1\""
+                "discretization.scheme: is \"{other}\", but friction contacts are solved with bds1 (first order) or cds and galerkin (event-fitted half steps, second order; src/formulation.md §9); set scheme = \"cds\", \"galerkin\" or \"bds1\""
             ))),
         }
     }
@@ -237,18 +232,37 @@ pub(super) fn solve(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, 
     let grid = FrictionGrid::new(problem.discretization().scheme, k, problem.period())?;
     let coupled = super::friction_coupled::couplings(model);
     let method = problem.solver_settings().method;
-    // Shooting where the dense LCP is refused (or asked for); the dense path keeps small N.
-    let shoot = method == LcpMethod::Shooting || (method == LcpMethod::Auto && nn > FRICTION_DENSE_MAX);
-    if grid.half_steps() {
-        // The step map is bds1's; a Jenkins slider's velocity at a half step would be the central
-        // difference (f_{j+1} − f_{j−1})/2h of the spring force, blind to f_j itself.
-        if shoot || model.frictions.iter().any(|f| f.stiffness.is_some() || f.contact.is_some()) {
-            return Err(SolveError::Invalid(format!(
-                "{HALF_STEPS_ENV}: the half-step friction pairing takes the dense LCP and rigid Coulomb contacts under a constant normal load only; unset it, or use solver.method = \"lemke\" without friction.stiffness and friction.contact"
-            )));
+    let relay_only = std::env::var_os(RELAY_HALF_STEPS_ENV).is_some();
+    if grid.half_steps() && (lay.mc > 0 || model.frictions.iter().any(|f| f.stiffness.is_some() || f.contact.is_some())) {
+        // A Jenkins slider at a half step would see only the central difference (f_(j+1) −
+        // f_(j−1))/2h of its spring force; the coupled rows and contacts have no laws yet.
+        return Err(SolveError::Invalid(format!(
+            "discretization.scheme: is \"{}\", whose friction pairing (event-fitted half steps, second order) takes rigid Coulomb contacts under a constant normal load without unilateral contacts; this scene has {}: set scheme = \"bds1\" (first order)",
+            problem.discretization().scheme,
+            if lay.mc > 0 { "unilateral contacts" } else { "a Jenkins element (friction.stiffness) or a coupled normal load (friction.contact)" }
+        )));
+    }
+    // Shooting where the dense LCP is refused (or asked for); the dense path keeps small N. The
+    // half steps shoot by default: dense Lemke's path on their LCP is degenerate (E(π) = 0).
+    let shoot = method == LcpMethod::Shooting || (method == LcpMethod::Auto && (nn > FRICTION_DENSE_MAX || grid.half_steps()));
+    if shoot && grid.half_steps() {
+        match HalfStepMap::new(problem, k) {
+            Ok(map) => {
+                let t_assembly = t_start.elapsed().as_secs_f64();
+                let (sol, lcp_time, path) = super::friction_half_steps::solve(problem, map, (asm, fft, &grid), relay_only)?;
+                return finish(problem, (asm, fft, &grid), sol, (t_start, t_assembly, lcp_time), path);
+            }
+            Err(why) if method == LcpMethod::Shooting || nn > FRICTION_DENSE_MAX => {
+                return Err(check_size(k, lay.mc, lay.mf)
+                    .err()
+                    .map_or(SolveError::Invalid(format!("solver.method: \"shooting\" needs a time-stepping map: {why}; use \"auto\"")), |e| {
+                        shooting_refused(e, &why)
+                    }));
+            }
+            Err(_) => {} // the dense LCP below
         }
     }
-    let (sol, t_assembly, lcp_time, path) = if shoot {
+    let (sol, t_assembly, lcp_time, path) = if shoot && !grid.half_steps() {
         let t_assembly = t_start.elapsed().as_secs_f64();
         let t_lcp = Instant::now();
         let map = match FrictionStepMap::new(problem, k, problem.period()) {
@@ -260,18 +274,8 @@ pub(super) fn solve(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, 
             }
             Err(why) => return Err(check_size(k, lay.mc, lay.mf).err().map_or(SolveError::Invalid(why.to_string()), |e| shooting_refused(e, &why))),
         };
-        let shot = map.shoot(coarse_start(problem, k, problem.period())).map_err(|e| SolveError::Lcp {
-            outcome: LcpOutcome::PivotLimit,
-            info: LcpInfo { pivots: e.iterations, residual: e.residual, ..LcpInfo::default() },
-            hint: format!(
-                "friction shooting: {} after {} Newton iterations (relative periodicity residual {:.1e}); remedies: add damping, or reduce discretization.steps to {} or fewer for the dense LCP",
-                e.why,
-                e.iterations,
-                e.residual,
-                FRICTION_DENSE_MAX / (lay.mc + 2 * lay.mf)
-            ),
-        })?;
-        let mut sol = certify(problem, asm, fft, &grid, &shot.forces);
+        let shot = map.shoot(coarse_start(problem, k, problem.period())).map_err(|e| shooting_failed(e, lay.mc + 2 * lay.mf))?;
+        let mut sol = certify(problem, (asm, fft, &grid), &shot.forces, None);
         let lcp_time = t_lcp.elapsed().as_secs_f64();
         sol.info.pivots = shot.iterations;
         sol.info.time_s = lcp_time;
@@ -305,7 +309,7 @@ pub(super) fn solve(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, 
             return Err(if coupled.iter().any(Option::is_some) { super::friction_coupled::no_solution(problem, asm, sol) } else { lcp_failure(sol) });
         }
         let mut rounds = 0;
-        if grid.half_steps() && std::env::var_os(EVENT_FITTED_ENV).is_some() {
+        if grid.half_steps() && !relay_only {
             (sol, rounds) = fit_events(problem, asm, (&a, &q), &lay, sol, &settings)?;
         }
         let lcp_time = t_lcp.elapsed().as_secs_f64();
@@ -318,6 +322,23 @@ pub(super) fn solve(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, 
         );
         (sol, t_assembly, lcp_time, path)
     };
+    finish(problem, (asm, fft, &grid), sol, (t_start, t_assembly, lcp_time), path)
+}
+
+/// The responses of a solved friction LCP `sol` (in the dense layout), with its timings
+/// (start, assembly, LCP) and path.
+pub(super) fn finish(
+    problem: &PeriodicProblem,
+    (asm, fft, grid): (&Assembly, &PeriodFft, &FrictionGrid),
+    sol: LcpSolution,
+    (t_start, t_assembly, lcp_time): (Instant, f64, f64),
+    path: String,
+) -> Result<Response, SolveError> {
+    let model = problem.model();
+    let (k, m) = (asm.k, asm.m);
+    let lay = Layout { k, mc: model.contacts.len(), mf: model.frictions.len() };
+    let nn = k * (lay.mc + 2 * lay.mf);
+    let coupled = super::friction_coupled::couplings(model);
     let slip: Vec<f64> = model.frictions.iter().map(|f| f.slip_force()).collect();
     // The forces in the assembly's row order (j·m + a), friction forces f = z₁ − μN.
     let mut z = vec![0.0; k * m];
@@ -340,7 +361,7 @@ pub(super) fn solve(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, 
     let rows = LcpSolution { outcome: sol.outcome, z, w: Vec::new(), info: sol.info.clone() };
     let t_rec = Instant::now();
     let mut response = recovery::recover(problem, asm, fft, &rows)?;
-    response.friction = (0..lay.mf).map(|t| friction_response(problem, (asm, fft, &grid), (&rows.z, &forces[t]), &sol, &lay, t)).collect::<Result<_, _>>()?;
+    response.friction = (0..lay.mf).map(|t| friction_response(problem, (asm, fft, grid), (&rows.z, &forces[t]), &sol, &lay, t)).collect::<Result<_, _>>()?;
     response.lcp.size = nn;
     response.lcp.path = path;
     // Warm starts are not used by this path: no active set to carry.
@@ -383,7 +404,7 @@ fn fit_events(
     };
     while rounds < MAX_ROUNDS {
         let (f, v) = samples(&sol, &laws);
-        let next = EventLaws::fit(asm, lay.mc, &slip, (&f, &v), h);
+        let next = EventLaws::fit(&nyquist(asm, lay.mc, lay.mf), &slip, (&f, &v), h);
         if next.repeats(&laws, 1e-10) {
             break;
         }
@@ -415,38 +436,71 @@ fn fit_events(
 }
 
 /// The full friction LCP's certificate of the forces f (k × m_f, time-major) of a friction-only
-/// problem: z₁ = f + μN, α = max(v, 0) with v = b_q-side slip velocity D(b xlin − G f) (− D f/k_t)
-/// by FFT products, w from the LCP's own rows; residual ‖min(z, w)‖∞ against solver.tolerance ×
-/// max(1, ‖q‖∞).
-fn certify(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, grid: &FrictionGrid, forces: &[f64]) -> LcpSolution {
+/// problem: z₁ = f + μN, α = max(σ, 0) with the slip velocity v = D(b xlin − G E f) (− D f/k_t)
+/// by FFT products (E the half steps' spread) and σ = v − c − ε f/μN in a law's sample (`laws`,
+/// the event-fitted half steps), w from the LCP's own rows; residual ‖min(z, w)‖∞ against
+/// solver.tolerance × max(1, ‖q‖∞). The answer's w₁ then holds −v + α (the unshifted velocity).
+pub(super) fn certify(
+    problem: &PeriodicProblem,
+    (asm, fft, grid): (&Assembly, &PeriodFft, &FrictionGrid),
+    forces: &[f64],
+    laws: Option<&EventLaws>,
+) -> LcpSolution {
     let model = problem.model();
     let (k, m, nh) = (asm.k, asm.m, asm.k / 2 + 1);
     let lay = Layout { k, mc: 0, mf: m };
     let nn = 2 * k * m;
     let (mut z, mut w, mut q) = (vec![0.0; nn], vec![0.0; nn], vec![0.0; nn]);
     let f_hat: Vec<Vec<C>> = (0..m).map(|t| fft.forward(&(0..k).map(|j| forces[j * m + t]).collect::<Vec<_>>())).collect();
+    let mut velocity = vec![0.0; nn];
     for (t, fr) in model.frictions.iter().enumerate() {
         let mu_n = fr.slip_force();
         let bq = fft.inverse(&(0..nh).map(|p| -asm.bxlin_hat[p * m + t] * grid.velocity[p]).collect::<Vec<_>>());
         let jenkins = fr.stiffness.map_or(0.0, |kt| 1.0 / kt);
-        let af_hat: Vec<C> =
-            (0..nh).map(|p| grid.velocity[p] * ((0..m).map(|b| asm.g_hat[(p * m + t) * m + b] * f_hat[b][p]).sum::<C>() + f_hat[t][p] * jenkins)).collect();
+        let af_hat: Vec<C> = (0..nh)
+            .map(|p| grid.velocity[p] * ((0..m).map(|b| asm.g_hat[(p * m + t) * m + b] * f_hat[b][p]).sum::<C>() * grid.spread[p] + f_hat[t][p] * jenkins))
+            .collect();
         let af = fft.inverse(&af_hat);
         for j in 0..k {
             let (r, sl) = (lay.row(t, j), lay.slack(t, j));
-            let slip_velocity = -(af[j] + bq[j]);
-            z[r] = forces[j * m + t] + mu_n;
-            z[sl] = slip_velocity.max(0.0);
-            w[r] = af[j] + bq[j] + z[sl];
+            let (c, eps) = laws.and_then(|l| l.at(t, j)).filter(|_| mu_n > 0.0).unwrap_or((0.0, 0.0));
+            let f = forces[j * m + t];
+            velocity[r] = -(af[j] + bq[j]);
+            let sigma = velocity[r] - c - eps * f / mu_n.max(f64::MIN_POSITIVE);
+            z[r] = f + mu_n;
+            z[sl] = sigma.max(0.0);
+            w[r] = z[sl] - sigma;
             w[sl] = 2.0 * mu_n - z[r];
-            q[r] = bq[j];
+            q[r] = bq[j] + c - eps;
             q[sl] = 2.0 * mu_n;
         }
     }
     let (residual, relative_error) = residuals(&q, &z, &w);
     let qmax = q.iter().fold(1.0f64, |a, v| a.max(v.abs()));
     let outcome = if residual <= problem.solver_settings().tolerance * qmax { LcpOutcome::Solved } else { LcpOutcome::Inaccurate };
+    for t in 0..m {
+        for j in 0..k {
+            let (r, sl) = (lay.row(t, j), lay.slack(t, j));
+            w[r] = z[sl] - velocity[r];
+        }
+    }
     LcpSolution { outcome, z, w, info: LcpInfo { residual, relative_error, ..LcpInfo::default() } }
+}
+
+/// The typed outcome of a friction shooting that did not converge (`per_instant`: the dense LCP's
+/// unknowns per instant, for the remedy).
+pub(super) fn shooting_failed(e: ShotFailure, per_instant: usize) -> SolveError {
+    SolveError::Lcp {
+        outcome: LcpOutcome::PivotLimit,
+        info: LcpInfo { pivots: e.iterations, residual: e.residual, ..LcpInfo::default() },
+        hint: format!(
+            "friction shooting: {} after {} Newton iterations (relative periodicity residual {:.1e}); remedies: add damping, or reduce discretization.steps to {} or fewer for the dense LCP",
+            e.why,
+            e.iterations,
+            e.residual,
+            FRICTION_DENSE_MAX / per_instant
+        ),
+    }
 }
 
 /// The dense size refusal, with why shooting does not apply either.

@@ -1,5 +1,5 @@
 //! Event-fitted laws for the half-step friction pairing (src/formulation.md §9 "Event-fitted half
-//! steps"): a diagnostic, opt-in by [`EVENT_FITTED_ENV`] on top of the half steps' switch.
+//! steps"): cds's and galerkin's friction law at each slip end (off with [`RELAY_HALF_STEPS_ENV`]).
 //!
 //! The half-step sample f_j is the mean force over (t_j, t_(j+1)) and pairs with the mean slip
 //! velocity v̄_j. Where the slip ends inside a step the exact mean force lies inside the box while
@@ -18,8 +18,15 @@
 //! cds); the laws are refitted until they repeat (a fixed point: no existence theorem covers it).
 use super::Assembly;
 
-/// Set (with [`super::HALF_STEPS_ENV`]) to fit each slip end's law on the half steps; diagnostic.
-pub const EVENT_FITTED_ENV: &str = "PERIODIC_CONTACT_FRICTION_EVENT_FITTED";
+/// Set (to anything) to solve cds and galerkin friction on the plain relay half steps, without
+/// the laws: a diagnostic of src/formulation.md §9 "Why not a second-order pairing" only.
+pub const RELAY_HALF_STEPS_ENV: &str = "PERIODIC_CONTACT_FRICTION_RELAY_HALF_STEPS";
+
+/// The receptance of each friction row (after `mc` contact rows) at the Nyquist harmonic.
+pub(super) fn nyquist(asm: &Assembly, mc: usize, mf: usize) -> Vec<f64> {
+    let (k, m) = (asm.k, asm.m);
+    (0..mf).map(|t| if k.is_multiple_of(2) { asm.g_hat[((k / 2) * m + mc + t) * m + mc + t].re } else { 0.0 }).collect()
+}
 
 /// Refits of the laws at most. Why: measured (validation/peers/friction_event_fitted.py) they
 /// repeat after 4–8 rounds; a law set that keeps moving ends the loop with the last one.
@@ -58,17 +65,15 @@ impl EventLaws {
     }
 
     /// The laws fitted to one solution: `forces` and mean slip velocities `velocity` (k × mf,
-    /// time-major), μN per contact, step h.
-    pub(super) fn fit(asm: &Assembly, mc: usize, slip: &[f64], (forces, velocity): (&[f64], &[f64]), h: f64) -> Self {
-        let (k, m) = (asm.k, asm.m);
+    /// time-major), μN and the receptance at the Nyquist harmonic G(π) per contact, step h.
+    pub(super) fn fit(nyquist: &[f64], slip: &[f64], (forces, velocity): (&[f64], &[f64]), h: f64) -> Self {
         let mf = slip.len();
+        let k = forces.len() / mf.max(1);
         let mut out = EventLaws::none(k, mf);
-        for (t, &mu_n) in slip.iter().enumerate() {
-            let a = mc + t;
+        for (t, (&mu_n, &g_nyquist)) in slip.iter().zip(nyquist).enumerate() {
             // cds: G(π) = 1/(k_s − 4m/h²), so 1/m = −4G(π)/h² up to O(h²); a massless or
-            // statically condensed row has G(π) ≥ 0 and no finite g: the relay stays.
-            let g_nyquist = asm.g_hat[((k / 2) * m + a) * m + a].re;
-            if k % 2 != 0 || g_nyquist >= 0.0 {
+            // statically condensed row has G(π) ≥ 0 and no finite g: the relay stays (μN = 0 too).
+            if !k.is_multiple_of(2) || g_nyquist >= 0.0 || mu_n <= 0.0 {
                 continue;
             }
             let g = -4.0 * g_nyquist / (h * h) * mu_n;

@@ -56,6 +56,8 @@ pub(super) struct FrictionShot {
     /// The periodic state y = (x, v, g) at t_(k−1).
     pub state: Vec<f64>,
     pub forces: Vec<f64>,
+    /// The march's slip velocities (half steps: the mean v̄_j; bds1: the backward v_j).
+    pub velocity: Vec<f64>,
     pub iterations: usize,
     /// max |y_end − y| / max(|y|, tiny) of the last march.
     pub residual: f64,
@@ -68,11 +70,23 @@ pub(super) struct ShotFailure {
     pub why: &'static str,
 }
 
-/// One march over the period: the end state, each instant's modes and forces.
-struct March {
-    end: Vec<f64>,
-    modes: Vec<i8>,
-    forces: Vec<f64>,
+/// One march over the period: the end state, each instant's modes, forces and slip velocities
+/// (k × mf, time-major; the half steps' mean velocities v̄_j, bds1's backward v_j).
+pub(super) struct March {
+    pub end: Vec<f64>,
+    pub modes: Vec<i8>,
+    pub forces: Vec<f64>,
+    pub velocity: Vec<f64>,
+}
+
+/// A period map with friction sets: marched, and differentiated with the sets fixed, for
+/// [`shoot`].
+pub(super) trait FrictionMarch {
+    fn state_size(&self) -> usize;
+    /// Marches one period from `y`; step j starts from `guess[j]`'s modes (or the previous step's).
+    fn march(&self, y: &[f64], guess: Option<&[i8]>) -> March;
+    /// ∂y_end/∂y₀ with every instant's modes fixed.
+    fn period_tangent(&self, modes: &[i8]) -> Mat<f64>;
 }
 
 impl FrictionStepMap {
@@ -166,16 +180,49 @@ impl FrictionStepMap {
         Ok(FrictionStepMap { n, mf, k, h, jenkins, slip, rows, wbt, t, forcing, dofs })
     }
 
+    /// The box problems' relay with this map's T.
+    fn relay(&self) -> Relay<'_> {
+        Relay { t: &self.t, slip: &self.slip }
+    }
+
+    /// ∂y_j/∂y₀ from ∂y_(j−1)/∂y₀ with step j's modes fixed (stuck rows: T_SS df_S = dQ_S).
+    fn step_tangent(&self, p: &Mat<f64>, mode: &[i8]) -> Mat<f64> {
+        let (n, d) = (self.n, p.ncols());
+        let rp = dense_product(&self.rows, p);
+        let df = self.relay().stuck_tangent(mode, |i, c| rp[(n + i, c)], d);
+        let mut next = Mat::<f64>::zeros(d, d);
+        for c in 0..d {
+            for r in 0..n {
+                let dv = rp[(r, c)] - (0..self.mf).map(|i| self.wbt[(r, i)] * df[(i, c)]).sum::<f64>();
+                next[(n + r, c)] = dv;
+                next[(r, c)] = p[(r, c)] + self.h * dv;
+            }
+            for (i, slot) in self.jenkins.iter().enumerate() {
+                if let Some(s) = slot {
+                    next[(2 * n + s, c)] = df[(i, c)];
+                }
+            }
+        }
+        next
+    }
+
+    /// Newton on the periodic state ([`shoot`]).
+    pub(super) fn shoot(&self, start: Option<Vec<f64>>) -> Result<FrictionShot, ShotFailure> {
+        shoot(self, start)
+    }
+}
+
+impl FrictionMarch for FrictionStepMap {
     fn state_size(&self) -> usize {
         2 * self.n + self.jenkins.iter().flatten().count()
     }
 
-    /// Marches one period from `y`; step j starts from `guess[j]`'s modes (or the previous step's).
     fn march(&self, y: &[f64], guess: Option<&[i8]>) -> March {
         let (n, mf, d) = (self.n, self.mf, self.state_size());
         let mut state = y.to_vec();
         let mut modes = vec![0i8; self.k * mf];
         let mut forces = vec![0.0; self.k * mf];
+        let mut velocity = vec![0.0; self.k * mf];
         let mut pred = vec![0.0; n + mf];
         let mut last = vec![0i8; mf];
         for j in 0..self.k {
@@ -191,7 +238,7 @@ impl FrictionStepMap {
             let mode = &mut modes[j * mf..(j + 1) * mf];
             mode.copy_from_slice(guess.map_or(&last[..], |g| &g[j * mf..(j + 1) * mf]));
             let f = &mut forces[j * mf..(j + 1) * mf];
-            self.box_step(&pred[n..], mode, f);
+            self.relay().box_step(&pred[n..], mode, f);
             last.copy_from_slice(mode);
             // v = v_pred − W B_fᵀ f, x += h v, g = f.
             for r in 0..n {
@@ -199,51 +246,39 @@ impl FrictionStepMap {
                 state[n + r] = v;
                 state[r] += self.h * v;
             }
+            for (i, &(dof, dir)) in self.dofs.iter().enumerate() {
+                velocity[j * mf + i] = dir * state[n + dof];
+            }
             for (i, slot) in self.jenkins.iter().enumerate() {
                 if let Some(s) = slot {
                     state[2 * n + s] = f[i];
                 }
             }
         }
-        March { end: state, modes, forces }
+        March { end: state, modes, forces, velocity }
     }
 
-    /// ∂y_j/∂y₀ from ∂y_(j−1)/∂y₀ with step j's modes fixed (stuck rows: T_SS df_S = dQ_S).
-    fn step_tangent(&self, p: &Mat<f64>, mode: &[i8]) -> Mat<f64> {
-        let (n, d) = (self.n, p.ncols());
-        let rp = dense_product(&self.rows, p);
-        let stuck: Vec<usize> = (0..self.mf).filter(|&i| mode[i] == 0).collect();
-        let mut df = Mat::<f64>::zeros(self.mf, d);
-        if !stuck.is_empty() {
-            let ts = Mat::from_fn(stuck.len(), stuck.len(), |a, b| self.t[stuck[a] * self.mf + stuck[b]]);
-            let lu = DenseLu::new(&ts);
-            for c in 0..d {
-                let col = lu.solve(&stuck.iter().map(|&i| rp[(n + i, c)]).collect::<Vec<_>>());
-                for (a, &i) in stuck.iter().enumerate() {
-                    df[(i, c)] = col[a];
-                }
-            }
+    fn period_tangent(&self, modes: &[i8]) -> Mat<f64> {
+        let d = self.state_size();
+        let mut p = Mat::<f64>::identity(d, d);
+        for j in 0..self.k {
+            p = self.step_tangent(&p, &modes[j * self.mf..(j + 1) * self.mf]);
         }
-        let mut next = Mat::<f64>::zeros(d, d);
-        for c in 0..d {
-            for r in 0..n {
-                let dv = rp[(r, c)] - stuck.iter().map(|&i| self.wbt[(r, i)] * df[(i, c)]).sum::<f64>();
-                next[(n + r, c)] = dv;
-                next[(r, c)] = p[(r, c)] + self.h * dv;
-            }
-            for (i, slot) in self.jenkins.iter().enumerate() {
-                if let Some(s) = slot {
-                    next[(2 * n + s, c)] = df[(i, c)];
-                }
-            }
-        }
-        next
+        p
     }
+}
 
-    /// The instant's box problem σ = s⁰ − T f, f ∈ [−μN, μN] ⊥ σ: from the guessed modes by a
-    /// primal–dual active set (mode updates from the violations), else Lemke on the relay LCP.
-    fn box_step(&self, s0: &[f64], mode: &mut [i8], f: &mut [f64]) {
-        let mf = self.mf;
+/// One instant's box problem σ = s⁰ − T f, f ∈ [−μN, μN] ⊥ σ (T row-major, mf × mf; μN per row).
+pub(super) struct Relay<'a> {
+    pub t: &'a [f64],
+    pub slip: &'a [f64],
+}
+
+impl Relay<'_> {
+    /// Solves from the guessed modes by a primal–dual active set (mode updates from the
+    /// violations), else Lemke on the relay LCP; `mode` and `f` hold the answer.
+    pub(super) fn box_step(&self, s0: &[f64], mode: &mut [i8], f: &mut [f64]) {
+        let mf = self.slip.len();
         for _ in 0..2 * mf + 2 {
             self.solve_modes(s0, mode, f);
             if !self.update_modes(s0, mode, f) {
@@ -280,7 +315,7 @@ impl FrictionStepMap {
 
     /// f with the modes fixed: slipping rows at ±μN, stuck rows from T_SS f_S = s⁰_S − T_SL f_L.
     fn solve_modes(&self, s0: &[f64], mode: &[i8], f: &mut [f64]) {
-        let mf = self.mf;
+        let mf = self.slip.len();
         let stuck: Vec<usize> = (0..mf).filter(|&i| mode[i] == 0).collect();
         for i in 0..mf {
             f[i] = f64::from(mode[i]) * self.slip[i];
@@ -298,7 +333,7 @@ impl FrictionStepMap {
 
     /// Moves violated rows to their other mode; whether any moved.
     fn update_modes(&self, s0: &[f64], mode: &mut [i8], f: &[f64]) -> bool {
-        let mf = self.mf;
+        let mf = self.slip.len();
         let scale = s0.iter().fold(0.0f64, |a, v| a.max(v.abs()))
             + (0..mf).map(|i| (0..mf).map(|l| self.t[i * mf + l].abs() * self.slip[l]).sum::<f64>()).fold(0.0, f64::max);
         let tol = 1e-12 * scale.max(f64::MIN_POSITIVE);
@@ -318,67 +353,93 @@ impl FrictionStepMap {
         moved
     }
 
-    /// max |y_end − y| relative to the states' size.
-    fn residual(y: &[f64], march: &March) -> f64 {
-        let scale = y.iter().chain(&march.end).fold(0.0f64, |a, v| a.max(v.abs())).max(f64::MIN_POSITIVE);
-        march.end.iter().zip(y).fold(0.0f64, |a, (e, s)| a.max((e - s).abs())) / scale
-    }
-
-    /// ∂y_end/∂y₀ with every instant's modes fixed (the state does not enter: a replay).
-    fn period_tangent(&self, modes: &[i8]) -> Mat<f64> {
-        let d = self.state_size();
-        let mut p = Mat::<f64>::identity(d, d);
-        for j in 0..self.k {
-            p = self.step_tangent(&p, &modes[j * self.mf..(j + 1) * self.mf]);
-        }
-        p
-    }
-
-    /// Newton on the periodic state with each march's sets fixed, from `start` (a coarser
-    /// grid's orbit, [`coarse_start`]) or rest. A step that does not lower the residual is
-    /// halved (at most [`HALVINGS`] times, then taken at the least length): the piecewise-affine
-    /// map can make full steps cycle between sets.
-    pub(super) fn shoot(&self, start: Option<Vec<f64>>) -> Result<FrictionShot, ShotFailure> {
-        let d = self.state_size();
-        let mut y = start.filter(|s| s.len() == d).unwrap_or_else(|| vec![0.0; d]);
-        let mut march = self.march(&y, None);
-        let mut residual = Self::residual(&y, &march);
-        let mut unchanged = false;
-        for iteration in 0..MAX_ITERATIONS {
-            if !residual.is_finite() {
-                return Err(ShotFailure { iterations: iteration, residual, why: "the march overflowed" });
-            }
-            // Round-off, or the sets of the affine solve came back unchanged (its fixed point).
-            if residual <= 1e-12 || (unchanged && residual <= 1e-8) {
-                return Ok(FrictionShot { state: y, forces: march.forces, iterations: iteration, residual });
-            }
-            let p = self.period_tangent(&march.modes);
-            let i_minus_p = Mat::from_fn(d, d, |a, b| if a == b { 1.0 } else { 0.0 } - p[(a, b)]);
-            let r: Vec<f64> = march.end.iter().zip(&y).map(|(e, s)| e - s).collect();
-            let delta = DenseLu::new(&i_minus_p).solve(&r);
-            if delta.iter().any(|v| !v.is_finite()) {
-                return Err(ShotFailure {
-                    iterations: iteration,
-                    residual,
-                    why: "I − P is singular (a rigid contact stuck over the whole period leaves its position undetermined)",
-                });
-            }
-            let mut length = 1.0;
-            let (next_y, next) = loop {
-                let cand: Vec<f64> = y.iter().zip(&delta).map(|(s, dl)| s + length * dl).collect();
-                let m = self.march(&cand, Some(&march.modes));
-                if Self::residual(&cand, &m) < residual || length < 0.5f64.powi(HALVINGS) {
-                    break (cand, m);
+    /// df (mf × d) with the modes fixed: stuck rows solve T_SS df_S = ds⁰_S (`ds0(i, c)`), slipping
+    /// rows keep their force.
+    pub(super) fn stuck_tangent(&self, mode: &[i8], ds0: impl Fn(usize, usize) -> f64, d: usize) -> Mat<f64> {
+        let mf = self.slip.len();
+        let stuck: Vec<usize> = (0..mf).filter(|&i| mode[i] == 0).collect();
+        let mut df = Mat::<f64>::zeros(mf, d);
+        if !stuck.is_empty() {
+            let ts = Mat::from_fn(stuck.len(), stuck.len(), |a, b| self.t[stuck[a] * mf + stuck[b]]);
+            let lu = DenseLu::new(&ts);
+            for c in 0..d {
+                let col = lu.solve(&stuck.iter().map(|&i| ds0(i, c)).collect::<Vec<_>>());
+                for (a, &i) in stuck.iter().enumerate() {
+                    df[(i, c)] = col[a];
                 }
-                length *= 0.5;
-            };
-            unchanged = length == 1.0 && next.modes == march.modes;
-            y = next_y;
-            march = next;
-            residual = Self::residual(&y, &march);
+            }
         }
-        Err(ShotFailure { iterations: MAX_ITERATIONS, residual, why: "the stick/slip sets kept changing" })
+        df
     }
+}
+
+/// max |y_end − y| relative to the states' size.
+fn residual(y: &[f64], march: &March) -> f64 {
+    let scale = y.iter().chain(&march.end).fold(0.0f64, |a, v| a.max(v.abs())).max(f64::MIN_POSITIVE);
+    march.end.iter().zip(y).fold(0.0f64, |a, (e, s)| a.max((e - s).abs())) / scale
+}
+
+/// Newton on the periodic state with each march's sets fixed, from `start` (a coarser grid's
+/// orbit, [`coarse_start`]) or rest. A step that does not lower the residual is halved (at most
+/// [`HALVINGS`] times, then taken at the least length): the piecewise-affine map can make full
+/// steps cycle between sets.
+pub(super) fn shoot(map: &impl FrictionMarch, start: Option<Vec<f64>>) -> Result<FrictionShot, ShotFailure> {
+    let d = map.state_size();
+    let mut y = start.filter(|s| s.len() == d).unwrap_or_else(|| vec![0.0; d]);
+    let mut march = map.march(&y, None);
+    let mut res = residual(&y, &march);
+    let mut unchanged = false;
+    for iteration in 0..MAX_ITERATIONS {
+        if !res.is_finite() {
+            return Err(ShotFailure { iterations: iteration, residual: res, why: "the march overflowed" });
+        }
+        // Round-off, or the sets of the affine solve came back unchanged (its fixed point).
+        if res <= 1e-12 || (unchanged && res <= 1e-8) {
+            return Ok(FrictionShot { state: y, forces: march.forces, velocity: march.velocity, iterations: iteration, residual: res });
+        }
+        let p = map.period_tangent(&march.modes);
+        let i_minus_p = Mat::from_fn(d, d, |a, b| if a == b { 1.0 } else { 0.0 } - p[(a, b)]);
+        let r: Vec<f64> = march.end.iter().zip(&y).map(|(e, s)| e - s).collect();
+        let mut delta = DenseLu::new(&i_minus_p).solve(&r);
+        if delta.iter().any(|v| !v.is_finite()) {
+            // A family of periodic orbits (eigenvalue 1 of P: the half steps' relay on an undamped
+            // structure, whose force at an interior step the structure feels only in mean): the
+            // least-norm step, by normal equations with a Tikhonov term at round-off.
+            delta = least_norm_step(&i_minus_p, &r);
+        }
+        if delta.iter().any(|v| !v.is_finite()) {
+            return Err(ShotFailure {
+                iterations: iteration,
+                residual: res,
+                why: "I − P is singular (a rigid contact stuck over the whole period leaves its position undetermined)",
+            });
+        }
+        let mut length = 1.0;
+        let (next_y, next) = loop {
+            let cand: Vec<f64> = y.iter().zip(&delta).map(|(s, dl)| s + length * dl).collect();
+            let m = map.march(&cand, Some(&march.modes));
+            if residual(&cand, &m) < res || length < 0.5f64.powi(HALVINGS) {
+                break (cand, m);
+            }
+            length *= 0.5;
+        };
+        unchanged = length == 1.0 && next.modes == march.modes;
+        y = next_y;
+        march = next;
+        res = residual(&y, &march);
+    }
+    Err(ShotFailure { iterations: MAX_ITERATIONS, residual: res, why: "the stick/slip sets kept changing" })
+}
+
+/// δ of least norm for A δ = r (A square, singular): (AᵀA + μI) δ = Aᵀr with μ at round-off of
+/// AᵀA's diagonal.
+fn least_norm_step(a: &Mat<f64>, r: &[f64]) -> Vec<f64> {
+    let d = a.nrows();
+    let ata = dense_product(&a.transpose().to_owned(), a);
+    let mu = 1e-13 * (0..d).map(|i| ata[(i, i)]).fold(f64::MIN_POSITIVE, f64::max);
+    let reg = Mat::from_fn(d, d, |i, l| ata[(i, l)] + if i == l { mu } else { 0.0 });
+    let atr: Vec<f64> = (0..d).map(|i| (0..d).map(|l| a[(l, i)] * r[l]).sum()).collect();
+    DenseLu::new(&reg).solve(&atr)
 }
 
 /// The orbit's state on the grid of k/4 instants (recursively from k/16, …, down to

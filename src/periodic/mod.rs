@@ -5,6 +5,7 @@ mod cache;
 mod friction;
 mod friction_coupled;
 mod friction_events;
+mod friction_half_steps;
 mod friction_shooting;
 pub mod limits;
 use crate::linalg::fft; // the crate's one FFT plan type, shared with lcp
@@ -18,8 +19,8 @@ mod tuning;
 
 pub use assembly::Assembly;
 pub use fft::PeriodFft;
-pub use friction::{FRICTION_DENSE_MAX, FrictionGrid, HALF_STEPS_ENV, friction_lcp};
-pub use friction_events::EVENT_FITTED_ENV;
+pub use friction::{FRICTION_DENSE_MAX, FrictionGrid, friction_lcp};
+pub use friction_events::RELAY_HALF_STEPS_ENV;
 pub use pilot::{PILOT_MIN_STEPS, carried_active_set};
 pub use problem::{MAX_DENSE_FLOPS, MAX_LCP_SIZE, MAX_STEPS, MIN_STEPS, PeriodicProblem};
 pub use recovery::render_path as render_lcp_path;

@@ -72,10 +72,10 @@ pub fn shooting_work(k: usize, d: usize, m: usize) -> f64 {
 pub struct NoStepMap(pub String);
 
 /// Lead L and the coefficients a2·h², a1·h, a0 of a difference scheme.
-type Coefficients = (usize, Vec<f64>, Vec<f64>, Vec<f64>);
+pub(super) type Coefficients = (usize, Vec<f64>, Vec<f64>, Vec<f64>);
 
 /// The coefficients of a difference scheme; `None` for fourier.
-fn coefficients(scheme: Scheme) -> Option<Coefficients> {
+pub(super) fn coefficients(scheme: Scheme) -> Option<Coefficients> {
     Some(match scheme {
         Scheme::Cds => (1, vec![1.0, -2.0, 1.0], vec![0.5, 0.0, -0.5], vec![0.0, 1.0, 0.0]),
         Scheme::Galerkin => (1, vec![1.0, -2.0, 1.0], vec![0.5, 0.0, -0.5], vec![1.0 / 6.0, 4.0 / 6.0, 1.0 / 6.0]),
