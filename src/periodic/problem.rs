@@ -255,16 +255,12 @@ impl PeriodicProblem {
         Ok(self)
     }
 
-    /// The model DOFs whose responses the outputs need, sorted and unique.
-    pub fn recovery_dofs(&self) -> Vec<usize> {
+    /// The outputs to recover, sorted by label: each with its (model DOF, coefficient) terms (a
+    /// DOF alone without an output map).
+    pub(super) fn recovery_rows(&self) -> Vec<assembly::RecoveryRow> {
         match &self.output_map {
-            None => self.outputs.dofs(),
-            Some(map) => {
-                let mut d: Vec<usize> = self.outputs.dofs().iter().flat_map(|l| map.rows[l].iter().map(|&(d, _)| d)).collect();
-                d.sort_unstable();
-                d.dedup();
-                d
-            }
+            None => assembly::unit_rows(&self.outputs.dofs()),
+            Some(map) => self.outputs.dofs().into_iter().map(|l| (l, map.rows[&l].clone())).collect(),
         }
     }
 
@@ -353,7 +349,7 @@ impl PeriodicProblem {
         let model = super::friction::with_rows(&self.model)?;
         // Rubbing contacts' tangential rows too, folded into their contacts' columns.
         let model = super::rubbing::with_rows(&model);
-        let wide = assembly::assemble_with(&model, op, self.disc.scheme, self.period(), &self.recovery_dofs(), fft, self.solver.parallel)?;
+        let wide = assembly::assemble_with(&model, op, self.disc.scheme, self.period(), &self.recovery_rows(), fft, self.solver.parallel)?;
         Ok(super::rubbing::fold(&self.model, wide))
     }
 
