@@ -384,42 +384,6 @@ impl PeriodicProblem {
         Ok(response)
     }
 
-    /// The LCP of the period: A block-circulant from the inverse FFT of Ĝ, and q = gap − B xlin,
-    /// each contact row shifted by its pairing offset (λ_j ⊥ gap(t_{j+s})).
-    pub fn lcp(&self, asm: &Assembly, fft: &PeriodFft) -> (BlockCirculant, Vec<f64>) {
-        let (k, m) = (asm.k, asm.m);
-        let nh = k / 2 + 1;
-        let mut blocks = vec![0.0; k * m * m];
-        let mut q = vec![0.0; k * m];
-        let mut spec = vec![num_complex::Complex64::ZERO; nh];
-        let angles = crate::model::GridAngles::new(k);
-        for (a, ca) in self.model.contacts.iter().enumerate() {
-            let s = self.pairing_of(ca).offset();
-            for b in 0..m {
-                for (p, v) in spec.iter_mut().enumerate() {
-                    *v = asm.g_hat[(p * m + a) * m + b];
-                }
-                let col = fft.inverse(&spec);
-                for d in 0..k {
-                    blocks[(d * m + a) * m + b] = col[(d + s) % k];
-                }
-            }
-            for (p, v) in spec.iter_mut().enumerate() {
-                *v = asm.bxlin_hat[p * m + a];
-            }
-            let bx = fft.inverse(&spec);
-            let gap = ca.gap_samples(&angles, self.period_multiple);
-            for j in 0..k {
-                let jj = (j + s) % k;
-                q[j * m + a] = gap[jj] - bx[jj];
-            }
-            if let crate::model::Compliance::Compliant { stiffness } = ca.compliance {
-                blocks[a * m + a] += 1.0 / stiffness;
-            }
-        }
-        (BlockCirculant::new(k, m, blocks), q)
-    }
-
     /// The LCP's data must be finite; when they are not, name the contact and the instant.
     /// Why: values that pass validation one by one (a static gap plus obstacle motions near
     /// 1e308, say) can still sum past f64, and a solver's "non-finite data" says nothing of where.
