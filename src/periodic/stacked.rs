@@ -68,3 +68,44 @@ impl PeriodicProblem {
         spectrum
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::assembly::tests::chain_with_massless_boundary;
+    use super::super::{OutputSelection, PeriodFft, PeriodicProblem, SolverSettings};
+    use crate::lcp::{BlockCirculant, CirculantOperator, LcpMatrix};
+    use crate::model::Compliance;
+    use crate::time::{Discretization, Pairing, Scheme};
+
+    /// The block spectrum taken from Ĝ (shifted by the pairing, with a compliance) gives the same
+    /// products as the blocks' own: the FFT product on the spectrum against the direct product
+    /// on the blocks, under both pairings (offsets 0 and 1) and with a compliant contact.
+    #[test]
+    fn the_spectrum_from_the_assembly_gives_the_blocks_products() {
+        let mut model = chain_with_massless_boundary();
+        model.contacts[2].compliance = Compliance::Compliant { stiffness: 2.0e4 };
+        for pairing in [Pairing::Same, Pairing::Forward] {
+            let disc = Discretization { scheme: Scheme::Bds1, steps: 64, pairing: Some(pairing) };
+            let p = PeriodicProblem::new(model.clone(), disc, OutputSelection::default(), SolverSettings::default()).unwrap();
+            let fft = PeriodFft::new(64);
+            let (a, _) = p.assemble_lcp(&fft).unwrap();
+            assert!(a.spectrum().is_some(), "the LCP carries its spectrum");
+            let z: Vec<f64> = (0..a.dim()).map(|i| ((i * 37 % 11) as f64 - 3.0).max(0.0)).collect();
+            let (mut fast, mut direct) = (vec![0.0; a.dim()], vec![0.0; a.dim()]);
+            CirculantOperator::new(&a).mul_into(&z, &mut fast);
+            a.mul_into(&z, &mut direct);
+            let plain = BlockCirculant::new(a.k(), a.m(), a.blocks().to_vec());
+            let mut refft = vec![0.0; a.dim()];
+            CirculantOperator::new(&plain).mul_into(&z, &mut refft);
+            let scale = direct.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+            let worst = fast.iter().zip(&direct).fold(0.0f64, |w, (x, y)| w.max((x - y).abs()));
+            let against_fft = fast.iter().zip(&refft).fold(0.0f64, |w, (x, y)| w.max((x - y).abs()));
+            eprintln!(
+                "{pairing:?}: spectrum product against the direct one {:.1e}, against the blocks' FFT {:.1e} (of {scale:.2e})",
+                worst / scale,
+                against_fft / scale
+            );
+            assert!(scale > 0.0 && worst <= 1e-12 * scale && against_fft <= 1e-12 * scale, "{pairing:?}: {worst:e}, {against_fft:e} of {scale:e}");
+        }
+    }
+}

@@ -16,6 +16,7 @@
 pub mod marching;
 mod refill;
 mod refine;
+mod seam;
 pub mod spectrum;
 
 use crate::analysis::{accuracy, continuation};
@@ -246,6 +247,10 @@ pub fn run(
             .collect()
     });
     let mut points: Vec<SweepPoint> = results.into_iter().flatten().collect();
+    if settings.warm_start && bounds.len() > 1 {
+        let starts: Vec<usize> = bounds.iter().map(|b| b.0).collect();
+        seam::repair_seams(base, &mut points, &starts, settings);
+    }
     if settings.warm_start && guarded(session.problem()) {
         refill(base, &mut points, settings);
     }

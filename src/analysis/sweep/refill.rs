@@ -43,7 +43,7 @@ pub fn refill(template: &PeriodicProblem, points: &mut [SweepPoint], settings: &
 
 /// The sweep point of an answer `r` the refill found (after `substeps` ω sub-steps), estimated
 /// and refined like a point of the forward pass.
-fn refilled_point(
+pub(super) fn refilled_point(
     solver: &PeriodicSolver,
     (second, levels): (&mut Option<(PeriodicSolver, Option<f64>)>, &mut refine::Levels),
     settings: &SweepSettings,
@@ -94,4 +94,3 @@ fn refill_pass(
         }
     }
 }
-
