@@ -40,8 +40,9 @@ fn coarse_blade_sweep_of_300_points_shows_the_stiffening_shift_of_the_resonance(
     // contact limits the amplitude.
     assert!(f_nl > 1.02 * f_lin, "peak with contact at {f_nl}, linear at {f_lin}");
     assert!(a_nl < a_lin);
-    // Off resonance there is no contact and both curves coincide.
-    for x in points.iter().filter(|x| x.frequency < 2150.0 || x.frequency > 2450.0) {
+    // Below resonance there is no contact and both curves coincide. (Above it the chunks now
+    // follow the contact branch up as one sequential sweep does: the seams are re-checked.)
+    for x in points.iter().filter(|x| x.frequency < 2150.0) {
         assert!(x.max_force.iter().all(|&f| f == 0.0), "contact at ω = {}", x.frequency);
         assert!((x.amplitude[0] - x.linear_amplitude[0]).abs() <= 1e-9 * x.linear_amplitude[0]);
     }
