@@ -92,18 +92,39 @@ impl LcpMatrix for DenseMatrix {
 
 /// A block-circulant matrix of k×k blocks of size m×m, indexed time-major: row (j, a) is j·m + a.
 /// Entry ((j, a), (l, b)) = blocks[d][a][b] with d = (j − l) mod k: k·m² numbers in all.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub struct BlockCirculant {
     k: usize,
     m: usize,
     /// blocks[(d·m + a)·m + b]
     blocks: Vec<f64>,
+    /// The blocks' DFT when the caller had it (Ĝ_p row-major m×m, p = 0..=k/2): the FFT
+    /// products then skip the m² transforms of [`super::CirculantOperator`].
+    spectrum: Option<Vec<num_complex::Complex64>>,
+}
+
+/// Equal blocks are equal matrices, whether a spectrum came with them or not.
+impl PartialEq for BlockCirculant {
+    fn eq(&self, other: &Self) -> bool {
+        (self.k, self.m) == (other.k, other.m) && self.blocks == other.blocks
+    }
 }
 
 impl BlockCirculant {
     pub fn new(k: usize, m: usize, blocks: Vec<f64>) -> Self {
         assert_eq!(blocks.len(), k * m * m, "BlockCirculant: {} values for k={k}, m={m}", blocks.len());
-        BlockCirculant { k, m, blocks }
+        BlockCirculant { k, m, blocks, spectrum: None }
+    }
+    /// The same matrix with its block spectrum Ĝ_p = Σ_d blocks[d] e^(−2πi pd/k) (row-major m×m,
+    /// p = 0..=k/2), e.g. from the frequency-domain assembly it was transformed from.
+    pub fn with_spectrum(mut self, spectrum: Vec<num_complex::Complex64>) -> Self {
+        assert_eq!(spectrum.len(), (self.k / 2 + 1) * self.m * self.m, "BlockCirculant: spectrum of {} values for k={}, m={}", spectrum.len(), self.k, self.m);
+        self.spectrum = Some(spectrum);
+        self
+    }
+    /// The block spectrum, when it came with the matrix.
+    pub fn spectrum(&self) -> Option<&[num_complex::Complex64]> {
+        self.spectrum.as_deref()
     }
     pub fn k(&self) -> usize {
         self.k
@@ -117,8 +138,13 @@ impl BlockCirculant {
     }
     /// Adds diag(values) (length m) to every diagonal block: A + I_k ⊗ diag(values).
     pub fn add_block_diagonal(&mut self, values: &[f64]) {
+        let m = self.m;
         for (a, v) in values.iter().enumerate() {
-            self.blocks[a * self.m + a] += v;
+            self.blocks[a * m + a] += v;
+            // Block 0 alone changes: every harmonic's diagonal by the same value.
+            if let Some(s) = self.spectrum.as_mut() {
+                s.chunks_exact_mut(m * m).for_each(|block| block[a * m + a] += v);
+            }
         }
     }
     #[inline]
@@ -162,7 +188,7 @@ impl BlockCirculant {
                         }
                     }
                 }
-                return Some(BlockCirculant { k, m, blocks });
+                return Some(BlockCirculant { k, m, blocks, spectrum: None });
             }
         }
         None

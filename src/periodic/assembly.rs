@@ -21,7 +21,8 @@ pub struct Assembly {
     pub k: usize,
     /// Number of contacts m.
     pub m: usize,
-    /// DOFs at which responses are recovered (sorted, unique).
+    /// Labels of the recovered outputs, in row order of `xlin_hat` and `h_hat` (model DOFs,
+    /// or the output map's labels: each row is its combination of model DOFs, [`RecoveryRow`]).
     pub dofs: Vec<usize>,
     pub symbols: Symbols,
     /// Ĝ_p, row-major m×m, for p = 0..=k/2.
@@ -220,6 +221,21 @@ impl Operator {
     }
 }
 
+/// A recovered output: its label and its (model DOF, coefficient) terms. Why combinations: a
+/// reduced model's physical output mixes every reduced DOF (69 on the real blade), and the
+/// assembly at the 5 outputs instead of at the 69 DOFs is 14× smaller (issue 23).
+pub type RecoveryRow = (usize, Vec<(usize, f64)>);
+
+/// Each DOF as its own row (no output map).
+pub fn unit_rows(dofs: &[usize]) -> Vec<RecoveryRow> {
+    dofs.iter().map(|&d| (d, vec![(d, 1.0)])).collect()
+}
+
+/// Σ c·value(d) over a row's terms (a unit row gives value(d) exactly).
+fn along_row<T: Copy + Default + std::ops::Add<Output = T> + std::ops::Mul<f64, Output = T>>(terms: &[(usize, f64)], value: impl Fn(usize) -> T) -> T {
+    terms.iter().fold(T::default(), |acc, &(d, c)| acc + value(d) * c)
+}
+
 /// What one harmonic contributes.
 struct HarmonicBlock {
     g: Vec<C>,
@@ -232,7 +248,7 @@ struct HarmonicBlock {
 /// (k instants over `period`: T, or p·T for an orbit of p forcing periods).
 /// `parallel`: spread the harmonics over rayon's threads (never from inside an FMU).
 pub fn assemble(model: &Model, scheme: Scheme, period: f64, dofs: &[usize], fft: &PeriodFft, parallel: bool) -> Result<Assembly, SolveError> {
-    assemble_with(model, &StructureOperator::new(model)?, scheme, period, dofs, fft, parallel)
+    assemble_with(model, &StructureOperator::new(model)?, scheme, period, &unit_rows(dofs), fft, parallel)
 }
 
 /// The ω-independent part of the assembly, built once per structure (M, C, K) and reused at every
@@ -259,13 +275,13 @@ impl std::fmt::Debug for StructureOperator {
 }
 
 /// [`assemble`] on a structure operator built before (by [`StructureOperator::new`] on a model
-/// with the same M, C and K; the contacts, forces and frequency are `model`'s).
+/// with the same M, C and K; the contacts, forces and frequency are `model`'s), recovering `rows`.
 pub fn assemble_with(
     model: &Model,
     op: &StructureOperator,
     scheme: Scheme,
     period: f64,
-    dofs: &[usize],
+    rows: &[RecoveryRow],
     fft: &PeriodFft,
     parallel: bool,
 ) -> Result<Assembly, SolveError> {
@@ -284,13 +300,13 @@ pub fn assemble_with(
         )));
     }
     if let Operator::Modal { phi, lambda, c, residual } = op {
-        let mut asm = assemble_modal(model, symbols, &forces, dofs, phi, lambda, c, k)?;
+        let mut asm = assemble_modal(model, symbols, &forces, rows, phi, lambda, c, k)?;
         if let Some(r) = residual {
-            add_residual(&mut asm, model, &forces, r)?;
+            add_residual(&mut asm, model, &forces, rows, r)?;
         }
         return Ok(asm);
     }
-    let nd = dofs.len();
+    let nd = rows.len();
     let one = |p: usize| -> Result<HarmonicBlock, SolveError> {
         let (s1, s2, w) = (symbols.sigma1[p], symbols.sigma2[p], symbols.weight[p]);
         // Right-hand sides: Bᵀ (m columns, B_iᵀ) then w_p F̂_p.
@@ -311,10 +327,10 @@ pub fn assemble_with(
             }
             b.bx[a] = ca.along(|d| y[(d, m)]);
         }
-        for (r, &d) in dofs.iter().enumerate() {
-            b.xl[r] = y[(d, m)];
+        for (r, (_, terms)) in rows.iter().enumerate() {
+            b.xl[r] = along_row(terms, |d| y[(d, m)]);
             for j in 0..m {
-                b.h[r * m + j] = y[(d, j)];
+                b.h[r * m + j] = along_row(terms, |d| y[(d, j)]);
             }
         }
         Ok(b)
@@ -328,7 +344,7 @@ pub fn assemble_with(
     let mut asm = Assembly {
         k,
         m,
-        dofs: dofs.to_vec(),
+        dofs: rows.iter().map(|r| r.0).collect(),
         symbols,
         g_hat: Vec::with_capacity(nh * m * m),
         xlin_hat: Vec::with_capacity(nh * nd),
@@ -353,7 +369,7 @@ fn assemble_modal(
     model: &Model,
     symbols: Symbols,
     forces: &[(usize, Vec<C>)],
-    dofs: &[usize],
+    rows: &[RecoveryRow],
     phi: &Mat<f64>,
     lambda: &[f64],
     c: &[f64],
@@ -362,7 +378,7 @@ fn assemble_modal(
     // Modes (columns of Φ): n without massless DOFs, fewer with them.
     let n = phi.ncols();
     let m = model.contacts.len();
-    let nd = dofs.len();
+    let nd = rows.len();
     let nh = k / 2 + 1;
     // D_p[i], stored [i][p] as real and imaginary parts.
     let mut dre = Mat::<f64>::zeros(n, nh);
@@ -389,13 +405,13 @@ fn assemble_modal(
     let ure = Mat::<f64>::from_fn(n, nh, |i, p| dre[(i, p)] * fre[(i, p)] - dim[(i, p)] * fim[(i, p)]);
     let uim = Mat::<f64>::from_fn(n, nh, |i, p| dre[(i, p)] * fim[(i, p)] + dim[(i, p)] * fre[(i, p)]);
     let bphi = Mat::<f64>::from_fn(m, n, |a, i| model.contacts[a].along(|d| phi[(d, i)]));
-    let phio = Mat::<f64>::from_fn(nd, n, |r, i| phi[(dofs[r], i)]);
+    let phio = Mat::<f64>::from_fn(nd, n, |r, i| along_row(&rows[r].1, |d| phi[(d, i)]));
     let (xre, xim) = (&phio * &ure, &phio * &uim);
     let (bre, bim) = (&bphi * &ure, &bphi * &uim);
     let mut asm = Assembly {
         k,
         m,
-        dofs: dofs.to_vec(),
+        dofs: rows.iter().map(|r| r.0).collect(),
         symbols,
         g_hat: vec![C::ZERO; nh * m * m],
         xlin_hat: vec![C::ZERO; nh * nd],
@@ -435,13 +451,17 @@ fn assemble_modal(
 
 /// Adds the residual flexibility's part R / w_p of Ẑ_p⁻¹ to a modal assembly: B R Bᵀ / w_p to Ĝ_p,
 /// R_out Bᵀ / w_p to Ẑ_p⁻¹Bᵀ, and R F̂_p (the right-hand side is w_p F̂_p) to X̂lin_p and B X̂lin_p.
-fn add_residual(asm: &mut Assembly, model: &Model, forces: &[(usize, Vec<C>)], r: &Mat<f64>) -> Result<(), SolveError> {
+fn add_residual(asm: &mut Assembly, model: &Model, forces: &[(usize, Vec<C>)], rows: &[RecoveryRow], r: &Mat<f64>) -> Result<(), SolveError> {
     let (m, nd, nh) = (asm.m, asm.dofs.len(), asm.k / 2 + 1);
     let n = r.nrows();
     let rbt = Mat::<f64>::from_fn(n, m, |d, b| model.contacts[b].along(|e| r[(d, e)]));
     let brbt = Mat::<f64>::from_fn(m, m, |a, b| model.contacts[a].along(|d| rbt[(d, b)]));
     // B R at each loaded DOF's column: the static response of the contacts to that force.
     let brf: Vec<Vec<f64>> = forces.iter().map(|(l, _)| (0..m).map(|a| model.contacts[a].along(|d| r[(d, *l)])).collect()).collect();
+    // The rows' R_out Bᵀ and R_out at each loaded DOF.
+    let rrow = |row: usize, col: &dyn Fn(usize) -> f64| along_row(&rows[row].1, col);
+    let rbt_out: Vec<f64> = (0..nd).flat_map(|row| (0..m).map(move |b| (row, b))).map(|(row, b)| rrow(row, &|d| rbt[(d, b)])).collect();
+    let rf_out: Vec<f64> = (0..nd).flat_map(|row| forces.iter().map(move |(l, _)| (row, *l))).map(|(row, l)| rrow(row, &|d| r[(d, l)])).collect();
     for p in 0..nh {
         let w = asm.symbols.weight[p];
         let inv_w = 1.0 / w;
@@ -453,12 +473,12 @@ fn add_residual(asm: &mut Assembly, model: &Model, forces: &[(usize, Vec<C>)], r
                 asm.g_hat[(p * m + a) * m + b] += C::from(brbt[(a, b)] * inv_w);
             }
         }
-        for (row, &d) in asm.dofs.iter().enumerate() {
+        for row in 0..nd {
             for b in 0..m {
-                asm.h_hat[(p * nd + row) * m + b] += C::from(rbt[(d, b)] * inv_w);
+                asm.h_hat[(p * nd + row) * m + b] += C::from(rbt_out[row * m + b] * inv_w);
             }
-            for (dof, spec) in forces {
-                asm.xlin_hat[p * nd + row] += spec[p] * r[(d, *dof)];
+            for (l, (_, spec)) in forces.iter().enumerate() {
+                asm.xlin_hat[p * nd + row] += spec[p] * rf_out[row * forces.len() + l];
             }
         }
         for (l, (_, spec)) in forces.iter().enumerate() {

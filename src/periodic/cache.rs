@@ -51,7 +51,7 @@ fn key(p: &PeriodicProblem) -> (u64, f64) {
     model.frequency.to_bits().hash(&mut h);
     (disc.steps, p.period_multiple()).hash(&mut h);
     disc.scheme.name().hash(&mut h);
-    p.recovery_dofs().hash(&mut h);
+    p.recovery_rows().iter().for_each(|(l, terms)| (l, terms.iter().map(|&(d, c)| (d, c.to_bits())).collect::<Vec<_>>()).hash(&mut h));
     hash_structure(&model.structure, &mut h);
     for c in &model.contacts {
         c.row.iter().for_each(|&(d, v)| (d, v.to_bits()).hash(&mut h));

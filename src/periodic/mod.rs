@@ -14,6 +14,7 @@ mod problem;
 mod recovery;
 mod rubbing;
 mod session;
+mod stacked;
 mod state_space;
 mod tuning;
 

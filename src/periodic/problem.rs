@@ -255,16 +255,12 @@ impl PeriodicProblem {
         Ok(self)
     }
 
-    /// The model DOFs whose responses the outputs need, sorted and unique.
-    pub fn recovery_dofs(&self) -> Vec<usize> {
+    /// The outputs to recover, sorted by label: each with its (model DOF, coefficient) terms (a
+    /// DOF alone without an output map).
+    pub(super) fn recovery_rows(&self) -> Vec<assembly::RecoveryRow> {
         match &self.output_map {
-            None => self.outputs.dofs(),
-            Some(map) => {
-                let mut d: Vec<usize> = self.outputs.dofs().iter().flat_map(|l| map.rows[l].iter().map(|&(d, _)| d)).collect();
-                d.sort_unstable();
-                d.dedup();
-                d
-            }
+            None => assembly::unit_rows(&self.outputs.dofs()),
+            Some(map) => self.outputs.dofs().into_iter().map(|l| (l, map.rows[&l].clone())).collect(),
         }
     }
 
@@ -353,7 +349,7 @@ impl PeriodicProblem {
         let model = super::friction::with_rows(&self.model)?;
         // Rubbing contacts' tangential rows too, folded into their contacts' columns.
         let model = super::rubbing::with_rows(&model);
-        let wide = assembly::assemble_with(&model, op, self.disc.scheme, self.period(), &self.recovery_dofs(), fft, self.solver.parallel)?;
+        let wide = assembly::assemble_with(&model, op, self.disc.scheme, self.period(), &self.recovery_rows(), fft, self.solver.parallel)?;
         Ok(super::rubbing::fold(&self.model, wide))
     }
 
@@ -386,42 +382,6 @@ impl PeriodicProblem {
         }
         response.timing_s.total = t_start.elapsed().as_secs_f64();
         Ok(response)
-    }
-
-    /// The LCP of the period: A block-circulant from the inverse FFT of Ĝ, and q = gap − B xlin,
-    /// each contact row shifted by its pairing offset (λ_j ⊥ gap(t_{j+s})).
-    pub fn lcp(&self, asm: &Assembly, fft: &PeriodFft) -> (BlockCirculant, Vec<f64>) {
-        let (k, m) = (asm.k, asm.m);
-        let nh = k / 2 + 1;
-        let mut blocks = vec![0.0; k * m * m];
-        let mut q = vec![0.0; k * m];
-        let mut spec = vec![num_complex::Complex64::ZERO; nh];
-        let angles = crate::model::GridAngles::new(k);
-        for (a, ca) in self.model.contacts.iter().enumerate() {
-            let s = self.pairing_of(ca).offset();
-            for b in 0..m {
-                for (p, v) in spec.iter_mut().enumerate() {
-                    *v = asm.g_hat[(p * m + a) * m + b];
-                }
-                let col = fft.inverse(&spec);
-                for d in 0..k {
-                    blocks[(d * m + a) * m + b] = col[(d + s) % k];
-                }
-            }
-            for (p, v) in spec.iter_mut().enumerate() {
-                *v = asm.bxlin_hat[p * m + a];
-            }
-            let bx = fft.inverse(&spec);
-            let gap = ca.gap_samples(&angles, self.period_multiple);
-            for j in 0..k {
-                let jj = (j + s) % k;
-                q[j * m + a] = gap[jj] - bx[jj];
-            }
-            if let crate::model::Compliance::Compliant { stiffness } = ca.compliance {
-                blocks[a * m + a] += 1.0 / stiffness;
-            }
-        }
-        (BlockCirculant::new(k, m, blocks), q)
     }
 
     /// The LCP's data must be finite; when they are not, name the contact and the instant.

@@ -27,36 +27,20 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
     let mut acceleration = BTreeMap::new();
     let mut linear_displacement = BTreeMap::new();
     let out = &problem.outputs();
-    // Each output label as (index into asm.dofs, coefficient) terms: the DOF itself, or the
-    // user-numbered combination of the output map.
-    let rows: Vec<(usize, Vec<(usize, f64)>)> = match &problem.output_map() {
-        None => asm.dofs.iter().enumerate().map(|(r, &d)| (d, vec![(r, 1.0)])).collect(),
-        Some(map) => out
-            .dofs()
-            .into_iter()
-            .map(|l| {
-                let terms = map.rows[&l].iter().map(|&(d, c)| (asm.dofs.binary_search(&d).expect("recovery DOF assembled"), c)).collect();
-                (l, terms)
-            })
-            .collect(),
-    };
     let mut x_hat = vec![C::ZERO; nh];
     let mut xl_hat = vec![C::ZERO; nh];
     let mut tmp = vec![C::ZERO; nh];
-    for (d, terms) in &rows {
-        let d = *d;
-        x_hat.iter_mut().for_each(|v| *v = C::ZERO);
-        xl_hat.iter_mut().for_each(|v| *v = C::ZERO);
-        for &(r, c) in terms {
-            for p in 0..nh {
-                let lin = asm.xlin_hat[p * nd + r];
-                let mut v = lin;
-                for (b, zb) in z_hat.iter().enumerate() {
-                    v -= asm.h_hat[(p * nd + r) * m + b] * zb[p];
-                }
-                x_hat[p] += v * c;
-                xl_hat[p] += lin * c;
+    // Row r of the assembly is output label d (the output map's combination of model DOFs
+    // already taken there).
+    for (r, &d) in asm.dofs.iter().enumerate() {
+        for p in 0..nh {
+            let lin = asm.xlin_hat[p * nd + r];
+            let mut v = lin;
+            for (b, zb) in z_hat.iter().enumerate() {
+                v -= asm.h_hat[(p * nd + r) * m + b] * zb[p];
             }
+            x_hat[p] = v;
+            xl_hat[p] = lin;
         }
         let key = d.to_string();
         if out.displacement.contains(&d) {

@@ -14,7 +14,9 @@
 //! and one chunk (`--threads 1 --chunks-per-thread 1`).
 #[cfg(feature = "reference")]
 pub mod marching;
+mod refill;
 mod refine;
+mod seam;
 pub mod spectrum;
 
 use crate::analysis::continuation;
@@ -24,6 +26,8 @@ use crate::periodic::{LEMKE_AFTER_SHOOTING_MAX, LcpMethod, PeriodicProblem, Peri
 use crate::response::Response;
 use rayon::prelude::*;
 use std::time::Instant;
+
+pub use refill::refill;
 
 /// How to run a sweep.
 #[derive(Clone, Debug, PartialEq)]
@@ -202,12 +206,11 @@ pub fn run(
                     let t = Instant::now();
                     let mut substeps = 0;
                     let mut r = if guarded {
-                        // Inside a run of failures (past a fold) the cold try stops before the
-                        // offset homotopy: there it missed after 70–100 kinks (2–5 s each), while
-                        // the branch beyond (2473 rad/s) is reached by Newton from the
-                        // contact-free orbit; the refill then follows it back over the run.
-                        let cold = if last.is_none() && last_solved.is_some() { ColdTry::WithoutHomotopy } else { ColdTry::Full };
-                        let (r, n) = solve_guarded(&mut solver, last_solved, f, cold);
+                        // The cold try stops before the offset homotopy: past a fold it missed
+                        // after 70–100 kinks (2–5 s each), while the branch beyond (2473 rad/s)
+                        // is reached by Newton from the contact-free orbit and the refill follows
+                        // it back. The homotopy waits for the points the refill misses (`refill`).
+                        let (r, n) = solve_guarded(&mut solver, last_solved, f, ColdTry::WithoutHomotopy);
                         substeps = n;
                         r
                     } else {
@@ -255,65 +258,14 @@ pub fn run(
             .collect()
     });
     let mut points: Vec<SweepPoint> = results.into_iter().flatten().collect();
+    if settings.warm_start && bounds.len() > 1 {
+        let starts: Vec<usize> = bounds.iter().map(|b| b.0).collect();
+        seam::repair_seams(base, &mut points, &starts, settings);
+    }
     if settings.warm_start && guarded(session.problem()) {
         refill(base, &mut points, settings);
     }
     Ok(points)
-}
-
-/// Retries the failed points of a sweep of `template` from their nearest solved neighbours
-/// ([`refill_pass`]): from the neighbour after each first (the branch beyond a fold, followed
-/// back), then from the one before. `run` does this for a guarded sweep.
-pub fn refill(template: &PeriodicProblem, points: &mut [SweepPoint], settings: &SweepSettings) {
-    if points.iter().all(|x| x.error.is_none()) {
-        return;
-    }
-    let mut solver = PeriodicSolver::new(template.clone());
-    let (mut second, mut levels) = (refine::Coarser::new(), refine::Levels::new());
-    for reverse in [true, false] {
-        refill_pass(&mut solver, (&mut second, &mut levels), settings, points, reverse);
-    }
-}
-
-/// Retries a guarded sweep's failed points from their nearest solved neighbour in the sweep's
-/// order, scanning backwards (`reverse`: the neighbour after each) or forwards: warm shooting
-/// from the neighbour's active sets with ω sub-steps from its frequency, no cold try (the
-/// point's own pass made it). Why (issue 23, real blade): past the fold where the contact
-/// branch ends, the forward pass loses the orbit (the neighbour's sets lead nowhere and cold
-/// shooting's homotopy misses), while the other branch, once reached further up, continues
-/// down to those points in a few Newton iterations each. A point still missed keeps its failure.
-fn refill_pass(
-    solver: &mut PeriodicSolver,
-    (second, levels): (&mut refine::Coarser, &mut refine::Levels),
-    settings: &SweepSettings,
-    points: &mut [SweepPoint],
-    reverse: bool,
-) {
-    let order: Vec<usize> = if reverse { (0..points.len()).rev().collect() } else { (0..points.len()).collect() };
-    let mut neighbour: Option<usize> = None;
-    for i in order {
-        let Some(j) = neighbour.filter(|_| points[i].error.is_some()) else {
-            neighbour = if points[i].error.is_none() { Some(i) } else { neighbour };
-            continue;
-        };
-        let t = Instant::now();
-        let f = points[i].frequency;
-        solver.set_warm_start(&points[j].active_set);
-        let (r, substeps) = solve_guarded(solver, Some(points[j].frequency), f, ColdTry::No);
-        let before = points[i].time_s;
-        match r {
-            Ok(r) => {
-                let mut point = SweepPoint::from_response(solver.problem(), f, &r);
-                (point.substeps, point.warm_start_used) = (substeps, true);
-                let below = refine::estimate(&mut point, solver, &r, second, settings);
-                refine::refine(&mut point, solver.problem(), &r, below, levels, settings);
-                point.time_s = before + t.elapsed().as_secs_f64();
-                points[i] = point;
-                neighbour = Some(i);
-            }
-            Err(_) => points[i].time_s = before + t.elapsed().as_secs_f64(),
-        }
-    }
 }
 
 /// The last try of [`solve_guarded`]: none, cold shooting, or cold shooting without its offset
@@ -362,13 +314,13 @@ fn solve_guarded(solver: &mut PeriodicSolver, last: Option<f64>, f: f64, cold: C
     // Cold shooting, unless the first try already was.
     let last_try = match cold {
         ColdTry::Full if had_warm => at(solver, f, false),
-        ColdTry::WithoutHomotopy => solver.update_frequency(f).and_then(|()| solver.solve_by_shooting_with(false, false)),
+        ColdTry::WithoutHomotopy if had_warm => solver.update_frequency(f).and_then(|()| solver.solve_by_shooting_with(false, false)),
         _ => Err(first),
     };
     match last_try {
         Ok(r) => (Ok(r), substeps),
         Err(SolveError::Lcp { outcome, info, .. }) => {
-            let how = if cold == ColdTry::WithoutHomotopy { " (without the offset homotopy: the point before failed too)" } else { "" };
+            let how = if cold == ColdTry::WithoutHomotopy { " (without the offset homotopy, which the refill tries last)" } else { "" };
             let from = last.map_or_else(|| "no solved point just before it".to_string(), |f0| format!("{substeps} ω sub-steps from {f0} rad/s"));
             let hint = format!(
                 "shooting missed ω = {f} rad/s from the last point's active sets, after {from}, and cold{how}; the sweep skips the dense fallback above N = {LEMKE_AFTER_SHOOTING_MAX} (block pivoting then Lemke: minutes); remedies: more --points (a smaller ω step), or `periodic-contact solve SCENE --frequency {f}` for this point alone (it runs the dense fallback)"

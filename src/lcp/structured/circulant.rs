@@ -15,8 +15,8 @@ use num_complex::Complex64 as C;
 /// A [`BlockCirculant`] with its block spectrum and FFT plans, for fast products.
 pub struct CirculantOperator<'a> {
     a: &'a BlockCirculant,
-    /// Ĝ_p row-major m×m for p = 0..=k/2.
-    spectrum: Vec<C>,
+    /// Ĝ_p row-major m×m for p = 0..=k/2 (the matrix's own when it came with one).
+    spectrum: std::borrow::Cow<'a, [C]>,
     fft: PeriodFft,
     work: Mutex<Work>,
 }
@@ -51,6 +51,9 @@ impl<'a> CirculantOperator<'a> {
         let fft = fft.clone();
         let nh = fft.bins();
         let mut work = Work::new(&fft, m);
+        if let Some(spectrum) = a.spectrum() {
+            return CirculantOperator { a, spectrum: spectrum.into(), fft, work: Mutex::new(work) };
+        }
         let mut spectrum = vec![C::ZERO; nh * m * m];
         for i in 0..m {
             for j in 0..m {
@@ -63,7 +66,7 @@ impl<'a> CirculantOperator<'a> {
                 }
             }
         }
-        CirculantOperator { a, spectrum, fft, work: Mutex::new(work) }
+        CirculantOperator { a, spectrum: spectrum.into(), fft, work: Mutex::new(work) }
     }
 
     /// out = A z with the buffers `w`.

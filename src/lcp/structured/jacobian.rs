@@ -15,6 +15,7 @@
 use super::step_lcp::MAX_PAIRS;
 use super::step_map::{DenseLu, StepMapLcp};
 use faer::Mat;
+use std::collections::HashMap;
 
 /// Above this size a product goes to faer's gemm (cache blocking and SIMD, several times faster);
 /// below, plain loops. Why not faer always: its kernels keep thread-local packing buffers that an
@@ -67,33 +68,31 @@ impl PhiPowers {
     }
 }
 
-/// J ← T^n J from the powers T^(2^i) (as many as n needs); returns the products formed.
-fn apply_powers(powers: &[Mat<f64>], mut n: usize, j: &mut Mat<f64>) -> usize {
-    let mut formed = 0;
-    let mut i = 0;
-    while n > 0 {
-        if n & 1 == 1 {
-            *j = product(&powers[i], j);
-            formed += 1;
-        }
-        n >>= 1;
-        i += 1;
-    }
-    formed
+/// T^n from the powers T^(2^i) (as many as n needs; n ≥ 1); returns it and the products formed.
+fn from_powers(powers: &[Mat<f64>], n: usize) -> (Mat<f64>, usize) {
+    let mut bits = (0..usize::BITS as usize).filter(|&i| n >> i & 1 == 1);
+    let first = bits.next().expect("n ≥ 1");
+    bits.fold((powers[first].clone(), 0), |(acc, formed), i| (product(&powers[i], &acc), formed + 1))
 }
 
-/// J ← T^n J for one T, by repeated squaring; returns the products formed.
-fn apply_power(t: Mat<f64>, mut n: usize, j: &mut Mat<f64>) -> usize {
+/// T^n (n ≥ 1) by repeated squaring; returns it and the products formed.
+fn power(t: Mat<f64>, mut n: usize) -> (Mat<f64>, usize) {
     let mut formed = 0;
     let mut base = t;
+    let mut acc: Option<Mat<f64>> = None;
     loop {
         if n & 1 == 1 {
-            *j = product(&base, j);
-            formed += 1;
+            acc = Some(match acc {
+                None => base.clone(),
+                Some(a) => {
+                    formed += 1;
+                    product(&base, &a)
+                }
+            });
         }
         n >>= 1;
         if n == 0 {
-            return formed;
+            return (acc.expect("n ≥ 1"), formed);
         }
         base = product(&base, &base);
         formed += 1;
@@ -132,25 +131,77 @@ pub(super) fn step_matrix(sm: &StepMapLcp, powers: &PhiPowers, mask: u64) -> Mat
 /// Jacobian depends on the sets alone (dP/ds0 is the discrete monodromy matrix when the orbit
 /// closes). Returns the (d+1)×(d+1) products it formed (the work, with the runs' steps).
 pub(super) fn period_jacobian(sm: &StepMapLcp, masks: &[u64], powers: &PhiPowers, j: &mut Mat<f64>) -> usize {
-    // Small states keep the step-by-step product (k products of d³ are cheap there): the runs'
-    // squaring rounds differently, and the discrete walk's kink tests on NLvib 03 at k = 4096
-    // (tests/continuation.rs, nlvib03_branch_events_amplitudes_stability) lose the branch with it.
-    if sm.d <= STEPWISE_MAX_D {
-        *j = by_steps(sm, masks, powers);
-        return masks.len();
+    RunsJacobian::default().form(sm, masks, powers, j)
+}
+
+/// The period Jacobian by runs, keeping between calls on one step map what the next call can
+/// reuse: each set's step matrix, each run's power T_a^L, and the product after each run of the
+/// last call, so that a call whose sets first differ at run r starts from the product before r.
+/// Why: Newton's Jacobians within one solve differ in a few steps (a warm start's sets, then the
+/// answer's), and the same sets recur along a period (two lobes per revolution): on the real
+/// blade (issue 23) most of a sweep point's Jacobian work was forming what the last call formed.
+#[derive(Default)]
+pub(super) struct RunsJacobian {
+    steps: HashMap<u64, Mat<f64>>,
+    powers: HashMap<(u64, usize), Mat<f64>>,
+    /// The last call's runs (set, length) with the product of the runs up to each.
+    prefix: Vec<((u64, usize), Mat<f64>)>,
+}
+
+/// Run powers kept at most (each (d+1)² numbers): a long homotopy meets thousands of runs.
+const KEPT_POWERS: usize = 2048;
+
+impl RunsJacobian {
+    /// [`period_jacobian`], reusing this cache's products (`sm` and `powers` the same at every call).
+    pub(super) fn form(&mut self, sm: &StepMapLcp, masks: &[u64], powers: &PhiPowers, j: &mut Mat<f64>) -> usize {
+        // Small states keep the step-by-step product (k products of d³ are cheap there): the runs'
+        // squaring rounds differently, and the discrete walk's kink tests on NLvib 03 at k = 4096
+        // (tests/continuation.rs, nlvib03_branch_events_amplitudes_stability) lose the branch with it.
+        if sm.d <= STEPWISE_MAX_D {
+            *j = by_steps(sm, masks, powers);
+            return masks.len();
+        }
+        let d = sm.d;
+        let mut runs = Vec::new();
+        let mut start = 0;
+        while start < masks.len() {
+            let len = masks[start..].iter().take_while(|&&m| m == masks[start]).count();
+            runs.push((masks[start], len));
+            start += len;
+        }
+        let same = self.prefix.iter().zip(&runs).take_while(|(kept, run)| kept.0 == **run).count();
+        self.prefix.truncate(same);
+        if self.powers.len() > KEPT_POWERS {
+            self.powers.clear();
+        }
+        let mut formed = 0;
+        for &(mask, len) in &runs[same..] {
+            if !self.powers.contains_key(&(mask, len)) {
+                let (p, n) = if mask == 0 {
+                    from_powers(&powers.0, len)
+                } else {
+                    let t = self.steps.entry(mask).or_insert_with(|| step_matrix(sm, powers, mask));
+                    power(t.clone(), len)
+                };
+                formed += n;
+                self.powers.insert((mask, len), p);
+            }
+            let p = &self.powers[&(mask, len)];
+            let acc = match self.prefix.last() {
+                Some((_, before)) => {
+                    formed += 1;
+                    product(p, before)
+                }
+                None => p.clone(),
+            };
+            self.prefix.push(((mask, len), acc));
+        }
+        *j = match self.prefix.last() {
+            Some((_, acc)) => acc.as_ref().submatrix(0, 0, d, d + 1).to_owned(),
+            None => Mat::<f64>::identity(d + 1, d + 1).as_ref().submatrix(0, 0, d, d + 1).to_owned(),
+        };
+        formed
     }
-    let d = sm.d;
-    let mut acc = Mat::<f64>::identity(d + 1, d + 1);
-    let mut formed = 0;
-    let mut start = 0;
-    while start < masks.len() {
-        let mask = masks[start];
-        let len = masks[start..].iter().take_while(|&&m| m == mask).count();
-        formed += if mask == 0 { apply_powers(&powers.0, len, &mut acc) } else { apply_power(step_matrix(sm, powers, mask), len, &mut acc) };
-        start += len;
-    }
-    *j = acc.as_ref().submatrix(0, 0, d, d + 1).to_owned();
-    formed
 }
 
 /// Up to this state size the period Jacobian is formed step by step: NLvib 03's small state

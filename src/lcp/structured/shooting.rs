@@ -9,7 +9,7 @@
 //! takes over: at δ₀ no pair is active on the contact-free orbit, which is then the answer, and δ
 //! is brought to 0 by steps, each solved by Newton from a secant prediction of the previous.
 //! Nothing here is certified on the stacked LCP: the caller does that and falls back.
-use super::jacobian::{PhiPowers, period_jacobian};
+use super::jacobian::{PhiPowers, RunsJacobian};
 use super::step_map::{Contacts, DenseLu, March, StepMapLcp, march};
 use faer::Mat;
 
@@ -123,6 +123,8 @@ pub struct ShootingSolution {
 struct Newton<'a> {
     sm: &'a StepMapLcp,
     powers: PhiPowers,
+    /// What the next Jacobian can reuse of the last ones (the same step map throughout).
+    runs: RunsJacobian,
     settings: &'a ShootingSettings,
     scale: f64,
     iterations: usize,
@@ -175,7 +177,7 @@ impl<'a> Newton<'a> {
     fn ensure_jacobian(&mut self, masks: &[u64]) {
         if self.jac_masks.as_deref() != Some(masks) {
             let clock = std::time::Instant::now();
-            let products = period_jacobian(self.sm, masks, &self.powers, &mut self.jac);
+            let products = self.runs.form(self.sm, masks, &self.powers, &mut self.jac);
             self.jacobian_s += clock.elapsed().as_secs_f64();
             self.jac_masks = Some(masks.to_vec());
             self.jacobians += 1;
@@ -251,6 +253,7 @@ pub fn solve_shooting(sm: &StepMapLcp, warm: Option<&[u64]>, settings: &Shooting
     let mut nt = Newton {
         sm,
         powers: PhiPowers::new(sm),
+        runs: RunsJacobian::default(),
         settings,
         scale: scale.max(f64::MIN_POSITIVE),
         iterations: 0,
@@ -312,7 +315,7 @@ fn shoot(nt: &mut Newton<'_>, warm: Option<&[u64]>) -> ShootingSolution {
     // 1. Newton from the warm sets' orbit, then from the contact-free orbit (formed only when
     // the warm start fails: its Jacobian costs as much as a Newton iteration).
     if let Some(sets) = warm.filter(|w| w.len() == k)
-        && let Some((s, _)) = fixed_point(nt, Contacts::Frozen(sets))
+        && let Some(s) = fixed_state(nt, Contacts::Frozen(sets))
         && let Ok(it) = nt.solve(s, 0.0, sets, settings.max_iterations)
     {
         return done(nt, it, 0, "warm");
@@ -514,6 +517,15 @@ fn correct(nt: &mut Newton<'_>, here: &PathPoint, tangent: &[f64], ds: f64) -> O
 /// The fixed point of the affine map the march is for these contacts (free, or frozen sets):
 /// s = (I − J)⁻¹ P(0) with J = dP/ds; with its march from that point.
 fn fixed_point(nt: &mut Newton<'_>, contacts: Contacts<'_>) -> Option<(Vec<f64>, March)> {
+    let s = fixed_state(nt, contacts)?;
+    nt.marches += 1;
+    nt.work += nt.march_work;
+    let m = march(nt.sm, &s, 0.0, contacts)?;
+    Some((s, m))
+}
+
+/// [`fixed_point`]'s state alone (a warm start's Newton marches from it with the sets solved).
+fn fixed_state(nt: &mut Newton<'_>, contacts: Contacts<'_>) -> Option<Vec<f64>> {
     let d = nt.sm.d;
     let zero = vec![0.0; d];
     nt.marches += 1;
@@ -522,11 +534,5 @@ fn fixed_point(nt: &mut Newton<'_>, contacts: Contacts<'_>) -> Option<(Vec<f64>,
     nt.ensure_jacobian(&m0.masks);
     let a = Mat::from_fn(d, d, |i, j| if i == j { 1.0 } else { 0.0 } - nt.jac[(i, j)]);
     let s = DenseLu::new(&a).solve(&m0.end);
-    if !s.iter().all(|v| v.is_finite()) {
-        return None;
-    }
-    nt.marches += 1;
-    nt.work += nt.march_work;
-    let m = march(nt.sm, &s, 0.0, contacts)?;
-    Some((s, m))
+    s.iter().all(|v| v.is_finite()).then_some(s)
 }

@@ -1,0 +1,111 @@
+//! The period's LCP from the assembly (src/formulation.md §3): the block-circulant matrix of the
+//! contacts' responses with its spectrum, and q.
+use super::{Assembly, PeriodFft, PeriodicProblem};
+use crate::lcp::BlockCirculant;
+
+impl PeriodicProblem {
+    /// The LCP of the period: A block-circulant from the inverse FFT of Ĝ, and q = gap − B xlin,
+    /// each contact row shifted by its pairing offset (λ_j ⊥ gap(t_{j+s})).
+    pub fn lcp(&self, asm: &Assembly, fft: &PeriodFft) -> (BlockCirculant, Vec<f64>) {
+        let (k, m) = (asm.k, asm.m);
+        let nh = k / 2 + 1;
+        let mut blocks = vec![0.0; k * m * m];
+        let mut q = vec![0.0; k * m];
+        let mut spec = vec![num_complex::Complex64::ZERO; nh];
+        let angles = crate::model::GridAngles::new(k);
+        for (a, ca) in self.model().contacts.iter().enumerate() {
+            let s = self.pairing_of(ca).offset();
+            for b in 0..m {
+                for (p, v) in spec.iter_mut().enumerate() {
+                    *v = asm.g_hat[(p * m + a) * m + b];
+                }
+                let col = fft.inverse(&spec);
+                for d in 0..k {
+                    blocks[(d * m + a) * m + b] = col[(d + s) % k];
+                }
+            }
+            for (p, v) in spec.iter_mut().enumerate() {
+                *v = asm.bxlin_hat[p * m + a];
+            }
+            let bx = fft.inverse(&spec);
+            let gap = ca.gap_samples(&angles, self.period_multiple());
+            for j in 0..k {
+                let jj = (j + s) % k;
+                q[j * m + a] = gap[jj] - bx[jj];
+            }
+            if let crate::model::Compliance::Compliant { stiffness } = ca.compliance {
+                blocks[a * m + a] += 1.0 / stiffness;
+            }
+        }
+        (BlockCirculant::new(k, m, blocks).with_spectrum(self.lcp_spectrum(asm)), q)
+    }
+
+    /// The DFT of [`Self::lcp`]'s blocks from Ĝ directly: row a shifted by its pairing offset s
+    /// multiplies harmonic p by e^(2πi ps/k) (the shift theorem), a compliance adds 1/k_c to
+    /// every harmonic's diagonal; the DC and Nyquist bins keep their real parts, as the blocks'
+    /// real transform does. Why: the FFT products' m² forward transforms of the blocks were a
+    /// tenth of a real-blade sweep point (issue 23).
+    fn lcp_spectrum(&self, asm: &Assembly) -> Vec<num_complex::Complex64> {
+        let (k, m) = (asm.k, asm.m);
+        let mut spectrum = asm.g_hat.clone();
+        for (a, ca) in self.model().contacts.iter().enumerate() {
+            let s = self.pairing_of(ca).offset();
+            let compliance = match ca.compliance {
+                crate::model::Compliance::Compliant { stiffness } => 1.0 / stiffness,
+                crate::model::Compliance::Rigid => 0.0,
+            };
+            for p in 0..=k / 2 {
+                let turn = 2.0 * std::f64::consts::PI * ((p * s) % k) as f64 / k as f64;
+                let shift = num_complex::Complex64::from_polar(1.0, turn);
+                let row = &mut spectrum[(p * m + a) * m..(p * m + a + 1) * m];
+                row.iter_mut().for_each(|v| *v = if s == 0 { *v } else { *v * shift });
+                row[a] += compliance;
+                if p == 0 || 2 * p == k {
+                    row.iter_mut().for_each(|v| v.im = 0.0);
+                }
+            }
+        }
+        spectrum
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::assembly::tests::chain_with_massless_boundary;
+    use super::super::{OutputSelection, PeriodFft, PeriodicProblem, SolverSettings};
+    use crate::lcp::{BlockCirculant, CirculantOperator, LcpMatrix};
+    use crate::model::Compliance;
+    use crate::time::{Discretization, Pairing, Scheme};
+
+    /// The block spectrum taken from Ĝ (shifted by the pairing, with a compliance) gives the same
+    /// products as the blocks' own: the FFT product on the spectrum against the direct product
+    /// on the blocks, under both pairings (offsets 0 and 1) and with a compliant contact.
+    #[test]
+    fn the_spectrum_from_the_assembly_gives_the_blocks_products() {
+        let mut model = chain_with_massless_boundary();
+        model.contacts[2].compliance = Compliance::Compliant { stiffness: 2.0e4 };
+        for pairing in [Pairing::Same, Pairing::Forward] {
+            let disc = Discretization { scheme: Scheme::Bds1, steps: 64, pairing: Some(pairing) };
+            let p = PeriodicProblem::new(model.clone(), disc, OutputSelection::default(), SolverSettings::default()).unwrap();
+            let fft = PeriodFft::new(64);
+            let (a, _) = p.assemble_lcp(&fft).unwrap();
+            assert!(a.spectrum().is_some(), "the LCP carries its spectrum");
+            let z: Vec<f64> = (0..a.dim()).map(|i| ((i * 37 % 11) as f64 - 3.0).max(0.0)).collect();
+            let (mut fast, mut direct) = (vec![0.0; a.dim()], vec![0.0; a.dim()]);
+            CirculantOperator::new(&a).mul_into(&z, &mut fast);
+            a.mul_into(&z, &mut direct);
+            let plain = BlockCirculant::new(a.k(), a.m(), a.blocks().to_vec());
+            let mut refft = vec![0.0; a.dim()];
+            CirculantOperator::new(&plain).mul_into(&z, &mut refft);
+            let scale = direct.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+            let worst = fast.iter().zip(&direct).fold(0.0f64, |w, (x, y)| w.max((x - y).abs()));
+            let against_fft = fast.iter().zip(&refft).fold(0.0f64, |w, (x, y)| w.max((x - y).abs()));
+            eprintln!(
+                "{pairing:?}: spectrum product against the direct one {:.1e}, against the blocks' FFT {:.1e} (of {scale:.2e})",
+                worst / scale,
+                against_fft / scale
+            );
+            assert!(scale > 0.0 && worst <= 1e-12 * scale && against_fft <= 1e-12 * scale, "{pairing:?}: {worst:e}, {against_fft:e} of {scale:e}");
+        }
+    }
+}
