@@ -38,8 +38,8 @@ pub struct SweepSettings {
     pub threads: usize,
     /// Contiguous chunks per thread (more balance the load, fewer keep more warm starts).
     pub chunks_per_thread: usize,
-    /// Estimate every point's error ([`crate::analysis::accuracy`]): a second, warm-started
-    /// sweep at k/2 (or 2k where k/2 breaks the scheme's limit) beside the first.
+    /// Estimate every point's error ([`crate::analysis::accuracy`]): warm-started sweeps at k/2
+    /// (or 2k where k/2 breaks the scheme's limit) and k/4 (the observed order) beside the first.
     pub estimate: bool,
     /// Refine every point whose estimate exceeds this (relative to the peak-to-peak amplitude):
     /// k → 2k while it does, up to `max_steps` ([`refine`]). Needs `estimate`.
@@ -58,7 +58,7 @@ impl Default for SweepSettings {
             chunks_per_thread: 4,
             estimate: false,
             tolerance: None,
-            max_steps: 4096,
+            max_steps: 8192,
             measure: AmplitudeMeasure::Largest,
         }
     }
