@@ -7,7 +7,8 @@
 //! clearance 0 at a compliant switch), as COCO's `hspo` (Dankowicz & Schilder, "Recipes for
 //! Continuation", ch. 19) with a fixed segment signature.
 use super::super::{Parameter, floquet};
-use crate::analysis::polish::{Event, PolishedOrbit, Touch};
+use super::metric::Metric;
+use crate::analysis::polish::{Event, EventKind as Switch, PolishedOrbit, Touch};
 use crate::model::{Compliance, Model};
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
@@ -36,6 +37,8 @@ const CONVERGED: f64 = 1e-10;
 const ATTAINABLE: f64 = 1e-8;
 const NOISE_DEFECT: f64 = 1e-9;
 const MAX_ITERATIONS: usize = 12;
+/// Chord iterations go on while each correction is at most this fraction of the one before.
+const CHORD_CONTRACTION: f64 = 0.25;
 /// Central-difference step of the Jacobian (unknowns are O(1)).
 const DIFF: f64 = 1e-7;
 
@@ -48,8 +51,19 @@ pub(super) struct Family {
     n2: usize,
     /// The state's weights ([`state_weights`]): unknown i is y_i·weight_i/y_s.
     weight: Vec<f64>,
+    /// The arclength's metric ([`Metric`]).
+    pub metric: Metric,
     /// The corrector's last solution and its Jacobian, for the point's tangent.
     last_jacobian: std::cell::RefCell<Option<(Vec<f64>, DMatrix<f64>)>>,
+    /// The Jacobian of the last point solved, for the next corrector's chord iterations.
+    chord: std::cell::RefCell<Option<Chord>>,
+}
+
+type ChordKey = (Vec<(usize, Switch)>, Vec<usize>, f64);
+
+struct Chord {
+    key: ChordKey,
+    jacobian: DMatrix<f64>,
 }
 
 /// A solved point with its unit tangent (oriented along the branch), orbit, multipliers and the
@@ -76,7 +90,8 @@ impl Node {
 impl Family {
     pub fn new(base: &Model, param: Parameter, rho: f64, ys: f64, sig: Signature) -> Family {
         let weight = state_weights(base);
-        Family { base: base.clone(), param, rho, ys, sig, n2: 2 * base.n(), weight, last_jacobian: Default::default() }
+        let metric = Metric::new(base, &weight);
+        Family { base: base.clone(), param, rho, ys, sig, n2: 2 * base.n(), weight, metric, last_jacobian: Default::default(), chord: Default::default() }
     }
 
     /// The largest weighted state component of `y`: the state scale y_s of an orbit.
@@ -155,9 +170,12 @@ impl Family {
     /// on orbits rebuilt at λ ± h·ρ. By central differences throughout where the variational flow
     /// does not apply.
     pub fn jacobian(&self, w: &[f64]) -> Option<DMatrix<f64>> {
+        self.jacobian_at(&self.orbit(w[w.len() - 1] * self.rho)?, w)
+    }
+
+    /// [`Self::jacobian`] with the orbit at w's λ already built.
+    fn jacobian_at(&self, here: &PolishedOrbit, w: &[f64]) -> Option<DMatrix<f64>> {
         let d = self.dim();
-        let lambda = w[d - 1] * self.rho;
-        let here = self.orbit(lambda)?;
         let (y, times) = self.unpack(w, here.period());
         let mut j = DMatrix::zeros(d - 1, d);
         if let Some((_, dr)) = here.shooting_jacobian(&y, &times) {
@@ -179,7 +197,7 @@ impl Family {
             let (mut up, mut dn) = (w.to_vec(), w.to_vec());
             up[c] += DIFF;
             dn[c] -= DIFF;
-            let col = (self.residual_with(&here, &up)? - self.residual_with(&here, &dn)?) / (2.0 * DIFF);
+            let col = (self.residual_with(here, &up)? - self.residual_with(here, &dn)?) / (2.0 * DIFF);
             j.set_column(c, &col);
         }
         let (mut up, mut dn) = (w.to_vec(), w.to_vec());
@@ -190,14 +208,33 @@ impl Family {
         Some(j)
     }
 
-    /// Newton on F(w) = 0, normal·w = target, from `pred`.
+    /// Newton on F(w) = 0, normal·w = target, from `pred`. Chord iterations first, with the
+    /// Jacobian of the last point solved ([`Self::node_with`]) while they contract by
+    /// [`CHORD_CONTRACTION`] or better; fresh Jacobians (Newton) from the first that does not.
+    /// One Jacobian costs the variational flow and two orbits rebuilt at λ ± h, a chord
+    /// iteration one residual: on the coarse blade a step's Jacobians were most of its cost.
     pub fn correct(&self, pred: &[f64], normal: &[f64], target: f64) -> Option<Vec<f64>> {
+        let chord = self.chord.borrow().as_ref().filter(|c| c.key == self.key()).map(|c| c.jacobian.clone());
+        if chord.is_some()
+            && let Some(w) = self.newton(pred, normal, target, chord)
+        {
+            return Some(w);
+        }
+        self.newton(pred, normal, target, None)
+    }
+
+    fn newton(&self, pred: &[f64], normal: &[f64], target: f64, mut chord: Option<DMatrix<f64>>) -> Option<Vec<f64>> {
         let d = self.dim();
         let mut w = pred.to_vec();
         let mut last = f64::INFINITY;
         for _ in 0..MAX_ITERATIONS {
-            let f = self.residual(&w)?;
-            let jac = self.jacobian(&w)?;
+            let here = self.orbit(w[d - 1] * self.rho)?;
+            let f = self.residual_with(&here, &w)?;
+            let fresh = chord.is_none();
+            let jac = match &chord {
+                Some(j) => j.clone(),
+                None => self.jacobian_at(&here, &w)?,
+            };
             let mut a = DMatrix::zeros(d, d);
             a.view_mut((0, 0), (d - 1, d)).copy_from(&jac);
             let mut rhs = DVector::zeros(d);
@@ -212,14 +249,26 @@ impl Family {
             if !step.is_finite() || step > 1.0 {
                 return None;
             }
+            // A chord step is exact to Θ/(1 − Θ) of itself: CONVERGED holds it below 1e-10/3.
             if step < CONVERGED || (step < ATTAINABLE && step >= last && f.amax() < NOISE_DEFECT) {
-                // The Jacobian of the last iterate, ‖Δw‖ away: the tangent's.
-                self.last_jacobian.replace(Some((w.clone(), jac)));
+                if fresh {
+                    // The Jacobian of the last iterate, ‖Δw‖ away: the tangent's.
+                    self.last_jacobian.replace(Some((w.clone(), jac)));
+                }
                 return Some(w);
+            }
+            if !fresh && step > CHORD_CONTRACTION * last && step >= ATTAINABLE {
+                chord = None;
             }
             last = step;
         }
         None
+    }
+
+    /// What a Jacobian depends on besides w: the signature and the state scale.
+    fn key(&self) -> ChordKey {
+        let events = self.sig.events.iter().map(|e| (e.contact, e.kind)).collect();
+        (events, self.sig.always.clone(), self.ys)
     }
 
     /// The unit tangent of the branch at w: [J; prevᵀ] t = e_last, oriented along `prev`.
@@ -250,6 +299,7 @@ impl Family {
             _ => self.jacobian(&w)?,
         };
         let tangent = self.tangent(&jac, prev)?;
+        self.chord.replace(Some(Chord { key: self.key(), jacobian: jac }));
         let orbit = self.orbit(lambda)?;
         let (y, times) = self.unpack(&w, orbit.period());
         let defect = self.residual_with(&orbit, &w)?.amax() * self.ys;

@@ -16,6 +16,7 @@
 //! impact): their signature changes are located on the exact orbit and the branch goes on from
 //! there, from the grid LCP only where that fails ([`rigid`]).
 mod family;
+mod metric;
 mod rigid;
 mod signature;
 
@@ -198,7 +199,9 @@ impl Walk<'_> {
                 return done(self, stop, false, false);
             }
             // A phase between two events of one contact shrinking to nothing: a grazing.
-            let shrinking = self.shrinking(&here);
+            // The step is measured in the metric: the tangent of unit metric length.
+            let along = self.fam.metric.unit(&here.tangent);
+            let shrinking = self.shrinking(&here, &along);
             if let Some(&(e, len, rate)) = shrinking.iter().find(|s| s.1 < VANISH) {
                 let _ = (len, rate);
                 let next = if self.rigid_event(e) { self.rigid_vanish(&here, e, to) } else { self.remove_pair(&here, e) };
@@ -219,12 +222,16 @@ impl Walk<'_> {
             for &(_, len, rate) in &shrinking {
                 step = step.min(0.75 * len / rate);
             }
-            let pred: Vec<f64> = here.w.iter().zip(&here.tangent).map(|(w, t)| w + step * t).collect();
-            let target: f64 = here.tangent.iter().zip(&pred).map(|(t, p)| t * p).sum();
-            let next = self.fam.correct(&pred, &here.tangent, target).and_then(|w| self.fam.node(w, &here.tangent));
-            let drift = |n: &Node| n.w.iter().zip(&pred).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt();
+            let pred: Vec<f64> = here.w.iter().zip(&along).map(|(w, t)| w + step * t).collect();
+            let normal = self.fam.metric.lower(&along);
+            let target = dot(&normal, &pred);
+            // Oriented in the metric too: the stiff components' turning must not decide the sense.
+            let next = self.fam.correct(&pred, &normal, target).and_then(|w| self.fam.node(w, &normal));
+            let metric = &self.fam.metric;
+            let drift = |n: &Node| metric.norm(&n.w.iter().zip(&pred).map(|(a, b)| a - b).collect::<Vec<_>>());
+            let turn = |n: &Node| metric.dot(&metric.unit(&n.tangent), &along);
             let next = match next {
-                Some(n) if (dot(&n.tangent, &here.tangent) >= MIN_COS || step <= settings.min_step) && drift(&n) <= MAX_DRIFT * step => n,
+                Some(n) if (turn(&n) >= MIN_COS || step <= settings.min_step) && drift(&n) <= MAX_DRIFT * step => n,
                 _ => {
                     ds = step / 2.0;
                     if ds < settings.min_step {
@@ -252,7 +259,7 @@ impl Walk<'_> {
                 let pred: Vec<f64> = w0.iter().zip(&next.w).map(|(a, b)| a + f * (b - a)).collect();
                 let d = self.fam.dim();
                 let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
-                self.fam.correct(&pred, &e_l, bound / rho).and_then(|w| self.fam.node(w, &here.tangent)).unwrap_or(next)
+                self.fam.correct(&pred, &e_l, bound / rho).and_then(|w| self.fam.node(w, &normal)).unwrap_or(next)
             } else {
                 next
             };
@@ -338,7 +345,7 @@ impl Walk<'_> {
 
     /// Phases between two events of one contact that shrink along the tangent: (phase, length,
     /// rate of shrinking per unit arclength).
-    fn shrinking(&self, here: &Node) -> Vec<(usize, f64, f64)> {
+    fn shrinking(&self, here: &Node, along: &[f64]) -> Vec<(usize, f64, f64)> {
         let events = &self.fam.sig.events;
         let ne = events.len();
         let n2 = here.w.len() - 1 - ne;
@@ -347,7 +354,7 @@ impl Walk<'_> {
             .filter_map(|e| {
                 let b = (e + 1) % ne;
                 let len = here.w[n2 + b] - here.w[n2 + e] + if b == 0 { 1.0 } else { 0.0 };
-                let rate = here.tangent[n2 + e] - here.tangent[n2 + b];
+                let rate = along[n2 + e] - along[n2 + b];
                 (rate > 0.0).then_some((e, len, rate))
             })
             .collect()
