@@ -357,40 +357,19 @@ impl MultiOrbit {
         (res, states)
     }
 
-    fn jacobian(&self, u: &DVector<f64>, r0: &DVector<f64>) -> DMatrix<f64> {
-        let mut j = DMatrix::zeros(r0.len(), u.len());
-        for c in 0..u.len() {
-            let h = 1e-7 * u[c].abs().max(if c < self.nr() { 1.0 } else { self.period });
-            let mut up = u.clone();
-            up[c] += h;
-            j.set_column(c, &((self.shoot(&up).0 - r0) / h));
-        }
-        j
-    }
-
-    /// Least squares J du = −r (pinned rows make a stuck contact's constant unique).
-    fn step(j: &DMatrix<f64>, r: &DVector<f64>) -> Option<DVector<f64>> {
-        if j.nrows() == j.ncols() {
-            return j.clone().lu().solve(&(-r));
-        }
-        let svd = j.clone().svd(true, true);
-        let tol = 1e-13 * svd.singular_values.max();
-        svd.solve(&(-r), tol).ok()
-    }
-
     /// The unknowns at the seeded times, the state at the fixed point of the (affine) one-period
     /// map those times give (one Newton step with the times held).
     pub fn seeded(&self) -> Result<DVector<f64>, PolishFailure> {
         let nr = self.nr();
         let mut u = DVector::from_iterator(nr + self.times.len(), std::iter::repeat_n(0.0, nr).chain(self.times.iter().copied()));
         let r0 = self.shoot(&u).0;
-        let j = self.jacobian(&u, &r0);
+        let j = super::newton::Shooting::jacobian(self, &u, &r0);
         // The periodicity and pin rows on the state columns (the event rows need the times).
         let m = self.times.len();
         let rows: Vec<usize> = (0..nr).chain(nr + m..r0.len()).collect();
         let a = DMatrix::from_fn(rows.len(), nr, |r, c| j[(rows[r], c)]);
         let r0 = DVector::from_fn(rows.len(), |r, _| r0[rows[r]]);
-        let Some(du) = Self::step(&a, &r0) else { return fail("the one-period map at the seeded events has a multiplier 1") };
+        let Some(du) = super::newton::solve_step(&a, &r0) else { return fail("the one-period map at the seeded events has a multiplier 1") };
         let mut x = u.rows_mut(0, nr);
         x += du;
         Ok(u)
@@ -401,28 +380,20 @@ impl MultiOrbit {
         self.seeded().ok().map(|u| (self.start, self.first.clone(), self.state_at_start(&u)))
     }
 
-    /// Newton on the state and the event times from the seed.
+    /// Newton on the state and the event times from the seed (src/analysis/polish/friction/newton.rs).
     pub fn converge(&mut self) -> Result<(), PolishFailure> {
-        let nr = self.nr();
-        let mut u = self.seeded()?;
-        let scale = |u: &DVector<f64>| u.amax().max(f64::MIN_POSITIVE);
-        for it in 1..=40 {
-            let r0 = self.shoot(&u).0;
-            let j = self.jacobian(&u, &r0);
-            let Some(du) = Self::step(&j, &r0) else { return fail("singular Newton matrix: an event grazes") };
-            u += &du;
-            self.iterations = it;
-            self.correction = du.amax();
-            if self.correction <= 1e-13 * scale(&u) {
-                let (r, states) = self.shoot(&u);
-                self.residual = r.amax();
-                self.times = u.rows(nr, self.times.len()).iter().copied().collect();
-                self.states = states;
-                self.monodromy = super::event_condensed_monodromy(&self.jacobian(&u, &r), nr, self.times.len());
-                return Ok(());
-            }
-        }
-        fail(format_args!("Newton did not converge in 40 iterations, last correction {:.2e}", self.correction))
+        let newton = match super::newton::Newton::run(&*self, self.seeded()?) {
+            Ok(n) => n,
+            Err(e) => return fail(e),
+        };
+        let (nr, u) = (self.nr(), &newton.u);
+        (self.iterations, self.correction) = (newton.iterations, newton.correction);
+        let (r, states) = self.shoot(u);
+        self.residual = r.amax();
+        self.times = u.rows(nr, self.times.len()).iter().copied().collect();
+        self.states = states;
+        self.monodromy = super::event_condensed_monodromy(&super::newton::Shooting::jacobian(&*self, u, &r), nr, self.times.len());
+        Ok(())
     }
 
     /// The least and greatest friction force of contact `i` over 1024 points of the period.
@@ -583,6 +554,16 @@ impl MultiOrbit {
                 EventRecord { time: self.times[e].rem_euclid(self.period), contact, kind: kind.into(), impulse: 0.0 }
             })
             .collect()
+    }
+}
+
+impl super::newton::Shooting for MultiOrbit {
+    fn residual(&self, u: &DVector<f64>) -> DVector<f64> {
+        self.shoot(u).0
+    }
+
+    fn scale(&self, c: usize) -> f64 {
+        if c < self.nr() { 1.0 } else { self.period }
     }
 }
 

@@ -212,17 +212,10 @@ fn settle(fl: &MultiFlows, period: f64, (t0, mut mode, y): (f64, Mode, DVector<f
 
 /// Replaces `r`'s series by the orbit's at the same instants, and every contact's outputs.
 pub fn write(orbit: &MultiOrbit, problem: &PeriodicProblem, r: &mut Response) {
-    let n = orbit.flows.n;
-    let states: Vec<DVector<f64>> = r.time.iter().map(|&t| orbit.state(t)).collect();
-    let accs: Vec<DVector<f64>> = r
-        .time
-        .iter()
-        .map(|&t| {
-            let (mode, y) = orbit.at(t);
-            (&orbit.flows.mode(mode).a * y).rows(n, n).into_owned()
-        })
-        .collect();
-    super::super::super::orbit::write_kinematics(r, problem.output_map(), &states, &accs, n);
+    super::super::write_flow_kinematics(r, problem, orbit.flows.n, |t| {
+        let (mode, y) = orbit.at(t);
+        (&orbit.flows.mode(mode).a * &y, y)
+    });
     for (i, f) in r.friction.iter_mut().enumerate() {
         for (j, &t) in r.time.iter().enumerate() {
             (f.force[j], f.slip_velocity[j], f.displacement[j], f.stuck[j]) = orbit.contact(i, t);
