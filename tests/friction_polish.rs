@@ -235,9 +235,19 @@ fn peak_over_frequency_at_a_normal_load_meets_closed_forms_and_the_simulation() 
 /// member of tests/friction.rs (Ω = 1.438, μN = 0.818), then `draws` members drawn by seed `seed`
 /// (Ω ∈ [0.3, 2.2], μN ∈ [0.3, 0.95], kept where Den Hartog's continuous motion does not apply and
 /// the simulation sticks part of the period), polished from the LCP at k = 128 against the
-/// event-driven simulation at 97 times. Rows: (error of the amplitude, Ω, μN, stuck fraction
-/// error, events (polish, simulation), stuck fraction), or the failure.
-fn den_hartog_with_stops(draws: usize, seed: u64) -> (Vec<(f64, f64, f64, f64, (usize, usize), f64)>, Vec<String>) {
+/// event-driven simulation at 97 times. Rows, or the failures.
+struct StopsRow {
+    /// max |x − x_exact| at 97 times over the amplitude.
+    err: f64,
+    omega: f64,
+    slip: f64,
+    stuck_err: f64,
+    /// Event counts: the polish's and the simulation's.
+    events: (usize, usize),
+    stuck: f64,
+}
+
+fn den_hartog_with_stops(draws: usize, seed: u64) -> (Vec<StopsRow>, Vec<String>) {
     let mut draw = Draw(seed);
     let mut cases = vec![(1.438, 0.818)];
     let (mut rows, mut failures) = (Vec::new(), Vec::new());
@@ -259,13 +269,14 @@ fn den_hartog_with_stops(draws: usize, seed: u64) -> (Vec<(f64, f64, f64, f64, (
                 let err =
                     (0..97).map(|i| i as f64 * o.period() / 97.0).map(|t| (orbit.state(t)[0] - reference.displacement(t)[0]).abs()).fold(0.0, f64::max) / scale;
                 let stuck = (orbit.stuck_fraction() - reference.stuck_fraction).abs();
-                rows.push((err, omega, slip, stuck, (orbit.times.len(), reference.events().len()), reference.stuck_fraction));
+                let events = (orbit.times.len(), reference.events().len());
+                rows.push(StopsRow { err, omega, slip, stuck_err: stuck, events, stuck: reference.stuck_fraction });
             }
             Err(e) => failures.push(format!("Ω = {omega:.4}, μN = {slip:.4} (stuck {:.3}): {e}", reference.stuck_fraction)),
         }
     }
-    rows.sort_by(|a, b| b.0.total_cmp(&a.0));
-    for (err, omega, slip, stuck, (events, exact), frac) in &rows {
+    rows.sort_by(|a, b| b.err.total_cmp(&a.err));
+    for StopsRow { err, omega, slip, stuck_err: stuck, events: (events, exact), stuck: frac } in &rows {
         println!(
             "c = 0 with stops, Ω = {omega:.4}, μN = {slip:.4}: displacement error {err:.2e} of the amplitude, {events} events (simulation {exact}), stuck fraction {frac:.6} (error {stuck:.1e})"
         );
@@ -279,7 +290,7 @@ fn polish_meets_den_hartog_with_stops_at_c_0() {
     let (rows, failures) = den_hartog_with_stops(2, 31);
     assert!(failures.is_empty(), "{failures:?}");
     assert_eq!(rows.len(), 3);
-    for (err, _, _, stuck, (events, exact), _) in &rows {
+    for StopsRow { err, stuck_err: stuck, events: (events, exact), .. } in &rows {
         assert!(*err < 1e-8 && *stuck < 1e-8 && events == exact, "error {err:.2e}, stuck fraction error {stuck:.1e}, {events} events against {exact}");
     }
 }
@@ -293,11 +304,11 @@ fn den_hartog_stops_family() {
     let draws: usize =
         std::env::var("PC_FRICTION_STOPS_FAMILY").ok().and_then(|v| v.parse().ok()).expect("set PC_FRICTION_STOPS_FAMILY to the number of draws");
     let (rows, failures) = den_hartog_with_stops(draws, 2029);
-    let within = rows.iter().filter(|r| r.0 < 1e-8 && r.3 < 1e-8).count();
+    let within = rows.iter().filter(|r| r.err < 1e-8 && r.stuck_err < 1e-8).count();
     println!(
         "{within} of {} polish to 1e-8; worst {:.2e}; {} not polished",
         rows.len() + failures.len(),
-        rows.first().map_or(f64::NAN, |r| r.0),
+        rows.first().map_or(f64::NAN, |r| r.err),
         failures.len()
     );
     assert_eq!(within, draws + 1, "{failures:?}");
