@@ -3,7 +3,8 @@ unilateral stop): the reference simulation validation/peers/friction_rigid_exact
 forms (the departure from the stop, Ω t_d = arccos((k g − μN)/F); μN = 0 is the impact
 oscillator's, src/formulation.md §6.3) and friction_exact.py (a stop out of reach); then, given the
 CLI (PC_CLI), the crate's plain LCP converging to it at first order and its frictionless rigid
-polish meeting it. The stick–slip polish does not fit rigid stops with friction yet (README).
+polish meeting it. The stick–slip polish with rigid stops is checked against its numbers in
+tests/friction_polish_contact.rs.
 """
 from __future__ import annotations
 
