@@ -109,3 +109,125 @@ fn friction_with_a_compliant_stop_meets_the_event_driven_simulation() {
         assert!(rho < 1.0, "damped: the simulation converged onto it");
     }
 }
+
+/// Den Hartog's unit oscillator (m = k = F = 1) with rigid Coulomb friction and a rigid stop
+/// x ≤ gap (plastic impacts): the reference numbers were produced by
+/// `cd validation/peers && python -c "import friction_rigid_exact as fr; …"` (the solve of
+/// friction_rigid_exact.py, x(jT/16) and its resting fraction; that simulation meets the closed-form
+/// departure from the stop, arccos((k g − μN)/F)/Ω, to 3e-13). Not copied from our own output.
+struct RigidStopCase {
+    c: f64,
+    omega: f64,
+    slip: f64,
+    gap: f64,
+    /// The simulation's events: impact, departure, reversal.
+    events: usize,
+    stuck_fraction: f64,
+    x: [f64; 16],
+}
+
+const RIGID_STOP_CASES: [RigidStopCase; 3] = [
+    RigidStopCase {
+        c: 0.0,
+        omega: 0.8,
+        slip: 0.3,
+        gap: 0.5,
+        events: 3,
+        stuck_fraction: 0.2777536994016705,
+        x: [
+            0.5,
+            0.5,
+            0.5,
+            0.5,
+            0.497906368034242,
+            0.44731400520447356,
+            0.2727282612142047,
+            -0.06024470204447063,
+            -0.5235008828365605,
+            -1.025382667316002,
+            -1.429623127991491,
+            -1.590235982144265,
+            -1.465975920011874,
+            -1.066361933008908,
+            -0.39656177159960787,
+            0.46086981775332314,
+        ],
+    },
+    RigidStopCase {
+        c: 0.1,
+        omega: 1.438,
+        slip: 0.2,
+        gap: 0.3,
+        events: 3,
+        stuck_fraction: 0.07565689478647711,
+        x: [
+            -0.644260551797547,
+            -0.3164140850554971,
+            0.07776607623110066,
+            0.3,
+            0.2999193988705117,
+            0.2905341531523224,
+            0.2471032417533208,
+            0.15031854810449385,
+            -0.006930666108818831,
+            -0.21698784421651052,
+            -0.45755412731432477,
+            -0.6945532763640859,
+            -0.8873253454805058,
+            -0.9953435544946028,
+            -0.9901901539873227,
+            -0.8736325111628547,
+        ],
+    },
+    RigidStopCase {
+        c: 0.05,
+        omega: 1.438,
+        slip: 0.5,
+        gap: 0.1,
+        events: 3,
+        stuck_fraction: 0.2066409983282121,
+        x: [
+            -0.2172286591426597,
+            -0.047666869057049185,
+            0.1,
+            0.1,
+            0.1,
+            0.1,
+            0.09634753139490998,
+            0.07105154519914889,
+            0.010526723101565327,
+            -0.0858127691365077,
+            -0.20484576927159232,
+            -0.32173986471763993,
+            -0.40433785059963434,
+            -0.42287133002272426,
+            -0.4016538635613846,
+            -0.3365578273051677,
+        ],
+    },
+];
+
+#[test]
+fn friction_with_a_rigid_stop_meets_the_event_driven_simulation() {
+    for case in &RIGID_STOP_CASES {
+        let mut model = crate::friction::oscillator(case.c, case.omega, case.slip, None).model();
+        model.contacts.push(Contact::on_dof(0, 1.0, case.gap, Compliance::Rigid));
+        let period = 2.0 * std::f64::consts::PI / case.omega;
+        let name = format!("c = {}, Ω = {}, μN = {}, stop at {}", case.c, case.omega, case.slip, case.gap);
+        let (_, orbit, _) = polished(model, 256);
+        let orbit = orbit.unwrap_or_else(|e| panic!("{name}: {e}"));
+        let scale = case.x.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let err = (0..16).map(|j| (orbit.state(j as f64 * period / 16.0)[0] - case.x[j]).abs()).fold(0.0, f64::max) / scale;
+        let stuck = (orbit.stuck_fraction(0) - case.stuck_fraction).abs();
+        let kinds: Vec<String> = orbit.event_records().into_iter().map(|e| e.kind).collect();
+        println!(
+            "{name}: displacement error {err:.2e} of the largest |x|, resting fraction to {stuck:.1e}, {} events (simulation {}) {kinds:?}, Newton {} iterations",
+            orbit.times.len(),
+            case.events,
+            orbit.iterations
+        );
+        assert!(err < 1e-8 && stuck < 1e-8, "{name}: error {err:.2e}, resting fraction {stuck:.2e}");
+        // One more than the simulation's: the stop opens at λ = 0 before friction lets go at −μN.
+        assert_eq!(orbit.times.len(), case.events + 1, "{name}: {kinds:?}");
+    }
+}

@@ -24,6 +24,7 @@
 //! radius of the monodromy is below 1, and they are reported as they are.
 use super::PolishFailure;
 pub mod multi;
+mod newton;
 mod settle;
 use crate::model::Model;
 use crate::periodic::PeriodicProblem;
@@ -255,18 +256,6 @@ impl StickSlipOrbit {
         DVector::from_iterator(self.nr + self.times.len(), state.iter().copied().chain(self.times.iter().copied()))
     }
 
-    fn jacobian(&self, u: &DVector<f64>, r0: &DVector<f64>) -> DMatrix<f64> {
-        let nu = u.len();
-        let mut j = DMatrix::zeros(nu, nu);
-        for c in 0..nu {
-            let h = 1e-7 * u[c].abs().max(if c < self.nr { 1.0 } else { self.period });
-            let mut up = u.clone();
-            up[c] += h;
-            j.set_column(c, &((self.shoot(&up).0 - r0) / h));
-        }
-        j
-    }
-
     /// The unknowns at the seeded times with the state at the periodic fixed point of the
     /// (affine) one-period map those times give.
     fn seed(&self) -> Result<DVector<f64>, PolishFailure> {
@@ -288,29 +277,18 @@ impl StickSlipOrbit {
     }
 
     /// Seeds the state by the periodic fixed point of the (affine) one-period map at the seeded
-    /// times, then Newton on state and times.
+    /// times, then Newton on state and times (src/analysis/polish/friction/newton.rs).
     fn converge(&mut self) -> Result<(), PolishFailure> {
-        let fail = |w: String| PolishFailure(format!("stick–slip polish: {w}; the LCP's orbit is kept"));
-        let nr = self.nr;
-        let mut u = self.seed()?;
-        let scale = |u: &DVector<f64>| u.amax().max(f64::MIN_POSITIVE);
-        for it in 1..=40 {
-            let r0 = self.shoot(&u).0;
-            let j = self.jacobian(&u, &r0);
-            let du = j.clone().lu().solve(&(-&r0)).ok_or_else(|| fail("singular Newton matrix (an event grazes)".into()))?;
-            u += &du;
-            self.iterations = it;
-            self.correction = du.amax();
-            if self.correction <= 1e-13 * scale(&u) {
-                let (r, states) = self.shoot(&u);
-                self.residual = r.amax();
-                self.times = u.rows(nr, self.times.len()).iter().copied().collect();
-                self.states = states;
-                self.monodromy = event_condensed_monodromy(&self.jacobian(&u, &r), nr, self.times.len());
-                return Ok(());
-            }
-        }
-        Err(fail(format!("Newton did not converge in 40 iterations (last correction {:.2e})", self.correction)))
+        let fail = |w: newton::NewtonFailure| PolishFailure(format!("stick–slip polish: {w}; the LCP's orbit is kept"));
+        let newton = newton::Newton::run(&*self, self.seed()?).map_err(fail)?;
+        let (nr, u) = (self.nr, &newton.u);
+        (self.iterations, self.correction) = (newton.iterations, newton.correction);
+        let (r, states) = self.shoot(u);
+        self.residual = r.amax();
+        self.times = u.rows(nr, self.times.len()).iter().copied().collect();
+        self.states = states;
+        self.monodromy = event_condensed_monodromy(&newton::Shooting::jacobian(&*self, u, &r), nr, self.times.len());
+        Ok(())
     }
 
     /// The dense check of the contact law along the converged orbit.
@@ -424,6 +402,16 @@ impl StickSlipOrbit {
                 EventRecord { time: self.times[e].rem_euclid(self.period), contact: 0, kind: kind.into(), impulse: 0.0 }
             })
             .collect()
+    }
+}
+
+impl newton::Shooting for StickSlipOrbit {
+    fn residual(&self, u: &DVector<f64>) -> DVector<f64> {
+        self.shoot(u).0
+    }
+
+    fn scale(&self, c: usize) -> f64 {
+        if c < self.nr { 1.0 } else { self.period }
     }
 }
 
@@ -560,20 +548,21 @@ pub(super) fn event_condensed_monodromy(j: &DMatrix<f64>, nr: usize, m: usize) -
     }
 }
 
+/// Replaces `r`'s kinematic series by an exact orbit's at the same instants: `at(t)` gives the
+/// augmented state's rate and the state (x, v, …) there.
+pub(super) fn write_flow_kinematics(r: &mut Response, problem: &PeriodicProblem, n: usize, at: impl Fn(f64) -> (DVector<f64>, DVector<f64>)) {
+    let (accs, states): (Vec<DVector<f64>>, Vec<DVector<f64>>) =
+        r.time.iter().map(|&t| at(t)).map(|(rate, y)| (rate.rows(n, n).into_owned(), y.rows(0, 2 * n).into_owned())).unzip();
+    super::orbit::write_kinematics(r, problem.output_map(), &states, &accs, n);
+}
+
 /// Replaces `r`'s series by the orbit's at the same instants, and its friction outputs (the
 /// slip velocity is the exact bᵀẋ(t_j), the energy ∮ f v dt = μN Σ |Δ(bᵀx)| over the slips).
 pub fn write(orbit: &StickSlipOrbit, problem: &PeriodicProblem, r: &mut Response) {
-    let n = orbit.flows.n;
-    let states: Vec<DVector<f64>> = r.time.iter().map(|&t| orbit.state(t)).collect();
-    let accs: Vec<DVector<f64>> = r
-        .time
-        .iter()
-        .map(|&t| {
-            let (p, y) = orbit.at(t);
-            (&orbit.flows.a[p.index()] * y).rows(n, n).into_owned()
-        })
-        .collect();
-    super::orbit::write_kinematics(r, problem.output_map(), &states, &accs, n);
+    write_flow_kinematics(r, problem, orbit.flows.n, |t| {
+        let (p, y) = orbit.at(t);
+        (&orbit.flows.a[p.index()] * &y, y)
+    });
     if let Some(f) = r.friction.first_mut() {
         for (j, &t) in r.time.iter().enumerate() {
             (f.force[j], f.slip_velocity[j], f.displacement[j], f.stuck[j]) = orbit.contact(t);

@@ -99,16 +99,23 @@ impl MultiFlows {
         self.b.len() + self.stops.len()
     }
 
-    /// The stuck rigid contacts' directions as columns, and W = (BᵀM⁻¹B)⁻¹BᵀM⁻¹.
-    fn constraint(&self, mode: &[Slide]) -> Option<(DMatrix<f64>, DMatrix<f64>)> {
-        let stuck: Vec<usize> = (0..mode.len()).filter(|&i| mode[i] == Slide::Stick && self.kt[i].is_none()).collect();
-        if stuck.is_empty() {
+    /// The constrained rows of `mode`: the closed rigid stops' normals, then the stuck rigid
+    /// contacts' directions, each kept if independent of those before (a friction direction in
+    /// the span of closed stops: the stop carries the reaction, the friction force is 0). As
+    /// columns B, W = (BᵀM⁻¹B)⁻¹BᵀM⁻¹, and each column's mode entry.
+    fn constraint(&self, mode: &[Slide]) -> Option<(DMatrix<f64>, DMatrix<f64>, Vec<usize>)> {
+        let nb = self.b.len();
+        let stops = (0..self.stops.len()).filter(|&j| mode[nb + j] == Slide::Closed && self.stops[j].rigid()).map(|j| (nb + j, &self.stops[j].normal));
+        let stuck = (0..nb).filter(|&i| mode[i] == Slide::Stick && self.kt[i].is_none()).map(|i| (i, &self.b[i]));
+        let mut basis = Vec::new();
+        let kept: Vec<(usize, &DVector<f64>)> = stops.chain(stuck).filter(|(_, col)| stops::extend_basis(&mut basis, col)).collect();
+        if kept.is_empty() {
             return None;
         }
-        let bs = DMatrix::from_fn(self.n, stuck.len(), |r, c| self.b[stuck[c]][r]);
+        let bs = DMatrix::from_fn(self.n, kept.len(), |r, c| kept[c].1[r]);
         let mb = &self.minv * &bs;
         let w = (bs.transpose() * &mb).try_inverse()? * mb.transpose();
-        Some((bs, w))
+        Some((bs, w, kept.iter().map(|k| k.0).collect()))
     }
 
     fn mode(&self, mode: &[Slide]) -> Rc<ModeFlow> {
@@ -144,11 +151,11 @@ impl MultiFlows {
             }
         }
         let mut acc = h.clone();
-        if let Some((bs, w)) = self.constraint(mode) {
+        if let Some((bs, w, rows)) = self.constraint(mode) {
+            // M x'' = H ỹ − B f: a stop's f is its compressive force λ (along −c).
             let reactions = &w * &h;
             acc -= &bs * &reactions;
-            let stuck = (0..mode.len()).filter(|&i| mode[i] == Slide::Stick && self.kt[i].is_none());
-            for (r, i) in stuck.enumerate() {
+            for (r, &i) in rows.iter().enumerate() {
                 force[i] = reactions.row(r).transpose();
             }
         }
@@ -199,6 +206,8 @@ impl MultiFlows {
     /// The event function of contact `i` leaving its phase in `mode` for `to` (0 at the event).
     fn event(&self, mode: &[Slide], i: usize, to: Slide, y: &DVector<f64>) -> f64 {
         match (mode[i], to) {
+            // A rigid stop opens where its force vanishes.
+            (Slide::Closed, _) if self.stops[i - self.b.len()].rigid() => self.force(mode, i, y),
             (Slide::Open | Slide::Closed, _) => self.stops[i - self.b.len()].penetration(y),
             (Slide::Slip(_), _) => self.velocity(i, y),
             (Slide::Stick, Slide::Slip(s)) => self.force(mode, i, y) - s * self.slip[i],
@@ -210,6 +219,10 @@ impl MultiFlows {
     /// onto the new stuck set's B_Sᵀv = 0 (mass metric), a Jenkins stick places its slider where
     /// the spring carries the slip force.
     pub fn enter(&self, before: &[Slide], after: &[Slide], i: usize, mut y: DVector<f64>) -> DVector<f64> {
+        // A rigid stop's plastic impact (e = 0, as the LCP): v projected onto the new constraint.
+        if i >= self.b.len() && after[i] == Slide::Closed && self.stops[i - self.b.len()].rigid() {
+            return self.project(after, y);
+        }
         if let (Slide::Slip(s), Slide::Stick) = (before[i], after[i]) {
             match self.kt[i] {
                 None => y = self.project(after, y),
@@ -221,7 +234,7 @@ impl MultiFlows {
 
     /// `y` with v moved onto the stuck rigid contacts' B_Sᵀv = 0 of `mode` (mass metric).
     pub fn project(&self, mode: &[Slide], mut y: DVector<f64>) -> DVector<f64> {
-        if let Some((bs, w)) = self.constraint(mode) {
+        if let Some((bs, w, _)) = self.constraint(mode) {
             let dv = w.transpose() * (bs.transpose() * y.rows(self.n, self.n));
             let mut vv = y.rows_mut(self.n, self.n);
             vv -= dv;
@@ -251,7 +264,13 @@ impl MultiFlows {
         match mode[i] {
             Slide::Slip(s) => s * self.velocity(i, y) < 0.0,
             Slide::Stick => self.force(mode, i, y).abs() > self.slip[i],
+            // A rigid stop resting at its gap (v = 0, friction holding) is not hit again.
+            Slide::Open if self.stops[i - self.b.len()].rigid() => {
+                let stop = &self.stops[i - self.b.len()];
+                stop.penetration(y) > 0.0 && stop.normal.dot(&y.rows(self.n, self.n)) > 0.0
+            }
             Slide::Open => self.stops[i - self.b.len()].penetration(y) > 0.0,
+            Slide::Closed if self.stops[i - self.b.len()].rigid() => self.force(mode, i, y) < 0.0,
             Slide::Closed => self.stops[i - self.b.len()].penetration(y) < 0.0,
         }
     }
@@ -285,11 +304,12 @@ impl MultiOrbit {
     pub fn new(flows: MultiFlows, period: f64, start: f64, first: Mode, events: Vec<(usize, Slide)>, times: Vec<f64>, constants: &[f64]) -> Self {
         let sliders: Vec<usize> = (0..first.len()).filter(|&i| first[i] == Slide::Stick && flows.kt[i].is_some()).collect();
         let pins = (0..first.len()).filter(|&i| first[i] == Slide::Stick && !events.iter().any(|e| e.0 == i)).map(|i| (i, constants[i])).collect();
+        let first = flows.pin_to_stops(first);
         let mut modes = vec![first.clone()];
         for &(i, to) in &events {
             let mut next = modes[modes.len() - 1].clone();
             next[i] = to;
-            modes.push(next);
+            modes.push(flows.pin_to_stops(next));
         }
         MultiOrbit {
             flows,
@@ -357,40 +377,19 @@ impl MultiOrbit {
         (res, states)
     }
 
-    fn jacobian(&self, u: &DVector<f64>, r0: &DVector<f64>) -> DMatrix<f64> {
-        let mut j = DMatrix::zeros(r0.len(), u.len());
-        for c in 0..u.len() {
-            let h = 1e-7 * u[c].abs().max(if c < self.nr() { 1.0 } else { self.period });
-            let mut up = u.clone();
-            up[c] += h;
-            j.set_column(c, &((self.shoot(&up).0 - r0) / h));
-        }
-        j
-    }
-
-    /// Least squares J du = −r (pinned rows make a stuck contact's constant unique).
-    fn step(j: &DMatrix<f64>, r: &DVector<f64>) -> Option<DVector<f64>> {
-        if j.nrows() == j.ncols() {
-            return j.clone().lu().solve(&(-r));
-        }
-        let svd = j.clone().svd(true, true);
-        let tol = 1e-13 * svd.singular_values.max();
-        svd.solve(&(-r), tol).ok()
-    }
-
     /// The unknowns at the seeded times, the state at the fixed point of the (affine) one-period
     /// map those times give (one Newton step with the times held).
     pub fn seeded(&self) -> Result<DVector<f64>, PolishFailure> {
         let nr = self.nr();
         let mut u = DVector::from_iterator(nr + self.times.len(), std::iter::repeat_n(0.0, nr).chain(self.times.iter().copied()));
         let r0 = self.shoot(&u).0;
-        let j = self.jacobian(&u, &r0);
+        let j = super::newton::Shooting::jacobian(self, &u, &r0);
         // The periodicity and pin rows on the state columns (the event rows need the times).
         let m = self.times.len();
         let rows: Vec<usize> = (0..nr).chain(nr + m..r0.len()).collect();
         let a = DMatrix::from_fn(rows.len(), nr, |r, c| j[(rows[r], c)]);
         let r0 = DVector::from_fn(rows.len(), |r, _| r0[rows[r]]);
-        let Some(du) = Self::step(&a, &r0) else { return fail("the one-period map at the seeded events has a multiplier 1") };
+        let Some(du) = super::newton::solve_step(&a, &r0) else { return fail("the one-period map at the seeded events has a multiplier 1") };
         let mut x = u.rows_mut(0, nr);
         x += du;
         Ok(u)
@@ -401,28 +400,20 @@ impl MultiOrbit {
         self.seeded().ok().map(|u| (self.start, self.first.clone(), self.state_at_start(&u)))
     }
 
-    /// Newton on the state and the event times from the seed.
+    /// Newton on the state and the event times from the seed (src/analysis/polish/friction/newton.rs).
     pub fn converge(&mut self) -> Result<(), PolishFailure> {
-        let nr = self.nr();
-        let mut u = self.seeded()?;
-        let scale = |u: &DVector<f64>| u.amax().max(f64::MIN_POSITIVE);
-        for it in 1..=40 {
-            let r0 = self.shoot(&u).0;
-            let j = self.jacobian(&u, &r0);
-            let Some(du) = Self::step(&j, &r0) else { return fail("singular Newton matrix: an event grazes") };
-            u += &du;
-            self.iterations = it;
-            self.correction = du.amax();
-            if self.correction <= 1e-13 * scale(&u) {
-                let (r, states) = self.shoot(&u);
-                self.residual = r.amax();
-                self.times = u.rows(nr, self.times.len()).iter().copied().collect();
-                self.states = states;
-                self.monodromy = super::event_condensed_monodromy(&self.jacobian(&u, &r), nr, self.times.len());
-                return Ok(());
-            }
-        }
-        fail(format_args!("Newton did not converge in 40 iterations, last correction {:.2e}", self.correction))
+        let newton = match super::newton::Newton::run(&*self, self.seeded()?) {
+            Ok(n) => n,
+            Err(e) => return fail(e),
+        };
+        let (nr, u) = (self.nr(), &newton.u);
+        (self.iterations, self.correction) = (newton.iterations, newton.correction);
+        let (r, states) = self.shoot(u);
+        self.residual = r.amax();
+        self.times = u.rows(nr, self.times.len()).iter().copied().collect();
+        self.states = states;
+        self.monodromy = super::event_condensed_monodromy(&super::newton::Shooting::jacobian(&*self, u, &r), nr, self.times.len());
+        Ok(())
     }
 
     /// The least and greatest friction force of contact `i` over 1024 points of the period.
@@ -483,6 +474,8 @@ impl MultiOrbit {
         // A stop's clearance is checked against the largest |x| or gap.
         let xscale = (0..64).map(|k| self.state(self.start + k as f64 * self.period / 64.0).rows(0, fl.n).amax()).fold(0.0, f64::max);
         let ptol = 1e-9 * fl.stops.iter().fold(xscale, |m, s| m.max(s.gap.abs())).max(f64::MIN_POSITIVE);
+        // A rigid stop's force against the structure's largest force term at that scale.
+        let ltol = 1e-9 * (1.0 + fl.g.amax() * xscale.max(1.0));
         let samples = if self.times.is_empty() { 4096 } else { 64 };
         for (e, y0) in self.states.iter().enumerate() {
             let (mode, len) = (&self.modes[e], ends[e + 1] - ends[e]);
@@ -492,6 +485,9 @@ impl MultiOrbit {
                 for (i, &phase) in mode.iter().enumerate() {
                     let ftol = 1e-9 * fl.slip.get(i).copied().unwrap_or(0.0).max(f64::MIN_POSITIVE);
                     match phase {
+                        Slide::Closed if fl.stops[i - fl.contacts()].rigid() && fl.force(mode, i, &y) < -ltol => {
+                            return fail(format_args!("the fitted orbit's rigid stop {} pulls at t = {:.6}", i - fl.contacts(), ends[e] + t));
+                        }
                         Slide::Open | Slide::Closed if fl.stops[i - fl.contacts()].breaks(phase, &y, ptol) => {
                             return fail(format_args!(
                                 "the fitted orbit's stop {} is {phase:?} against its clearance at t = {:.6}",
@@ -583,6 +579,16 @@ impl MultiOrbit {
                 EventRecord { time: self.times[e].rem_euclid(self.period), contact, kind: kind.into(), impulse: 0.0 }
             })
             .collect()
+    }
+}
+
+impl super::newton::Shooting for MultiOrbit {
+    fn residual(&self, u: &DVector<f64>) -> DVector<f64> {
+        self.shoot(u).0
+    }
+
+    fn scale(&self, c: usize) -> f64 {
+        if c < self.nr() { 1.0 } else { self.period }
     }
 }
 

@@ -47,7 +47,12 @@ fn from_series(fl: &MultiFlows, series: &[Vec<Slide>], h: f64, period: f64, cons
     for (i, s) in series.iter().enumerate() {
         evs.extend((0..k).filter(|&j| s[j] != s[(j + k - 1) % k]).map(|j| (j, i, s[j])));
     }
-    evs.sort_by_key(|e| (e.0, e.1));
+    // A pinned contact's sticking is the stop's impact, not an event of its own.
+    evs.retain(|&(j, i, to)| !(to == Slide::Stick && i < fl.contacts() && fl.pinned(&series.iter().map(|s| s[j]).collect::<Vec<_>>(), i)));
+    // At one instant a rigid stop switches first: it opens (λ = 0) before the friction contact
+    // it pinned can slip.
+    let rigid = |i: usize| i >= fl.contacts() && fl.stops[i - fl.contacts()].rigid();
+    evs.sort_by_key(|e| (e.0, !rigid(e.1), e.1));
     let j0 = evs.first().map_or(1, |e| e.0);
     let before = series.iter().map(|s| s[(j0 + k - 1) % k]).collect();
     let switches: Vec<Switch> = evs.iter().map(|&(j, i, to)| ((j as f64 - 1.0) * h, i, to)).collect();
@@ -109,7 +114,13 @@ pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<MultiOrbit, Pol
     let mut series: Vec<Vec<Slide>> =
         r.friction.iter().map(|f| f.stuck.iter().zip(&f.force).map(|(&st, &x)| if st { Slide::Stick } else { Slide::Slip(x.signum()) }).collect()).collect();
     // The stops' phases follow the friction contacts' in a mode.
-    series.extend(super::stops::series(r));
+    series.extend(super::stops::series(r, &fl.stops));
+    // Pressed on a rigid stop a friction contact along its normal is stuck (whatever the LCP's
+    // split of the force between them).
+    for j in 0..k {
+        let mode = fl.pin_to_stops(series.iter().map(|s| s[j]).collect());
+        series.iter_mut().zip(mode).for_each(|(s, p)| s[j] = p);
+    }
     // Every friction contact stuck, the stops as the LCP has them at instant 0.
     let all_stuck: Mode = (0..fl.elements()).map(|i| if i < fl.contacts() { Slide::Stick } else { series[i][0] }).collect();
     // The slider constants of contacts stuck all period: the LCP's mean of bᵀx (rigid) or of
@@ -193,6 +204,7 @@ fn settle(fl: &MultiFlows, period: f64, (t0, mut mode, y): (f64, Mode, DVector<f
             let to = fl.next(&mode, i, &ye);
             let mut after = mode.clone();
             after[i] = to;
+            let after = fl.pin_to_stops(after);
             (y, t) = (fl.enter(&mode, &after, i, ye), t + hi);
             if to != mode[i] {
                 events.push((t - p as f64 * period, i, to));
@@ -212,17 +224,10 @@ fn settle(fl: &MultiFlows, period: f64, (t0, mut mode, y): (f64, Mode, DVector<f
 
 /// Replaces `r`'s series by the orbit's at the same instants, and every contact's outputs.
 pub fn write(orbit: &MultiOrbit, problem: &PeriodicProblem, r: &mut Response) {
-    let n = orbit.flows.n;
-    let states: Vec<DVector<f64>> = r.time.iter().map(|&t| orbit.state(t)).collect();
-    let accs: Vec<DVector<f64>> = r
-        .time
-        .iter()
-        .map(|&t| {
-            let (mode, y) = orbit.at(t);
-            (&orbit.flows.mode(mode).a * y).rows(n, n).into_owned()
-        })
-        .collect();
-    super::super::super::orbit::write_kinematics(r, problem.output_map(), &states, &accs, n);
+    super::super::write_flow_kinematics(r, problem, orbit.flows.n, |t| {
+        let (mode, y) = orbit.at(t);
+        (&orbit.flows.mode(mode).a * &y, y)
+    });
     for (i, f) in r.friction.iter_mut().enumerate() {
         for (j, &t) in r.time.iter().enumerate() {
             (f.force[j], f.slip_velocity[j], f.displacement[j], f.stuck[j]) = orbit.contact(i, t);
