@@ -82,7 +82,11 @@ fn main() {
     let target = built.accuracy_target.expect("the scene must have scheme = \"auto\"");
     let choice = built.scheme_choice.unwrap_or_default();
     let d = base.discretization();
-    println!("# scene {} omega {omega} setup cpu {setup_cpu:.2} s wall {setup_wall:.2} s", a[1]);
+    let tm = &built.timings;
+    println!(
+        "# scene {} omega {omega} setup cpu {setup_cpu:.2} s wall {setup_wall:.2} s (wall: structure read {:.2} s, reduction {:.2} s)",
+        a[1], tm.structure, tm.reduction
+    );
     println!("# auto: {:?} k0 = {} ({choice})", d.scheme, d.steps);
 
     // The reference.
@@ -108,13 +112,13 @@ fn main() {
     println!("method reduction_run target_or_setting k_or_N march_tol periods converged error cpu_s wall_s");
     for &tol in &ours_tols {
         let mut p = base.clone();
-        let t = periodic_contact::periodic::limits::AccuracyTarget { tolerance: tol, ..target.clone() };
+        let t = periodic_contact::periodic::limits::AccuracyTarget { tolerance: tol, ..target };
         let (c0, t0) = (cpu_s(), Instant::now());
         match scheme_auto::solve_to_tolerance(&mut p, &t, &choice) {
             Ok(r) => {
                 let (cpu, wall) = (cpu_s() - c0, t0.elapsed().as_secs_f64());
                 let e = error(&lcp_outputs(&p, &r), &reference);
-                let met = r.scheme_choice.as_ref().map_or(false, |s| s.met);
+                let met = r.scheme_choice.as_ref().is_some_and(|s| s.met);
                 println!("ours auto tol={tol:.0e} {} - - met={met} {e:.3e} {cpu:.2} {wall:.2}", r.steps);
             }
             Err(e) => println!("ours auto tol={tol:.0e} - - - failed:{e} nan nan nan"),
