@@ -312,11 +312,47 @@ fn massless_contact_point_marches_to_the_exact_orbit_at_second_order() {
     let w = stable_omega_max(&model).unwrap();
     assert!((w - 11f64.sqrt()).abs() < 1e-5, "ω_max for marching {w} vs √11");
     let exact = CompliantStopOrbit::solve(&COMPLIANT, k2, g0, None).unwrap();
+    // The force is finite and the contact point is held at the stop while it acts.
+    march_the_massless_point(&model, &exact, |x, f| {
+        assert!(f >= 0.0 && (f == 0.0 || (x[1] - g0).abs() < 1e-12), "force {f} at x = {}", x[1]);
+    });
+    // Below the closed contact's limit the march is refused, naming the steps needed.
+    let period = 2.0 * std::f64::consts::PI / COMPLIANT.omega;
+    let few = (period * w / 2.0).floor() as usize - 1;
+    let err = march(&model, &MarchSettings { steps_per_period: few, ..Default::default() }).unwrap_err().to_string();
+    assert!(err.contains("contacts closed") && err.contains("steps per period"), "{err}");
+}
+
+/// The march of a compliant contact on a massless DOF (its spring k_c in series in the step's
+/// statics): the steady state converges at second order to the exact orbit of the bilinear
+/// oscillator with the series stiffness k2·k_c/(k2 + k_c) (no time grid), and equals the periodic
+/// cds LCP's orbit at the same k (the same recurrence, reached by marching instead of one LCP).
+#[test]
+fn a_compliant_contact_on_a_massless_point_marches_to_the_series_spring_orbit() {
+    use periodic_contact::marching::stable_omega_max;
+    let (k2, kc, g0) = (10.0, 30.0, 1.0);
+    let model = massless_contact_point(&COMPLIANT, k2, g0, Compliance::Compliant { stiffness: kc });
+    let series = k2 * kc / (k2 + kc);
+    let w = stable_omega_max(&model).unwrap();
+    assert!((w - (1.0 + series).sqrt()).abs() < 1e-9, "ω_max for marching {w} vs √(1 + k_s)");
+    let exact = CompliantStopOrbit::solve(&COMPLIANT, series, g0, None).unwrap();
+    // The force is the springs': k_c times the point's penetration, k2 times the stretch.
+    march_the_massless_point(&model, &exact, |x, f| {
+        let (pen, stretch) = ((x[1] - g0).max(0.0), x[0] - x[1]);
+        assert!((f - kc * pen).abs() < 1e-9 && (f == 0.0 || (f - k2 * stretch).abs() < 1e-9), "force {f} at x = {x:?}");
+    });
+}
+
+/// Marches `model` (the massless contact point) at k = 128, 256, 512: each steady state equals the
+/// cds LCP's orbit at the same k to 1e-9 of the amplitude, its error against `exact` falls at
+/// second order, and `check_force(x_j, force_j)` holds at every sample.
+fn march_the_massless_point(model: &periodic_contact::model::Model, exact: &CompliantStopOrbit, check_force: impl Fn(&[f64], f64)) {
+    use periodic_contact::marching::{MarchSettings, march};
     let ptp = exact.peak_to_peak();
     let ks = [128, 256, 512];
     let mut e = Vec::new();
     for &k in &ks {
-        let m = march(&model, &MarchSettings { steps_per_period: k, tolerance: 1e-12, max_periods: 5000, ..Default::default() }).unwrap();
+        let m = march(model, &MarchSettings { steps_per_period: k, tolerance: 1e-12, max_periods: 5000, ..Default::default() }).unwrap();
         assert!(m.converged, "k = {k}: no steady state in {} periods", m.periods);
         let err = m.time.iter().zip(&m.displacement).map(|(&t, x)| (x[0] - exact.eval(t).0).abs()).fold(0.0, f64::max) / ptp;
         let outputs = OutputSelection { displacement: vec![0, 1], velocity: vec![], acceleration: vec![], contacts: true };
@@ -327,9 +363,8 @@ fn massless_contact_point_marches_to_the_exact_orbit_at_second_order() {
         let d = (0..k)
             .map(|j| (r.displacement["0"][j] - m.displacement[j][0]).abs().max((r.displacement["1"][j] - m.displacement[j][1]).abs()))
             .fold(0.0, f64::max);
-        // The force is finite and the contact point is held at the stop while it acts.
         for (x, f) in m.displacement.iter().zip(&m.contact_force) {
-            assert!(f[0] >= 0.0 && (f[0] == 0.0 || (x[1] - g0).abs() < 1e-12), "force {} at x = {}", f[0], x[1]);
+            check_force(x, f[0]);
         }
         eprintln!("massless march k = {k}: error {err:.3e} of ptp vs exact, {d:.2e} vs the cds LCP, {} periods", m.periods);
         assert!(d < 1e-9 * ptp, "k = {k}: march vs LCP {d:e}");
@@ -337,9 +372,4 @@ fn massless_contact_point_marches_to_the_exact_orbit_at_second_order() {
     }
     let order = fitted_order(&ks, &e);
     assert!(order > 1.8, "observed order {order:.2}: {e:?}");
-    // Below the closed contact's limit the march is refused, naming the steps needed.
-    let period = 2.0 * std::f64::consts::PI / COMPLIANT.omega;
-    let few = (period * w / 2.0).floor() as usize - 1;
-    let err = march(&model, &MarchSettings { steps_per_period: few, ..Default::default() }).unwrap_err().to_string();
-    assert!(err.contains("contacts closed") && err.contains("steps per period"), "{err}");
 }

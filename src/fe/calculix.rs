@@ -7,7 +7,6 @@
 //! Every error names the file, the line (1-based) and the remedy.
 use super::nodes::NodeMap;
 use faer::sparse::{SparseColMat, Triplet};
-use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
 /// A CalculiX job's matrices and its node map, in the `.dof` order.
@@ -40,14 +39,20 @@ pub fn job_files(stem: &Path) -> [PathBuf; 3] {
 
 const REGENERATE: &str = "regenerate it with `ccx JOBNAME` from a deck with *FREQUENCY, SOLVER=MATRIXSTORAGE";
 
-/// Reads job `stem`: `stem.dof` first (it fixes the order n), then `stem.sti` and `stem.mas`.
+/// Reads job `stem`: `stem.dof` first (it fixes the order n), then `stem.sti` and `stem.mas`, the
+/// two matrices side by side (each is a third of a real blade's set-up).
 pub fn read_calculix(stem: &Path) -> Result<CalculixModel, CalculixError> {
     let [sti, mas, dof] = job_files(stem);
     let nodes = parse_dof(&read(&dof)?, &dof.display().to_string())?;
     let n = count_dofs(&nodes);
-    let stiffness = parse_matrix(&read(&sti)?, &sti.display().to_string(), n, &dof.display().to_string())?;
-    let mass = parse_matrix(&read(&mas)?, &mas.display().to_string(), n, &dof.display().to_string())?;
-    Ok(CalculixModel { mass, stiffness, nodes })
+    let dof_name = dof.display().to_string();
+    let matrix = |path: &Path| parse_matrix(&read(path)?, &path.display().to_string(), n, &dof_name);
+    let (stiffness, mass) = std::thread::scope(|s| {
+        let mass = s.spawn(|| matrix(&mas));
+        let stiffness = matrix(&sti);
+        (stiffness, mass.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
+    });
+    Ok(CalculixModel { mass: mass?, stiffness: stiffness?, nodes })
 }
 
 fn count_dofs(nodes: &NodeMap) -> usize {
@@ -92,37 +97,45 @@ pub fn parse_dof(text: &str, file: &str) -> Result<NodeMap, CalculixError> {
 }
 
 /// A `.sti` or `.mas` file of order `n` (the `.dof` map's count, from `dof_file`): both triangles
-/// are returned; each pair may be given once, in either triangle.
+/// are returned; each pair may be given once, in either triangle. One pass over the lines without
+/// allocating per line; the repeated-pair check sorts only when the pairs are not in ccx's order.
 pub fn parse_matrix(text: &str, file: &str, n: usize, dof_file: &str) -> Result<SparseColMat<usize, f64>, CalculixError> {
-    let mut triplets = Vec::new();
-    let mut seen = HashSet::new();
+    // (row, column, value), 1-based, in file order.
+    let mut entries: Vec<(u32, u32, f64)> = Vec::with_capacity(text.len() / 30);
     let mut max_index = 0;
+    let key = |r: usize, c: usize| r.max(c) as u64 * (n as u64 + 1) + r.min(c) as u64;
+    let (mut last_key, mut in_order) = (0, true);
     for (i, line) in text.lines().enumerate() {
         let err = |message: String| CalculixError { file: file.to_string(), line: i + 1, message };
-        let words: Vec<&str> = line.split_whitespace().collect();
-        if words.is_empty() {
+        if line.trim_ascii().is_empty() {
             continue;
         }
-        let entry = match words.as_slice() {
-            [r, c, v] => r.parse::<usize>().ok().zip(c.parse::<usize>().ok()).zip(v.parse::<f64>().ok()),
-            _ => None,
-        };
-        let Some(((r, c), v)) = entry else {
+        let Some(((r, c), v)) = matrix_entry(line) else {
             return Err(err(format!("\"{}\" is not `row column value` (1-based indices, a number); {REGENERATE}", line.trim())));
         };
-        if r == 0 || c == 0 || r > n || c > n {
+        if r == 0 || c == 0 || r > n || c > n || n > u32::MAX as usize {
             return Err(err(format!("entry ({r}, {c}) is outside 1..{n}, the DOFs listed in {dof_file}: the files come from different runs; {REGENERATE}")));
         }
         if !v.is_finite() {
             return Err(err(format!("value {v} is not finite; {REGENERATE}")));
         }
-        if !seen.insert((r.min(c), r.max(c))) {
-            return Err(err(format!("entry ({r}, {c}) is given twice (a symmetric matrix stores one triangle); {REGENERATE}")));
-        }
         max_index = max_index.max(r.max(c));
-        triplets.push(Triplet::new(r - 1, c - 1, v));
-        if r != c {
-            triplets.push(Triplet::new(c - 1, r - 1, v));
+        // ccx writes column by column, row ≤ column: keys strictly increasing, no pair twice.
+        in_order &= key(r, c) > last_key;
+        last_key = key(r, c);
+        entries.push((r as u32, c as u32, v));
+    }
+    if !in_order {
+        // (key, line) of every entry: the first repeat in file order is reported.
+        let mut keys: Vec<(u64, usize)> = text.lines().enumerate().filter_map(|(i, l)| matrix_entry(l).map(|((r, c), _)| (key(r, c), i))).collect();
+        keys.sort_unstable();
+        if let Some(line) = keys.windows(2).filter(|w| w[0].0 == w[1].0).map(|w| w[1].1).min() {
+            let (r, c) = text.lines().nth(line).and_then(matrix_entry).map_or((0, 0), |e| e.0);
+            return Err(CalculixError {
+                file: file.to_string(),
+                line: line + 1,
+                message: format!("entry ({r}, {c}) is given twice (a symmetric matrix stores one triangle); {REGENERATE}"),
+            });
         }
     }
     if max_index < n {
@@ -132,11 +145,28 @@ pub fn parse_matrix(text: &str, file: &str, n: usize, dof_file: &str) -> Result<
             message: format!("has rows up to {max_index} but {dof_file} lists {n} DOFs: the files come from different runs; {REGENERATE}"),
         });
     }
+    let mut triplets = Vec::with_capacity(2 * entries.len());
+    for &(r, c, v) in &entries {
+        let (r, c) = (r as usize, c as usize);
+        triplets.push(Triplet::new(r - 1, c - 1, v));
+        if r != c {
+            triplets.push(Triplet::new(c - 1, r - 1, v));
+        }
+    }
     SparseColMat::try_new_from_triplets(n, n, &triplets).map_err(|e| CalculixError {
         file: file.to_string(),
         line: 0,
         message: format!("cannot build the sparse matrix: {e:?}"),
     })
+}
+
+/// `row column value` of one line without allocating; `None` for anything else (a blank line too).
+fn matrix_entry(line: &str) -> Option<((usize, usize), f64)> {
+    let mut words = line.split_ascii_whitespace();
+    match (words.next(), words.next(), words.next(), words.next()) {
+        (Some(r), Some(c), Some(v), None) => r.parse::<usize>().ok().zip(c.parse::<usize>().ok()).zip(v.parse::<f64>().ok()),
+        _ => None,
+    }
 }
 
 #[cfg(test)]
@@ -152,6 +182,9 @@ mod tests {
         let k = parse_matrix("1 1 2.0\n1 2 -1.0\n2 2 2.0\n2 3 -0.5\n3 3 1.0\n", "j.sti", 3, "j.dof").unwrap();
         let dense = k.to_dense();
         assert_eq!((dense[(1, 0)], dense[(0, 1)], dense[(2, 1)], dense[(2, 2)]), (-1.0, -1.0, -0.5, 1.0));
+        // Any order, either triangle, blank lines: the same matrix.
+        let shuffled = parse_matrix("3 2 -0.5\n\n2 2 2.0\n1 1 2.0\n3 3 1.0\n2 1 -1.0\n", "j.sti", 3, "j.dof").unwrap();
+        assert_eq!(shuffled.to_dense(), dense);
     }
 
     #[test]
@@ -166,6 +199,12 @@ mod tests {
         assert!(e.message.contains("outside 1..2"), "{e}");
         let e = parse_matrix("1 1 2.0\n", "j.sti", 2, "j.dof").unwrap_err();
         assert!(e.message.contains("lists 2 DOFs"), "{e}");
-        assert!(parse_matrix("1 1 2.0\n2 1 1\n1 2 1\n2 2 1\n", "j.sti", 2, "j.dof").unwrap_err().message.contains("twice"));
+        let e = parse_matrix("1 1 2.0\n2 1 1\n1 2 1\n2 2 1\n", "j.sti", 2, "j.dof").unwrap_err();
+        assert!(e.message.contains("entry (1, 2) is given twice") && e.line == 3, "{e}");
+        // Out of ccx's order, the first repeat in file order is the one named.
+        let e = parse_matrix("2 2 1\n1 1 2.0\n\n2 2 3\n1 1 1\n", "j.sti", 2, "j.dof").unwrap_err();
+        assert!(e.message.contains("entry (2, 2) is given twice") && e.line == 4, "{e}");
+        let e = parse_matrix("1 1 2.0\n0 1 1\n", "j.sti", 2, "j.dof").unwrap_err();
+        assert!(e.message.contains("outside 1..2") && e.line == 2, "{e}");
     }
 }

@@ -1,13 +1,14 @@
 //! Explicit marching of a model with a massless boundary (src/formulation.md §4.1): the massive
 //! DOFs a by central differences, the massless DOFs b condensed statically at every instant,
-//! with the rigid contacts (all on massless DOFs) enforced at that same instant:
+//! with the contacts (all on massless DOFs) enforced at that same instant:
 //!
 //! ```text
 //! a_{n+1} = Ŵ_aa [ f_a(t_n) + (2M_aa/h² − K_aa) a_n − K_ab b_n − (M_aa/h² − C_aa/(2h)) a_{n−1} ]
 //! K_bb b_{n+1} = f_b(t_{n+1}) − K_ba a_{n+1} − B_bᵀ λ_{n+1},   gap(t_{n+1}) − B_b b_{n+1} ≥ 0 ⟂ λ_{n+1} ≥ 0
 //! ```
 //!
-//! The step LCP has G = B_b K_bb⁻¹ B_bᵀ (symmetric positive definite for independent rows): the
+//! The step LCP has G = B_b K_bb⁻¹ B_bᵀ (symmetric positive definite for independent rows), plus
+//! 1/k_c on the diagonal of a compliant contact (its spring in series, the same instant): the
 //! force is finite, as in the periodic LCP's step map. Stable for h < 2/ω_max with ω_max of the
 //! condensed pencil with the contacts closed ([`stable_omega_max`]).
 use super::small_lcp::solve_small_lcp;
@@ -55,10 +56,9 @@ pub(super) fn march_massless(model: &Model, settings: &MarchSettings, massless: 
         }
     }
     for (i, c) in model.contacts.iter().enumerate() {
-        if !c.is_rigid() || !model.contact_is_massless(c) {
+        if !model.contact_is_massless(c) {
             return Err(setting(format!(
-                "contact[{i}] is {} a massless DOF; with a massless boundary the marcher takes rigid contacts on massless DOFs only",
-                if c.is_rigid() { "rigid but not on" } else { "compliant on" }
+                "contact[{i}] is not on a massless DOF; with a massless boundary the marcher takes contacts (rigid or compliant) on massless DOFs only"
             )));
         }
     }
@@ -92,7 +92,17 @@ pub(super) fn march_massless(model: &Model, settings: &MarchSettings, massless: 
     };
     let m = model.contacts.len();
     let cols: Vec<Vec<f64>> = model.contacts.iter().map(|c| (0..nb).map(|r| c.row.iter().map(|&(d, v)| v * s[(r, pos[d])]).sum()).collect()).collect();
-    let g: Vec<f64> = (0..m * m).map(|k| model.contacts[k / m].row.iter().map(|&(d, v)| v * cols[k % m][pos[d]]).sum()).collect();
+    // A compliant contact adds its spring in series: λ/k_c of penetration at force λ
+    // (w = gap − B b + λ/k_c ≥ 0 ⟂ λ ≥ 0 is λ = k_c·max(0, B b − gap), §4.1's statics).
+    let g: Vec<f64> = (0..m * m)
+        .map(|k| {
+            let series = match model.contacts[k / m].compliance {
+                Compliance::Compliant { stiffness } if k / m == k % m => 1.0 / stiffness,
+                _ => 0.0,
+            };
+            model.contacts[k / m].row.iter().map(|&(d, v)| v * cols[k % m][pos[d]]).sum::<f64>() + series
+        })
+        .collect();
     let omega = model.frequency;
     let mut f = vec![0.0; n];
     // The massless DOFs of x at t from its massive ones (statics and the contact LCP); λ out.
