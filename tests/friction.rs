@@ -145,6 +145,10 @@ fn event_fitted_half_steps_are_second_order_and_within_1e_3_at_k_512() {
         ("Den Hartog", oscillator(0.0, 1.7, 0.2, None)),
         ("c = 0 with stops", oscillator(0.0, 1.438, 0.818, None)),
         ("damped", oscillator(0.1, 0.7, 0.6, None)),
+        // Stuck 52 % (seed 11): the stop's law drifted off the stuck force (1.84e-3 at k = 512).
+        ("damped, long stick", oscillator(0.167, 1.324, 0.885, None)),
+        // Seed 11: Newton from bds1's laws cycled at k = 256 (I − P near singular).
+        ("Den Hartog, k = 256 cycled", oscillator(0.0, 1.506, 0.51, None)),
         ("chain", chain),
     ];
     for (name, osc) in cases {
