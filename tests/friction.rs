@@ -126,7 +126,8 @@ fn error_at_instants(r: &Response, orbit: &FrictionOrbit, period: f64, dof: usiz
 /// (continuous motion, the closed form), damped with stops, and the 2-DOF chain (friction on m2).
 /// Measured (this test, load 20): Den Hartog Ω = 0.6, μN = 0.3: 6.77e-5 → 1.98e-5 (k = 256 → 512,
 /// order 1.78, estimate/true 0.92); Ω = 1.7, μN = 0.2: 1.11e-4 → 2.56e-5 (2.11, 1.11); damped
-/// c = 0.1, Ω = 0.7, μN = 0.6: 1.49e-4 → 6.0e-5 (1.31, 0.71); the others in README "Friction".
+/// c = 0.1, Ω = 0.7, μN = 0.6: 1.49e-4 → 6.0e-5 (1.31, 0.71); long stick c = 0.167, Ω = 1.324,
+/// μN = 0.885: 1.82e-3 → 1.89e-4 (3.26, 2.89; load 13); the others in README "Friction".
 #[test]
 fn event_fitted_half_steps_are_second_order_and_within_1e_3_at_k_512() {
     // The 2-DOF chain of validation/peers/friction_half_steps_family.py (seed 11, rounded).
