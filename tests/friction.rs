@@ -126,7 +126,8 @@ fn error_at_instants(r: &Response, orbit: &FrictionOrbit, period: f64, dof: usiz
 /// (continuous motion, the closed form), damped with stops, and the 2-DOF chain (friction on m2).
 /// Measured (this test, load 20): Den Hartog Ω = 0.6, μN = 0.3: 6.77e-5 → 1.98e-5 (k = 256 → 512,
 /// order 1.78, estimate/true 0.92); Ω = 1.7, μN = 0.2: 1.11e-4 → 2.56e-5 (2.11, 1.11); damped
-/// c = 0.1, Ω = 0.7, μN = 0.6: 1.49e-4 → 6.0e-5 (1.31, 0.71); the others in README "Friction".
+/// c = 0.1, Ω = 0.7, μN = 0.6: 1.49e-4 → 6.0e-5 (1.31, 0.71); long stick c = 0.167, Ω = 1.324,
+/// μN = 0.885: 1.82e-3 → 1.89e-4 (3.26, 2.89; load 13); the others in README "Friction".
 #[test]
 fn event_fitted_half_steps_are_second_order_and_within_1e_3_at_k_512() {
     // The 2-DOF chain of validation/peers/friction_half_steps_family.py (seed 11, rounded).
@@ -145,6 +146,12 @@ fn event_fitted_half_steps_are_second_order_and_within_1e_3_at_k_512() {
         ("Den Hartog", oscillator(0.0, 1.7, 0.2, None)),
         ("c = 0 with stops", oscillator(0.0, 1.438, 0.818, None)),
         ("damped", oscillator(0.1, 0.7, 0.6, None)),
+        // Stuck 52 % (seed 11): the stop's law drifted off the stuck force (1.84e-3 at k = 512).
+        ("damped, long stick", oscillator(0.167, 1.324, 0.885, None)),
+        // Seed 11: Newton from bds1's laws cycled at k = 256 (I − P near singular); it solves
+        // from bds1's orbit alone, whose laws end 1.18e-4 → 5.74e-5 (order 1.04: k = 256's
+        // error is low, not 512's high), so its order is not asserted.
+        ("Den Hartog, k = 256 from bds1 alone", oscillator(0.0, 1.506, 0.51, None)),
         ("chain", chain),
     ];
     for (name, osc) in cases {
@@ -181,7 +188,7 @@ fn event_fitted_half_steps_are_second_order_and_within_1e_3_at_k_512() {
         assert!(runs[1].lcp.path.contains("event-fitted laws"), "{}", runs[1].lcp.path);
         assert!(e[1] < 1e-3, "k = 512: {:.3e}", e[1]);
         // The order with stops or damping wanders (0.94–2.57 over the family, README "Friction").
-        assert!(closed.is_none() || order > 1.6, "order {order:.2}");
+        assert!(closed.is_none() || name.contains("bds1 alone") || order > 1.6, "order {order:.2}");
         assert!((0.1..10.0).contains(&(estimate / truth)), "estimate {estimate:.3e} against {truth:.3e}");
     }
 }

@@ -97,9 +97,22 @@ impl EventLaws {
                 // The velocity's slope in slip before the event, a0 − g·p.
                 let before = if phase(j - 1) == p { (v(j) - v(j - 1)) / h } else { (v(j - 1) - v(j - 2)) / h };
                 let a0 = before + g * f64::from(p);
-                let law = if a0.abs() > g { (-0.5 * h * g * a0.signum(), 0.5 * h * a0.abs()) } else { (-0.5 * h * a0, 0.5 * h * g) };
+                if a0.abs() > g {
+                    let law = (-0.5 * h * g * a0.signum(), 0.5 * h * a0.abs());
+                    for i in j + 1 - WINDOW..=j + 1 + WINDOW {
+                        out.laws[t * k + i % k] = Some(law);
+                    }
+                    continue;
+                }
+                // A stop: each window step's law holds its own a0 (at its middle, t_(i+1/2)), so a
+                // stuck step's law gives the stuck force there. Why: with a0 frozen at the event
+                // the steps after it leave the stuck force by ȧ0·h per step, and the half steps
+                // carry that misfit on as the unfelt mode f_j + (−1)ʲc through the whole stick
+                // phase, which then releases early (measured, src/formulation.md §9).
+                let drift = if (j + 3..=j + 5).all(|i| phase(i) == 0) { g * (s(j + 5) - s(j + 3)) / (2.0 * h) } else { 0.0 };
                 for i in j + 1 - WINDOW..=j + 1 + WINDOW {
-                    out.laws[t * k + i % k] = Some(law);
+                    let a0_i = a0 + drift * (i as f64 + 0.5 - j as f64) * h;
+                    out.laws[t * k + i % k] = Some((-0.5 * h * a0_i, 0.5 * h * g));
                 }
             }
         }
