@@ -11,6 +11,7 @@
 //! events, checked densely and at every local minimum; impulses ≥ 0; a pure impact may not call
 //! for sticking); otherwise the LCP's orbit is kept, with a warning that says why.
 mod continued;
+mod eigen_flow;
 pub mod events;
 pub mod friction;
 mod orbit;

@@ -204,15 +204,13 @@ impl PolishedOrbit {
             let ev = self.events[next];
             let c = ev.contact;
             if ev.kind == EventKind::Release {
-                // The held force z(y, t) is affine in y: its y-gradient times a column is
-                // z(column) − z(0); its explicit t-derivative by central differences.
+                // The held force z(y, t) is affine in y: its y-gradient is the phase's
+                // (`stuck_force_gradient`); its explicit t-derivative by central differences.
                 let z = |y: &DVector<f64>, t: f64| ph.stuck_forces(y, t).into_iter().find(|(k, _)| *k == c).map(|(_, z)| z);
-                let (zero, h) = (DVector::zeros(n2), 1e-7 * self.period);
-                let z0 = z(&zero, t1)?;
+                let h = 1e-7 * self.period;
+                let row = ph.stuck_contacts().position(|k| k == c)?;
                 g[next] = z(&ym, t1)?;
-                for col in 0..cols {
-                    dg[(next, col)] = z(&dy.column(col).into_owned(), t1)? - z0;
-                }
+                dg.row_mut(next).copy_from(&(ph.stuck_force_gradient().row(row) * &dy));
                 dg[(next, end_col)] += (z(&ym, t1 + h)? - z(&ym, t1 - h)?) / (2.0 * h);
             } else {
                 g[next] = self.clearance(c, &ym, t1);
