@@ -131,6 +131,17 @@ impl PolishedOrbit {
         })
     }
 
+    /// Takes the eigendecompositions and force gradients of `other`'s phases for the phases of
+    /// the same matrices (they do not depend on the frequency: one decomposition per contact set
+    /// for a whole sweep).
+    pub(super) fn share_modes(&mut self, other: &PolishedOrbit) {
+        for ph in &mut self.phases {
+            if let Some(o) = other.phases.iter().find(|o| o.same_matrix(ph)) {
+                ph.share_modes(o);
+            }
+        }
+    }
+
     pub(super) fn gap(&self, i: usize, t: f64, order: u32) -> f64 {
         let w = self.model.frequency;
         self.gaps[i]
@@ -273,7 +284,7 @@ impl PolishedOrbit {
         tau.windows(2).all(|w| w[0] < w[1]) && tau.last().is_none_or(|&l| l < tau[0] + self.period)
     }
 
-    fn newton(&mut self) -> Result<(), PolishFailure> {
+    pub(super) fn newton(&mut self) -> Result<(), PolishFailure> {
         let n2 = 2 * self.model.n();
         let ne = self.events.len();
         let fail = |w: &str| PolishFailure(w.to_string());
@@ -463,7 +474,7 @@ impl PolishedOrbit {
     }
 
     /// Every contact's [`Self::contact_force`] at `t`, from one state.
-    fn contact_forces(&self, t: f64) -> Vec<f64> {
+    pub fn contact_forces(&self, t: f64) -> Vec<f64> {
         let (e, tt) = self.locate(t);
         let y = self.state(tt);
         let mut out: Vec<f64> = (0..self.model.contacts.len())

@@ -232,6 +232,20 @@ impl Phase {
         self.stuck == stuck && self.closed == closed
     }
 
+    /// Whether `other` flows by the same matrix Â (the same contact sets on the same structure).
+    pub fn same_matrix(&self, other: &Phase) -> bool {
+        self.stuck == other.stuck && self.closed == other.closed && self.speed == other.speed && self.a == other.a && self.b_stuck == other.b_stuck
+    }
+
+    /// Shares `other`'s eigendecomposition and force gradient (made or to be made once for both):
+    /// only for a phase of [`Self::same_matrix`] and the same M, C, K.
+    pub fn share_modes(&mut self, other: &Phase) {
+        if self.same_matrix(other) && self.m == other.m && self.c == other.c && self.k == other.k {
+            self.eigen = Arc::clone(&other.eigen);
+            self.force_gradient = Arc::clone(&other.force_gradient);
+        }
+    }
+
     /// Whether compliant contact `i` is closed in this phase.
     pub fn closed(&self, i: usize) -> bool {
         self.closed.contains(&i)
@@ -271,17 +285,6 @@ impl Phase {
     /// Â's eigendecomposition, made once per phase (shared by its clones); `None` where refused.
     fn eigen(&self) -> Option<&EigenFlow> {
         self.eigen.get_or_init(|| EigenFlow::new(&self.a)).as_ref()
-    }
-
-    /// κ₁ of Â's eigenvectors when the phase flows by them ([`EigenFlow`]), else `None`.
-    pub fn eigen_condition(&self) -> Option<f64> {
-        self.eigen().map(|f| f.condition)
-    }
-
-    /// The Padé exponential D e^{Âτ} D⁻¹ regardless of the eigendecomposition: the reference
-    /// of the eigen path's tests.
-    pub fn exp_pade(&self, tau: f64) -> DMatrix<f64> {
-        self.unbalanced((&self.a * tau).exp())
     }
 
     /// [N_aᵀ x; N_aᵀ v] of the full state [x; v]: the massive free coordinates.

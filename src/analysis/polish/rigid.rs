@@ -46,17 +46,10 @@ fn smallest(ph: &Phase, samples: &[(f64, DVector<f64>)], f: &dyn Fn(&DVector<f64
     let mut best = vs.iter().zip(samples).map(|(&v, s)| (v, s.0)).fold((f64::INFINITY, 0.0), |m, x| if x.0 < m.0 { x } else { m });
     let mut minima: Vec<usize> = (1..vs.len().saturating_sub(1)).filter(|&i| vs[i] <= vs[i - 1] && vs[i] <= vs[i + 1]).collect();
     minima.sort_by(|&x, &y| vs[x].total_cmp(&vs[y]));
-    let g = 0.5 * (5f64.sqrt() - 1.0);
     for &i in minima.iter().take(REFINED) {
         let (t0, y0) = (samples[i - 1].0, &samples[i - 1].1);
         let at = |t: f64| f(&ph.flow(t0, y0, t), t);
-        let (mut lo, mut hi) = (t0, samples[i + 1].0);
-        for _ in 0..40 {
-            let (c, d) = (hi - g * (hi - lo), lo + g * (hi - lo));
-            if at(c) < at(d) { hi = d } else { lo = c }
-        }
-        let t = 0.5 * (lo + hi);
-        let v = at(t);
+        let (t, v) = super::verify::golden(t0, samples[i + 1].0, 40, &at);
         if v < best.0 {
             best = (v, t);
         }
