@@ -219,6 +219,36 @@ impl PolishedOrbit {
         out
     }
 
+    /// The fraction of the period each contact is closed (compliant) or stuck (rigid): the
+    /// phases' exact durations.
+    pub fn contact_fractions(&self) -> Vec<f64> {
+        let m = self.model.contacts.len();
+        let mut out = vec![0.0; m];
+        for e in 0..self.events.len().max(1) {
+            let span = if self.events.is_empty() { self.period } else { self.end_of(e) - self.times[e] };
+            let ph = &self.phases[e];
+            for (i, share) in out.iter_mut().enumerate() {
+                if ph.closed(i) || ph.stuck_contacts().any(|k| k == i) {
+                    *share += span / self.period;
+                }
+            }
+        }
+        out
+    }
+
+    /// Each contact's largest force at `samples` equally spaced instants of the period (impulses
+    /// not counted: [`Self::event_records`] has them).
+    pub fn max_forces(&self, samples: usize) -> Vec<f64> {
+        let mut out = vec![0.0f64; self.model.contacts.len()];
+        for j in 0..samples {
+            let t = self.times[0] + self.period * j as f64 / samples as f64;
+            for (m, f) in out.iter_mut().zip(self.contact_forces(t)) {
+                *m = m.max(f);
+            }
+        }
+        out
+    }
+
     /// Peak-to-peak / 2 of user DOF `dof`'s displacement over the period (through the output
     /// map when there is one): its extrema located as [`Self::touches`] locates minima.
     pub fn amplitude(&self, map: Option<&OutputMap>, dof: usize) -> Option<f64> {

@@ -11,6 +11,7 @@
 //! events, checked densely and at every local minimum; impulses ≥ 0; a pure impact may not call
 //! for sticking); otherwise the LCP's orbit is kept, with a warning that says why.
 mod continued;
+mod eigen_flow;
 pub mod events;
 pub mod friction;
 mod orbit;
@@ -23,6 +24,7 @@ pub use events::{Event, EventKind};
 pub use orbit::{OrbitParts, PolishedOrbit, user_value};
 pub use rigid::{CLEARANCE, HOLD, RigidMargin, STUCK};
 
+use crate::model::Model;
 use crate::periodic::PeriodicProblem;
 use crate::response::{EventRecord, PolishSummary, Response};
 use std::time::Instant;
@@ -73,6 +75,33 @@ pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<PolishedOrbit, 
         }
     };
     verify::check(&orbit)?;
+    Ok(orbit)
+}
+
+/// The exact orbit of `model` (the model of `prev` at another frequency) on `prev`'s event
+/// signature: Newton from `prev`'s event times scaled to the new period (the state from the
+/// affine one-period map's fixed point there), verified as [`polish`]'s orbit is. The phases'
+/// eigendecompositions are `prev`'s ([`PolishedOrbit`]'s phases depend on ω only through the
+/// forcing). For a sweep's next point (`sweep --exact`).
+pub fn follow(model: &Model, prev: &PolishedOrbit) -> Result<PolishedOrbit, PolishFailure> {
+    let parts = prev.parts();
+    let scale = model.period() / prev.period();
+    let events = parts.events.into_iter().map(|e| Event { seed: e.seed * scale, ..e }).collect();
+    let mut orbit = PolishedOrbit::new(model, events, &parts.always)?;
+    orbit.share_modes(prev);
+    orbit.newton()?;
+    verify::check(&orbit)?;
+    Ok(orbit)
+}
+
+/// The contact-free periodic orbit of `model` (every contact open all period, not checked
+/// against the obstacles): `sweep --exact`'s linear curve, `prev`'s decomposition reused.
+pub fn linear(model: &Model, prev: Option<&PolishedOrbit>) -> Result<PolishedOrbit, PolishFailure> {
+    let mut orbit = PolishedOrbit::new(model, vec![], &[])?;
+    if let Some(p) = prev {
+        orbit.share_modes(p);
+    }
+    orbit.newton()?;
     Ok(orbit)
 }
 

@@ -131,6 +131,17 @@ impl PolishedOrbit {
         })
     }
 
+    /// Takes the eigendecompositions and force gradients of `other`'s phases for the phases of
+    /// the same matrices (they do not depend on the frequency: one decomposition per contact set
+    /// for a whole sweep).
+    pub(super) fn share_modes(&mut self, other: &PolishedOrbit) {
+        for ph in &mut self.phases {
+            if let Some(o) = other.phases.iter().find(|o| o.same_matrix(ph)) {
+                ph.share_modes(o);
+            }
+        }
+    }
+
     pub(super) fn gap(&self, i: usize, t: f64, order: u32) -> f64 {
         let w = self.model.frequency;
         self.gaps[i]
@@ -273,19 +284,17 @@ impl PolishedOrbit {
         tau.windows(2).all(|w| w[0] < w[1]) && tau.last().is_none_or(|&l| l < tau[0] + self.period)
     }
 
-    fn newton(&mut self) -> Result<(), PolishFailure> {
+    pub(super) fn newton(&mut self) -> Result<(), PolishFailure> {
         let n2 = 2 * self.model.n();
         let ne = self.events.len();
         let fail = |w: &str| PolishFailure(w.to_string());
         // Seed: the fixed point of the affine one-period map at the seeded times.
+        // The map is affine in the state at fixed times: its offset and its derivative (the
+        // variation's state columns) from one flow of the period from 0.
         let zero = DVector::zeros(n2);
-        let c = self.shoot(&zero, &self.times).ok_or_else(|| fail("the seeded event sequence cannot be flowed"))?.end;
-        let mut phi = DMatrix::zeros(n2, n2);
-        for k in 0..n2 {
-            let mut e = zero.clone();
-            e[k] = 1.0;
-            phi.set_column(k, &(self.shoot(&e, &self.times).ok_or_else(|| fail("the seeded flow failed"))?.end - &c));
-        }
+        let ret = self.times[0] + self.period;
+        let v = self.variation(&zero, &self.times, ret).ok_or_else(|| fail("the seeded event sequence cannot be flowed"))?;
+        let (c, phi) = (v.end, v.d_end.columns(0, n2).into_owned());
         let y0 = (DMatrix::identity(n2, n2) - &phi).lu().solve(&c).ok_or_else(|| fail("the seeded one-period map has a multiplier 1"))?;
         let mut u = DVector::zeros(n2 + ne);
         u.rows_mut(0, n2).copy_from(&y0);
@@ -464,19 +473,35 @@ impl PolishedOrbit {
         }
     }
 
-    /// ∫ of contact `i`'s force over [a, b] plus the impulses in [a, b), by 5-point Gauss–Legendre
-    /// on each piece between events.
-    fn force_integral(&self, i: usize, a: f64, b: f64) -> f64 {
+    /// Every contact's [`Self::contact_force`] at `t`, from one state.
+    pub fn contact_forces(&self, t: f64) -> Vec<f64> {
+        let (e, tt) = self.locate(t);
+        let y = self.state(tt);
+        let mut out: Vec<f64> = (0..self.model.contacts.len())
+            .map(|i| match self.model.contacts[i].compliance {
+                crate::model::Compliance::Compliant { stiffness } => stiffness * (-self.clearance(i, &y, tt)).max(0.0),
+                crate::model::Compliance::Rigid => 0.0,
+            })
+            .collect();
+        for (i, z) in self.phases[e].stuck_forces(&y, tt) {
+            out[i] = z;
+        }
+        out
+    }
+
+    /// ∫ of every contact's force over [a, b] plus its impulses in [a, b), by 5-point
+    /// Gauss–Legendre on each piece between events (one state per node for all contacts).
+    fn force_integrals(&self, a: f64, b: f64) -> Vec<f64> {
         const X: [f64; 5] = [0.0, -0.538_469_310_105_683, 0.538_469_310_105_683, -0.906_179_845_938_664, 0.906_179_845_938_664];
         const W: [f64; 5] = [0.568_888_888_888_889, 0.478_628_670_499_366, 0.478_628_670_499_366, 0.236_926_885_056_189, 0.236_926_885_056_189];
         let mut cuts = vec![a, b];
-        let mut total = 0.0;
+        let mut total = vec![0.0; self.model.contacts.len()];
         for (e, (&t, &p)) in self.times.iter().zip(&self.impulses).enumerate() {
             for tk in [t - self.period, t, t + self.period] {
                 if tk >= a && tk < b {
                     cuts.push(tk);
-                    if self.events.get(e).is_some_and(|ev| ev.contact == i) {
-                        total += p;
+                    if let Some(ev) = self.events.get(e) {
+                        total[ev.contact] += p;
                     }
                 }
             }
@@ -485,7 +510,11 @@ impl PolishedOrbit {
         for w in cuts.windows(2) {
             let (c, h) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
             if h > 0.0 {
-                total += h * X.iter().zip(W).map(|(x, wt)| wt * self.contact_force(i, c + h * x)).sum::<f64>();
+                for (x, wt) in X.iter().zip(W) {
+                    for (sum, f) in total.iter_mut().zip(self.contact_forces(c + h * x)) {
+                        *sum += h * wt * f;
+                    }
+                }
             }
         }
         total
@@ -500,10 +529,15 @@ impl PolishedOrbit {
         let states: Vec<DVector<f64>> = r.time.iter().map(|&t| self.state(t)).collect();
         let accs: Vec<DVector<f64>> = if r.acceleration.is_empty() { vec![] } else { r.time.iter().map(|&t| self.acceleration(t)).collect() };
         write_kinematics(r, problem.output_map(), &states, &accs, n);
+        let rigid = self.model.contacts.iter().any(|c| c.is_rigid());
+        let integrals: Vec<Vec<f64>> = if rigid { r.time.iter().map(|&t| self.force_integrals(t, t + h)).collect() } else { vec![] };
         for (i, rc) in r.contacts.iter_mut().enumerate() {
             for (j, &t) in r.time.iter().enumerate() {
                 rc.gap[j] = self.clearance(i, &states[j], t);
-                rc.force[j] = if self.model.contacts[i].is_rigid() { self.force_integral(i, t, t + h) / h } else { self.contact_force(i, t) };
+                rc.force[j] = match self.model.contacts[i].compliance {
+                    crate::model::Compliance::Rigid => integrals[j][i] / h,
+                    crate::model::Compliance::Compliant { stiffness } => stiffness * (-rc.gap[j]).max(0.0),
+                };
             }
             let s = problem.pairing_at(i).offset();
             let k = rc.gap.len();

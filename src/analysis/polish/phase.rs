@@ -9,9 +9,11 @@
 //! Massless free coordinates x_b (a massless boundary, src/formulation.md §4.1: no mass, no
 //! damping) answer statically, K_ba x_a + K_bb x_b = g_b(t): they are condensed, the closed
 //! compliant springs on them included, and the state that flows is the massive [x_a; v_a] only.
+use super::eigen_flow::EigenFlow;
 use crate::model::{Compliance, Model};
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64 as C;
+use std::sync::{Arc, OnceLock};
 
 /// Complex amplitudes of a harmonic signal: value(t) = Re Σ_p amp_p e^{i p ω t}.
 pub(super) type Harmonics = Vec<(u32, DVector<C>)>;
@@ -50,6 +52,12 @@ pub(super) struct Phase {
     slave: DMatrix<f64>,
     slave_map: DMatrix<f64>,
     slave_part: Harmonics,
+    /// Â's eigendecomposition, made at the first flow and shared by the phase's clones (a
+    /// reordered orbit's, a continuation step's); `None` inside where Â is refused
+    /// ([`EigenFlow::new`]): the Padé and Taylor paths then.
+    eigen: Arc<OnceLock<Option<EigenFlow>>>,
+    /// [`Phase::stuck_force_gradient`], made at its first use.
+    force_gradient: Arc<OnceLock<DMatrix<f64>>>,
 }
 
 /// The longest span ‖Â τ‖₁ that [`Phase::flow`] takes by the Taylor action rather than the
@@ -213,6 +221,8 @@ impl Phase {
             slave,
             slave_map,
             slave_part,
+            eigen: Arc::default(),
+            force_gradient: Arc::default(),
         })
     }
 
@@ -220,6 +230,20 @@ impl Phase {
     /// `closed` (both ascending): a reordered orbit reuses it.
     pub fn is_for(&self, stuck: &[usize], closed: &[usize]) -> bool {
         self.stuck == stuck && self.closed == closed
+    }
+
+    /// Whether `other` flows by the same matrix Â (the same contact sets on the same structure).
+    pub fn same_matrix(&self, other: &Phase) -> bool {
+        self.stuck == other.stuck && self.closed == other.closed && self.speed == other.speed && self.a == other.a && self.b_stuck == other.b_stuck
+    }
+
+    /// Shares `other`'s eigendecomposition and force gradient (made or to be made once for both):
+    /// only for a phase of [`Self::same_matrix`] and the same M, C, K.
+    pub fn share_modes(&mut self, other: &Phase) {
+        if self.same_matrix(other) && self.m == other.m && self.c == other.c && self.k == other.k {
+            self.eigen = Arc::clone(&other.eigen);
+            self.force_gradient = Arc::clone(&other.force_gradient);
+        }
     }
 
     /// Whether compliant contact `i` is closed in this phase.
@@ -240,14 +264,27 @@ impl Phase {
     /// in [x; v] a stiff phase's A has entries up to ω_max² beside 1, and scaling and squaring
     /// (nalgebra's Padé `exp`) then loses about ω_max/ω_ref digits; balanced, ‖Â‖ ≈ ω_max
     /// (Higham, "Functions of Matrices", §10.3; the coarse blade's stall at ω_max = 6.3e5 rad/s).
+    /// With Â's eigendecomposition ([`EigenFlow`]) when it is well conditioned.
     pub fn exp(&self, tau: f64) -> DMatrix<f64> {
+        self.unbalanced(match self.eigen() {
+            Some(f) => f.exp(tau),
+            None => (&self.a * tau).exp(),
+        })
+    }
+
+    /// D E D⁻¹, D = diag(I, speed·I): an exponential of Â back in [x; v] (see [`Self::exp`]).
+    fn unbalanced(&self, mut e: DMatrix<f64>) -> DMatrix<f64> {
         let nf = self.free.ncols();
-        let mut e = (&self.a * tau).exp();
         if nf > 0 {
             e.view_mut((0, nf), (nf, nf)).scale_mut(1.0 / self.speed);
             e.view_mut((nf, 0), (nf, nf)).scale_mut(self.speed);
         }
         e
+    }
+
+    /// Â's eigendecomposition, made once per phase (shared by its clones); `None` where refused.
+    fn eigen(&self) -> Option<&EigenFlow> {
+        self.eigen.get_or_init(|| EigenFlow::new(&self.a)).as_ref()
     }
 
     /// [N_aᵀ x; N_aᵀ v] of the full state [x; v]: the massive free coordinates.
@@ -272,9 +309,10 @@ impl Phase {
     /// A short span (‖Â τ‖₁ ≤ [`SHORT_SPAN`]) is flowed by the Taylor series on the vector, whose
     /// terms cost O(n²) where the Padé exponential costs O(n³) (the sampled orbit's states and
     /// golden sections: thousands of short flows on the coarse blade); a longer one by `exp`.
+    /// With Â's eigendecomposition, any span costs O(n_a²) ([`EigenFlow::apply`]).
     pub fn flow(&self, t0: f64, y0: &DVector<f64>, t1: f64) -> DVector<f64> {
         let tau = t1 - t0;
-        if self.a_norm * tau.abs() > SHORT_SPAN {
+        if self.eigen().is_none() && self.a_norm * tau.abs() > SHORT_SPAN {
             return self.flow_with(&self.exp(tau), t0, y0, t1);
         }
         let nf2 = 2 * self.free.ncols();
@@ -293,6 +331,11 @@ impl Phase {
             return u;
         }
         u.rows_mut(nf, nf).scale_mut(1.0 / self.speed);
+        if let Some(f) = self.eigen() {
+            let mut out = f.apply(tau, &u);
+            out.rows_mut(nf, nf).scale_mut(self.speed);
+            return out;
+        }
         let substeps = (self.a_norm * tau.abs()).ceil().max(1.0);
         let h = tau / substeps;
         for _ in 0..substeps as usize {
@@ -355,8 +398,12 @@ impl Phase {
 
     /// Acceleration of every DOF in state `y` at `t` (its massless DOFs condensed first).
     pub fn acceleration(&self, y: &DVector<f64>, t: f64) -> DVector<f64> {
+        self.acceleration_condensed(&self.condensed(y, t), t)
+    }
+
+    /// [`Self::acceleration`] of a state already condensed ([`Self::condensed`]).
+    fn acceleration_condensed(&self, y: &DVector<f64>, t: f64) -> DVector<f64> {
         let n = self.n;
-        let y = self.condensed(y, t);
         let (x, v) = (y.rows(0, n).into_owned(), y.rows(n, n).into_owned());
         let acc = eval(&self.presc, self.omega, t, 2, n);
         let rhs = eval(&self.force, self.omega, t, 0, n) - &self.c * &v - &self.k * &x - &self.m * &acc;
@@ -376,11 +423,37 @@ impl Phase {
     pub fn stuck_forces(&self, y: &DVector<f64>, t: f64) -> Vec<(usize, f64)> {
         let n = self.n;
         let y = self.condensed(y, t);
-        let acc = self.acceleration(&y, t);
+        let acc = self.acceleration_condensed(&y, t);
         let (x, v) = (y.rows(0, n).into_owned(), y.rows(n, n).into_owned());
         let r = eval(&self.force, self.omega, t, 0, n) - &self.m * acc - &self.c * v - &self.k * x;
         let z = &self.b_stuck * r;
         self.stuck.iter().enumerate().map(|(a, &i)| (i, z[a])).collect()
+    }
+}
+
+impl Phase {
+    /// The stuck contacts' forces' gradient in the full state y = [x; v] (|stuck| × 2n, rows in
+    /// [`Self::stuck_contacts`]' order): [`Self::stuck_forces`] is affine in y, z(y, t) = z(0, t) + G y.
+    /// With L = N_a + N_b S (the condensed lift) and the massive coordinates x_a = N_aᵀ x,
+    /// v_a = N_aᵀ v: a = L a_a, a_a = −M_aa⁻¹ N_aᵀ (K L x_a + C L v_a), so
+    /// G = −B_S [(K L − M L M_aa⁻¹ N_aᵀ K L) N_aᵀ, (C L − M L M_aa⁻¹ N_aᵀ C L) N_aᵀ]
+    /// (the terms of [`Self::stuck_forces`], linear part). Made once per phase: a release's
+    /// variation took one force evaluation per column (2n + ne + 1 of them) per Newton iteration.
+    pub fn stuck_force_gradient(&self) -> &DMatrix<f64> {
+        self.force_gradient.get_or_init(|| {
+            let n = self.n;
+            let lift = &self.free + &self.slave * &self.slave_map;
+            let ml = &self.m * &lift;
+            let block = |a: &DMatrix<f64>| {
+                let al = a * &lift;
+                let acc = &self.mff_inv * (self.free.transpose() * &al);
+                -(&self.b_stuck * (al - &ml * acc)) * self.free.transpose()
+            };
+            let mut g = DMatrix::zeros(self.stuck.len(), 2 * n);
+            g.columns_mut(0, n).copy_from(&block(&self.k));
+            g.columns_mut(n, n).copy_from(&block(&self.c));
+            g
+        })
     }
 }
 

@@ -46,17 +46,10 @@ fn smallest(ph: &Phase, samples: &[(f64, DVector<f64>)], f: &dyn Fn(&DVector<f64
     let mut best = vs.iter().zip(samples).map(|(&v, s)| (v, s.0)).fold((f64::INFINITY, 0.0), |m, x| if x.0 < m.0 { x } else { m });
     let mut minima: Vec<usize> = (1..vs.len().saturating_sub(1)).filter(|&i| vs[i] <= vs[i - 1] && vs[i] <= vs[i + 1]).collect();
     minima.sort_by(|&x, &y| vs[x].total_cmp(&vs[y]));
-    let g = 0.5 * (5f64.sqrt() - 1.0);
     for &i in minima.iter().take(REFINED) {
         let (t0, y0) = (samples[i - 1].0, &samples[i - 1].1);
         let at = |t: f64| f(&ph.flow(t0, y0, t), t);
-        let (mut lo, mut hi) = (t0, samples[i + 1].0);
-        for _ in 0..40 {
-            let (c, d) = (hi - g * (hi - lo), lo + g * (hi - lo));
-            if at(c) < at(d) { hi = d } else { lo = c }
-        }
-        let t = 0.5 * (lo + hi);
-        let v = at(t);
+        let (t, v) = super::verify::golden(t0, samples[i + 1].0, 40, &at);
         if v < best.0 {
             best = (v, t);
         }
@@ -204,15 +197,13 @@ impl PolishedOrbit {
             let ev = self.events[next];
             let c = ev.contact;
             if ev.kind == EventKind::Release {
-                // The held force z(y, t) is affine in y: its y-gradient times a column is
-                // z(column) − z(0); its explicit t-derivative by central differences.
+                // The held force z(y, t) is affine in y: its y-gradient is the phase's
+                // (`stuck_force_gradient`); its explicit t-derivative by central differences.
                 let z = |y: &DVector<f64>, t: f64| ph.stuck_forces(y, t).into_iter().find(|(k, _)| *k == c).map(|(_, z)| z);
-                let (zero, h) = (DVector::zeros(n2), 1e-7 * self.period);
-                let z0 = z(&zero, t1)?;
+                let h = 1e-7 * self.period;
+                let row = ph.stuck_contacts().position(|k| k == c)?;
                 g[next] = z(&ym, t1)?;
-                for col in 0..cols {
-                    dg[(next, col)] = z(&dy.column(col).into_owned(), t1)? - z0;
-                }
+                dg.row_mut(next).copy_from(&(ph.stuck_force_gradient().row(row) * &dy));
                 dg[(next, end_col)] += (z(&ym, t1 + h)? - z(&ym, t1 - h)?) / (2.0 * h);
             } else {
                 g[next] = self.clearance(c, &ym, t1);

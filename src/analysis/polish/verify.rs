@@ -24,20 +24,35 @@ pub(super) fn minimum(ts: &[f64], vs: &[f64], f: &dyn Fn(f64) -> f64) -> (f64, f
             best = (vs[i], ts[i]);
         }
         if i > 0 && i + 1 < ts.len() && vs[i] <= vs[i - 1] && vs[i] <= vs[i + 1] {
-            let (mut lo, mut hi) = (ts[i - 1], ts[i + 1]);
-            let g = 0.5 * (5f64.sqrt() - 1.0);
-            for _ in 0..60 {
-                let (c, d) = (hi - g * (hi - lo), lo + g * (hi - lo));
-                if f(c) < f(d) { hi = d } else { lo = c }
-            }
-            let t = 0.5 * (lo + hi);
-            let v = f(t);
+            let (t, v) = golden(ts[i - 1], ts[i + 1], 60, f);
             if v < best.0 {
                 best = (v, t);
             }
         }
     }
     best
+}
+
+/// The minimum of a unimodal `f` on [lo, hi] by `iterations` golden-section steps, one new value
+/// per step (the other interior point is the last step's; Press et al., "Numerical Recipes",
+/// §10.2): (time, value) at the final bracket's middle.
+pub(super) fn golden(mut lo: f64, mut hi: f64, iterations: usize, f: &dyn Fn(f64) -> f64) -> (f64, f64) {
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut c, mut d) = (hi - g * (hi - lo), lo + g * (hi - lo));
+    let (mut fc, mut fd) = (f(c), f(d));
+    for _ in 0..iterations {
+        if fc < fd {
+            (hi, d, fd) = (d, c, fc);
+            c = hi - g * (hi - lo);
+            fc = f(c);
+        } else {
+            (lo, c, fc) = (c, d, fd);
+            d = lo + g * (hi - lo);
+            fd = f(d);
+        }
+    }
+    let t = 0.5 * (lo + hi);
+    (t, f(t))
 }
 
 pub(super) fn check(o: &PolishedOrbit) -> Result<(), PolishFailure> {

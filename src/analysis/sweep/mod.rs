@@ -12,6 +12,7 @@
 //! cold. With `steps = "auto"` every point shares one k, chosen at the sweep's lowest frequency
 //! (the largest h = 2π/(ω·k), where the scheme's limit bites first). For a strictly sequential continuation in the direction of the sweep, use one thread
 //! and one chunk (`--threads 1 --chunks-per-thread 1`).
+pub mod exact;
 #[cfg(feature = "reference")]
 pub mod marching;
 mod refill;
@@ -105,6 +106,8 @@ pub struct SweepPoint {
     pub substeps: usize,
     /// Active set of the solution (warm start of a neighbour).
     pub active_set: Vec<usize>,
+    /// `sweep --exact` ([`exact`]): "exact", "polished" or "grid"; empty otherwise.
+    pub source: String,
 }
 
 impl SweepPoint {
@@ -132,6 +135,7 @@ impl SweepPoint {
             lcp_path: r.lcp.path.clone(),
             substeps: 0,
             active_set: r.active_set.clone(),
+            source: String::new(),
         }
     }
 }
@@ -379,6 +383,10 @@ pub fn to_csv(param: &str, values: &[f64], problem: &PeriodicProblem, points: &[
     if estimated {
         head.push("error_estimate_relative".into());
     }
+    let sourced = points.iter().any(|p| !p.source.is_empty());
+    if sourced {
+        head.push("source".into());
+    }
     s.push_str(&head.join(","));
     s.push('\n');
     for (v, p) in values.iter().zip(points) {
@@ -407,6 +415,9 @@ pub fn to_csv(param: &str, values: &[f64], problem: &PeriodicProblem, points: &[
         });
         if estimated {
             row.push(num(p.estimate_relative.as_ref()));
+        }
+        if sourced {
+            row.push(p.source.clone());
         }
         s.push_str(&row.join(","));
         s.push('\n');

@@ -79,6 +79,12 @@ pub struct Args {
     /// peaks differ by more than 10×).
     #[arg(long)]
     pub log_amplitude: bool,
+    /// Each point's exact orbit (the polish's: exact flows between events), by Newton from the
+    /// previous point's; the grid solve and the polish where the event signature changes or
+    /// Newton fails. The CSV's `source` column says which (exact | polished | grid), and
+    /// `error_estimate_relative` is the exact orbit's last Newton correction or the grid's estimate.
+    #[arg(long)]
+    pub exact: bool,
     /// No PNG.
     #[arg(long)]
     pub no_plot: bool,
@@ -191,7 +197,8 @@ pub fn run(a: &Args) -> Result<(), Failure> {
         bar.set_message(format!("(last {what})"));
         bar.inc(1);
     };
-    let points = sweep::run(problem, &freqs, &settings, &on_point).map_err(Failure::from)?;
+    let points = if a.exact { sweep::exact::run(problem, &freqs, &settings, &on_point) } else { sweep::run(problem, &freqs, &settings, &on_point) }
+        .map_err(Failure::from)?;
     let wall = t.elapsed().as_secs_f64();
     bar.finish_and_clear();
 
@@ -215,7 +222,11 @@ pub fn run(a: &Args) -> Result<(), Failure> {
         fallback,
         a.output.display()
     );
-    if settings.estimate {
+    if a.exact {
+        let count = |s: &str| points.iter().filter(|p| p.source == s).count();
+        eprintln!("  exact sweep: {} exact, {} polished, {} grid", count("exact"), count("polished"), count("grid"));
+    }
+    if settings.estimate || a.exact {
         let worst = points
             .iter()
             .filter(|p| p.error.is_none())
