@@ -397,16 +397,16 @@ impl Walk<'_> {
             if touch.closed { "open" } else { "closed" }
         );
         self.push(&lo, Some(EventKind::Grazing), detail);
-        let first = self.open_phase(sig, &guess, pair, NEW_PAIR)?;
+        let first = self.open_phase(sig, &guess, pair)?;
         self.multipliers_across(&lo, &first);
         Some(first)
     }
 
     /// The first point of the branch of signature `sig` whose phase between its events `ia` and
     /// `ib` (one contact's) begins at a grazing: corrected from `guess` with that phase
-    /// `len` ([`NEW_PAIR`] at a compliant grazing) and twice that long, its tangent along the secant (the phase growing). The
+    /// [`NEW_PAIR`] and twice that long, its tangent along the secant (the phase growing). The
     /// family keeps its old signature when the corrector fails.
-    fn open_phase(&mut self, sig: Signature, guess: &[f64], (ia, ib): (usize, usize), len: f64) -> Option<Node> {
+    fn open_phase(&mut self, sig: Signature, guess: &[f64], (ia, ib): (usize, usize)) -> Option<Node> {
         let old = std::mem::replace(&mut self.fam.sig, sig);
         let d = self.fam.dim();
         let n2 = d - 1 - self.fam.ne();
@@ -414,11 +414,11 @@ impl Walk<'_> {
         normal[n2 + ib] = 1.0;
         normal[n2 + ia] = -1.0;
         let wrap = if ib < ia { 1.0 } else { 0.0 };
-        let first = self.fam.correct(guess, &normal, len - wrap).and_then(|w1| {
+        let first = self.fam.correct(guess, &normal, NEW_PAIR - wrap).and_then(|w1| {
             let mut g2 = w1.clone();
-            g2[n2 + ia] -= 0.5 * len;
-            g2[n2 + ib] += 0.5 * len;
-            let w2 = self.fam.correct(&g2, &normal, 2.0 * len - wrap)?;
+            g2[n2 + ia] -= 0.5 * NEW_PAIR;
+            g2[n2 + ib] += 0.5 * NEW_PAIR;
+            let w2 = self.fam.correct(&g2, &normal, 2.0 * NEW_PAIR - wrap)?;
             let sec: Vec<f64> = w2.iter().zip(&w1).map(|(a, b)| a - b).collect();
             self.fam.node(w1, &sec)
         });

@@ -23,9 +23,6 @@ use crate::time::Discretization;
 
 /// Margins above −this are admissible (the relative tolerance of the polish's own checks).
 const TOL: f64 = 1e-9;
-/// The flight (fraction of the period) a re-impact is started with where a flight of
-/// [`NEW_PAIR`] is out of reach.
-const MICRO_FLIGHT: f64 = 1e-7;
 /// The trial steps that orient a restarted branch (scaled unknowns), in turn: past an impact
 /// added at a grazing on the coarse blade the next impact (the stiff modes ringing) comes
 /// 0.003 rad/s further, closer than 1e-3 reaches.
@@ -42,7 +39,7 @@ const REFINE_DOFS: usize = 64;
 /// clearance at the re-impact Δ later is ½aΔ² + ⅙jΔ³ (a, j its acceleration and jerk after the
 /// impact; Δ ≈ −3a/j), whose root at Δ = 0 is double. The condition itself turns tangent in its
 /// time as Δ → 0 (the coarse blade at 2215.5 rad/s: Δ = 2.5e-6 and the corrector stalls);
-/// over Δ² it is ½a + ⅙jΔ, regular through the merge (Budd & Dux 1994, chattering impacts).
+/// over Δ² it is ½a + ⅙jΔ (Taylor at the impact), regular through the merge.
 const REIMPACT_REF: f64 = 1e-4;
 
 /// The factor 1 + (Δ_ref/Δ)² of a re-impact's condition after a flight Δ (fraction of the period).
@@ -80,9 +77,6 @@ impl Walk<'_> {
         let t = lo.orbit.period();
         let mut list = timed(&lo.orbit);
         let land = if m.what == polish::STUCK { landing(&lo, m.contact, m.time) } else { None };
-        if std::env::var("PC_TRACE_MERGE").is_ok() {
-            eprintln!("TRACE crossing at λ = {}: {m:?}, landing {land:?}, events {:?}", lo.lambda(self.fam.rho), timed(&lo.orbit).iter().map(|l| (l.0, format!("{:?}", l.1.kind))).collect::<Vec<_>>());
-        }
         let changed = match (m.what, m.event) {
             (polish::CLEARANCE, _) => {
                 let base = list.first().map_or(0.0, |l| l.0);
@@ -105,7 +99,7 @@ impl Walk<'_> {
             (polish::HOLD, Some(e)) => {
                 list[e].1.kind = Switch::Impact { stick: true };
                 list.insert(e + 1, (list[e].0 + NEW_PAIR, Event { contact: m.contact, kind: Switch::Release, seed: 0.0 }));
-                if let Some(n) = self.begin_phase(&lo, &list, (e, e + 1), &what, NEW_PAIR) {
+                if let Some(n) = self.begin_phase(&lo, &list, (e, e + 1), &what) {
                     return Some(n);
                 }
                 false
@@ -115,17 +109,11 @@ impl Walk<'_> {
             (polish::STUCK, None) if land.is_some() => {
                 let e = land.expect("guarded");
                 // The force touches zero where the sticking impact lands: the impact turns pure,
-                // and a flight of zero length leads to the sticking impact. That flight grows as
-                // the force at the landing (−3a/j, a and j the clearance's acceleration and jerk):
-                // on the coarse blade a flight of 1e-5 of the period is never reached (a stays
-                // within 4e-5 of the force scale), so a micro-flight is tried next.
-                for len in [NEW_PAIR, MICRO_FLIGHT] {
-                    let mut split = list.clone();
-                    split[e].1.kind = Switch::Impact { stick: false };
-                    split.insert(e + 1, (split[e].0 + len, Event { contact: m.contact, kind: Switch::Impact { stick: true }, seed: 0.0 }));
-                    if let Some(n) = self.begin_phase(&lo, &split, (e, e + 1), &what, len) {
-                        return Some(n);
-                    }
+                // and a flight of zero length leads to the sticking impact.
+                list[e].1.kind = Switch::Impact { stick: false };
+                list.insert(e + 1, (list[e].0 + NEW_PAIR, Event { contact: m.contact, kind: Switch::Impact { stick: true }, seed: 0.0 }));
+                if let Some(n) = self.begin_phase(&lo, &list, (e, e + 1), &what) {
+                    return Some(n);
                 }
                 false
             }
@@ -133,7 +121,7 @@ impl Walk<'_> {
                 let touch = Touch { phase: 0, contact: m.contact, value: 0.0, time: m.time, closed: true };
                 let (sig, guess, pair) =
                     signature::insert(&self.fam, &lo.orbit, &touch, (Switch::Release, Switch::Impact { stick: true }), NEW_PAIR, lo.w[lo.w.len() - 1]);
-                if let Some(n) = self.start_phase(&lo, sig, &guess, pair, &what, NEW_PAIR) {
+                if let Some(n) = self.start_phase(&lo, sig, &guess, pair, &what) {
                     return Some(n);
                 }
                 false
@@ -151,17 +139,17 @@ impl Walk<'_> {
     }
 
     /// [`Self::start_phase`] for the time-ordered `list` (fractions of the period) of the orbit at `at`.
-    fn begin_phase(&mut self, at: &Node, list: &[(f64, Event)], pair: (usize, usize), what: &str, len: f64) -> Option<Node> {
+    fn begin_phase(&mut self, at: &Node, list: &[(f64, Event)], pair: (usize, usize), what: &str) -> Option<Node> {
         let sig = Signature { events: list.iter().map(|l| l.1).collect(), always: at.orbit.always_closed().to_vec() };
         let guess = signature::guess(&self.fam, &at.orbit, list, at.w[at.w.len() - 1]);
-        self.start_phase(at, sig, &guess, pair, what, len)
+        self.start_phase(at, sig, &guess, pair, what)
     }
 
     /// The branch of signature `sig` (unknowns `guess`) whose phase between the events `pair`
     /// begins at `at`, where it has zero length: its first point, the grazing recorded at `at`.
-    fn start_phase(&mut self, at: &Node, sig: Signature, guess: &[f64], pair: (usize, usize), what: &str, len: f64) -> Option<Node> {
+    fn start_phase(&mut self, at: &Node, sig: Signature, guess: &[f64], pair: (usize, usize), what: &str) -> Option<Node> {
         let before = self.fam.ne();
-        let first = self.open_phase(sig, guess, pair, len)?;
+        let first = self.open_phase(sig, guess, pair)?;
         let detail = format!("{what}; events per period {before} -> {} (the new phase started on the exact orbit)", self.fam.ne());
         self.push(at, Some(EventKind::Grazing), detail);
         self.multipliers_across(at, &first);
@@ -277,9 +265,6 @@ impl Walk<'_> {
             // between them 2.5e-6 of the period when the corrector stalls, and no zero ahead).
             (Switch::Impact { stick: false }, Switch::Impact { stick: true }) => {
                 list.remove(e);
-                if std::env::var("PC_TRACE_MERGE").is_ok() {
-                    self.trace_merged(here, &list, lambda);
-                }
                 // The flight vanishes where the merged orbit's force at its landing touches zero:
                 // ahead by the flight over its rate of shrinking (the coarse blade at 2226.26 rad/s,
                 // ρ = 30: a flight of 6.5e-7 of the period, the zero 0.03–0.3 rad/s ahead).
@@ -291,9 +276,6 @@ impl Walk<'_> {
                 let mut reach = vec![1e-5, 1e-4, 1e-3, 1.5 * ahead, 3.0 * ahead, 1e-2];
                 reach.retain(|f| *f > 0.0 && *f <= 1e-2);
                 reach.sort_by(f64::total_cmp);
-                if std::env::var("PC_TRACE_MERGE").is_ok() {
-                    eprintln!("  flight {len:e}, ahead {ahead:e} of ρ, reach {reach:?}");
-                }
                 if let Some(n) = reach.into_iter().find_map(|f| self.fade((lambda, lambda + sense * f * rho), here, list.clone(), what, "the impact")) {
                     return Some(n);
                 }
@@ -359,34 +341,6 @@ impl Walk<'_> {
             }
         }
         None
-    }
-}
-
-impl Walk<'_> {
-    fn trace_merged(&mut self, here: &Node, list: &[(f64, Event)], lambda: f64) {
-        let rho = self.fam.rho;
-        eprintln!("TRACE merge at λ = {lambda}: margin {:?}", here.orbit.rigid_margin());
-        eprintln!("  times {:?}", timed(&here.orbit).iter().map(|l| (l.0, l.1.contact, format!("{:?}", l.1.kind))).collect::<Vec<_>>());
-        eprintln!("  impulses {:?}", here.orbit.event_records().iter().map(|r| r.impulse).collect::<Vec<_>>());
-        let guess = signature::guess(&self.fam, &here.orbit, list, 0.0);
-        let sig = Signature { events: list.iter().map(|l| l.1).collect(), always: here.orbit.always_closed().to_vec() };
-        let old = std::mem::replace(&mut self.fam.sig, sig);
-        let d = self.fam.dim();
-        let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
-        let mut from = guess.clone();
-        for f in [0.0, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2, -1e-5, -1e-4, -1e-3, -1e-2] {
-            let l = lambda + f * rho;
-            let mut g = from.clone();
-            g[d - 1] = l / rho;
-            match correct_far(&mut self.fam, &g, &e_l, l / rho).and_then(|w| self.fam.node_with(w, &e_l, false)) {
-                Some(n) => {
-                    eprintln!("  merged at λ = {l}: margin {:?} times {:?} impulses {:?}", n.orbit.rigid_margin(), timed(&n.orbit).iter().map(|l| l.0).collect::<Vec<_>>(), n.orbit.event_records().iter().map(|r| r.impulse).collect::<Vec<_>>());
-                    if f == 0.0 { from = n.w.clone(); }
-                }
-                None => eprintln!("  merged at λ = {l}: corrector failed"),
-            }
-        }
-        self.fam.sig = old;
     }
 }
 
