@@ -8,7 +8,7 @@
 //! Continuation", ch. 19) with a fixed segment signature.
 use super::super::{Parameter, floquet};
 use super::metric::Metric;
-use crate::analysis::polish::{Event, EventKind as Switch, PolishedOrbit, Touch};
+use crate::analysis::polish::{Event, EventKind, PolishedOrbit, Touch};
 use crate::model::{Compliance, Model};
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
@@ -59,7 +59,7 @@ pub(super) struct Family {
     chord: std::cell::RefCell<Option<Chord>>,
 }
 
-type ChordKey = (Vec<(usize, Switch)>, Vec<usize>, f64);
+type ChordKey = (Vec<(usize, EventKind)>, Vec<usize>, f64);
 
 struct Chord {
     key: ChordKey,
@@ -158,7 +158,29 @@ impl Family {
         let (y, times) = self.unpack(w, orbit.period());
         let mut r = orbit.shooting_residual(&y, &times)?;
         r.iter_mut().enumerate().for_each(|(i, v)| *v *= self.row_scale(i));
+        for (row, e, p, wrap) in self.reimpacts() {
+            r[row] *= super::rigid::reimpact_factor(w[e] + wrap - w[p]);
+        }
         r.iter().all(|v| v.is_finite()).then_some(r)
+    }
+
+    /// The re-impacts of the signature: (residual row, unknown of its time, unknown of the pure
+    /// impact of the same rigid contact just before it, 1 when the flight wraps the period),
+    /// whose condition is desingularised ([`super::rigid::reimpact_factor`]).
+    fn reimpacts(&self) -> Vec<(usize, usize, usize, f64)> {
+        let ev = &self.sig.events;
+        let ne = ev.len();
+        (0..ne)
+            .filter(|&e| {
+                let p = ev[(e + ne - 1) % ne];
+                ne >= 2
+                    && p.kind == EventKind::Impact { stick: false }
+                    && matches!(ev[e].kind, EventKind::Impact { .. })
+                    && p.contact == ev[e].contact
+                    && !self.base.contact_is_massless(&self.base.contacts[p.contact])
+            })
+            .map(|e| (self.n2 + e, self.n2 + e, self.n2 + (e + ne - 1) % ne, if e == 0 { 1.0 } else { 0.0 }))
+            .collect()
     }
 
     pub fn residual(&self, w: &[f64]) -> Option<DVector<f64>> {
@@ -185,6 +207,19 @@ impl Family {
             }
             for r in 0..d - 1 {
                 j.row_mut(r).scale_mut(self.row_scale(r));
+            }
+            // A re-impact's condition over its flight² (rigid.rs): F̃ = s(Δ)·F, dF̃ = s·dF + F·s'(Δ)·dΔ.
+            let reimpacts = self.reimpacts();
+            if !reimpacts.is_empty() {
+                let f = self.residual_with(&here, w)?;
+                for (row, e, p, wrap) in reimpacts {
+                    let flight = w[e] + wrap - w[p];
+                    let (s, ds) = (super::rigid::reimpact_factor(flight), super::rigid::reimpact_factor_rate(flight));
+                    let unscaled = f[row] / s;
+                    j.row_mut(row).scale_mut(s);
+                    j[(row, e)] += unscaled * ds;
+                    j[(row, p)] -= unscaled * ds;
+                }
             }
             let (mut up, mut dn) = (w.to_vec(), w.to_vec());
             up[d - 1] += DIFF;
