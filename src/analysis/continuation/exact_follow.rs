@@ -21,6 +21,9 @@ use crate::time::Discretization;
 /// closings) a Jacobian is one flow of the period and its variation, and no size limit applies.
 const MAX_DOFS_DIFFERENCES: usize = 8;
 
+/// A knob change below this (relative) keeps the current exact orbit.
+const ROUND_OFF: f64 = 1e-12;
+
 /// The one knob that changed from `a` to `b`, as the continued parameter: (parameter, its values
 /// at `a` and `b`, the tuning whose problem the exact family varies: that knob at its neutral value,
 /// as [`Parameter`] scales the scene's forces and offsets its gaps). `Err(why)` otherwise.
@@ -100,6 +103,11 @@ pub(super) fn resolve(session: &mut PeriodicSolver, base: &PeriodicProblem, disc
         return Ok(Outcome::Discrete(format!(
             "the model has {n} DOFs and its exact orbit has no variational Jacobian here; the finite-difference one costs 2n + events + 1 shooting runs a step, and the re-solves take it up to {MAX_DOFS_DIFFERENCES} DOFs"
         )));
+    }
+    // A change at the knob's round-off (an FMU host's interpolated input: 1.2625 then
+    // 1.2625000000000002) is no step of the walk (it crawled 400 points): the exact orbit stands.
+    if (to - from).abs() <= ROUND_OFF * from.abs().max(to.abs()) {
+        return Ok(Outcome::Followed(Box::new(on_branch(session, c, orbit.clone())?)));
     }
     let stepped = match exact::step(&family, param, from, to, orbit) {
         Ok(s) => s,
