@@ -1,10 +1,12 @@
 //! Branches through the C API (issue 13 item 6, issue 24 item 4): re-solves continue the orbit
 //! along its exact branch, jump where it ends at a fold, and report the orbit's Floquet stability. References: the
 //! damped linear oscillator's multipliers e^{−cT/2m} (a contact-free orbit), its grazing
-//! frequency |1 − ω² + icω| = F/gap (where the contact-free branch of a run-down ends), and the
-//! contact-free amplitude after the run-up's jump.
+//! frequency |1 − ω² + icω| = F/gap (where the contact-free branch of a run-down ends), the
+//! contact-free amplitude after the run-up's jump, and the closed-form impact oscillator of
+//! src/exact/rigid.rs (its orbits and the fold of its stable impacting orbit).
 use periodic_contact::analysis::continuation::{self, ContinuationSettings, Parameter};
 use periodic_contact::capi::*;
+use periodic_contact::exact::{Oscillator, RigidRegime, RigidStopOrbit};
 use periodic_contact::scene::Scene;
 use std::ffi::CString;
 
@@ -30,6 +32,8 @@ struct Step {
     multiplier: f64,
     /// Half the peak-to-peak of displacement 0 over the k instants.
     amplitude: f64,
+    /// (t_j, displacement 0) at the k instants.
+    samples: Vec<(f64, f64)>,
 }
 
 /// The demo's scene on k instants.
@@ -59,8 +63,11 @@ fn ramp_scene(scene: &str, omegas: &[f64]) -> Vec<Step> {
                 let mut x = vec![0.0; k];
                 assert_eq!(pc_result_displacement(r, 0, x.as_mut_ptr(), k), PC_OK);
                 let amplitude = (x.iter().fold(f64::MIN, |a, &b| a.max(b)) - x.iter().fold(f64::MAX, |a, &b| a.min(b))) / 2.0;
+                let mut time = vec![0.0; k];
+                assert_eq!(pc_result_time(r, time.as_mut_ptr(), k), PC_OK);
+                let samples = time.into_iter().zip(x).collect();
                 pc_result_free(r);
-                Step { jumped: jumped == 1, fold, from, to, stable: stable == 1, multiplier: mu, amplitude }
+                Step { jumped: jumped == 1, fold, from, to, stable: stable == 1, multiplier: mu, amplitude, samples }
             })
             .collect();
         pc_problem_free(p);
@@ -192,5 +199,57 @@ fn one_walk_turns_at_both_folds_of_the_demo() {
         let mu = (-C / 2.0 * 2.0 * std::f64::consts::PI / w).exp();
         assert!((q.max_multiplier - mu).abs() <= 1e-3 && q.stable, "ω = {w}: |μ| {} vs {mu}", q.max_multiplier);
         assert!((q.amplitude[0] - linear(w)).abs() <= 1e-3 * linear(w), "ω = {w}: {} vs {}", q.amplitude[0], linear(w));
+    }
+}
+
+/// The impact oscillator of tests/rigid_branch.rs: m = 1, c = 0.1, k = 1, F = cos ωt, a rigid stop
+/// (plastic impacts) at clearance 1.5; bds1, k = 512, each answer polished.
+const IMPACT: &str = "[structure]\nmass = [[1.0]]\nstiffness = [[1.0]]\n[damping]\nmatrix = [[0.1]]\n[excitation]\nfrequency = 1.3\n\
+[[force]]\ndof = 0\namplitude = 1.0\n[[contact]]\ndof = 0\ngap = 1.5\n\
+[discretization]\nscheme = \"bds1\"\nsteps = 512\npolish = true\n[output]\ndisplacement = [0]\nstability = true\n";
+
+/// The largest difference between a step's displacement at the instants and `orbit`'s.
+fn off_closed_form(s: &Step, orbit: &RigidStopOrbit) -> f64 {
+    s.samples.iter().map(|&(t, x)| (x - orbit.eval(t).0).abs()).fold(0.0, f64::max)
+}
+
+/// Issue 24 items 3–4 (rigid contact): a run-up through the fold of the impact oscillator's stable
+/// impacting orbit and a run-down through the grazing of its contact-free orbit (where the
+/// impacting branch born there turns back) follow the exact branch through the C API and jump once
+/// each, at the first step past the closed form's fold (bisection on the existence of its stable
+/// impacting orbit, src/exact/rigid.rs) and at the analytic grazing F/|1 − ω² + icω| = gap, within
+/// 1e-4 (relative); before and after each jump the answer is the closed-form orbit (polished,
+/// within 1e-6 of the gap at the instants). Ramps of 0.01 rad/s, 1e-4 near the fold.
+#[test]
+fn an_impact_oscillator_jumps_once_each_way_at_its_exact_fold() {
+    let (gap, osc) = (1.5, |w: f64| Oscillator::new(1.0, 0.1, 1.0, 1.0, w));
+    let impacting = |w: f64| RigidStopOrbit::with_contact(&osc(w), gap).ok().filter(|o| o.regime() == RigidRegime::Impacting);
+    let (mut lo, mut hi) = (1.35, 1.45);
+    assert!(impacting(lo).is_some() && impacting(hi).is_none());
+    while hi - lo > 1e-10 {
+        let mid = 0.5 * (lo + hi);
+        if impacting(mid).is_some() { lo = mid } else { hi = mid }
+    }
+    let fold = lo;
+    // |1 − ω² + icω| = F/gap: ω⁴ − (2 − c²)ω² + 1 − (F/gap)² = 0, the larger root.
+    let (b, q) = (2.0 - 0.01, 1.0 - (1.0f64 / gap).powi(2));
+    let grazing = ((b + (b * b - 4.0 * q).sqrt()) / 2.0).sqrt();
+    let free = |w: f64| RigidStopOrbit::solve(&osc(w), gap).ok().filter(|o| o.regime() == RigidRegime::NoContact);
+    // The orbit with contact (the stable impacting one) or the contact-free one, at ω.
+    let closed_form = |contact: bool, w: f64| if contact { impacting(w) } else { free(w) }.unwrap_or_else(|| panic!("no closed-form orbit at {w}"));
+    for (name, omegas, at, contact_before) in
+        [("run-up", path(1.2, 1.375, 1.385, 0.01, 1e-4), fold, true), ("run-down", path(1.45, 1.29, 1.28, 0.01, 1e-4), grazing, false)]
+    {
+        let s = ramp_scene(IMPACT, &omegas);
+        let jumps: Vec<usize> = (0..s.len()).filter(|&i| s[i].jumped).collect();
+        assert_eq!(jumps.len(), 1, "{name}: jumps at {:?}", jumps.iter().map(|&i| omegas[i]).collect::<Vec<_>>());
+        let (i, j) = (jumps[0], &s[jumps[0]]);
+        eprintln!("{name}: jump at ω = {}, fold {:.9} (reference {at:.9}), amplitude {} -> {}", omegas[i], j.fold, j.from, j.to);
+        assert!((j.fold - at).abs() <= 1e-4 * at, "{name}: the jump's fold {} vs the reference's {at}", j.fold);
+        assert!((omegas[i - 1] - at) * (omegas[i] - at) <= 0.0, "{name}: the jump at {} is not the first step past {at}", omegas[i]);
+        let x = off_closed_form(&s[i - 1], &closed_form(contact_before, omegas[i - 1]));
+        let y = off_closed_form(j, &closed_form(!contact_before, omegas[i]));
+        eprintln!("{name}: off the closed form by {x:.1e} before the jump, {y:.1e} after");
+        assert!(x <= 1e-6 * gap && y <= 1e-6 * gap, "{name}: the answers off the closed-form orbits by {x:.1e} before, {y:.1e} after the jump");
     }
 }

@@ -63,6 +63,17 @@ impl RigidStopOrbit {
     /// one-impact periodic orbit exists (the free flight would cross the stop, the impact would
     /// fall outside the sticking window with no pure-impact orbit either, or no stable one).
     pub fn solve(osc: &Oscillator, gap: f64) -> Result<Self, ExactError> {
+        Self::solve_from(osc, gap, true)
+    }
+
+    /// The orbit with contact where one exists, even where the contact-free orbit is admissible
+    /// too (the hysteresis of the impact oscillator: the stable impacting orbit up to its fold);
+    /// otherwise as [`Self::solve`].
+    pub fn with_contact(osc: &Oscillator, gap: f64) -> Result<Self, ExactError> {
+        Self::solve_from(osc, gap, false)
+    }
+
+    fn solve_from(osc: &Oscillator, gap: f64, contact_free_first: bool) -> Result<Self, ExactError> {
         osc.validate()?;
         osc.require_stiffness()?;
         check_finite("gap", gap)?;
@@ -72,7 +83,7 @@ impl RigidStopOrbit {
         let linear = LinearOrbit::solve(osc)?;
         let free = PhaseFlow::new(osc.mass, osc.damping, osc.stiffness, osc.force, osc.omega, 0.0)?;
         let mut orbit = RigidStopOrbit { osc: *osc, gap, kind: Kind::NoContact, free, linear, min_x: -linear.amplitude(), max_x: linear.amplitude() };
-        if linear.amplitude() <= gap {
+        if linear.amplitude() <= gap && contact_free_first {
             return Ok(orbit);
         }
         let (f, k, w) = (osc.force, osc.stiffness, osc.omega);

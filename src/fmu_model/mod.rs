@@ -120,6 +120,8 @@ pub struct ContactModel {
     /// Why the last re-solve followed the discrete branch, not the exact one; the log says it once.
     discrete_why: Option<String>,
     said_discrete: bool,
+    /// The log has said that the re-solves follow the exact branch.
+    said_exact: bool,
     /// τ(t) = t + phase_offset (mod T): keeps the phase continuous across frequency changes.
     phase_offset: f64,
     initialized: bool,
@@ -193,6 +195,7 @@ impl ContactModel {
             branch: None,
             discrete_why: None,
             said_discrete: false,
+            said_exact: false,
             phase_offset: 0.0,
             initialized: false,
             start_time: 0.0,
@@ -500,6 +503,10 @@ impl CoSimModel for ContactModel {
                     "jump at t = {t}: the branch ended at a fold (frequency {:.9} rad/s) between frequency {old:.9} and {:.9}; amplitude {:.6e} -> {:.6e} (jump {})",
                     j.fold.frequency, cfg.tuning.frequency, j.from_amplitude, j.to_amplitude, sol.jumps
                 ));
+            }
+            if old.is_some() && self.branch.is_some() && self.discrete_why.is_none() && !self.said_exact {
+                self.said_exact = true;
+                log.event("the re-solves follow the exact branch: each is a step of the exact walk from the current exact orbit, its jumps at the exact folds");
             }
             if let (Some(why), false) = (self.discrete_why.take(), self.said_discrete) {
                 self.said_discrete = true;

@@ -2,7 +2,9 @@
 frequencies from W0 to W1; prints each jump (pc_result_jump) and the last amplitude of
 displacement 0 (half its peak-to-peak over the k instants) with the CPU time.
 
-    python3 validation/demo/capi_ramp.py target/release/libperiodic_contact.so SCENE.toml W0 W1 N
+    python3 validation/demo/capi_ramp.py target/release/libperiodic_contact.so SCENE.toml W0 W1 N [-v]
+
+-v prints every step (frequency, amplitude, CPU so far) as it is solved.
 
 A scene without [output] gets displacement = [0, 1]. The README's follow figures ("Branches",
 the FMU section) come from this script.
@@ -14,7 +16,7 @@ import sys
 import time
 
 
-def main(lib_path: str, scene: str, w0: float, w1: float, n: int) -> int:
+def main(lib_path: str, scene: str, w0: float, w1: float, n: int, verbose: bool = False) -> int:
     lib = c.CDLL(lib_path)
     lib.pc_problem_from_scene_text.restype = c.c_void_p
     lib.pc_problem_from_scene_text.argtypes = [c.c_char_p]
@@ -51,7 +53,9 @@ def main(lib_path: str, scene: str, w0: float, w1: float, n: int) -> int:
         lib.pc_result_displacement(r, 0, x, k)
         amplitude = (max(x) - min(x)) / 2
         if jumped.value:
-            print(f"jump at step {i} w={w:.7f}: fold {fold.value:.7f}, amplitude {before.value:.4f} -> {after.value:.4f}")
+            print(f"jump at step {i} w={w:.7f}: fold {fold.value:.7f}, amplitude {before.value:.4f} -> {after.value:.4f}", flush=True)
+        if verbose:
+            print(f"step {i} w={w:.7f} amplitude_0 {amplitude:.6e} cpu {time.process_time() - t0:.1f} s", flush=True)
         lib.pc_result_free(r)
     lib.pc_problem_free(p)
     print(f"end w={w:.5f} amplitude_0 {amplitude:.6f}; cpu {time.process_time() - t0:.1f} s")
@@ -59,4 +63,4 @@ def main(lib_path: str, scene: str, w0: float, w1: float, n: int) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1], sys.argv[2], float(sys.argv[3]), float(sys.argv[4]), int(sys.argv[5])))
+    sys.exit(main(sys.argv[1], sys.argv[2], float(sys.argv[3]), float(sys.argv[4]), int(sys.argv[5]), sys.argv[6:] == ["-v"]))

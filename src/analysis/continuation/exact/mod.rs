@@ -130,10 +130,6 @@ pub(super) enum Stepped {
 /// small change of the knob is a short arclength: one step or a few.
 pub(super) fn step(problem: &PeriodicProblem, param: Parameter, from: f64, to: f64, orbit: &PolishedOrbit) -> Result<Stepped, Error> {
     check(problem)?;
-    // The front ends' steps re-solve the grid on the branch; their rigid case is not validated yet.
-    if let Some(i) = problem.model().contacts.iter().position(|c| c.is_rigid()) {
-        return Err(Error::input(format!("contact[{i}] is rigid: the front ends' exact follow takes compliant contacts only (the discrete follow stays)")));
-    }
     let rho = from.abs().max(to.abs()).max((to - from).abs());
     let defaults = ContinuationSettings::default();
     let reach = 1.2 * (to - from).abs() / rho;
@@ -171,6 +167,16 @@ impl Walk<'_> {
         });
     }
 
+    /// A front end's step (`stop_at_fold`): the branch past a change of signature starts at `n`
+    /// turning back in λ against `dir`, so the old one ended there (a fold at a grazing), recorded.
+    fn ends_here(&mut self, n: &Node, dir: f64) -> bool {
+        let back = self.stop_at_fold && n.tangent[n.tangent.len() - 1] * dir < 0.0;
+        if back {
+            self.fold = Some(n.lambda(self.fam.rho));
+        }
+        back
+    }
+
     fn name(&self) -> &'static str {
         self.points.first().map_or("parameter", |_| "λ")
     }
@@ -206,6 +212,7 @@ impl Walk<'_> {
                 let _ = (len, rate);
                 let next = if self.rigid_event(e) { self.rigid_vanish(&here, e, to) } else { self.remove_pair(&here, e) };
                 match next {
+                    Some(next) if self.ends_here(&next, dir) => return done(self, "a fold at a grazing".into(), false, false),
                     Some(next) => {
                         here = next;
                         ds = settings.initial_step;
@@ -237,6 +244,9 @@ impl Walk<'_> {
                     if ds < settings.min_step {
                         // Rigid events merging (a flight between two impacts, an impact fading): the branch past them.
                         if let Some(n) = self.rigid_stall(&here, to) {
+                            if self.ends_here(&n, dir) {
+                                return done(self, "a fold at a grazing".into(), false, false);
+                            }
                             on_point(n.lambda(rho));
                             here = n;
                             ds = settings.initial_step;
@@ -266,6 +276,7 @@ impl Walk<'_> {
             // A rigid contact's signature broken between here and next: located, the branch goes on past it.
             if rigid::margin(&next) < -1e-9 && rigid::margin(&here) >= -1e-9 {
                 match self.rigid_crossing(&here, &next, to) {
+                    Some(n) if self.ends_here(&n, dir) => return done(self, "a fold at a grazing".into(), false, false),
                     Some(n) => {
                         on_point(n.lambda(rho));
                         here = n;
@@ -287,9 +298,7 @@ impl Walk<'_> {
                 match self.insert_pair(&here, &next, &crossed) {
                     Some(n) => {
                         on_point(n.lambda(rho));
-                        // The branch with the new phase turns back: the old one ended at the grazing.
-                        if self.stop_at_fold && n.tangent[n.tangent.len() - 1] * dir < 0.0 {
-                            self.fold = Some(n.lambda(rho));
+                        if self.ends_here(&n, dir) {
                             return done(self, "a fold at a grazing".into(), false, false);
                         }
                         here = n;
