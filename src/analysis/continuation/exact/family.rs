@@ -211,7 +211,7 @@ impl Family {
             // A re-impact's condition over its flight² (rigid.rs): F̃ = s(Δ)·F, dF̃ = s·dF + F·s'(Δ)·dΔ.
             let reimpacts = self.reimpacts();
             if !reimpacts.is_empty() {
-                let f = self.residual_with(&here, w)?;
+                let f = self.residual_with(here, w)?;
                 for (row, e, p, wrap) in reimpacts {
                     let flight = w[e] + wrap - w[p];
                     let (s, ds) = (super::rigid::reimpact_factor(flight), super::rigid::reimpact_factor_rate(flight));
