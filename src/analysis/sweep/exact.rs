@@ -24,9 +24,7 @@ pub fn run(
     settings: &SweepSettings,
     on_point: &(dyn Fn(&SweepPoint) + Sync),
 ) -> Result<Vec<SweepPoint>, crate::Error> {
-    if let Some(f) = frequencies.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
-        return Err(crate::Error::input(format!("frequency: {f} is not a finite angular frequency > 0 [rad/s]")));
-    }
+    super::check_frequencies(frequencies)?;
     let pool = rayon::ThreadPoolBuilder::new().num_threads(settings.threads).build().map_err(|e| crate::Error::input(format!("threads: {e}")))?;
     let chunks = pool.current_num_threads().max(1);
     let size = frequencies.len().div_ceil(chunks).max(1);

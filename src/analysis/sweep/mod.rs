@@ -160,6 +160,14 @@ pub fn solve_point(problem: &PeriodicProblem, frequency: f64, warm: Option<&[usi
     (r, solver.last_start() == WarmStart::ColdFallback)
 }
 
+/// Refuses a frequency that is not finite and positive (every sweep's first check).
+pub(super) fn check_frequencies(frequencies: &[f64]) -> Result<(), crate::Error> {
+    match frequencies.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
+        Some(f) => Err(crate::Error::input(format!("frequency: {f} is not a finite angular frequency > 0 [rad/s]"))),
+        None => Ok(()),
+    }
+}
+
 /// Runs the sweep over `frequencies` (any order; chunks are contiguous in the given order).
 /// `on_point` is called with each point (from worker threads), e.g. to advance a progress bar
 /// and show the point's time and solver.
@@ -169,9 +177,7 @@ pub fn run(
     settings: &SweepSettings,
     on_point: &(dyn Fn(&SweepPoint) + Sync),
 ) -> Result<Vec<SweepPoint>, crate::Error> {
-    if let Some(f) = frequencies.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
-        return Err(crate::Error::input(format!("frequency: {f} is not a finite angular frequency > 0 [rad/s]")));
-    }
+    check_frequencies(frequencies)?;
     let mut template = template.clone();
     // `steps = "auto"`: one k for every point, chosen at the lowest frequency (the largest h).
     if let Some(lowest) = frequencies.iter().copied().reduce(f64::min) {
