@@ -52,7 +52,9 @@ pub fn read_calculix(stem: &Path) -> Result<CalculixModel, CalculixError> {
         let stiffness = matrix(&sti);
         (stiffness, mass.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
     });
-    Ok(CalculixModel { mass: mass?, stiffness: stiffness?, nodes })
+    // The stiffness's error first (the .sti is named before the .mas, as when read in turn).
+    let stiffness = stiffness?;
+    Ok(CalculixModel { mass: mass?, stiffness, nodes })
 }
 
 fn count_dofs(nodes: &NodeMap) -> usize {
