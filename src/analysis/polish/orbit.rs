@@ -134,7 +134,7 @@ impl PolishedOrbit {
     /// Takes the eigendecompositions and force gradients of `other`'s phases for the phases of
     /// the same matrices (they do not depend on the frequency: one decomposition per contact set
     /// for a whole sweep).
-    pub(super) fn share_modes(&mut self, other: &PolishedOrbit) {
+    pub fn share_modes(&mut self, other: &PolishedOrbit) {
         for ph in &mut self.phases {
             if let Some(o) = other.phases.iter().find(|o| o.same_matrix(ph)) {
                 ph.share_modes(o);
@@ -292,9 +292,13 @@ impl PolishedOrbit {
         // The map is affine in the state at fixed times: its offset and its derivative (the
         // variation's state columns) from one flow of the period from 0.
         let zero = DVector::zeros(n2);
-        let ret = self.times[0] + self.period;
-        let v = self.variation(&zero, &self.times, ret).ok_or_else(|| fail("the seeded event sequence cannot be flowed"))?;
-        let (c, phi) = (v.end, v.d_end.columns(0, n2).into_owned());
+        let c = self.shoot(&zero, &self.times).ok_or_else(|| fail("the seeded event sequence cannot be flowed"))?.end;
+        let mut phi = DMatrix::zeros(n2, n2);
+        for k in 0..n2 {
+            let mut e = zero.clone();
+            e[k] = 1.0;
+            phi.set_column(k, &(self.shoot(&e, &self.times).ok_or_else(|| fail("the seeded flow failed"))?.end - &c));
+        }
         let y0 = (DMatrix::identity(n2, n2) - &phi).lu().solve(&c).ok_or_else(|| fail("the seeded one-period map has a multiplier 1"))?;
         let mut u = DVector::zeros(n2 + ne);
         u.rows_mut(0, n2).copy_from(&y0);

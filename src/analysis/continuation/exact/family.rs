@@ -57,6 +57,9 @@ pub(super) struct Family {
     last_jacobian: std::cell::RefCell<Option<(Vec<f64>, DMatrix<f64>)>>,
     /// The Jacobian of the last point solved, for the next corrector's chord iterations.
     chord: std::cell::RefCell<Option<Chord>>,
+    /// The first orbit built, whose phases' eigendecompositions every later orbit shares (the
+    /// phase matrices do not depend on the parameter: one decomposition per contact set).
+    modes: std::cell::RefCell<Option<PolishedOrbit>>,
 }
 
 type ChordKey = (Vec<(usize, EventKind)>, Vec<usize>, f64);
@@ -91,7 +94,19 @@ impl Family {
     pub fn new(base: &Model, param: Parameter, rho: f64, ys: f64, sig: Signature) -> Family {
         let weight = state_weights(base);
         let metric = Metric::new(base, &weight);
-        Family { base: base.clone(), param, rho, ys, sig, n2: 2 * base.n(), weight, metric, last_jacobian: Default::default(), chord: Default::default() }
+        Family {
+            base: base.clone(),
+            param,
+            rho,
+            ys,
+            sig,
+            n2: 2 * base.n(),
+            weight,
+            metric,
+            last_jacobian: Default::default(),
+            chord: Default::default(),
+            modes: Default::default(),
+        }
     }
 
     /// The largest weighted state component of `y`: the state scale y_s of an orbit.
@@ -145,7 +160,13 @@ impl Family {
         if !lambda.is_finite() {
             return None;
         }
-        PolishedOrbit::unsolved(&self.model_at(lambda), self.sig.events.clone(), &self.sig.always).ok()
+        let mut orbit = PolishedOrbit::unsolved(&self.model_at(lambda), self.sig.events.clone(), &self.sig.always).ok()?;
+        if let Some(first) = self.modes.borrow().as_ref() {
+            orbit.share_modes(first);
+            return Some(orbit);
+        }
+        *self.modes.borrow_mut() = Some(orbit.clone());
+        Some(orbit)
     }
 
     fn unpack(&self, w: &[f64], period: f64) -> (Vec<f64>, Vec<f64>) {
