@@ -289,8 +289,9 @@ impl PolishedOrbit {
         let ne = self.events.len();
         let fail = |w: &str| PolishFailure(w.to_string());
         // Seed: the fixed point of the affine one-period map at the seeded times.
-        // The map is affine in the state at fixed times: its offset and its derivative (the
-        // variation's state columns) from one flow of the period from 0.
+        // The map is affine in the state at fixed times: its offset and its derivative from
+        // 2n + 1 shoots (the variation's state columns instead lost the coarse blade's compliant
+        // branch at its 2422.35 rad/s grazings; cause not traced).
         let zero = DVector::zeros(n2);
         let c = self.shoot(&zero, &self.times).ok_or_else(|| fail("the seeded event sequence cannot be flowed"))?.end;
         let mut phi = DMatrix::zeros(n2, n2);
