@@ -14,10 +14,7 @@ without friction and stop (so that most stops close; those that never do are cou
 """
 from __future__ import annotations
 
-import json
 import os
-import resource
-import subprocess
 import sys
 import tempfile
 
@@ -83,25 +80,7 @@ def family(cases, seed, cli):
             if ex.residual > 1e-10:
                 rows.append((np.inf, desc, "reference failed", f"shooting residual {ex.residual:.1e}", 0.0, touches))
                 continue
-            path, out = os.path.join(tmp, "s.toml"), os.path.join(tmp, "r.json")
-            with open(path, "w") as f:
-                f.write(scene(s, 512))
-            before = resource.getrusage(resource.RUSAGE_CHILDREN)
-            p = subprocess.run([cli, "solve", path, "--polish", "--no-estimate", "-o", out], capture_output=True, text=True)
-            after = resource.getrusage(resource.RUSAGE_CHILDREN)
-            cpu = after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime
-            if p.returncode != 0:
-                rows.append((np.inf, desc, "cli failed", p.stderr.strip()[:200], cpu, touches))
-                continue
-            r = json.load(open(out))
-            x = np.array([r["displacement"][str(d)] for d in range(s.n)])
-            xe = np.array([ex.displacement(t) for t in r["time"]]).T
-            if any(ex.stuck_fraction(i) > 1 - 1e-12 for i in range(s.m)):  # unique up to the sliders' constants
-                x, xe = x - x.mean(1, keepdims=True), xe - xe.mean(1, keepdims=True)
-            err = float(np.abs(x - xe).max() / np.abs(xe).max())
-            pol = r.get("polish") or {}
-            status = pol.get("status", "?")
-            why = pol.get("reason", "") if status != "polished" else f"{len(pol.get('events', []))} events (exact {len(ex.events)})"
+            err, status, why, cpu = fm.polish_against(cli, tmp, scene(s, 512), s, ex)
             rows.append((err, desc, status, why, cpu, touches))
             print(f"{desc}: {status}, error {err:.2e}, stop events {touches}, {why[:160]}", flush=True)
     rows.sort(key=lambda r: -r[0])
