@@ -57,12 +57,16 @@ pub(super) struct Family {
     last_jacobian: std::cell::RefCell<Option<(Vec<f64>, DMatrix<f64>)>>,
     /// The Jacobian of the last point solved, for the next corrector's chord iterations.
     chord: std::cell::RefCell<Option<Chord>>,
-    /// The first orbit built, whose phases' eigendecompositions every later orbit shares (the
-    /// phase matrices do not depend on the parameter: one decomposition per contact set).
-    modes: std::cell::RefCell<Option<PolishedOrbit>>,
+    /// The first orbit built of each signature met, whose phases' eigendecompositions every later
+    /// orbit shares (the phase matrices do not depend on the parameter: one decomposition per
+    /// contact set). With the first orbit's only, every orbit past the coarse blade's first
+    /// grazing decomposed its new phases again: a quarter of the walk's time.
+    modes: std::cell::RefCell<Vec<(SignatureKey, PolishedOrbit)>>,
 }
 
-type ChordKey = (Vec<(usize, EventKind)>, Vec<usize>, f64);
+/// A signature's events (contact, kind) and its contacts closed all period long.
+type SignatureKey = (Vec<(usize, EventKind)>, Vec<usize>);
+type ChordKey = (SignatureKey, f64);
 
 struct Chord {
     key: ChordKey,
@@ -161,11 +165,15 @@ impl Family {
             return None;
         }
         let mut orbit = PolishedOrbit::unsolved(&self.model_at(lambda), self.sig.events.clone(), &self.sig.always).ok()?;
-        if let Some(first) = self.modes.borrow().as_ref() {
+        let key = self.signature_key();
+        let mut modes = self.modes.borrow_mut();
+        if let Some((_, first)) = modes.iter().find(|(k, _)| *k == key) {
             orbit.share_modes(first);
             return Some(orbit);
         }
-        *self.modes.borrow_mut() = Some(orbit.clone());
+        // A new signature: its phases of contact sets met before share those decompositions.
+        modes.iter().for_each(|(_, o)| orbit.share_modes(o));
+        modes.push((key, orbit.clone()));
         Some(orbit)
     }
 
@@ -323,8 +331,11 @@ impl Family {
 
     /// What a Jacobian depends on besides w: the signature and the state scale.
     fn key(&self) -> ChordKey {
-        let events = self.sig.events.iter().map(|e| (e.contact, e.kind)).collect();
-        (events, self.sig.always.clone(), self.ys)
+        (self.signature_key(), self.ys)
+    }
+
+    fn signature_key(&self) -> SignatureKey {
+        (self.sig.events.iter().map(|e| (e.contact, e.kind)).collect(), self.sig.always.clone())
     }
 
     /// The unit tangent of the branch at w: [J; prevᵀ] t = e_last, oriented along `prev`.
