@@ -153,10 +153,9 @@ impl PolishedOrbit {
     }
 
     /// The period sampled phase by phase, each phase's samples equally spaced from its start
-    /// (one exponential e^{Ah} per phase, then a matrix-vector product per sample: the short
-    /// Taylor flows it replaces were most of the coarse blade's exact walk), with each phase's
-    /// state at its end (before the next event), so that every interval between samples lies
-    /// in one phase.
+    /// ([`super::phase::Phase::samples`]: one exponential e^{Ah} per phase, then a
+    /// matrix-vector product per sample), with each phase's state at its end (before the next
+    /// event), so that every interval between samples lies in one phase.
     fn sampled(&self) -> Sampled {
         let ne = self.events.len();
         let mut out = Sampled { samples: Vec::new(), states: Vec::new(), ends: Vec::new() };
@@ -164,15 +163,11 @@ impl PolishedOrbit {
             let (a, b) = (self.times[e], self.end_of(e));
             let count = (((b - a) * self.phases[e].speed_hint().max(self.model.frequency) * SAMPLES_PER_RADIAN).ceil() as usize).max(MIN_SAMPLES);
             let h = (b - a) / count as f64;
-            let step = self.phases[e].exp(h);
-            let mut y = self.after[e].clone();
-            for j in 0..count {
-                let t = a + h * j as f64;
-                let next = if j + 1 == count { self.phases[e].flow(t, &y, b) } else { self.phases[e].flow_with(&step, t, &y, t + h) };
-                out.samples.push((t, e));
-                out.states.push(std::mem::replace(&mut y, next));
-            }
-            out.ends.push(y);
+            let states = self.phases[e].samples(a, &self.after[e], h, count);
+            out.samples.extend((0..count).map(|j| (a + h * j as f64, e)));
+            // The phase's end flowed from its last sample, as the last interval is.
+            out.ends.push(self.phases[e].flow(a + h * (count - 1) as f64, &states[count - 1], b));
+            out.states.extend(states);
         }
         out
     }
@@ -185,7 +180,17 @@ impl PolishedOrbit {
     /// A contact's own events, where its signed clearance comes down to 0 from both sides, are
     /// not minima: each interval is taken in its phase up to the phase's end (left limit).
     pub fn touches(&self) -> Vec<Touch> {
+        self.touches_in(&self.sampled())
+    }
+
+    /// [`Self::touches`] and [`Self::amplitudes`] from one sampling of the period (a branch
+    /// point's: the sampling was most of the exact walk's time, and each point took two).
+    pub fn touches_and_amplitudes(&self, map: Option<&OutputMap>, dofs: &[usize]) -> (Vec<Touch>, Vec<Option<f64>>) {
         let sampled = self.sampled();
+        (self.touches_in(&sampled), self.amplitudes_in(&sampled, map, dofs))
+    }
+
+    fn touches_in(&self, sampled: &Sampled) -> Vec<Touch> {
         let mut out = Vec::new();
         for (i, c) in self.model.contacts.iter().enumerate() {
             if c.is_rigid() {
@@ -257,8 +262,11 @@ impl PolishedOrbit {
 
     /// [`Self::amplitude`] of each of `dofs`, from one sampling of the period.
     pub fn amplitudes(&self, map: Option<&OutputMap>, dofs: &[usize]) -> Vec<Option<f64>> {
+        self.amplitudes_in(&self.sampled(), map, dofs)
+    }
+
+    fn amplitudes_in(&self, sampled: &Sampled, map: Option<&OutputMap>, dofs: &[usize]) -> Vec<Option<f64>> {
         let n = self.model.n();
-        let sampled = self.sampled();
         let one = |dof: usize| {
             user_value(map, dof, &self.y0, 0, n)?;
             let jet = |e: usize, y: &DVector<f64>, t: f64, sign: f64, curvature: bool| {

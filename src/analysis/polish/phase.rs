@@ -287,8 +287,16 @@ impl Phase {
         self.eigen.get_or_init(|| EigenFlow::new(&self.a)).as_ref()
     }
 
+    /// Every DOF free and massive: N_a = I, no prescribed motion, nothing condensed.
+    fn plain(&self) -> bool {
+        self.stuck.is_empty() && self.slave.ncols() == 0
+    }
+
     /// [N_aᵀ x; N_aᵀ v] of the full state [x; v]: the massive free coordinates.
     fn free_state(&self, y: &DVector<f64>) -> DVector<f64> {
+        if self.plain() {
+            return y.clone();
+        }
         let (n, nf) = (self.n, self.free.ncols());
         let mut out = DVector::zeros(2 * nf);
         out.rows_mut(0, nf).copy_from(&(self.free.transpose() * y.rows(0, n)));
@@ -304,6 +312,29 @@ impl Phase {
         let p1 = eval(&self.part, self.omega, t1, 0, nf2);
         let yf = p1 + e * (self.free_state(y0) - p0);
         self.assemble(&yf, t1)
+    }
+
+    /// The states at t0 + j·h, j < `count` (the first `y0` itself), flowed in this phase: e^{Ah}
+    /// once, then the free state's homogeneous part z = y_f − p(t) stepped by z ← e^{Ah} z, one
+    /// product per sample (a flow per sample, [`Self::flow_with`], also projected and re-formed
+    /// the state and evaluated the particular solution twice: most of the exact walk's time).
+    pub fn samples(&self, t0: f64, y0: &DVector<f64>, h: f64, count: usize) -> Vec<DVector<f64>> {
+        let nf2 = 2 * self.free.ncols();
+        let mut out = Vec::with_capacity(count);
+        out.push(y0.clone());
+        if count < 2 {
+            return out;
+        }
+        let step = self.exp(h);
+        let mut z = self.free_state(y0) - eval(&self.part, self.omega, t0, 0, nf2);
+        let mut next = DVector::zeros(nf2);
+        for j in 1..count {
+            let t = t0 + h * j as f64;
+            next.gemv(1.0, &step, &z, 0.0);
+            std::mem::swap(&mut z, &mut next);
+            out.push(self.assemble(&(eval(&self.part, self.omega, t, 0, nf2) + &z), t));
+        }
+        out
     }
 
     /// A short span (‖Â τ‖₁ ≤ [`SHORT_SPAN`]) is flowed by the Taylor series on the vector, whose
@@ -355,6 +386,9 @@ impl Phase {
     /// [x_c + N_a x_a + N_b x_b; v_c + N_a v_a + N_b v_b], the massless coordinates condensed:
     /// x_b = X_b(t) + S (x_a − X_a(t)) (the particular solution and S = −K_bb⁻¹ K_ba).
     fn assemble(&self, yf: &DVector<f64>, t: f64) -> DVector<f64> {
+        if self.plain() {
+            return yf.clone();
+        }
         let (n, nf) = (self.n, self.free.ncols());
         let mut y = DVector::zeros(2 * n);
         let mut x = eval(&self.presc, self.omega, t, 0, n) + &self.free * yf.rows(0, nf);
@@ -384,7 +418,7 @@ impl Phase {
     /// condensation: neither carries state). `e` itself when every DOF is free and massive.
     pub fn transition(&self, e: &DMatrix<f64>) -> DMatrix<f64> {
         let (n, nf) = (self.n, self.free.ncols());
-        if self.stuck.is_empty() && self.slave.ncols() == 0 {
+        if self.plain() {
             return e.clone();
         }
         let lift = &self.free + &self.slave * &self.slave_map;

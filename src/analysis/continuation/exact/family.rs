@@ -82,6 +82,8 @@ pub(super) struct Node {
     pub orbit: PolishedOrbit,
     pub mu: Vec<Complex64>,
     pub touches: Vec<Touch>,
+    /// The outputs' amplitudes when surveyed with the touches (empty: not yet).
+    pub amplitude: Vec<f64>,
 }
 
 impl Node {
@@ -373,7 +375,7 @@ impl Family {
         let orbit = orbit.at(&y, &times, defect).ok()?;
         let mu = floquet::multipliers(orbit.monodromy());
         let touches = if touches { orbit.touches() } else { Vec::new() };
-        Some(Node { w, tangent, orbit, mu, touches })
+        Some(Node { w, tangent, orbit, mu, touches, amplitude: Vec::new() })
     }
 }
 

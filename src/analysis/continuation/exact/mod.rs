@@ -32,6 +32,9 @@ const VANISH: f64 = 1e-6;
 const NEW_PAIR: f64 = 1e-5;
 /// Bisection stops when the bracket is this short (scaled unknowns).
 const BRACKET: f64 = 1e-12;
+/// A bracket this short is located even where the corrector fails on its midpoint: the
+/// corrector's corrections stall at 1e-10 to 4e-9 on the coarse blade (family.rs, ATTAINABLE).
+const NEWTON_NOISE: f64 = 1e-8;
 /// Successive tangents at a larger angle than arccos(this) mean a step too long.
 const MIN_COS: f64 = 0.9;
 /// A corrected point farther than this × the step from the predictor is on another part of the
@@ -147,8 +150,7 @@ pub(super) fn step(problem: &PeriodicProblem, param: Parameter, from: f64, to: f
 impl Walk<'_> {
     fn push(&mut self, node: &Node, event: Option<EventKind>, detail: String) {
         let lambda = node.lambda(self.fam.rho);
-        let map = self.problem.output_map();
-        let amplitude = node.orbit.amplitudes(map, &self.problem.outputs().displacement).into_iter().map(|a| a.unwrap_or(f64::NAN)).collect();
+        let amplitude = if node.amplitude.is_empty() { self.amplitudes(&node.orbit).1 } else { node.amplitude.clone() };
         let max_multiplier = floquet::largest(&node.mu);
         self.points.push(BranchPoint {
             parameter: lambda,
@@ -165,6 +167,12 @@ impl Walk<'_> {
             tangent: node.tangent.clone(),
             source: Source::Exact,
         });
+    }
+
+    /// The touches and the outputs' amplitudes of `orbit`, from one sampling of its period.
+    fn amplitudes(&self, orbit: &PolishedOrbit) -> (Vec<polish::Touch>, Vec<f64>) {
+        let (touches, amplitude) = orbit.touches_and_amplitudes(self.problem.output_map(), &self.problem.outputs().displacement);
+        (touches, amplitude.into_iter().map(|a| a.unwrap_or(f64::NAN)).collect())
     }
 
     /// A front end's step (`stop_at_fold`): the branch past a change of signature starts at `n`
@@ -233,7 +241,8 @@ impl Walk<'_> {
             let normal = self.fam.metric.lower(&along);
             let target = dot(&normal, &pred);
             // Oriented in the metric too: the stiff components' turning must not decide the sense.
-            let next = self.fam.correct(&pred, &normal, target).and_then(|w| self.fam.node(w, &normal));
+            // Touches (a sampling of the period) only on the point taken ([`Self::amplitudes`]).
+            let next = self.fam.correct(&pred, &normal, target).and_then(|w| self.fam.node_with(w, &normal, false));
             let metric = &self.fam.metric;
             let drift = |n: &Node| metric.norm(&n.w.iter().zip(&pred).map(|(a, b)| a - b).collect::<Vec<_>>());
             let turn = |n: &Node| metric.dot(&metric.unit(&n.tangent), &along);
@@ -269,10 +278,12 @@ impl Walk<'_> {
                 let pred: Vec<f64> = w0.iter().zip(&next.w).map(|(a, b)| a + f * (b - a)).collect();
                 let d = self.fam.dim();
                 let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
-                self.fam.correct(&pred, &e_l, bound / rho).and_then(|w| self.fam.node(w, &normal)).unwrap_or(next)
+                self.fam.correct(&pred, &e_l, bound / rho).and_then(|w| self.fam.node_with(w, &normal, false)).unwrap_or(next)
             } else {
                 next
             };
+            let mut next = next;
+            (next.touches, next.amplitude) = self.amplitudes(&next.orbit);
             // A rigid contact's signature broken between here and next: located, the branch goes on past it.
             if rigid::margin(&next) < -1e-9 && rigid::margin(&here) >= -1e-9 {
                 match self.rigid_crossing(&here, &next, to) {
@@ -510,8 +521,11 @@ fn bisect(fam: &Family, a: &Node, b: &Node, same: &dyn Fn(&Node) -> bool, touche
         let normal: Vec<f64> = sec.iter().map(|x| x / len).collect();
         let pred: Vec<f64> = lo.w.iter().zip(&sec).map(|(x, s)| x + 0.5 * s).collect();
         let target = dot(&normal, &pred);
-        let w = fam.correct(&pred, &normal, target)?;
-        let node = fam.node_with(w, &lo.tangent, touches)?;
+        // A bracket within the corrector's accuracy is the event: the coarse blade's fold at
+        // 2795.947 rad/s, bracketed to 5e-11, lost its next midpoint to Newton's noise (≈1e-10).
+        let Some(node) = fam.correct(&pred, &normal, target).and_then(|w| fam.node_with(w, &lo.tangent, touches)) else {
+            return (len <= NEWTON_NOISE).then_some((lo, hi));
+        };
         if same(&node) {
             lo = node;
         } else {
