@@ -103,8 +103,9 @@ pub(super) fn estimate(point: &mut SweepPoint, solver: &PeriodicSolver, r: &Resp
     };
     let coarser = grid.instants() < solver.problem().instants();
     // A point refined whatever k/4 says skips it (`accuracy::least_estimate`).
-    let refined_anyway =
-        settings.tolerance.is_some_and(|t| settings.measure.of(&accuracy::least_estimate(solver.problem(), r, &half, &note)).is_some_and(|e| e > t));
+    let refinable = 2 * solver.problem().discretization().steps <= settings.max_steps;
+    let refined_anyway = refinable
+        && settings.tolerance.is_some_and(|t| settings.measure.of(&accuracy::least_estimate(solver.problem(), r, &half, &note)).is_some_and(|e| e > t));
     // Newton from the carried set alone: a k/4 grid near its stability limit can miss, and
     // then the estimate has two grids (a cold try there cost seconds per point).
     let quarter = (coarser && !refined_anyway)
