@@ -482,3 +482,33 @@ fn a_tolerance_refines_the_points_whose_estimate_exceeds_it() {
     }
     assert!(compared >= 1, "no refined point compared with its true error");
 }
+
+/// The k/4 solve a sweep with a tolerance skips (`accuracy::least_estimate`, Richardson at the
+/// scheme's order from k/2) is a floor of the estimate it would have given: on the two-stop chain
+/// at k = 256 (dense Lemke on each grid), at ω where the observed order differs from the scheme's
+/// (0.61 and 0.64: an impact beside a sticking arc; 0.85: k/4 not asymptotic), the estimate with
+/// k/4 and without it are both at least the floor, so a point above the tolerance by the floor is
+/// refined whatever k/4 says.
+#[test]
+fn the_skipped_quarter_grid_could_not_have_kept_a_point_within_the_tolerance() {
+    use periodic_contact::analysis::accuracy;
+    use periodic_contact::periodic::{LcpMethod, PeriodicSolver, SolverSettings};
+    let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("fmu/scenes/chain-3dof-two-stops.toml")).unwrap();
+    let p = Scene::parse(&text, "chain").unwrap().to_problem("chain").unwrap();
+    let at = |f: f64, steps: usize| {
+        let mut q = p.clone();
+        q.set_discretization(periodic_contact::time::Discretization { steps, ..p.discretization() }).unwrap();
+        q.set_frequency(f).unwrap();
+        q.set_solver_settings(SolverSettings { method: LcpMethod::Lemke, ..q.solver_settings().clone() }).unwrap();
+        let r = PeriodicSolver::new(q.clone()).solve().unwrap();
+        (q, r)
+    };
+    for f in [0.5, 0.61, 0.64, 0.7, 0.85] {
+        let ((q, r), (_, half), (_, quarter)) = (at(f, 256), at(f, 128), at(f, 64));
+        let floor = accuracy::least_estimate(&q, &r, &half, "k/2").relative.unwrap();
+        let with = accuracy::estimate_from(&q, &r, &half, Some(&quarter), "k/2").relative.unwrap();
+        let without = accuracy::estimate_from(&q, &r, &half, None, "k/2").relative.unwrap();
+        eprintln!("ω = {f}: floor {floor:.3e}, with k/4 {with:.3e}, without {without:.3e}");
+        assert!(floor > 0.0 && floor <= with * (1.0 + 1e-12) && floor <= without * (1.0 + 1e-12), "ω = {f}: floor {floor:e}, {with:e}, {without:e}");
+    }
+}

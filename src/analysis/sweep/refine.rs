@@ -102,11 +102,19 @@ pub(super) fn estimate(point: &mut SweepPoint, solver: &PeriodicSolver, r: &Resp
         }
     };
     let coarser = grid.instants() < solver.problem().instants();
+    // A point refined whatever k/4 says skips it (`accuracy::least_estimate`).
+    let refinable = 2 * solver.problem().discretization().steps <= settings.max_steps;
+    let refined_anyway = refinable
+        && settings.tolerance.is_some_and(|t| settings.measure.of(&accuracy::least_estimate(solver.problem(), r, &half, &note)).is_some_and(|e| e > t));
     // Newton from the carried set alone: a k/4 grid near its stability limit can miss, and
     // then the estimate has two grids (a cold try there cost seconds per point).
-    let quarter = coarser.then(|| accuracy::third_grid(&grid)).flatten().and_then(|g| second_solve(second, &g, r, settings.warm_start, ColdTry::No).ok());
+    let quarter = (coarser && !refined_anyway)
+        .then(|| accuracy::third_grid(&grid))
+        .flatten()
+        .and_then(|g| second_solve(second, &g, r, settings.warm_start, ColdTry::No).ok());
     let a = accuracy::estimate_from(solver.problem(), r, &half, quarter.as_ref(), &note);
-    (point.estimate_relative, point.estimate_method) = (settings.measure.of(&a), a.method);
+    let skipped = if coarser && refined_anyway { "; k/4 not solved: even Richardson at the scheme's order from k/2 exceeds the tolerance" } else { "" };
+    (point.estimate_relative, point.estimate_method) = (settings.measure.of(&a), a.method + skipped);
     coarser.then_some(half)
 }
 
