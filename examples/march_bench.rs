@@ -120,8 +120,27 @@ fn main() {
                 let e = error(&lcp_outputs(&p, &r), &reference);
                 let met = r.scheme_choice.as_ref().is_some_and(|s| s.met);
                 println!("ours auto tol={tol:.0e} {} - - met={met} {e:.3e} {cpu:.2} {wall:.2}", r.steps);
+                if let Some(c) = r.scheme_choice.as_ref().filter(|c| !c.met) {
+                    let tried: Vec<String> =
+                        c.tried.iter().map(|t| format!("k={} est={:?} bound={:?} {:.2}s", t.steps, t.estimate, t.bound, t.seconds)).collect();
+                    println!("#   not met: {}; tried {}", c.why, tried.join(", "));
+                }
             }
             Err(e) => println!("ours auto tol={tol:.0e} - - - failed:{e} nan nan nan"),
+        }
+    }
+
+    // Ours at the polished orbit's accuracy: `auto` at the loosest tolerance, then the polish.
+    if let Some(&tol) = ours_tols.iter().fold(None, |m: Option<&f64>, t| Some(m.map_or(t, |m| if t > m { t } else { m }))) {
+        let mut p = base.clone();
+        let t = periodic_contact::periodic::limits::AccuracyTarget { tolerance: tol, ..target };
+        let (c0, t0) = (cpu_s(), Instant::now());
+        if let Ok(mut r) = scheme_auto::solve_to_tolerance(&mut p, &t, &choice) {
+            let polished = polish::apply(&p, &mut r).is_some();
+            let (cpu, wall) = (cpu_s() - c0, t0.elapsed().as_secs_f64());
+            let e = error(&lcp_outputs(&p, &r), &reference);
+            let how = r.polish.as_ref().map(|p| format!("{}:{}", p.status, p.reason.replace(' ', "_"))).unwrap_or_default();
+            println!("ours auto+polish tol={tol:.0e} {} - - polished={polished}({how}) {e:.3e} {cpu:.2} {wall:.2}", r.steps);
         }
     }
 

@@ -13,7 +13,7 @@
 //! fall at the scheme's order ([`modes_in_asymptotic_range`]).
 use super::accuracy;
 use crate::periodic::limits::AccuracyTarget;
-use crate::periodic::{PeriodicProblem, SolveError};
+use crate::periodic::{PeriodicProblem, PeriodicSolver, SolveError, carried_active_set};
 use crate::response::{Response, SchemeChoice, SchemeTrial};
 use crate::time::Discretization;
 use std::time::Instant;
@@ -62,11 +62,18 @@ pub fn solve_to_tolerance(problem: &mut PeriodicProblem, target: &AccuracyTarget
                 Err(e) => return Err(e),
             },
         };
+        let (active, instants) = (r.active_set.clone(), problem.instants());
+        let rows = r.lcp.size / instants.max(1);
         let mut neighbour = |second: &PeriodicProblem| -> Result<Response, SolveError> {
             match solved.iter().find(|r| r.steps == second.instants()) {
                 Some(r) => Ok(r.clone()),
                 None => {
-                    let rs = second.solve()?;
+                    // Warm from this k's active set, as `accuracy::estimate` does. Why: cold, the
+                    // rigid massless blade at 2300 rad/s missed in shooting at 2k = 1024 and fell
+                    // back to dense Lemke, 40 s per try (README "Against time marching").
+                    let mut session = PeriodicSolver::new(second.clone());
+                    session.set_warm_start(&carried_active_set(&active, rows, instants, second.instants()));
+                    let rs = session.solve()?;
                     solved.push(rs.clone());
                     Ok(rs)
                 }
