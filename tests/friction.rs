@@ -152,6 +152,12 @@ fn event_fitted_half_steps_are_second_order_and_within_1e_3_at_k_512() {
         // from bds1's orbit alone, whose laws end 1.18e-4 → 5.74e-5 (order 1.04: k = 256's
         // error is low, not 512's high), so its order is not asserted.
         ("Den Hartog, k = 256 from bds1 alone", oscillator(0.0, 1.506, 0.51, None)),
+        // Seed 23: bds1 reverses 2 steps before the half steps at k = 512, its laws missed the
+        // event and Newton wandered (periodicity 1.4e-3 after 60 iterations); k/2's laws hold it.
+        ("Den Hartog, k = 512 from the laws at k/2", oscillator(0.0, 1.310, 0.647, None)),
+        // Seed 37: at k = 256 Newton stalled at periodicity 1.9e-5 on bds1's laws (4 steps off
+        // the reversal); the laws refitted to the stalled iterate converge: 2.10e-4 → 7.31e-5.
+        ("Den Hartog, k = 256 refitted after a stall", oscillator(0.0, 0.924, 0.665, None)),
         ("chain", chain),
     ];
     for (name, osc) in cases {
@@ -188,7 +194,12 @@ fn event_fitted_half_steps_are_second_order_and_within_1e_3_at_k_512() {
         assert!(runs[1].lcp.path.contains("event-fitted laws"), "{}", runs[1].lcp.path);
         assert!(e[1] < 1e-3, "k = 512: {:.3e}", e[1]);
         // The order with stops or damping wanders (0.94–2.57 over the family, README "Friction").
-        assert!(closed.is_none() || name.contains("bds1 alone") || order > 1.6, "order {order:.2}");
+        // The members whose k = 256 needed a fallback start: 256 → 512 is off the asymptote
+        // (measured 1.04 and 1.52; 512 → 1024 by validation/peers: 3.45 and 2.34).
+        assert!(closed.is_none() || name.contains("k = 256") || order > 1.6, "order {order:.2}");
+        if name.contains("at k/2") {
+            assert!(runs[1].lcp.path.contains("from the laws of its orbit at k/2"), "{}", runs[1].lcp.path);
+        }
         assert!((0.1..10.0).contains(&(estimate / truth)), "estimate {estimate:.3e} against {truth:.3e}");
     }
 }

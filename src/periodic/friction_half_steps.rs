@@ -30,38 +30,7 @@ pub(super) fn solve(
     let t_lcp = Instant::now();
     let (k, mf) = (map.k, map.mf);
     let nn = 2 * k * mf;
-    // Starts in turn: bds1's orbit with its laws, without them, rest. Why: from bds1's laws
-    // Newton cycled on Den Hartog c = 0, Ω = 1.506, μN = 0.51 at k = 256 (I − P near singular
-    // on those sets); from bds1's orbit on the relay it converges in 5 iterations (measured).
-    let pilot = bds1_start(problem, &map);
-    let mut starts: Vec<Start> = Vec::new();
-    if let Some((y, laws)) = pilot.clone()
-        && !relay_only
-    {
-        starts.push((Some(y), Some(laws), " from bds1's orbit and its laws"));
-    }
-    if let Some((y, _)) = pilot {
-        starts.push((Some(y), None, " from bds1's orbit"));
-    }
-    starts.push((None, None, " from rest"));
-    let mut failure = None;
-    let mut found = None;
-    for (y, laws, how) in starts {
-        let mut attempt = map.clone();
-        if let Some(l) = laws {
-            attempt.laws = l;
-        }
-        match attempt.shoot_fitted(y, relay_only) {
-            Ok(f) => {
-                found = Some((f, how));
-                break;
-            }
-            Err(e) => failure = failure.or(Some(e)),
-        }
-    }
-    let Some((fitted, started)) = found else {
-        return Err(shooting_failed(failure.expect("one start at least"), 2 * mf));
-    };
+    let (fitted, started) = fit_from_starts(problem, &map, relay_only).map_err(|e| shooting_failed(e, 2 * mf))?;
     let mut sol = certify(problem, (asm, fft, grid), &fitted.shot.forces, Some(&fitted.laws));
     let lcp_time = t_lcp.elapsed().as_secs_f64();
     sol.info.pivots = fitted.iterations;
@@ -85,6 +54,69 @@ pub(super) fn solve(
 
 /// A start for Newton: the state, the laws to begin with (none: the relay) and its sentence.
 type Start = (Option<Vec<f64>>, Option<EventLaws>, &'static str);
+
+/// The event-fitted orbit on `map` from the first start that converges, and that start's
+/// sentence; else the first start's failure.
+fn fit_from_starts(problem: &PeriodicProblem, map: &HalfStepMap, relay_only: bool) -> Result<(FittedShot, &'static str), ShotFailure> {
+    // Starts in turn: bds1's orbit with its laws; with the laws of the half steps' own orbit at
+    // k/2; bds1's orbit without laws; rest. Why the second: bds1 (numerically damped) reverses
+    // 2 steps before the half steps do on Den Hartog c = 0, Ω = 1.310, μN = 0.647 at k = 512, so
+    // its laws' window (±1 step) missed the reversal and Newton wandered off (periodicity 1.3e-2
+    // after 60 iterations); the k/2 orbit's laws hold the event (measured, README "Friction").
+    // Why the third: from bds1's laws Newton cycled on Den Hartog c = 0, Ω = 1.506, μN = 0.51 at
+    // k = 256 (I − P near singular on those sets); from bds1's orbit on the relay it converges.
+    let pilot = bds1_start(problem, map);
+    let mut failure = None;
+    for attempt in 0..4 {
+        let start: Option<Start> = match attempt {
+            0 if !relay_only => pilot.clone().map(|(y, laws)| (Some(y), Some(laws), " from bds1's orbit and its laws")),
+            1 if !relay_only => coarse_laws(problem, map).map(|laws| (pilot.as_ref().map(|p| p.0.clone()), Some(laws), " from the laws of its orbit at k/2")),
+            2 => pilot.clone().map(|(y, _)| (Some(y), None, " from bds1's orbit")),
+            3 => Some((None, None, " from rest")),
+            _ => None,
+        };
+        let Some((y, laws, how)) = start else { continue };
+        let mut trial = map.clone();
+        if let Some(l) = laws {
+            trial.laws = l;
+        }
+        match trial.shoot_fitted(y, relay_only) {
+            Ok(f) => return Ok((f, how)),
+            Err(e) => failure = failure.or(Some(e)),
+        }
+    }
+    Err(failure.expect("rest is always a start"))
+}
+
+/// Coarsest k whose half-step orbit lends its laws to 2k. Why: below it the laws' window spans
+/// a large part of a slip phase and the coarse solve's own fallbacks buy nothing.
+const COARSE_LAWS_MIN: usize = 64;
+
+/// The laws for `map`'s k fitted to the event-fitted orbit at k/2 (solved as here, recursively),
+/// its samples carried to k: each force over two steps, the mean velocities interpolated to the
+/// fine steps' middles. `None` for odd k, k/2 below [`COARSE_LAWS_MIN`], or when k/2 fails too.
+fn coarse_laws(problem: &PeriodicProblem, map: &HalfStepMap) -> Option<EventLaws> {
+    let (kc, mf) = (map.k / 2, map.mf);
+    if !map.k.is_multiple_of(2) || kc < COARSE_LAWS_MIN {
+        return None;
+    }
+    let coarse = HalfStepMap::new(problem, kc).ok()?;
+    let (fitted, _) = fit_from_starts(problem, &coarse, false).ok()?;
+    let (f, v) = (&fitted.shot.forces, &fitted.shot.velocity);
+    let (mut forces, mut velocity) = (vec![0.0; map.k * mf], vec![0.0; map.k * mf]);
+    for j in 0..map.k {
+        // Fine step j = 2i + r lies in coarse step i; its middle is 3/4 of the way from coarse
+        // middle i − 1 to i (r = 0) or 1/4 from i to i + 1 (r = 1).
+        let (i, r) = (j / 2, j % 2);
+        let (a, b) = if r == 0 { ((i + kc - 1) % kc, i) } else { (i, (i + 1) % kc) };
+        let wb = if r == 0 { 0.75 } else { 0.25 };
+        for t in 0..mf {
+            forces[j * mf + t] = f[i * mf + t];
+            velocity[j * mf + t] = (1.0 - wb) * v[a * mf + t] + wb * v[b * mf + t];
+        }
+    }
+    Some(EventLaws::fit(&map.nyquist, &map.slip, (&forces, &velocity), map.h))
+}
 
 /// The half-step map of a problem whose only nonsmooth rows are rigid Coulomb contacts under a
 /// constant normal load, every DOF with mass.
@@ -223,23 +255,42 @@ impl HalfStepMap {
     }
 
     /// Newton on this map from `start`, then the laws refitted from each orbit until they repeat
-    /// (none with `relay_only`).
+    /// (none with `relay_only`). A Newton that stalls below [`REFIT_STALLED`] also refits, from
+    /// its last iterate. Why: on Den Hartog c = 0, Ω = 0.924, μN = 0.665 at k = 256 (seed 37)
+    /// bds1's laws sat 4 steps after the half steps' reversal, and Newton on those sets stalled at
+    /// periodicity 1.2e-5 (the relay's unfelt force mode has no periodic orbit there); the laws
+    /// fitted to that iterate hold the event and Newton converges (measured).
     pub(super) fn shoot_fitted(mut self, start: Option<Vec<f64>>, relay_only: bool) -> Result<FittedShot, ShotFailure> {
-        let mut shot = shoot(&self, start)?;
-        let (mut refits, mut iterations) = (0, shot.iterations);
-        while !relay_only && refits < MAX_ROUNDS {
-            let next = EventLaws::fit(&self.nyquist, &self.slip, (&shot.forces, &shot.velocity), self.h);
-            if next.repeats(&self.laws, 1e-10) {
-                break;
-            }
-            self.laws = next;
-            refits += 1;
-            shot = shoot(&self, Some(shot.state)).map_err(|e| ShotFailure { iterations: iterations + e.iterations, ..e })?;
+        let (mut refits, mut iterations, mut state) = (0, 0, start);
+        loop {
+            let (shot, failure) = match shoot(&self, state) {
+                Ok(shot) => (shot, None),
+                Err(e) => match e.last {
+                    Some(last) if !relay_only && refits < MAX_ROUNDS && e.residual <= REFIT_STALLED => {
+                        (last, Some(ShotFailure { iterations: iterations + e.iterations, last: None, ..e }))
+                    }
+                    last => return Err(ShotFailure { iterations: iterations + e.iterations, last, ..e }),
+                },
+            };
             iterations += shot.iterations;
+            let next = (!relay_only && refits < MAX_ROUNDS).then(|| EventLaws::fit(&self.nyquist, &self.slip, (&shot.forces, &shot.velocity), self.h));
+            match (next, failure) {
+                (Some(next), _) if !next.repeats(&self.laws, 1e-10) => {
+                    self.laws = next;
+                    refits += 1;
+                    state = Some(shot.state);
+                }
+                (_, Some(failure)) => return Err(failure),
+                (_, None) => return Ok(FittedShot { shot, laws: self.laws, refits, iterations }),
+            }
         }
-        Ok(FittedShot { shot, laws: self.laws, refits, iterations })
     }
 }
+
+/// A stalled Newton's periodicity below which its last iterate refits the laws. Why: a stall
+/// there is a set pattern the laws' windows miss by a few steps (measured 1.2e-5, seed 37);
+/// far above it the iterate's events are no guide.
+const REFIT_STALLED: f64 = 1e-3;
 
 impl FrictionMarch for HalfStepMap {
     fn state_size(&self) -> usize {

@@ -74,6 +74,8 @@ pub(super) struct ShotFailure {
     pub iterations: usize,
     pub residual: f64,
     pub why: &'static str,
+    /// Newton's last iterate (not periodic) when the iterations ran out, for a refit.
+    pub last: Option<FrictionShot>,
 }
 
 /// One march over the period: the end state, each instant's modes, forces and slip velocities
@@ -397,7 +399,7 @@ pub(super) fn shoot(map: &impl FrictionMarch, start: Option<Vec<f64>>) -> Result
     let mut unchanged = false;
     for iteration in 0..MAX_ITERATIONS {
         if !res.is_finite() {
-            return Err(ShotFailure { iterations: iteration, residual: res, why: "the march overflowed" });
+            return Err(ShotFailure { iterations: iteration, residual: res, why: "the march overflowed", last: None });
         }
         // Round-off, or the sets of the affine solve came back unchanged (its fixed point).
         if res <= 1e-12 || (unchanged && res <= 1e-8) {
@@ -419,6 +421,7 @@ pub(super) fn shoot(map: &impl FrictionMarch, start: Option<Vec<f64>>) -> Result
                 iterations: iteration,
                 residual: res,
                 why: "I − P is singular (a rigid contact stuck over the whole period leaves its position undetermined)",
+                last: None,
             });
         }
         let mut length = 1.0;
@@ -435,7 +438,8 @@ pub(super) fn shoot(map: &impl FrictionMarch, start: Option<Vec<f64>>) -> Result
         march = next;
         res = residual(&y, &march);
     }
-    Err(ShotFailure { iterations: MAX_ITERATIONS, residual: res, why: "the stick/slip sets kept changing" })
+    let last = FrictionShot { state: y, forces: march.forces, velocity: march.velocity, iterations: MAX_ITERATIONS, residual: res };
+    Err(ShotFailure { iterations: MAX_ITERATIONS, residual: res, why: "the stick/slip sets kept changing", last: Some(last) })
 }
 
 /// δ of least norm for A δ = r (A square, singular): (AᵀA + μI) δ = Aᵀr with μ at round-off of
