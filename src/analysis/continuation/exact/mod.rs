@@ -388,10 +388,25 @@ impl Walk<'_> {
             return (pred, None);
         };
         self.fam.sig = sig;
+        // Events that passed event 0 change the contacts closed after it, and with them the state
+        // there (a massless tip's velocity): the state re-taken as the new phase 0 carries it,
+        // else the predictor lies off the branch by that jump and the corrector lands a fixed
+        // distance along it, however short the step (the event-0 crossing's stall).
         let mut moved = here.clone();
         moved.w = signature::reorder(&here.w, &order, true);
         moved.tangent = signature::reorder(&here.tangent, &order, false);
-        (signature::reorder(&pred, &order, true), Some(moved))
+        let pred = signature::reorder(&pred, &order, true);
+        let (Some(w), Some(sectioned)) = (self.fam.sectioned(&moved.w), self.fam.sectioned(&pred)) else {
+            return (pred, Some(moved));
+        };
+        // The tangent through the same map (affine in the state; by central differences for θ_0).
+        let h = 1e-6;
+        let shifted = |s: f64| self.fam.sectioned(&moved.w.iter().zip(&moved.tangent).map(|(a, b)| a + s * b).collect::<Vec<_>>());
+        if let (Some(up), Some(dn)) = (shifted(h), shifted(-h)) {
+            moved.tangent = up.iter().zip(&dn).map(|(a, b)| (a - b) / (2.0 * h)).collect();
+        }
+        moved.w = w;
+        (sectioned, Some(moved))
     }
 
     /// Phases between two events of one contact that shrink along the tangent: (phase, length,
