@@ -28,6 +28,8 @@ mod cli;
 mod continuation;
 #[path = "convergence.rs"]
 mod convergence;
+#[path = "event_swap.rs"]
+mod event_swap;
 #[path = "exact_jacobian.rs"]
 mod exact_jacobian;
 #[path = "fail_fast.rs"]

@@ -98,6 +98,17 @@ impl PolishedOrbit {
         Ok(self)
     }
 
+    /// The state `y` at `t` as the phase before event 0 carries it (the last one: the shooting
+    /// residual's return state, event 0's map being the identity where events pass each other):
+    /// its stuck DOFs on their obstacles, its massless DOFs condensed from the massive ones (the
+    /// phase's flow over no time). A massless DOF's velocity jumps where its rigid contact
+    /// closes (the mass's when free, the obstacle's when stuck), so this state changes with the
+    /// contacts closed before event 0.
+    pub fn section_state(&self, y: &[f64], t: f64) -> Vec<f64> {
+        let before = self.phases.last().expect("one phase at least");
+        before.flow(t, &DVector::from_column_slice(y), t).as_slice().to_vec()
+    }
+
     /// The event signature (times as seeds), the contacts closed all period long, the event
     /// times and the state just after event 0.
     pub fn events(&self) -> &[Event] {

@@ -214,6 +214,16 @@ impl Family {
             .collect()
     }
 
+    /// `w` with its state the one the signature's last phase carries at θ_0
+    /// ([`PolishedOrbit::section_state`]): for a predictor whose events passed event 0.
+    pub fn sectioned(&self, w: &[f64]) -> Option<Vec<f64>> {
+        let orbit = self.orbit(w[w.len() - 1] * self.rho)?;
+        let (y, times) = self.unpack(w, orbit.period());
+        let mut out = self.scaled(&orbit.section_state(&y, times[0]));
+        out.extend_from_slice(&w[self.n2..]);
+        Some(out)
+    }
+
     pub fn residual(&self, w: &[f64]) -> Option<DVector<f64>> {
         self.residual_with(&self.orbit(w[w.len() - 1] * self.rho)?, w)
     }

@@ -238,17 +238,24 @@ impl Walk<'_> {
                 step = step.min(0.75 * len / rate);
             }
             let pred: Vec<f64> = here.w.iter().zip(&along).map(|(w, t)| w + step * t).collect();
-            let normal = self.fam.metric.lower(&along);
-            let target = dot(&normal, &pred);
-            // Oriented in the metric too: the stiff components' turning must not decide the sense.
-            // Touches (a sampling of the period) only on the point taken ([`Self::amplitudes`]).
-            let next = self.fam.correct(&pred, &normal, target).and_then(|w| self.fam.node_with(w, &normal, false));
-            let metric = &self.fam.metric;
-            let drift = |n: &Node| metric.norm(&n.w.iter().zip(&pred).map(|(a, b)| a - b).collect::<Vec<_>>());
-            let turn = |n: &Node| metric.dot(&metric.unit(&n.tangent), &along);
-            let next = match next {
-                Some(n) if (turn(&n) >= MIN_COS || step <= settings.min_step) && drift(&n) <= MAX_DRIFT * step => n,
-                _ => {
+            // Events that may pass each other did: the same step in their new order (not a change);
+            // the corrector may cross a close pair the predictor did not, or the reverse: then the
+            // pair's order toggled.
+            let old = self.fam.sig.clone();
+            let tried = self.try_step(&here, pred.clone(), step, settings.min_step).or_else(|| {
+                self.fam.sig = old.clone();
+                let toggled = signature::toggled(&self.fam, self.problem.model(), &here.w, &pred)?;
+                self.try_step(&here, toggled, step, settings.min_step)
+            });
+            let next = match tried {
+                Some((n, moved)) => {
+                    if let Some(m) = moved {
+                        here = m;
+                    }
+                    n
+                }
+                None => {
+                    self.fam.sig = old;
                     ds = step / 2.0;
                     if ds < settings.min_step {
                         // Rigid events merging (a flight between two impacts, an impact fading): the branch past them.
@@ -278,7 +285,7 @@ impl Walk<'_> {
                 let pred: Vec<f64> = w0.iter().zip(&next.w).map(|(a, b)| a + f * (b - a)).collect();
                 let d = self.fam.dim();
                 let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
-                self.fam.correct(&pred, &e_l, bound / rho).and_then(|w| self.fam.node_with(w, &normal, false)).unwrap_or(next)
+                self.fam.correct(&pred, &e_l, bound / rho).and_then(|w| self.fam.node_with(w, &self.fam.metric.lower(&next.tangent), false)).unwrap_or(next)
             } else {
                 next
             };
@@ -361,6 +368,55 @@ impl Walk<'_> {
         node.tangent[..n2].iter_mut().for_each(|t| *t /= scale);
         let norm = node.tangent.iter().map(|t| t * t).sum::<f64>().sqrt();
         node.tangent.iter_mut().for_each(|t| *t /= norm);
+    }
+
+    /// The step from `here` to the predictor `pred` ([`Self::pass`] first): the corrected point
+    /// and `here` re-expressed in a new order of its events, when the successive tangents are
+    /// within arccos [`MIN_COS`] (or the step is the smallest) and the point within [`MAX_DRIFT`]
+    /// steps of the predictor.
+    fn try_step(&mut self, here: &Node, pred: Vec<f64>, step: f64, min_step: f64) -> Option<(Node, Option<Node>)> {
+        let (pred, passed) = self.pass(here, pred);
+        let metric = &self.fam.metric;
+        // The metric weighs the event times alike: re-ordering them keeps the tangent a unit one.
+        let along = metric.unit(passed.as_ref().map_or(&here.tangent, |p| &p.tangent));
+        let normal = metric.lower(&along);
+        let target = dot(&normal, &pred);
+        // Oriented in the metric too: the stiff components' turning must not decide the sense.
+        let n = self.fam.correct(&pred, &normal, target).and_then(|w| self.fam.node_with(w, &normal, false))?;
+        let metric = &self.fam.metric;
+        let drift = metric.norm(&n.w.iter().zip(&pred).map(|(a, b)| a - b).collect::<Vec<_>>());
+        let turn = metric.dot(&metric.unit(&n.tangent), &along);
+        ((turn >= MIN_COS || step <= min_step) && drift <= MAX_DRIFT * step).then_some((n, passed))
+    }
+
+    /// The predictor `pred` from `here` and, when events with identity state maps of different
+    /// contacts have passed each other in it ([`signature::passed`]), the family switched to
+    /// their new order with `pred` and `here` (unknowns and tangent) re-expressed in it; the
+    /// caller restores the signature if the step fails.
+    fn pass(&mut self, here: &Node, pred: Vec<f64>) -> (Vec<f64>, Option<Node>) {
+        let Some((sig, order)) = signature::passed(&self.fam, self.problem.model(), &pred) else {
+            return (pred, None);
+        };
+        self.fam.sig = sig;
+        // Events that passed event 0 change the contacts closed after it, and with them the state
+        // there (a massless tip's velocity): the state re-taken as the new phase 0 carries it,
+        // else the predictor lies off the branch by that jump and the corrector lands a fixed
+        // distance along it, however short the step (the event-0 crossing's stall).
+        let mut moved = here.clone();
+        moved.w = signature::reorder(&here.w, &order, true);
+        moved.tangent = signature::reorder(&here.tangent, &order, false);
+        let pred = signature::reorder(&pred, &order, true);
+        let (Some(w), Some(sectioned)) = (self.fam.sectioned(&moved.w), self.fam.sectioned(&pred)) else {
+            return (pred, Some(moved));
+        };
+        // The tangent through the same map (affine in the state; by central differences for θ_0).
+        let h = 1e-6;
+        let shifted = |s: f64| self.fam.sectioned(&moved.w.iter().zip(&moved.tangent).map(|(a, b)| a + s * b).collect::<Vec<_>>());
+        if let (Some(up), Some(dn)) = (shifted(h), shifted(-h)) {
+            moved.tangent = up.iter().zip(&dn).map(|(a, b)| (a - b) / (2.0 * h)).collect();
+        }
+        moved.w = w;
+        (sectioned, Some(moved))
     }
 
     /// Phases between two events of one contact that shrink along the tangent: (phase, length,

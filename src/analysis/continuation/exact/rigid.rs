@@ -77,7 +77,20 @@ impl Walk<'_> {
         let t = lo.orbit.period();
         let mut list = timed(&lo.orbit);
         let land = if m.what == polish::STUCK { landing(&lo, m.contact, m.time) } else { None };
+        let massless = self.problem.model().contact_is_massless(&self.problem.model().contacts[m.contact]);
         let changed = match (m.what, m.event) {
+            // A massless contact point's clearance touches zero: it closes without impulse and is
+            // held, then released, a held arc of zero length there (the orbit is the same) that
+            // grows on the exact orbit.
+            (polish::CLEARANCE, _) if massless => {
+                let touch = Touch { phase: 0, contact: m.contact, value: 0.0, time: m.time, closed: false };
+                let kinds = (Switch::Impact { stick: true }, Switch::Release);
+                let (sig, guess, pair) = signature::insert(&self.fam, &lo.orbit, &touch, kinds, NEW_PAIR, lo.w[lo.w.len() - 1]);
+                if let Some(n) = self.start_phase(&lo, sig, &guess, pair, &what) {
+                    return Some(n);
+                }
+                false
+            }
             (polish::CLEARANCE, _) => {
                 let base = list.first().map_or(0.0, |l| l.0);
                 let at = base + (m.time / t - base).rem_euclid(1.0);

@@ -2,8 +2,10 @@
 //! events adds a pair of events there (contact on/off around the touch of an open contact,
 //! off/on inside a closed one; release/impact inside a rigid contact's sticking arc whose force
 //! touches zero); a phase shrinking to nothing between two events of one contact removes the pair.
+//! Not a change: events of different contacts with identity state maps passing each other.
 use super::family::{Family, Signature};
 use crate::analysis::polish::{Event, EventKind, PolishedOrbit, Touch};
+use crate::model::Model;
 
 /// The signature of `orbit` with a pair of events (`first`, `second`) `delta` (fraction of the
 /// period) apart around the touch: the new unknowns' guess (at λ/ρ `wl`) and the pair's indices
@@ -64,4 +66,93 @@ pub(super) fn guess(fam: &Family, orbit: &PolishedOrbit, list: &[(f64, Event)], 
     w.extend(list.iter().map(|l| l.0));
     w.push(wl);
     w
+}
+
+/// Whether an event of contact `c` leaves the state as it is (identity saltation): a compliant
+/// switch (the force is zero at clearance 0), or a rigid contact on a massless DOF closing or
+/// releasing (no mass to stop, zero force at both; src/analysis/polish/continued.rs).
+fn identity_map(model: &Model, c: usize) -> bool {
+    let contact = &model.contacts[c];
+    !contact.is_rigid() || model.contact_is_massless(contact)
+}
+
+/// The signature after events of different contacts, both with identity state maps, have passed
+/// each other in the unknowns `w` (times out of order): the events re-sorted by their times,
+/// event 0 kept first (its state is the unknown), and the new order (old index of each new
+/// event). Two such events may cross without a change of topology: at the crossing both orders
+/// give the same orbit and, the maps being the identity, the same flow derivative (the phase
+/// between them has zero length). `None` when nothing passed, or when an event whose map is not
+/// the identity (a plastic impact on a DOF with mass) or two events of one contact did: there a
+/// crossing is a change of the orbit's topology.
+pub(super) fn passed(fam: &Family, model: &Model, w: &[f64]) -> Option<(Signature, Vec<usize>)> {
+    let ne = fam.ne();
+    if ne < 3 {
+        return None;
+    }
+    let theta = &w[w.len() - 1 - ne..w.len() - 1];
+    let events = &fam.sig.events;
+    let mut any = false;
+    for a in 0..ne {
+        for b in a + 1..ne {
+            let d = theta[b] - theta[a];
+            if d > 0.0 && d < 1.0 {
+                continue;
+            }
+            if events[a].contact == events[b].contact || !identity_map(model, events[a].contact) || !identity_map(model, events[b].contact) {
+                return None;
+            }
+            any = true;
+        }
+    }
+    if !any {
+        return None;
+    }
+    let mut order: Vec<usize> = (0..ne).collect();
+    let psi = |e: usize| theta[0] + (theta[e] - theta[0]).rem_euclid(1.0);
+    order[1..].sort_by(|&a, &b| psi(a).total_cmp(&psi(b)));
+    let sig = Signature { events: order.iter().map(|&e| events[e]).collect(), always: fam.sig.always.clone() };
+    Some((sig, order))
+}
+
+/// `v` (unknowns or a tangent: state, event times, λ) with its event components in the new
+/// `order` of [`passed`]; with `wrap`, each time moved by whole periods into
+/// [θ_0, θ_0 + 1) (unknowns; a tangent's components are rates and keep their values).
+pub(super) fn reorder(v: &[f64], order: &[usize], wrap: bool) -> Vec<f64> {
+    let ne = order.len();
+    let n2 = v.len() - 1 - ne;
+    let mut out = v.to_vec();
+    for (x, &e) in order.iter().enumerate() {
+        let t = v[n2 + e];
+        out[n2 + x] = if wrap { v[n2] + (t - v[n2]).rem_euclid(1.0) } else { t };
+    }
+    out
+}
+
+/// The predictor `pred` from the unknowns `here` (both in the family's order) with the order of
+/// each close pair of adjacent events that may pass each other toggled (their times exchanged):
+/// a pair whose gap shrinks along the step and whose crossing lies within that change of the
+/// predicted gap, so that the corrector may land on either side of it (with event 0, its state
+/// unknown then starts from the other event's time). `None` when there is no such pair.
+pub(super) fn toggled(fam: &Family, model: &Model, here: &[f64], pred: &[f64]) -> Option<Vec<f64>> {
+    let ne = fam.ne();
+    let n2 = pred.len() - 1 - ne;
+    let events = &fam.sig.events;
+    let mut out = pred.to_vec();
+    let mut any = false;
+    for e in 0..ne {
+        let b = (e + 1) % ne;
+        if events[e].contact == events[b].contact || !identity_map(model, events[e].contact) || !identity_map(model, events[b].contact) {
+            continue;
+        }
+        // The pair (last, 0) across the period's end: event 0 a period later.
+        let wrap = if b == 0 { 1.0 } else { 0.0 };
+        let gap = here[n2 + b] + wrap - here[n2 + e];
+        let predicted = pred[n2 + b] + wrap - pred[n2 + e];
+        if predicted < gap && predicted.abs() < gap - predicted {
+            out[n2 + e] = pred[n2 + b] + wrap;
+            out[n2 + b] = pred[n2 + e] - wrap;
+            any = true;
+        }
+    }
+    any.then_some(out)
 }

@@ -1,0 +1,196 @@
+//! Events of different contacts passing each other on the exact branch (issue 24; the real
+//! blade's 17 tips on a massless boundary): not a change of topology. Two uncoupled masses,
+//! each with a massless contact point behind a spring k2 resting on a rigid stop (no impulse at
+//! the closing, a held arc, a release: identity state maps), forced at different phases. Each
+//! mass is the 1-DOF compliant stop of stiffness k2 (`exact::CompliantStopOrbit`, closed form:
+//! tests/massless_polish.rs), so the orbit, its events and multipliers are known on the whole
+//! branch. Between ω = 1.2 and 1.3 mass B's closing passes mass A's, and so does its release.
+use periodic_contact::analysis::continuation::{self, ContinuationSettings, EventKind, Parameter, Source};
+use periodic_contact::exact::{CompliantStopOrbit, Oscillator};
+use periodic_contact::model::{Compliance, Contact, Force, Harmonic, Matrix, Model, Structure};
+use periodic_contact::periodic::{OutputSelection, PeriodicProblem, SolverSettings};
+use periodic_contact::time::{Discretization, Scheme};
+
+const C: f64 = 0.05;
+/// The masses' own springs (A, B): B's events move faster with ω than A's.
+const K1: [f64; 2] = [1.0, 0.8];
+const K2: f64 = 30.0;
+const G0: f64 = 1.0;
+const F: f64 = 1.0;
+/// B's forcing leads A's by this fraction of the period: its events come that much earlier.
+const LEAD: f64 = 0.0095;
+
+/// DOFs: mass A, its point, mass B, its point; the stops on the points.
+fn model(omega: f64) -> Model {
+    let mut k = vec![vec![0.0; 4]; 4];
+    let mut m = vec![vec![0.0; 4]; 4];
+    let mut c = vec![vec![0.0; 4]; 4];
+    for (b, k1) in K1.iter().enumerate() {
+        let (x, p) = (2 * b, 2 * b + 1);
+        k[x][x] = k1 + K2;
+        k[x][p] = -K2;
+        k[p][x] = -K2;
+        k[p][p] = K2;
+        m[x][x] = 1.0;
+        c[x][x] = C;
+    }
+    let force = |dof: usize, phase: f64| Force { dof, term: Harmonic { amplitude: F, harmonic: 1, phase } };
+    Model {
+        structure: Structure { mass: Matrix::from_rows(&m), stiffness: Matrix::from_rows(&k), damping: Some(Matrix::from_rows(&c)) },
+        forces: vec![force(0, 0.0), force(2, 2.0 * std::f64::consts::PI * LEAD)],
+        contacts: vec![Contact::on_dof(1, 1.0, G0, Compliance::Rigid), Contact::on_dof(3, 1.0, G0, Compliance::Rigid)],
+        frequency: omega,
+        frictions: Vec::new(),
+        rubbing: Vec::new(),
+    }
+}
+
+/// Mass `b`'s closed-form orbit at ω (B's a fraction LEAD of the period earlier).
+fn closed_form(b: usize, omega: f64) -> CompliantStopOrbit {
+    CompliantStopOrbit::solve(&Oscillator::new(1.0, C, K1[b], F, omega), K2, G0, None).unwrap()
+}
+
+/// Closing and release times of mass `b` as fractions of the period.
+fn events(b: usize, omega: f64) -> (f64, f64) {
+    let o = closed_form(b, omega);
+    let shift = if b == 1 { LEAD } else { 0.0 };
+    let t = o.period();
+    ((o.entry_time().unwrap() / t - shift).rem_euclid(1.0), (o.exit_time().unwrap() / t - shift).rem_euclid(1.0))
+}
+
+/// The walk from 1.2 to 1.3 passes both swaps on the exact orbit, with no event of the branch
+/// (a swap is no grazing), and every point's amplitudes and nonzero multipliers are the closed
+/// forms' (the multipliers are the monodromy's, the Jacobian's state block at the point: a
+/// discontinuous Jacobian at the swap would show there).
+#[test]
+fn events_of_two_massless_contacts_pass_each_other_on_the_exact_branch() {
+    let (lo, hi) = (1.2, 1.3);
+    // The precondition, from the closed forms: B's closing and release come before A's at 1.2, after at 1.3.
+    let (a0, b0) = (events(0, lo), events(1, lo));
+    let (a1, b1) = (events(0, hi), events(1, hi));
+    eprintln!("closing A/B {:.4}/{:.4} → {:.4}/{:.4}; release {:.4}/{:.4} → {:.4}/{:.4}", a0.0, b0.0, a1.0, b1.0, a0.1, b0.1, a1.1, b1.1);
+    assert!(b0.0 < a0.0 && b1.0 > a1.0 && b0.1 < a0.1 && b1.1 > a1.1, "the closings and releases must cross in the range");
+
+    let outputs = OutputSelection { displacement: vec![0, 2], velocity: vec![], acceleration: vec![], contacts: true };
+    let disc = Discretization { scheme: Scheme::Cds, steps: 256, pairing: None };
+    let p = PeriodicProblem::new(model(lo), disc, outputs, SolverSettings::default()).unwrap();
+    let start = std::time::Instant::now();
+    let b = continuation::run(&p, Parameter::Frequency, lo, hi, &ContinuationSettings::default(), &|_| {}).unwrap();
+    eprintln!("{} points in {:.2} s: {}", b.points.len(), start.elapsed().as_secs_f64(), b.stop);
+    assert!(b.reached(), "{}", b.stop);
+    assert!(b.points.iter().all(|q| q.source == Source::Exact), "{}", b.stop);
+    for e in b.events() {
+        eprintln!("event at ω = {}: {:?} {}", e.parameter, e.event, e.detail);
+    }
+    let kinds: Vec<EventKind> = b.events().filter_map(|e| e.event).collect();
+    assert!(kinds.is_empty(), "no event on this branch: {kinds:?}");
+    let (mut amp, mut mult) = (0.0f64, 0.0f64);
+    for q in &b.points {
+        let w = q.parameter;
+        let forms = [closed_form(0, w), closed_form(1, w)];
+        for (j, o) in forms.iter().enumerate() {
+            amp = amp.max((q.amplitude[j] - 0.5 * o.peak_to_peak()).abs() / (0.5 * o.peak_to_peak()));
+        }
+        let want: Vec<num_complex::Complex64> = forms.iter().flat_map(|o| o.floquet_multipliers()).collect();
+        let got: Vec<num_complex::Complex64> = q.multipliers.iter().copied().filter(|z| z.norm() > 1e-9).collect();
+        assert_eq!(got.len(), 4, "ω = {w}: four nonzero multipliers, {got:?}");
+        mult = mult.max(multiplier_distance(&got, &want));
+    }
+    eprintln!("largest amplitude error {amp:.1e} (relative), multiplier error {mult:.1e}");
+    assert!(amp < 1e-9, "amplitudes off the closed form by {amp:.1e}");
+    assert!(mult < 1e-7, "multipliers off the closed form by {mult:.1e}");
+}
+
+/// The gap of the grazing branch: the linear orbit's peak reaches it at ω_g below resonance.
+const GRAZE_GAP: f64 = 2.0;
+
+/// One mass (DOF 0) with a massless contact point (DOF 1) behind K2 and a rigid stop GRAZE_GAP
+/// away: the 1-DOF stop of stiffness K2 (`exact::CompliantStopOrbit`).
+fn grazing_model(omega: f64) -> Model {
+    let rows = |a: [[f64; 2]; 2]| Matrix::from_rows(&a.iter().map(|r| r.to_vec()).collect::<Vec<_>>());
+    Model {
+        structure: Structure {
+            mass: rows([[1.0, 0.0], [0.0, 0.0]]),
+            stiffness: rows([[K1[0] + K2, -K2], [-K2, K2]]),
+            damping: Some(rows([[C, 0.0], [0.0, 0.0]])),
+        },
+        forces: vec![Force { dof: 0, term: Harmonic { amplitude: F, harmonic: 1, phase: 0.0 } }],
+        contacts: vec![Contact::on_dof(1, 1.0, GRAZE_GAP, Compliance::Rigid)],
+        frequency: omega,
+        frictions: Vec::new(),
+        rubbing: Vec::new(),
+    }
+}
+
+/// The walk from 0.6 to 0.8 rad/s: below ω_g the point never reaches the stop (the linear
+/// orbit, amplitude F/√((k1 − ω²)² + (cω)²)); at ω_g its clearance touches zero, and a closing
+/// and a release are born together there (no impulse: the point is massless) with a held arc of
+/// zero length between them that grows. The grazing lies where the linear amplitude is the gap
+/// (closed form: (k1 − u)² + c²u = (F/g)², u = ω²), and the branch past it is the closed form's
+/// held-arc orbit, continued on the exact orbit (not restarted from the grid).
+#[test]
+fn a_massless_contact_grazing_starts_its_held_arc_on_the_exact_branch() {
+    let (lo, hi) = (0.6, 0.8);
+    // (k1 − u)² + c²u − (F/g)² = 0, the root below resonance.
+    let (b, c0) = (C * C - 2.0 * K1[0], K1[0] * K1[0] - (F / GRAZE_GAP).powi(2));
+    let graze = ((-b - (b * b - 4.0 * c0).sqrt()) / 2.0).sqrt();
+    let linear = |w: f64| F / ((K1[0] - w * w).powi(2) + (C * w).powi(2)).sqrt();
+    assert!(linear(lo) < GRAZE_GAP && linear(hi) > GRAZE_GAP, "the grazing must lie in the range");
+    let outputs = OutputSelection { displacement: vec![0], velocity: vec![], acceleration: vec![], contacts: true };
+    let disc = Discretization { scheme: Scheme::Cds, steps: 256, pairing: None };
+    let p = PeriodicProblem::new(grazing_model(lo), disc, outputs, SolverSettings::default()).unwrap();
+    let start = std::time::Instant::now();
+    let b = continuation::run(&p, Parameter::Frequency, lo, hi, &ContinuationSettings::default(), &|_| {}).unwrap();
+    eprintln!("{} points in {:.2} s: {}", b.points.len(), start.elapsed().as_secs_f64(), b.stop);
+    for e in b.events() {
+        eprintln!("event at ω = {}: {:?} {}", e.parameter, e.event, e.detail);
+    }
+    assert!(b.reached(), "{}", b.stop);
+    assert!(b.points.iter().all(|q| q.source == Source::Exact), "{}", b.stop);
+    let grazings: Vec<f64> = b.events().filter(|e| e.event == Some(EventKind::Grazing)).map(|e| e.parameter).collect();
+    assert_eq!(grazings.len(), 1, "one grazing: {grazings:?}");
+    eprintln!("grazing at {:.12} (closed form {graze:.12})", grazings[0]);
+    assert!((grazings[0] - graze).abs() < 1e-8, "grazing at {} instead of {graze}", grazings[0]);
+    assert!(b.events().all(|e| !e.detail.contains("not traced")), "the branch past the grazing is the exact orbit's");
+    let (mut amp, mut mult, mut held) = (0.0f64, 0.0f64, 0);
+    // The closed form's held-arc orbits from hi down, each Newton seeded by the one before (past
+    // the period doubling near ω_g the simulation that seeds it by default settles elsewhere).
+    let mut points: Vec<&periodic_contact::analysis::continuation::BranchPoint> = b.points.iter().filter(|q| (q.parameter - graze).abs() > 1e-6).collect();
+    points.sort_by(|a, b| b.parameter.total_cmp(&a.parameter));
+    let mut seed = None;
+    for q in points {
+        let w = q.parameter;
+        let osc = Oscillator::new(1.0, C, K1[0], F, w);
+        let o = if w > graze {
+            CompliantStopOrbit::solve(&osc, K2, GRAZE_GAP, seed).unwrap()
+        } else {
+            CompliantStopOrbit::solve(&osc, K2, GRAZE_GAP, None).unwrap()
+        };
+        assert_eq!(o.has_contact(), w > graze, "ω = {w}: the closed form's contact");
+        if w > graze {
+            seed = Some([o.entry_time().unwrap(), o.exit_time().unwrap(), o.entry_velocity().unwrap()]);
+        }
+        let want = if w > graze { 0.5 * o.peak_to_peak() } else { linear(w) };
+        amp = amp.max((q.amplitude[0] - want).abs() / want);
+        if w > graze {
+            held += 1;
+            let got: Vec<num_complex::Complex64> = q.multipliers.iter().copied().filter(|z| z.norm() > 1e-9).collect();
+            assert_eq!(got.len(), 2, "ω = {w}: two nonzero multipliers, {got:?}");
+            mult = mult.max(multiplier_distance(&got, &o.floquet_multipliers()));
+            assert_eq!(q.stable, o.is_stable(), "ω = {w}: stability against the closed form's");
+        }
+    }
+    eprintln!("{held} points with the held arc; largest amplitude error {amp:.1e} (relative), multiplier error {mult:.1e}");
+    assert!(held >= 3, "the held arc's branch is walked");
+    assert!(amp < 1e-9, "amplitudes off the closed form by {amp:.1e}");
+    assert!(mult < 1e-7, "multipliers off the closed form by {mult:.1e}");
+}
+
+/// The largest distance from a multiplier of `a` to the nearest of `b`, and from `b` to `a`
+/// (equal moduli make any sort order fragile).
+fn multiplier_distance(a: &[num_complex::Complex64], b: &[num_complex::Complex64]) -> f64 {
+    let one_way = |x: &[num_complex::Complex64], y: &[num_complex::Complex64]| {
+        x.iter().map(|p| y.iter().map(|q| (p - q).norm()).fold(f64::MAX, f64::min)).fold(0.0f64, f64::max)
+    };
+    one_way(a, b).max(one_way(b, a))
+}
