@@ -17,6 +17,7 @@ pub mod friction;
 mod orbit;
 mod phase;
 mod rigid;
+mod signals;
 mod verify;
 
 pub use continued::Touch;
@@ -62,6 +63,8 @@ pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<PolishedOrbit, 
     let offsets: Vec<usize> = (0..model.contacts.len()).map(|i| problem.pairing_at(i).offset()).collect();
     let (evs, always) = events::from_response(model, r, &offsets);
     let evs = events::isolated_first(evs, model.period());
+    let clock = Instant::now();
+    profile("start", clock);
     let orbit = match PolishedOrbit::solve(model, evs.clone(), &always) {
         Ok(orbit) => orbit,
         Err(e) => {
@@ -74,8 +77,20 @@ pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<PolishedOrbit, 
             PolishedOrbit::solve(model, events::isolated_first(fewer, model.period()), &always).map_err(|_| e)?
         }
     };
+    profile("Newton", clock);
+    let clock = Instant::now();
     verify::check(&orbit)?;
+    profile("admissibility check", clock);
     Ok(orbit)
+}
+
+/// Prints a stage's wall time, and the thread's CPU time so far (Linux: /proc/thread-self/schedstat,
+/// the figure to read on a loaded machine), under `PERIODIC_CONTACT_PROFILE` (as the LCP's shooting does).
+pub(super) fn profile(stage: &str, since: Instant) {
+    if std::env::var_os("PERIODIC_CONTACT_PROFILE").is_some() {
+        let cpu = std::fs::read_to_string("/proc/thread-self/schedstat").ok().and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok());
+        eprintln!("polish profile: {stage} {:.3} s wall (thread CPU so far {:.3} s)", since.elapsed().as_secs_f64(), cpu.unwrap_or(f64::NAN) * 1e-9);
+    }
 }
 
 /// The exact orbit of `model` (the model of `prev` at another frequency) on `prev`'s event
@@ -138,7 +153,9 @@ pub fn apply(problem: &PeriodicProblem, r: &mut Response) -> Option<PolishedOrbi
     }
     match polish(problem, r) {
         Ok(orbit) => {
+            let clock = Instant::now();
             orbit.write(problem, r);
+            profile("writing the series", clock);
             record(r, "event-fitted exact orbit", orbit.event_records(), (orbit.iterations(), orbit.residual(), orbit.correction()), t0);
             Some(orbit)
         }

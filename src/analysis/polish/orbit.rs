@@ -45,7 +45,7 @@ pub struct PolishedOrbit {
     /// State just after each event, and the impulse of each (0 but at impacts).
     pub(super) after: Vec<DVector<f64>>,
     pub(super) impulses: Vec<f64>,
-    gaps: Vec<phase::Harmonics>,
+    pub(super) gaps: Vec<phase::Harmonics>,
     pub(super) iterations: usize,
     pub(super) residual: f64,
     pub(super) correction: f64,
@@ -54,7 +54,9 @@ pub struct PolishedOrbit {
 
 impl PolishedOrbit {
     pub(super) fn solve(model: &Model, evs: Vec<Event>, always: &[usize]) -> Result<Self, PolishFailure> {
+        let clock = std::time::Instant::now();
         let mut o = Self::new(model, evs, always)?;
+        super::profile("building the phases", clock);
         o.newton()?;
         Ok(o)
     }
@@ -220,6 +222,38 @@ impl PolishedOrbit {
         Some(Shot { end: y, conditions: g, after, impulses: imp })
     }
 
+    /// The derivative of [`Self::shoot`]'s end state by its start state at fixed event times
+    /// `tau` (the map is affine): the phases' transitions ([`Phase::transition_times`]) chained
+    /// through the linear part of each plastic impact's velocity reset, dv⁺ = (I − W B) dv⁻
+    /// (src/formulation.md §5; [`Self::variation`]'s state columns).
+    fn state_map(&self, tau: &[f64]) -> Option<DMatrix<f64>> {
+        let (n, ne) = (self.model.n(), self.events.len());
+        let mut dy = DMatrix::identity(2 * n, 2 * n);
+        for e in 0..ne.max(1) {
+            let ph = &self.phases[e];
+            let span = if ne == 0 {
+                self.period
+            } else if e + 1 < ne {
+                tau[e + 1] - tau[e]
+            } else {
+                tau[0] + self.period - tau[e]
+            };
+            dy = ph.transition_times(&ph.exp(span), &dy);
+            let Some(ev) = self.events.get((e + 1) % ne.max(1)) else { break };
+            if matches!(ev.kind, EventKind::Impact { .. }) && !self.model.contact_is_massless(&self.model.contacts[ev.contact]) {
+                let mut set: Vec<usize> = ph.stuck_contacts().collect();
+                if !set.contains(&ev.contact) {
+                    set.push(ev.contact);
+                }
+                let (b, m_inv_bt, s_inv) = self.reset(&set)?;
+                let dv = dy.rows(n, n).into_owned();
+                let jump = m_inv_bt * (s_inv * (&b * &dv));
+                dy.rows_mut(n, n).copy_from(&(dv - jump));
+            }
+        }
+        dy.iter().all(|v| v.is_finite()).then_some(dy)
+    }
+
     pub(super) fn residual_of(&self, u: &DVector<f64>) -> Option<DVector<f64>> {
         let n2 = 2 * self.model.n();
         let y0 = u.rows(0, n2).into_owned();
@@ -289,18 +323,15 @@ impl PolishedOrbit {
         let ne = self.events.len();
         let fail = |w: &str| PolishFailure(w.to_string());
         // Seed: the fixed point of the affine one-period map at the seeded times.
-        // The map is affine in the state at fixed times: its offset and its derivative from
-        // 2n + 1 shoots (the variation's state columns instead lost the coarse blade's compliant
-        // branch at its 2422.35 rad/s grazings; cause not traced).
+        // The map is affine in the state at fixed times: its offset from one shoot, its
+        // derivative from the chained transitions (`state_map`; were 2n more shoots: 139 flows of
+        // the period on the real blade, 80 % of its Newton).
+        let clock = std::time::Instant::now();
         let zero = DVector::zeros(n2);
         let c = self.shoot(&zero, &self.times).ok_or_else(|| fail("the seeded event sequence cannot be flowed"))?.end;
-        let mut phi = DMatrix::zeros(n2, n2);
-        for k in 0..n2 {
-            let mut e = zero.clone();
-            e[k] = 1.0;
-            phi.set_column(k, &(self.shoot(&e, &self.times).ok_or_else(|| fail("the seeded flow failed"))?.end - &c));
-        }
+        let phi = self.state_map(&self.times).ok_or_else(|| fail("the seeded flow failed"))?;
         let y0 = (DMatrix::identity(n2, n2) - &phi).lu().solve(&c).ok_or_else(|| fail("the seeded one-period map has a multiplier 1"))?;
+        super::profile("Newton's seed", clock);
         let mut u = DVector::zeros(n2 + ne);
         u.rows_mut(0, n2).copy_from(&y0);
         for (i, &t) in self.times.iter().take(ne).enumerate() {
@@ -369,7 +400,10 @@ impl PolishedOrbit {
         if ne > 0 {
             self.times = u.iter().skip(n2).map(|t| t - shift).collect();
         }
-        self.finish()
+        let clock = std::time::Instant::now();
+        let done = self.finish();
+        super::profile("the monodromy", clock);
+        done
     }
 
     /// The states after the events, the impulses and the monodromy of the orbit at y0 and times.

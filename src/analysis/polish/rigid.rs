@@ -181,14 +181,13 @@ impl PolishedOrbit {
             let (t0, t1) = if ne == 0 { (0.0, self.period) } else { (tau[e], if e + 1 < ne { tau[e + 1] } else { ret }) };
             let ex = ph.exp(t1 - t0);
             let ym = ph.flow_with(&ex, t0, &y, t1);
-            let phi = ph.transition(&ex);
-            dy = &phi * dy;
+            dy = ph.transition_times(&ex, &dy);
             if ne == 0 {
                 y = ym;
                 break;
             }
             let (next, end_col) = ((e + 1) % ne, if e + 1 < ne { n2 + e + 1 } else { n2 + ne });
-            let f0 = &phi * field(e, &y, t0);
+            let f0 = ph.transition_times(&ex, &DMatrix::from_column_slice(n2, 1, field(e, &y, t0).as_slice())).column(0).into_owned();
             let f1 = field(e, &ym, t1);
             for r in 0..n2 {
                 dy[(r, n2 + e)] -= f0[r];
