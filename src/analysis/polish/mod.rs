@@ -102,11 +102,62 @@ pub fn follow(model: &Model, prev: &PolishedOrbit) -> Result<PolishedOrbit, Poli
     let parts = prev.parts();
     let scale = model.period() / prev.period();
     let events = parts.events.into_iter().map(|e| Event { seed: e.seed * scale, ..e }).collect();
-    let mut orbit = PolishedOrbit::new(model, events, &parts.always)?;
+    settle(model, prev, events, &parts.always).map_err(|(e, _)| e)
+}
+
+/// Newton on the signature `events` (seeded) from `prev`'s decompositions, then the check; on a
+/// failed check also the unverified orbit and where it dips through a contact.
+fn settle(model: &Model, prev: &PolishedOrbit, events: Vec<Event>, always: &[usize]) -> Result<PolishedOrbit, (PolishFailure, Option<verify::Dip>)> {
+    let mut orbit = PolishedOrbit::new(model, events, always).map_err(|e| (e, None))?;
     orbit.share_modes(prev);
-    orbit.newton()?;
-    verify::check(&orbit)?;
+    orbit.newton().map_err(|e| (e, None))?;
+    verify::check_dip(&orbit)?;
     Ok(orbit)
+}
+
+/// Shortest spans of one contact tried removed when [`follow_across`] looks for the next signature.
+const VANISHING: usize = 2;
+
+/// [`follow`], and where `prev`'s signature no longer holds, the neighbouring signatures it
+/// predicts (`sweep --exact` across signature changes; the real blade's changes every ~0.75 rad/s):
+/// where Newton converges but the orbit dips through a contact, that contact switched twice around
+/// the dip (a grazing crossed: a new arc or gap); where Newton fails, one of the [`VANISHING`]
+/// shortest arcs or gaps of one contact removed (it shrank to nothing, or two arcs merged), then
+/// once more switched around a dip. The first admissible orbit is taken; else `follow`'s failure.
+pub fn follow_across(model: &Model, prev: &PolishedOrbit) -> Result<PolishedOrbit, PolishFailure> {
+    let parts = prev.parts();
+    let period = model.period();
+    let events: Vec<Event> = parts.events.iter().map(|e| Event { seed: e.seed * period / prev.period(), ..*e }).collect();
+    let first = match settle(model, prev, events.clone(), &parts.always) {
+        Ok(orbit) => return Ok(orbit),
+        Err(e) => e,
+    };
+    let around = |(evs, always): (Vec<Event>, Vec<usize>), dip: &verify::Dip| {
+        let (evs, always) = events::with_run(model, &evs, &always, (dip.contact, dip.time, dip.closed), dip.half_width(period, &evs));
+        (events::normalised(evs, period), always)
+    };
+    let mut tries: Vec<(Vec<Event>, Vec<usize>)> = Vec::new();
+    if let Some(dip) = &first.1 {
+        tries.push(around((events.clone(), parts.always.clone()), dip));
+    }
+    tries.extend(
+        events::without_shortest(&events::normalised(events, period), &parts.always, period, VANISHING)
+            .into_iter()
+            .map(|(e, a)| (events::normalised(e, period), a)),
+    );
+    for (evs, always) in tries {
+        match settle(model, prev, evs.clone(), &always) {
+            Ok(orbit) => return Ok(orbit),
+            Err((_, Some(dip))) => {
+                let (evs, always) = around((evs, always), &dip);
+                if let Ok(orbit) = settle(model, prev, evs, &always) {
+                    return Ok(orbit);
+                }
+            }
+            Err(_) => {}
+        }
+    }
+    Err(first.0)
 }
 
 /// The contact-free periodic orbit of `model` (every contact open all period, not checked

@@ -222,38 +222,6 @@ impl PolishedOrbit {
         Some(Shot { end: y, conditions: g, after, impulses: imp })
     }
 
-    /// The derivative of [`Self::shoot`]'s end state by its start state at fixed event times
-    /// `tau` (the map is affine): the phases' transitions ([`Phase::transition_times`]) chained
-    /// through the linear part of each plastic impact's velocity reset, dv⁺ = (I − W B) dv⁻
-    /// (src/formulation.md §5; [`Self::variation`]'s state columns).
-    fn state_map(&self, tau: &[f64]) -> Option<DMatrix<f64>> {
-        let (n, ne) = (self.model.n(), self.events.len());
-        let mut dy = DMatrix::identity(2 * n, 2 * n);
-        for e in 0..ne.max(1) {
-            let ph = &self.phases[e];
-            let span = if ne == 0 {
-                self.period
-            } else if e + 1 < ne {
-                tau[e + 1] - tau[e]
-            } else {
-                tau[0] + self.period - tau[e]
-            };
-            dy = ph.transition_times(&ph.exp(span), &dy);
-            let Some(ev) = self.events.get((e + 1) % ne.max(1)) else { break };
-            if matches!(ev.kind, EventKind::Impact { .. }) && !self.model.contact_is_massless(&self.model.contacts[ev.contact]) {
-                let mut set: Vec<usize> = ph.stuck_contacts().collect();
-                if !set.contains(&ev.contact) {
-                    set.push(ev.contact);
-                }
-                let (b, m_inv_bt, s_inv) = self.reset(&set)?;
-                let dv = dy.rows(n, n).into_owned();
-                let jump = m_inv_bt * (s_inv * (&b * &dv));
-                dy.rows_mut(n, n).copy_from(&(dv - jump));
-            }
-        }
-        dy.iter().all(|v| v.is_finite()).then_some(dy)
-    }
-
     pub(super) fn residual_of(&self, u: &DVector<f64>) -> Option<DVector<f64>> {
         let n2 = 2 * self.model.n();
         let y0 = u.rows(0, n2).into_owned();

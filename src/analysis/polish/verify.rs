@@ -5,7 +5,7 @@
 //! impulses ≥ 0, and a pure impact may not call for sticking (the force that would hold the
 //! contact just after it must not be compressive).
 use super::PolishFailure;
-use super::events::EventKind;
+use super::events::{Event, EventKind};
 use super::orbit::PolishedOrbit;
 use super::phase::{Phase, Transient};
 use super::signals::Signal;
@@ -57,7 +57,42 @@ pub(super) fn golden(mut lo: f64, mut hi: f64, iterations: usize, f: &dyn Fn(f64
     (t, f(t))
 }
 
+/// Where an orbit dips through a contact between events: the contact, the time of its lowest
+/// value, whether it is closed there (stuck or on), and the events around.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Dip {
+    pub contact: usize,
+    pub time: f64,
+    pub closed: bool,
+    start: f64,
+    end: f64,
+}
+
+impl Dip {
+    /// Half the width of the run seeded around the dip: 1e-3 T, within 0.4 of the room to the
+    /// events around it (of the phase and of `events`).
+    pub fn half_width(&self, period: f64, events: &[Event]) -> f64 {
+        let room =
+            events.iter().map(|e| (e.seed - self.time).rem_euclid(period).min((self.time - e.seed).rem_euclid(period))).fold(self.time - self.start, f64::min);
+        (1e-3 * period).min(0.4 * room.min(self.end - self.time)).max(1e-9 * period)
+    }
+}
+
+/// [`check`], and where it fails between events, the dip ([`Dip`]).
+pub(super) fn check_dip(o: &PolishedOrbit) -> Result<(), (PolishFailure, Option<Dip>)> {
+    let mut dip = None;
+    check_with(o, &mut |d| dip = Some(d)).map_err(|e| (e, dip))
+}
+
 pub(super) fn check(o: &PolishedOrbit) -> Result<(), PolishFailure> {
+    check_with(o, &mut |_| {})
+}
+
+fn what_sign(o: &PolishedOrbit, e: usize, i: usize) -> bool {
+    o.phases[e].stuck_contacts().any(|k| k == i) || o.phases[e].closed(i)
+}
+
+fn check_with(o: &PolishedOrbit, on_dip: &mut dyn FnMut(Dip)) -> Result<(), PolishFailure> {
     let model = &o.model;
     let ne = o.events.len().max(1);
     // Scales: the largest normal displacement of a contact and the largest force met.
@@ -76,6 +111,7 @@ pub(super) fn check(o: &PolishedOrbit) -> Result<(), PolishFailure> {
         };
         for (i, v, t, what) in lowest {
             if v < -TOL {
+                on_dip(Dip { contact: i, time: t, closed: what_sign(o, e, i), start: a, end: b });
                 return Err(PolishFailure(format!(
                     "contact[{i}]: the {what} is negative ({:.3e} relative) at t = {:.6} between the events at {a:.6} and {b:.6}: the LCP's event sequence is not admissible for the exact orbit",
                     v,
