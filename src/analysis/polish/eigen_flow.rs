@@ -67,6 +67,15 @@ impl EigenFlow {
         re * &self.inv_re - im * &self.inv_im
     }
 
+    /// The eigenvalues λ_j and the columns of V scaled by the modal coordinates c = V⁻¹ u:
+    /// e^{Âτ} u = Re Σ_j (V_j c_j) e^{λ_j τ} (the phase's transient as exponentials, for the
+    /// admissibility check's closed-form signals).
+    pub fn modal(&self, u: &DVector<f64>) -> (Vec<C>, DMatrix<C>) {
+        let (re, im) = (&self.inv_re * u, &self.inv_im * u);
+        let q = DMatrix::from_fn(self.v_re.nrows(), self.lambda.len(), |i, j| C::new(self.v_re[(i, j)], self.v_im[(i, j)]) * C::new(re[j], im[j]));
+        (self.lambda.clone(), q)
+    }
+
     /// e^{Âτ} u in O(n_a²): V (e^{Λτ} ⊙ V⁻¹ u).
     pub fn apply(&self, tau: f64, u: &DVector<f64>) -> DVector<f64> {
         let (w_re, w_im) = (&self.inv_re * u, &self.inv_im * u);

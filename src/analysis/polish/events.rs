@@ -170,6 +170,58 @@ pub fn without_short_runs(model: &Model, events: &[Event], span: f64, period: f6
     events.iter().zip(&drop).filter(|(_, d)| !**d).map(|(e, _)| *e).collect()
 }
 
+/// `events` in [0, T), sorted, event 0 the most isolated ([`isolated_first`]).
+pub fn normalised(mut events: Vec<Event>, period: f64) -> Vec<Event> {
+    events.iter_mut().for_each(|e| e.seed = e.seed.rem_euclid(period));
+    events.sort_by(|a, b| a.seed.total_cmp(&b.seed));
+    isolated_first(events, period)
+}
+
+/// The signatures of `events` (with `always`) in which one contact's shortest runs vanish: for
+/// each of the `count` shortest spans between two consecutive events of the same contact (an arc
+/// or a gap that shrank toward nothing as the parameter moved), the events without those two;
+/// a contact whose only gap vanishes is then closed all period.
+pub fn without_shortest(events: &[Event], always: &[usize], period: f64, count: usize) -> Vec<(Vec<Event>, Vec<usize>)> {
+    let ne = events.len();
+    let mut spans: Vec<(f64, usize, usize)> = Vec::new();
+    for (a, e) in events.iter().enumerate() {
+        if let Some(b) = (1..ne).map(|s| (a + s) % ne).find(|&b| events[b].contact == e.contact) {
+            spans.push(((events[b].seed - e.seed).rem_euclid(period), a, b));
+        }
+    }
+    spans.sort_by(|x, y| x.0.total_cmp(&y.0));
+    spans
+        .into_iter()
+        .take(count)
+        .map(|(_, a, b)| {
+            let kept: Vec<Event> = events.iter().enumerate().filter(|(k, _)| *k != a && *k != b).map(|(_, e)| *e).collect();
+            let mut always = always.to_vec();
+            if !kept.iter().any(|e| e.contact == events[a].contact) && !after(events[a].kind) {
+                always.push(events[a].contact);
+                always.sort_unstable();
+            }
+            (kept, always)
+        })
+        .collect()
+}
+
+/// `events` with contact `i` switched twice around `t`, at t ∓ `half`: closed (a rigid contact
+/// stuck, a compliant one on) where it was free, free where it was closed (`closed`) — a grazing
+/// that the orbit now crosses. `always` loses `i` when it held it.
+pub fn with_run(model: &Model, events: &[Event], always: &[usize], (i, t, closed): (usize, f64, bool), half: f64) -> (Vec<Event>, Vec<usize>) {
+    let rigid = model.contacts[i].is_rigid();
+    let (first, second) = match (rigid, closed) {
+        (true, false) => (EventKind::Impact { stick: true }, EventKind::Release),
+        (true, true) => (EventKind::Release, EventKind::Impact { stick: true }),
+        (false, false) => (EventKind::On, EventKind::Off),
+        (false, true) => (EventKind::Off, EventKind::On),
+    };
+    let mut out = events.to_vec();
+    out.push(Event { contact: i, kind: first, seed: t - half });
+    out.push(Event { contact: i, kind: second, seed: t + half });
+    (out, always.iter().copied().filter(|&k| k != i).collect())
+}
+
 /// The contacts closed (stuck rigid, closed compliant) in the phase after each event: each
 /// contact is closed after its own last event of the sequence before wrapping around.
 pub fn phase_sets(model: &Model, events: &[Event], always: &[usize]) -> Vec<Vec<usize>> {

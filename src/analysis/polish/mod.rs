@@ -17,6 +17,7 @@ pub mod friction;
 mod orbit;
 mod phase;
 mod rigid;
+mod signals;
 mod verify;
 
 pub use continued::Touch;
@@ -62,6 +63,8 @@ pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<PolishedOrbit, 
     let offsets: Vec<usize> = (0..model.contacts.len()).map(|i| problem.pairing_at(i).offset()).collect();
     let (evs, always) = events::from_response(model, r, &offsets);
     let evs = events::isolated_first(evs, model.period());
+    let clock = Instant::now();
+    profile("start", clock);
     let orbit = match PolishedOrbit::solve(model, evs.clone(), &always) {
         Ok(orbit) => orbit,
         Err(e) => {
@@ -74,8 +77,20 @@ pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<PolishedOrbit, 
             PolishedOrbit::solve(model, events::isolated_first(fewer, model.period()), &always).map_err(|_| e)?
         }
     };
+    profile("Newton", clock);
+    let clock = Instant::now();
     verify::check(&orbit)?;
+    profile("admissibility check", clock);
     Ok(orbit)
+}
+
+/// Prints a stage's wall time, and the thread's CPU time so far (Linux: /proc/thread-self/schedstat,
+/// the figure to read on a loaded machine), under `PERIODIC_CONTACT_PROFILE` (as the LCP's shooting does).
+pub(super) fn profile(stage: &str, since: Instant) {
+    if std::env::var_os("PERIODIC_CONTACT_PROFILE").is_some() {
+        let cpu = std::fs::read_to_string("/proc/thread-self/schedstat").ok().and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok());
+        eprintln!("polish profile: {stage} {:.3} s wall (thread CPU so far {:.3} s)", since.elapsed().as_secs_f64(), cpu.unwrap_or(f64::NAN) * 1e-9);
+    }
 }
 
 /// The exact orbit of `model` (the model of `prev` at another frequency) on `prev`'s event
@@ -87,11 +102,62 @@ pub fn follow(model: &Model, prev: &PolishedOrbit) -> Result<PolishedOrbit, Poli
     let parts = prev.parts();
     let scale = model.period() / prev.period();
     let events = parts.events.into_iter().map(|e| Event { seed: e.seed * scale, ..e }).collect();
-    let mut orbit = PolishedOrbit::new(model, events, &parts.always)?;
+    settle(model, prev, events, &parts.always).map_err(|(e, _)| e)
+}
+
+/// Newton on the signature `events` (seeded) from `prev`'s decompositions, then the check; on a
+/// failed check also the unverified orbit and where it dips through a contact.
+fn settle(model: &Model, prev: &PolishedOrbit, events: Vec<Event>, always: &[usize]) -> Result<PolishedOrbit, (PolishFailure, Option<verify::Dip>)> {
+    let mut orbit = PolishedOrbit::new(model, events, always).map_err(|e| (e, None))?;
     orbit.share_modes(prev);
-    orbit.newton()?;
-    verify::check(&orbit)?;
+    orbit.newton().map_err(|e| (e, None))?;
+    verify::check_dip(&orbit)?;
     Ok(orbit)
+}
+
+/// Shortest spans of one contact tried removed when [`follow_across`] looks for the next signature.
+const VANISHING: usize = 2;
+
+/// [`follow`], and where `prev`'s signature no longer holds, the neighbouring signatures it
+/// predicts (`sweep --exact` across signature changes; the real blade's changes every ~0.75 rad/s):
+/// where Newton converges but the orbit dips through a contact, that contact switched twice around
+/// the dip (a grazing crossed: a new arc or gap); where Newton fails, one of the [`VANISHING`]
+/// shortest arcs or gaps of one contact removed (it shrank to nothing, or two arcs merged), then
+/// once more switched around a dip. The first admissible orbit is taken; else `follow`'s failure.
+pub fn follow_across(model: &Model, prev: &PolishedOrbit) -> Result<PolishedOrbit, PolishFailure> {
+    let parts = prev.parts();
+    let period = model.period();
+    let events: Vec<Event> = parts.events.iter().map(|e| Event { seed: e.seed * period / prev.period(), ..*e }).collect();
+    let first = match settle(model, prev, events.clone(), &parts.always) {
+        Ok(orbit) => return Ok(orbit),
+        Err(e) => e,
+    };
+    let around = |(evs, always): (Vec<Event>, Vec<usize>), dip: &verify::Dip| {
+        let (evs, always) = events::with_run(model, &evs, &always, (dip.contact, dip.time, dip.closed), dip.half_width(period, &evs));
+        (events::normalised(evs, period), always)
+    };
+    let mut tries: Vec<(Vec<Event>, Vec<usize>)> = Vec::new();
+    if let Some(dip) = &first.1 {
+        tries.push(around((events.clone(), parts.always.clone()), dip));
+    }
+    tries.extend(
+        events::without_shortest(&events::normalised(events, period), &parts.always, period, VANISHING)
+            .into_iter()
+            .map(|(e, a)| (events::normalised(e, period), a)),
+    );
+    for (evs, always) in tries {
+        match settle(model, prev, evs.clone(), &always) {
+            Ok(orbit) => return Ok(orbit),
+            Err((_, Some(dip))) => {
+                let (evs, always) = around((evs, always), &dip);
+                if let Ok(orbit) = settle(model, prev, evs, &always) {
+                    return Ok(orbit);
+                }
+            }
+            Err(_) => {}
+        }
+    }
+    Err(first.0)
 }
 
 /// The contact-free periodic orbit of `model` (every contact open all period, not checked
@@ -138,7 +204,9 @@ pub fn apply(problem: &PeriodicProblem, r: &mut Response) -> Option<PolishedOrbi
     }
     match polish(problem, r) {
         Ok(orbit) => {
+            let clock = Instant::now();
             orbit.write(problem, r);
+            profile("writing the series", clock);
             record(r, "event-fitted exact orbit", orbit.event_records(), (orbit.iterations(), orbit.residual(), orbit.correction()), t0);
             Some(orbit)
         }

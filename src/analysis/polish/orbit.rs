@@ -45,7 +45,7 @@ pub struct PolishedOrbit {
     /// State just after each event, and the impulse of each (0 but at impacts).
     pub(super) after: Vec<DVector<f64>>,
     pub(super) impulses: Vec<f64>,
-    gaps: Vec<phase::Harmonics>,
+    pub(super) gaps: Vec<phase::Harmonics>,
     pub(super) iterations: usize,
     pub(super) residual: f64,
     pub(super) correction: f64,
@@ -54,7 +54,9 @@ pub struct PolishedOrbit {
 
 impl PolishedOrbit {
     pub(super) fn solve(model: &Model, evs: Vec<Event>, always: &[usize]) -> Result<Self, PolishFailure> {
+        let clock = std::time::Instant::now();
         let mut o = Self::new(model, evs, always)?;
+        super::profile("building the phases", clock);
         o.newton()?;
         Ok(o)
     }
@@ -289,18 +291,15 @@ impl PolishedOrbit {
         let ne = self.events.len();
         let fail = |w: &str| PolishFailure(w.to_string());
         // Seed: the fixed point of the affine one-period map at the seeded times.
-        // The map is affine in the state at fixed times: its offset and its derivative from
-        // 2n + 1 shoots (the variation's state columns instead lost the coarse blade's compliant
-        // branch at its 2422.35 rad/s grazings; cause not traced).
+        // The map is affine in the state at fixed times: its offset from one shoot, its
+        // derivative from the chained transitions (`state_map`; were 2n more shoots: 139 flows of
+        // the period on the real blade, 80 % of its Newton).
+        let clock = std::time::Instant::now();
         let zero = DVector::zeros(n2);
         let c = self.shoot(&zero, &self.times).ok_or_else(|| fail("the seeded event sequence cannot be flowed"))?.end;
-        let mut phi = DMatrix::zeros(n2, n2);
-        for k in 0..n2 {
-            let mut e = zero.clone();
-            e[k] = 1.0;
-            phi.set_column(k, &(self.shoot(&e, &self.times).ok_or_else(|| fail("the seeded flow failed"))?.end - &c));
-        }
+        let phi = self.state_map(&self.times).ok_or_else(|| fail("the seeded flow failed"))?;
         let y0 = (DMatrix::identity(n2, n2) - &phi).lu().solve(&c).ok_or_else(|| fail("the seeded one-period map has a multiplier 1"))?;
+        super::profile("Newton's seed", clock);
         let mut u = DVector::zeros(n2 + ne);
         u.rows_mut(0, n2).copy_from(&y0);
         for (i, &t) in self.times.iter().take(ne).enumerate() {
@@ -369,7 +368,10 @@ impl PolishedOrbit {
         if ne > 0 {
             self.times = u.iter().skip(n2).map(|t| t - shift).collect();
         }
-        self.finish()
+        let clock = std::time::Instant::now();
+        let done = self.finish();
+        super::profile("the monodromy", clock);
+        done
     }
 
     /// The states after the events, the impulses and the monodromy of the orbit at y0 and times.

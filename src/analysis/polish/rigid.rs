@@ -147,6 +147,38 @@ pub(super) struct Variation {
 pub(super) type Reset = (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>);
 
 impl PolishedOrbit {
+    /// The derivative of the one-period shoot's end state by its start state at fixed event times
+    /// `tau` (the map is affine): the phases' transitions ([`Phase::transition_times`]) chained
+    /// through the linear part of each plastic impact's velocity reset, dv⁺ = (I − W B) dv⁻
+    /// (src/formulation.md §5; [`Self::variation`]'s state columns).
+    pub(super) fn state_map(&self, tau: &[f64]) -> Option<DMatrix<f64>> {
+        let (n, ne) = (self.model.n(), self.events.len());
+        let mut dy = DMatrix::identity(2 * n, 2 * n);
+        for e in 0..ne.max(1) {
+            let ph = &self.phases[e];
+            let span = if ne == 0 {
+                self.period
+            } else if e + 1 < ne {
+                tau[e + 1] - tau[e]
+            } else {
+                tau[0] + self.period - tau[e]
+            };
+            dy = ph.transition_times(&ph.exp(span), &dy);
+            let Some(ev) = self.events.get((e + 1) % ne.max(1)) else { break };
+            if matches!(ev.kind, EventKind::Impact { .. }) && !self.model.contact_is_massless(&self.model.contacts[ev.contact]) {
+                let mut set: Vec<usize> = ph.stuck_contacts().collect();
+                if !set.contains(&ev.contact) {
+                    set.push(ev.contact);
+                }
+                let (b, m_inv_bt, s_inv) = self.reset(&set)?;
+                let dv = dy.rows(n, n).into_owned();
+                let jump = m_inv_bt * (s_inv * (&b * &dv));
+                dy.rows_mut(n, n).copy_from(&(dv - jump));
+            }
+        }
+        dy.iter().all(|v| v.is_finite()).then_some(dy)
+    }
+
     pub(super) fn reset(&self, set: &[usize]) -> Option<Reset> {
         let n = self.model.n();
         let m_inv = super::phase::dense(&self.model.structure.mass, n).try_inverse()?;
@@ -181,14 +213,13 @@ impl PolishedOrbit {
             let (t0, t1) = if ne == 0 { (0.0, self.period) } else { (tau[e], if e + 1 < ne { tau[e + 1] } else { ret }) };
             let ex = ph.exp(t1 - t0);
             let ym = ph.flow_with(&ex, t0, &y, t1);
-            let phi = ph.transition(&ex);
-            dy = &phi * dy;
+            dy = ph.transition_times(&ex, &dy);
             if ne == 0 {
                 y = ym;
                 break;
             }
             let (next, end_col) = ((e + 1) % ne, if e + 1 < ne { n2 + e + 1 } else { n2 + ne });
-            let f0 = &phi * field(e, &y, t0);
+            let f0 = ph.transition_times(&ex, &DMatrix::from_column_slice(n2, 1, field(e, &y, t0).as_slice())).column(0).into_owned();
             let f1 = field(e, &ym, t1);
             for r in 0..n2 {
                 dy[(r, n2 + e)] -= f0[r];

@@ -5,10 +5,12 @@
 //! impulses ≥ 0, and a pure impact may not call for sticking (the force that would hold the
 //! contact just after it must not be compressive).
 use super::PolishFailure;
-use super::events::EventKind;
+use super::events::{Event, EventKind};
 use super::orbit::PolishedOrbit;
-use super::phase::Phase;
+use super::phase::{Phase, Transient};
+use super::signals::Signal;
 use nalgebra::DVector;
+use num_complex::Complex64 as C;
 
 /// Samples per phase before the local refinement.
 const SAMPLES: usize = 200;
@@ -55,7 +57,42 @@ pub(super) fn golden(mut lo: f64, mut hi: f64, iterations: usize, f: &dyn Fn(f64
     (t, f(t))
 }
 
+/// Where an orbit dips through a contact between events: the contact, the time of its lowest
+/// value, whether it is closed there (stuck or on), and the events around.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Dip {
+    pub contact: usize,
+    pub time: f64,
+    pub closed: bool,
+    start: f64,
+    end: f64,
+}
+
+impl Dip {
+    /// Half the width of the run seeded around the dip: 1e-3 T, within 0.4 of the room to the
+    /// events around it (of the phase and of `events`).
+    pub fn half_width(&self, period: f64, events: &[Event]) -> f64 {
+        let room =
+            events.iter().map(|e| (e.seed - self.time).rem_euclid(period).min((self.time - e.seed).rem_euclid(period))).fold(self.time - self.start, f64::min);
+        (1e-3 * period).min(0.4 * room.min(self.end - self.time)).max(1e-9 * period)
+    }
+}
+
+/// [`check`], and where it fails between events, the dip ([`Dip`]).
+pub(super) fn check_dip(o: &PolishedOrbit) -> Result<(), (PolishFailure, Option<Dip>)> {
+    let mut dip = None;
+    check_with(o, &mut |d| dip = Some(d)).map_err(|e| (e, dip))
+}
+
 pub(super) fn check(o: &PolishedOrbit) -> Result<(), PolishFailure> {
+    check_with(o, &mut |_| {})
+}
+
+fn what_sign(o: &PolishedOrbit, e: usize, i: usize) -> bool {
+    o.phases[e].stuck_contacts().any(|k| k == i) || o.phases[e].closed(i)
+}
+
+fn check_with(o: &PolishedOrbit, on_dip: &mut dyn FnMut(Dip)) -> Result<(), PolishFailure> {
     let model = &o.model;
     let ne = o.events.len().max(1);
     // Scales: the largest normal displacement of a contact and the largest force met.
@@ -68,36 +105,13 @@ pub(super) fn check(o: &PolishedOrbit) -> Result<(), PolishFailure> {
     }
     for e in 0..ne {
         let (a, b) = (o.times[e], if e + 1 < o.events.len() { o.times[e + 1] } else { o.times[0] + o.period });
-        let ph: &Phase = &o.phases[e];
-        let y0 = &o.after[e];
-        let state = |t: f64| ph.flow(a, y0, t);
-        // The samples' states once for every contact: one exponential, then a product per sample.
-        let ts: Vec<f64> = (0..=SAMPLES).map(|j| a + (b - a) * j as f64 / SAMPLES as f64).collect();
-        let step = ph.exp((b - a) / SAMPLES as f64);
-        let mut ys = vec![ph.flow(a, y0, a)];
-        for w in ts.windows(2) {
-            let next = ph.flow_with(&step, w[0], ys.last().expect("one"), w[1]);
-            ys.push(next);
-        }
-        let forces: Vec<Vec<(usize, f64)>> = ys.iter().zip(&ts).map(|(y, &t)| ph.stuck_forces(y, t)).collect();
-        let stuck: Vec<usize> = ph.stuck_contacts().collect();
-        for (i, c) in model.contacts.iter().enumerate() {
-            let (v, t, what) = if let Some(s) = stuck.iter().position(|&k| k == i) {
-                let vs: Vec<f64> = forces.iter().map(|z| z[s].1).collect();
-                let (v, t) = minimum(&ts, &vs, &|t| ph.stuck_forces(&state(t), t)[s].1);
-                (v / fs, t, "force")
-            } else if c.is_rigid() {
-                let vs: Vec<f64> = ys.iter().zip(&ts).map(|(y, &t)| o.clearance(i, y, t)).collect();
-                let (v, t) = minimum(&ts, &vs, &|t| o.clearance(i, &state(t), t));
-                (v / xs, t, "clearance")
-            } else {
-                let closed = o.phases[e].closed(i);
-                let sign = if closed { -1.0 } else { 1.0 };
-                let vs: Vec<f64> = ys.iter().zip(&ts).map(|(y, &t)| sign * o.clearance(i, y, t)).collect();
-                let (v, t) = minimum(&ts, &vs, &|t| sign * o.clearance(i, &state(t), t));
-                (v / xs, t, if closed { "penetration of the closed compliant contact" } else { "clearance of the open compliant contact" })
-            };
+        let lowest = match o.phases[e].transient(a, &o.after[e]) {
+            Some(transient) => closed_form(o, e, &transient, (a, b), (xs, fs)),
+            None => sampled(o, e, (a, b), (xs, fs)),
+        };
+        for (i, v, t, what) in lowest {
             if v < -TOL {
+                on_dip(Dip { contact: i, time: t, closed: what_sign(o, e, i), start: a, end: b });
                 return Err(PolishFailure(format!(
                     "contact[{i}]: the {what} is negative ({:.3e} relative) at t = {:.6} between the events at {a:.6} and {b:.6}: the LCP's event sequence is not admissible for the exact orbit",
                     v,
@@ -125,6 +139,86 @@ pub(super) fn check(o: &PolishedOrbit) -> Result<(), PolishFailure> {
         }
     }
     Ok(())
+}
+
+/// Each contact's smallest value over phase `e` on [a, b] of what [`check`] signs (the held force
+/// of a stuck contact, the clearance of a free rigid one, the signed clearance of a compliant
+/// one), over its scale (`xs` clearances, `fs` forces): (contact, value, time, what).
+type Lowest = Vec<(usize, f64, f64, &'static str)>;
+
+/// What is signed for contact `i` in phase `e`, and its sign (−1: a closed compliant contact's penetration).
+fn what(o: &PolishedOrbit, e: usize, i: usize) -> (&'static str, f64) {
+    if o.phases[e].stuck_contacts().any(|k| k == i) {
+        ("force", 1.0)
+    } else if o.model.contacts[i].is_rigid() {
+        ("clearance", 1.0)
+    } else if o.phases[e].closed(i) {
+        ("penetration of the closed compliant contact", -1.0)
+    } else {
+        ("clearance of the open compliant contact", 1.0)
+    }
+}
+
+/// [`Lowest`] from the signals in closed form (signals.rs): the phase's transient from its start
+/// state and its particular solution, each contact's row on them.
+fn closed_form(o: &PolishedOrbit, e: usize, transient: &Transient, (a, b): (f64, f64), (xs, fs): (f64, f64)) -> Lowest {
+    let (model, ph) = (&o.model, &o.phases[e]);
+    let (n, w) = (model.n(), model.frequency);
+    let part = ph.particular();
+    let stuck: Vec<usize> = ph.stuck_contacts().collect();
+    let held = if stuck.is_empty() { vec![] } else { ph.stuck_force_particular(&part) };
+    let mut out = Vec::new();
+    for (i, c) in model.contacts.iter().enumerate() {
+        let (what, sign) = what(o, e, i);
+        let (rho, harmonics, scale) = if let Some(s) = stuck.iter().position(|&k| k == i) {
+            let rho = ph.stuck_force_gradient().row(s).transpose();
+            (rho, held.iter().map(|(p, z)| (*p as f64 * w, z[s])).collect::<Vec<_>>(), fs)
+        } else {
+            // sign·(gap(t) − B_i x(t)).
+            let mut rho = DVector::zeros(2 * n);
+            c.row.iter().for_each(|&(d, cd)| rho[d] = -sign * cd);
+            let mut h: Vec<(f64, C)> = o.gaps[i].iter().map(|(p, g)| (*p as f64 * w, g[0] * sign)).collect();
+            h.extend(part.iter().map(|(p, y)| (*p as f64 * w, -c.along(|d| y[d]) * sign)));
+            (rho, h, xs)
+        };
+        let signal = Signal::new(a, transient.lambda.clone(), transient.coefficients(&rho), harmonics);
+        let (v, t) = signal.lowest(a, b, -TOL * scale);
+        out.push((i, v / scale, t, what));
+    }
+    out
+}
+
+/// [`Lowest`] by [`SAMPLES`] flows over the phase and a golden section around each sampled local
+/// minimum (a phase without an eigendecomposition: its flows are Padé's).
+fn sampled(o: &PolishedOrbit, e: usize, (a, b): (f64, f64), (xs, fs): (f64, f64)) -> Lowest {
+    let ph: &Phase = &o.phases[e];
+    let y0 = &o.after[e];
+    let state = |t: f64| ph.flow(a, y0, t);
+    // The samples' states once for every contact: one exponential, then a product per sample.
+    let ts: Vec<f64> = (0..=SAMPLES).map(|j| a + (b - a) * j as f64 / SAMPLES as f64).collect();
+    let step = ph.exp((b - a) / SAMPLES as f64);
+    let mut ys = vec![ph.flow(a, y0, a)];
+    for w in ts.windows(2) {
+        let next = ph.flow_with(&step, w[0], ys.last().expect("one"), w[1]);
+        ys.push(next);
+    }
+    let forces: Vec<Vec<(usize, f64)>> = ys.iter().zip(&ts).map(|(y, &t)| ph.stuck_forces(y, t)).collect();
+    let stuck: Vec<usize> = ph.stuck_contacts().collect();
+    let mut out = Vec::new();
+    for i in 0..o.model.contacts.len() {
+        let (what, sign) = what(o, e, i);
+        let (v, t) = if let Some(s) = stuck.iter().position(|&k| k == i) {
+            let vs: Vec<f64> = forces.iter().map(|z| z[s].1).collect();
+            let (v, t) = minimum(&ts, &vs, &|t| ph.stuck_forces(&state(t), t)[s].1);
+            (v / fs, t)
+        } else {
+            let vs: Vec<f64> = ys.iter().zip(&ts).map(|(y, &t)| sign * o.clearance(i, y, t)).collect();
+            let (v, t) = minimum(&ts, &vs, &|t| sign * o.clearance(i, &state(t), t));
+            (v / xs, t)
+        };
+        out.push((i, v, t, what));
+    }
+    out
 }
 
 impl PolishedOrbit {

@@ -1,8 +1,9 @@
 //! `sweep --exact`: every point's exact orbit (the event-fitted polish's, src/analysis/polish),
 //! each found by Newton from the previous point's exact orbit (same event signature, its event
 //! times scaled to the new period, the phases' eigendecompositions reused: [`polish::follow`]).
-//! Where the signature changes (the orbit is no longer admissible) or Newton fails, the point is
-//! solved on the grid and polished ([`polish::apply`]), and the walk goes on from that orbit; where
+//! Where the signature changes, the neighbouring signatures the previous orbit predicts are tried
+//! ([`polish::follow_across`]: an arc that shrank away removed, a grazing crossed added); where
+//! none holds, the point is solved on the grid and polished ([`polish::apply`]), and the walk goes on from that orbit; where
 //! the polish fails too the point is the grid's, with its error estimate. Each point says which
 //! (`source` = exact | polished | grid). The range is cut into one contiguous chunk per thread,
 //! each starting on the grid.
@@ -45,7 +46,7 @@ fn walk(template: &PeriodicProblem, chunk: &[f64], on_point: &(dyn Fn(&SweepPoin
             Ok(()) => {
                 let model = problem.model();
                 linear = polish::linear(model, linear.as_ref()).ok();
-                let followed = prev.as_ref().map(|p| polish::follow(model, p));
+                let followed = prev.as_ref().map(|p| polish::follow_across(model, p));
                 match followed {
                     Some(Ok(orbit)) => {
                         let point = exact_point(&problem, f, &orbit, linear.as_ref());
