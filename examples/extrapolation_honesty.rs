@@ -8,53 +8,25 @@
 //!
 //! `cargo run --release --example extrapolation_honesty -- SCENE LO HI DRAWS K [SEED]`
 use periodic_contact::analysis::accuracy;
-use periodic_contact::periodic::{PeriodicSolver, carried_active_set};
 use periodic_contact::response::Response;
-use periodic_contact::scene::Scene;
-use periodic_contact::study::families::SplitMix;
-use periodic_contact::time::Discretization;
-use std::path::Path;
+
+#[path = "honesty/grids.rs"]
+mod grids;
 
 fn main() {
-    let a: Vec<String> = std::env::args().collect();
-    let (lo, hi): (f64, f64) = (a[2].parse().unwrap(), a[3].parse().unwrap());
-    let (draws, k): (usize, usize) = (a[4].parse().unwrap(), a[5].parse().unwrap());
-    let seed: u64 = a.get(6).map_or(23, |s| s.parse().unwrap());
-    let (scene, _) = Scene::load(Path::new(&a[1])).unwrap();
-    let base = scene.to_problem(&a[1]).unwrap();
-    let m = base.model().contacts.len().max(1);
-    let grid = |steps: usize| {
-        let mut p = base.clone();
-        p.set_discretization(Discretization { steps, ..base.discretization() }).unwrap();
-        PeriodicSolver::new(p)
-    };
-    let mut solvers: Vec<PeriodicSolver> = [k / 4, k / 2, k, 4 * k, 8 * k].iter().map(|&s| grid(s)).collect();
+    // k/4, k/2, k, 4k, 8k.
+    let mut g = grids::Grids::from_args(&[1, 2, 4, 16, 32]);
+    let k = g.k;
     println!("omega k plain_est plain_true extrap_est extrap_true ref_own ratio_extrap method");
-    for draw in 0..draws {
-        let omega = if draws == 1 { lo } else { SplitMix::for_draw(seed, draw).uniform((lo, hi)) };
+    for draw in 0..g.draws {
+        let omega = g.omega(draw);
         let t = std::time::Instant::now();
-        let s = &mut solvers[2];
-        s.update_frequency(omega).unwrap();
-        let Ok(first) = s.solve_by_shooting(false) else {
-            println!("{omega:.2} {k} cold shooting missed at k");
-            continue;
-        };
-        let mut others: Vec<Option<Response>> = vec![];
-        for i in [0, 1, 3, 4] {
-            let s = &mut solvers[i];
-            if s.update_frequency(omega).is_err() {
-                others.push(None);
-                continue;
-            }
-            s.set_warm_start(&carried_active_set(&first.active_set, m, k, s.problem().instants()));
-            let r = s.solve_by_shooting(true).or_else(|_| s.solve_by_shooting(false));
-            others.push(r.ok());
-        }
-        let [Some(quarter), Some(half), Some(four), Some(eight)] = [&others[0], &others[1], &others[2], &others[3]] else {
+        let Some((first, others)) = g.solve(omega, 2) else { continue };
+        let [Some(quarter), Some(half), _, Some(four), Some(eight)] = [&others[0], &others[1], &others[2], &others[3], &others[4]] else {
             println!("{omega:.2} {k} a grid missed: {:?}", others.iter().map(|o| o.is_some()).collect::<Vec<_>>());
             continue;
         };
-        let p = solvers[2].problem();
+        let p = g.solvers[2].problem();
         let plain = accuracy::estimate_from(p, &first, half, Some(quarter), "k/2");
         let (mut est, mut truth, mut plain_truth, mut ref_own, mut ptp) = (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0.0f64);
         for (key, x) in &first.displacement {
