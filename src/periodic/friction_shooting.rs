@@ -99,6 +99,10 @@ pub(super) trait FrictionMarch {
     /// ∂y_(last)/∂y_(first − 1) over `steps` with every instant's modes (`modes`: the whole period's)
     /// fixed.
     fn tangent_over(&self, modes: &[i8], steps: Range<usize>) -> Mat<f64>;
+    /// Blocks [`PeriodTangent`] splits the period into (1: the tangent is rebuilt whole).
+    fn tangent_blocks(&self) -> usize {
+        1
+    }
 }
 
 /// Blocks of instants whose tangents [`PeriodTangent`] keeps. Why: measured on the bench case
@@ -122,7 +126,7 @@ impl PeriodTangent {
         let k = map.instants();
         let per = modes.len() / k.max(1);
         if self.blocks.is_empty() {
-            let length = k.div_ceil(TANGENT_BLOCKS).max(1);
+            let length = k.div_ceil(map.tangent_blocks().max(1)).max(1);
             self.blocks = (0..k).step_by(length).map(|a| (a..(a + length).min(k), Vec::new(), Mat::zeros(0, 0))).collect();
         }
         let d = map.state_size();
@@ -310,6 +314,10 @@ impl FrictionMarch for FrictionStepMap {
 
     fn instants(&self) -> usize {
         self.k
+    }
+
+    fn tangent_blocks(&self) -> usize {
+        TANGENT_BLOCKS
     }
 
     fn tangent_over(&self, modes: &[i8], steps: Range<usize>) -> Mat<f64> {
