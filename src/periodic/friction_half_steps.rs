@@ -17,6 +17,7 @@ use super::friction_shooting::{FrictionMarch, FrictionShot, FrictionStepMap, Mar
 use super::{Assembly, NoStepMap, PeriodFft, PeriodicProblem, SHOOTING_WORK_MAX, SolveError};
 use crate::lcp::{DenseLu, LcpMethod, LcpOutcome, LcpSolution, LcpStep, dense_product};
 use faer::Mat;
+use std::ops::Range;
 use std::time::Instant;
 
 /// Solves the friction problem on `map` (its k instants), certified on the full half-step LCP
@@ -333,10 +334,14 @@ impl FrictionMarch for HalfStepMap {
         March { end: state, modes, forces, velocity }
     }
 
-    fn period_tangent(&self, modes: &[i8]) -> Mat<f64> {
+    fn instants(&self) -> usize {
+        self.k
+    }
+
+    fn tangent_over(&self, modes: &[i8], steps: Range<usize>) -> Mat<f64> {
         let (n, mf, d) = (self.n, self.mf, self.state_size());
         let mut p = Mat::<f64>::identity(d, d);
-        for j in 0..self.k {
+        for j in steps {
             let rp = dense_product(&self.rows, &p);
             let (t, _) = self.step_relay(j);
             let df = Relay { t: &t, slip: &self.slip }.stuck_tangent(&modes[j * mf..(j + 1) * mf], |i, c| rp[(n + i, c)], d);

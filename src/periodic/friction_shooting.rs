@@ -17,6 +17,7 @@
 use super::{NoStepMap, PeriodicProblem, SHOOTING_WORK_MAX};
 use crate::lcp::{DenseLu, DenseMatrix, LcpOutcome, Lemke, LemkeSettings, dense_product};
 use faer::Mat;
+use std::ops::Range;
 
 /// Newton iterations of the friction shooting at most. Why: each fixes the sets of the last
 /// march; a set that keeps changing (a cycle of the piecewise-affine map) ends as a typed failure.
@@ -93,8 +94,53 @@ pub(super) trait FrictionMarch {
     fn state_size(&self) -> usize;
     /// Marches one period from `y`; step j starts from `guess[j]`'s modes (or the previous step's).
     fn march(&self, y: &[f64], guess: Option<&[i8]>) -> March;
-    /// ∂y_end/∂y₀ with every instant's modes fixed.
-    fn period_tangent(&self, modes: &[i8]) -> Mat<f64>;
+    /// Instants per period.
+    fn instants(&self) -> usize;
+    /// ∂y_(last)/∂y_(first − 1) over `steps` with every instant's modes (`modes`: the whole period's)
+    /// fixed.
+    fn tangent_over(&self, modes: &[i8], steps: Range<usize>) -> Mat<f64>;
+    /// Blocks [`PeriodTangent`] splits the period into (1: the tangent is rebuilt whole).
+    fn tangent_blocks(&self) -> usize {
+        1
+    }
+}
+
+/// Blocks of instants whose tangents [`PeriodTangent`] keeps. Why: measured on the bench case
+/// `friction` (seed 37, draw 1, k = 4096), Newton's last iterations change the modes of 1–30
+/// instants, so rebuilding only their blocks cuts the k-step tangent to a few blocks' worth.
+const TANGENT_BLOCKS: usize = 64;
+
+/// ∂y_end/∂y₀ as the product of per-block tangents, each rebuilt only when its modes changed
+/// (a step's tangent depends on its own modes alone).
+struct PeriodTangent {
+    blocks: Vec<(Range<usize>, Vec<i8>, Mat<f64>)>,
+}
+
+impl PeriodTangent {
+    fn new() -> Self {
+        PeriodTangent { blocks: Vec::new() }
+    }
+
+    /// The period's tangent with `modes` fixed.
+    fn at(&mut self, map: &impl FrictionMarch, modes: &[i8]) -> Mat<f64> {
+        let k = map.instants();
+        let per = modes.len() / k.max(1);
+        if self.blocks.is_empty() {
+            let length = k.div_ceil(map.tangent_blocks().max(1)).max(1);
+            self.blocks = (0..k).step_by(length).map(|a| (a..(a + length).min(k), Vec::new(), Mat::zeros(0, 0))).collect();
+        }
+        let d = map.state_size();
+        let mut p = Mat::<f64>::identity(d, d);
+        for (steps, kept, tangent) in &mut self.blocks {
+            let now = &modes[steps.start * per..steps.end * per];
+            if kept.as_slice() != now {
+                *tangent = map.tangent_over(modes, steps.clone());
+                *kept = now.to_vec();
+            }
+            p = dense_product(tangent, &p);
+        }
+        p
+    }
 }
 
 impl FrictionStepMap {
@@ -266,10 +312,18 @@ impl FrictionMarch for FrictionStepMap {
         March { end: state, modes, forces, velocity }
     }
 
-    fn period_tangent(&self, modes: &[i8]) -> Mat<f64> {
+    fn instants(&self) -> usize {
+        self.k
+    }
+
+    fn tangent_blocks(&self) -> usize {
+        TANGENT_BLOCKS
+    }
+
+    fn tangent_over(&self, modes: &[i8], steps: Range<usize>) -> Mat<f64> {
         let d = self.state_size();
         let mut p = Mat::<f64>::identity(d, d);
-        for j in 0..self.k {
+        for j in steps {
             p = self.step_tangent(&p, &modes[j * self.mf..(j + 1) * self.mf]);
         }
         p
@@ -397,6 +451,7 @@ pub(super) fn shoot(map: &impl FrictionMarch, start: Option<Vec<f64>>) -> Result
     let mut march = map.march(&y, None);
     let mut res = residual(&y, &march);
     let mut unchanged = false;
+    let mut tangent = PeriodTangent::new();
     for iteration in 0..MAX_ITERATIONS {
         if !res.is_finite() {
             return Err(ShotFailure { iterations: iteration, residual: res, why: "the march overflowed", last: None });
@@ -405,7 +460,7 @@ pub(super) fn shoot(map: &impl FrictionMarch, start: Option<Vec<f64>>) -> Result
         if res <= 1e-12 || (unchanged && res <= 1e-8) {
             return Ok(FrictionShot { state: y, forces: march.forces, velocity: march.velocity, iterations: iteration, residual: res });
         }
-        let p = map.period_tangent(&march.modes);
+        let p = tangent.at(map, &march.modes);
         let i_minus_p = Mat::from_fn(d, d, |a, b| if a == b { 1.0 } else { 0.0 } - p[(a, b)]);
         let r: Vec<f64> = march.end.iter().zip(&y).map(|(e, s)| e - s).collect();
         let mut delta = DenseLu::new(&i_minus_p).solve(&r);
