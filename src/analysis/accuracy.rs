@@ -103,6 +103,16 @@ fn runs(force: &[f64]) -> Vec<usize> {
     out
 }
 
+/// `grid` solved warm from an answer's active set (`rows` per instant, `instants` of them)
+/// carried to its instants. Why: Newton on the period map then starts on the right pieces, where
+/// a cold start's offset homotopy fails on stiff blades (the fine blade's 2k solve fell back to
+/// minutes of dense Lemke; `auto` on the rigid massless blade, 40 s per cold try).
+pub fn solve_warm(active: &[usize], rows: usize, instants: usize, grid: &PeriodicProblem) -> Result<Response, SolveError> {
+    let mut session = PeriodicSolver::new(grid.clone());
+    session.set_warm_start(&crate::periodic::carried_active_set(active, rows, instants, grid.instants()));
+    session.solve()
+}
+
 /// Estimates the error of `r` (solved from `problem`) by a second solve at k/2 and a third at
 /// k/4 for the observed order ([`estimate_from`]); when k/2 breaks the scheme's stability limit
 /// (ω_max·h ≥ limit: cds, galerkin on stiff models) by a second solve at 2k instead, and `method`
@@ -111,14 +121,7 @@ fn runs(force: &[f64]) -> Vec<usize> {
 /// refused or failed third solve leaves the two-grid estimate.
 pub fn estimate(problem: &PeriodicProblem, r: &Response) -> Accuracy {
     let instants = problem.instants();
-    let solve = |grid: &PeriodicProblem| {
-        // Warm-started from the first answer's active set on the other grid: Newton on the
-        // period map then starts on the right pieces, where a cold start's offset homotopy
-        // fails on stiff blades (the fine blade's 2k solve fell back to minutes of dense Lemke).
-        let mut session = PeriodicSolver::new(grid.clone());
-        session.set_warm_start(&crate::periodic::carried_active_set(&r.active_set, r.lcp.size / instants.max(1), instants, grid.instants()));
-        session.solve()
-    };
+    let solve = |grid: &PeriodicProblem| solve_warm(&r.active_set, r.lcp.size / instants.max(1), instants, grid);
     let (second, note) = match second_grid(problem, r) {
         Ok(g) => g,
         Err(a) => return a,

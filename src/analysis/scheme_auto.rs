@@ -13,7 +13,7 @@
 //! fall at the scheme's order ([`modes_in_asymptotic_range`]).
 use super::accuracy;
 use crate::periodic::limits::AccuracyTarget;
-use crate::periodic::{PeriodicProblem, PeriodicSolver, SolveError, carried_active_set};
+use crate::periodic::{PeriodicProblem, SolveError};
 use crate::response::{Response, SchemeChoice, SchemeTrial};
 use crate::time::Discretization;
 use std::time::Instant;
@@ -68,12 +68,9 @@ pub fn solve_to_tolerance(problem: &mut PeriodicProblem, target: &AccuracyTarget
             match solved.iter().find(|r| r.steps == second.instants()) {
                 Some(r) => Ok(r.clone()),
                 None => {
-                    // Warm from this k's active set, as `accuracy::estimate` does. Why: cold, the
-                    // rigid massless blade at 2300 rad/s missed in shooting at 2k = 1024 and fell
-                    // back to dense Lemke, 40 s per try (README "Against time marching").
-                    let mut session = PeriodicSolver::new(second.clone());
-                    session.set_warm_start(&carried_active_set(&active, rows, instants, second.instants()));
-                    let rs = session.solve()?;
+                    // Warm from this k's active set, as `accuracy::estimate` does (cold, the rigid
+                    // massless blade missed in shooting at 2k = 1024: README "Against time marching").
+                    let rs = accuracy::solve_warm(&active, rows, instants, second)?;
                     solved.push(rs.clone());
                     Ok(rs)
                 }
