@@ -5,31 +5,20 @@
 //! contact vanishes (a grazing), so the switch-detecting shooting must drop both switches.
 use periodic_contact::analysis::polish;
 use periodic_contact::exact::{CompliantStopOrbit, Oscillator};
-use periodic_contact::model::{Compliance, Contact, Force, Harmonic, Matrix, Model, Structure};
+use periodic_contact::model::Compliance;
 use periodic_contact::periodic::{OutputSelection, PeriodicProblem, SolverSettings};
 use periodic_contact::sweep::{self, SweepSettings};
 use periodic_contact::time::{Discretization, Scheme};
 
-const M: f64 = 1.0;
+use crate::massless_polish::{F, G0, K1, K2, M, damped_point_model};
+
 /// Damping high enough that the contact's hardening bends no fold into the range: one orbit per ω
 /// (the sweeps up and down agree to 2e-15), so the closed form's is the sweep's.
 const C: f64 = 0.5;
-const K1: f64 = 1.0;
-const K2: f64 = 30.0;
 const KC: f64 = 15.0;
-const G0: f64 = 1.0;
-const F: f64 = 1.0;
 
 fn problem(omega: f64) -> PeriodicProblem {
-    let rows = |a: [[f64; 2]; 2]| Matrix::from_rows(&a.iter().map(|r| r.to_vec()).collect::<Vec<_>>());
-    let model = Model {
-        structure: Structure { mass: rows([[M, 0.0], [0.0, 0.0]]), stiffness: rows([[K1 + K2, -K2], [-K2, K2]]), damping: Some(rows([[C, 0.0], [0.0, 0.0]])) },
-        forces: vec![Force { dof: 0, term: Harmonic { amplitude: F, harmonic: 1, phase: 0.0 } }],
-        contacts: vec![Contact::on_dof(1, 1.0, G0, Compliance::Compliant { stiffness: KC })],
-        frequency: omega,
-        frictions: Vec::new(),
-        rubbing: Vec::new(),
-    };
+    let model = damped_point_model(Compliance::Compliant { stiffness: KC }, C, omega);
     let outputs = OutputSelection { displacement: vec![0], velocity: vec![], acceleration: vec![], contacts: true };
     let disc = Discretization { scheme: Scheme::Cds, steps: 256, pairing: None };
     PeriodicProblem::new(model, disc, outputs, SolverSettings::default()).unwrap()
