@@ -13,22 +13,27 @@ use periodic_contact::response::Response;
 use periodic_contact::scene::Scene;
 use periodic_contact::time::{Discretization, Scheme};
 
-const M: f64 = 1.0;
+pub(crate) const M: f64 = 1.0;
 const C: f64 = 0.05;
-const K1: f64 = 1.0;
-const K2: f64 = 30.0;
-const G0: f64 = 1.0;
-const F: f64 = 1.0;
+pub(crate) const K1: f64 = 1.0;
+pub(crate) const K2: f64 = 30.0;
+pub(crate) const G0: f64 = 1.0;
+pub(crate) const F: f64 = 1.0;
 const OMEGA: f64 = 1.3;
 
 /// The mass (DOF 0) on k1, the massless point (DOF 1) behind k2, the stop on the point.
 fn point_model(compliance: Compliance) -> Model {
+    damped_point_model(compliance, C, OMEGA)
+}
+
+/// [`point_model`] with the mass's damping `c` at `omega` (tests/sweep_exact.rs sweeps it).
+pub(crate) fn damped_point_model(compliance: Compliance, c: f64, omega: f64) -> Model {
     let rows = |a: [[f64; 2]; 2]| Matrix::from_rows(&a.iter().map(|r| r.to_vec()).collect::<Vec<_>>());
     Model {
-        structure: Structure { mass: rows([[M, 0.0], [0.0, 0.0]]), stiffness: rows([[K1 + K2, -K2], [-K2, K2]]), damping: Some(rows([[C, 0.0], [0.0, 0.0]])) },
+        structure: Structure { mass: rows([[M, 0.0], [0.0, 0.0]]), stiffness: rows([[K1 + K2, -K2], [-K2, K2]]), damping: Some(rows([[c, 0.0], [0.0, 0.0]])) },
         forces: vec![Force { dof: 0, term: Harmonic { amplitude: F, harmonic: 1, phase: 0.0 } }],
         contacts: vec![Contact::on_dof(1, 1.0, G0, compliance)],
-        frequency: OMEGA,
+        frequency: omega,
         frictions: Vec::new(),
         rubbing: Vec::new(),
     }

@@ -96,3 +96,5 @@ mod shooting;
 mod study;
 #[path = "sweep.rs"]
 mod sweep;
+#[path = "sweep_exact.rs"]
+mod sweep_exact;

@@ -11,6 +11,7 @@
 //! events, checked densely and at every local minimum; impulses ≥ 0; a pure impact may not call
 //! for sticking); otherwise the LCP's orbit is kept, with a warning that says why.
 mod continued;
+mod detect;
 mod eigen_flow;
 pub mod events;
 pub mod friction;
@@ -21,6 +22,7 @@ mod signals;
 mod verify;
 
 pub use continued::Touch;
+pub use detect::follow_detected;
 pub use events::{Event, EventKind};
 pub use orbit::{OrbitParts, PolishedOrbit, user_value};
 pub use rigid::{CLEARANCE, HOLD, RigidMargin, STUCK};
@@ -86,11 +88,16 @@ pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<PolishedOrbit, 
 
 /// Prints a stage's wall time, and the thread's CPU time so far (Linux: /proc/thread-self/schedstat,
 /// the figure to read on a loaded machine), under `PERIODIC_CONTACT_PROFILE` (as the LCP's shooting does).
-pub(super) fn profile(stage: &str, since: Instant) {
+pub fn profile(stage: &str, since: Instant) {
     if std::env::var_os("PERIODIC_CONTACT_PROFILE").is_some() {
-        let cpu = std::fs::read_to_string("/proc/thread-self/schedstat").ok().and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok());
-        eprintln!("polish profile: {stage} {:.3} s wall (thread CPU so far {:.3} s)", since.elapsed().as_secs_f64(), cpu.unwrap_or(f64::NAN) * 1e-9);
+        eprintln!("polish profile: {stage} {:.3} s wall (thread CPU so far {:.3} s)", since.elapsed().as_secs_f64(), thread_cpu().unwrap_or(f64::NAN));
     }
+}
+
+/// The calling thread's CPU time [s] (Linux), for the profile.
+pub(super) fn thread_cpu() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    Some(s.split_whitespace().next()?.parse::<f64>().ok()? * 1e-9)
 }
 
 /// The exact orbit of `model` (the model of `prev` at another frequency) on `prev`'s event

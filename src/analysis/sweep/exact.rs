@@ -1,7 +1,10 @@
-//! `sweep --exact`: every point's exact orbit (the event-fitted polish's, src/analysis/polish),
-//! each found by Newton from the previous point's exact orbit (same event signature, its event
-//! times scaled to the new period, the phases' eigendecompositions reused: [`polish::follow`]).
-//! Where the signature changes, the neighbouring signatures the previous orbit predicts are tried
+//! `sweep --exact`: every point's exact orbit (the event-fitted polish's, src/analysis/polish).
+//! With compliant contacts only, by shooting with switch detection from the state at t = 0
+//! predicted by the secant through the two previous orbits ([`polish::follow_detected`]: the
+//! signature is the flow's own, so any number of switches may appear or vanish between points).
+//! Otherwise (or where that fails) by Newton from the previous point's exact orbit (same event
+//! signature, its event times scaled to the new period, the phases' eigendecompositions reused:
+//! [`polish::follow`]); where the signature changes, the neighbouring signatures the previous orbit predicts are tried
 //! ([`polish::follow_across`]: an arc that shrank away removed, a grazing crossed added); where
 //! none holds, the point is solved on the grid and polished ([`polish::apply`]), and the walk goes on from that orbit; where
 //! the polish fails too the point is the grid's, with its error estimate. Each point says which
@@ -38,6 +41,8 @@ fn walk(template: &PeriodicProblem, chunk: &[f64], on_point: &(dyn Fn(&SweepPoin
     let mut out = Vec::with_capacity(chunk.len());
     let (mut prev, mut linear): (Option<PolishedOrbit>, Option<PolishedOrbit>) = (None, None);
     let mut active: Option<Vec<usize>> = None;
+    // (ω, state at t = 0) of the last exact or polished orbits in a row: the predictor's points.
+    let mut trail: Vec<(f64, Vec<f64>)> = Vec::new();
     for &f in chunk {
         let t0 = Instant::now();
         let mut problem = template.clone();
@@ -46,10 +51,18 @@ fn walk(template: &PeriodicProblem, chunk: &[f64], on_point: &(dyn Fn(&SweepPoin
             Ok(()) => {
                 let model = problem.model();
                 linear = polish::linear(model, linear.as_ref()).ok();
-                let followed = prev.as_ref().map(|p| polish::follow_across(model, p));
+                let followed = prev.as_ref().map(|p| {
+                    let start = predicted(&trail, f);
+                    polish::follow_detected(model, p, &start).or_else(|e| {
+                        polish::profile(&format!("switch detection failed at {f}: {e}"), t0);
+                        polish::follow_across(model, p)
+                    })
+                });
                 match followed {
                     Some(Ok(orbit)) => {
+                        polish::profile(&format!("exact at {f}: {} Newton iterations, {} events", orbit.iterations(), orbit.events().len()), t0);
                         let point = exact_point(&problem, f, &orbit, linear.as_ref());
+                        polish::profile("the point's amplitudes, forces and fractions", t0);
                         prev = Some(orbit);
                         point
                     }
@@ -58,11 +71,32 @@ fn walk(template: &PeriodicProblem, chunk: &[f64], on_point: &(dyn Fn(&SweepPoin
                 }
             }
         };
+        match &prev {
+            Some(p) if point.error.is_none() => trail.push((f, p.state(0.0).as_slice().to_vec())),
+            Some(_) => {}
+            None => trail.clear(),
+        }
+        if trail.len() > 2 {
+            trail.remove(0);
+        }
         point.time_s = t0.elapsed().as_secs_f64();
         on_point(&point);
         out.push(point);
     }
     out
+}
+
+/// The state at t = 0 predicted at `f`: the secant through the last two orbits' (one orbit's
+/// own state when there is one; the forcing phase at t = 0 is the same at every ω).
+fn predicted(trail: &[(f64, Vec<f64>)], f: f64) -> Vec<f64> {
+    match trail {
+        [.., (f0, y0), (f1, y1)] => {
+            let s = (f - f1) / (f1 - f0);
+            y1.iter().zip(y0).map(|(a, b)| a + s * (a - b)).collect()
+        }
+        [.., (_, y1)] => y1.clone(),
+        [] => Vec::new(),
+    }
 }
 
 fn failed(f: f64, why: String) -> SweepPoint {

@@ -80,8 +80,9 @@ pub struct Args {
     #[arg(long)]
     pub log_amplitude: bool,
     /// Each point's exact orbit (the polish's: exact flows between events), by Newton from the
-    /// previous point's; the grid solve and the polish where the event signature changes or
-    /// Newton fails. The CSV's `source` column says which (exact | polished | grid), and
+    /// previous point's (compliant contacts: shooting with switch detection, the signature
+    /// may change); the grid solve and the polish where that fails. Each point is printed as it
+    /// comes (not with --quiet). The CSV's `source` column says which (exact | polished | grid), and
     /// `error_estimate_relative` is the exact orbit's last Newton correction or the grid's estimate.
     #[arg(long)]
     pub exact: bool,
@@ -189,7 +190,12 @@ pub fn run(a: &Args) -> Result<(), Failure> {
     // (not with --quiet), so that a sweep that stalls shows where.
     let on_point = |p: &sweep::SweepPoint| {
         let what = format!("ω = {}: {:.2} s, {}, {} iterations", p.frequency, p.time_s, sweep::solver_label(&p.lcp_path), p.pivots);
-        if !a.quiet && (p.time_s > SLOW_POINT_S || p.substeps > 0 || p.error.is_some()) {
+        if !a.quiet && a.exact {
+            // An exact sweep's points each on a line: which orbit (exact | polished | grid), its
+            // estimate and time, the progress of long work in a log file too.
+            let est = p.estimate_relative.map_or_else(|| "no estimate".to_string(), |e| format!("estimate {e:.1e}"));
+            bar.suspend(|| eprintln!("  point ω = {}: {}, {est}, {:.2} s", p.frequency, p.source, p.time_s));
+        } else if !a.quiet && (p.time_s > SLOW_POINT_S || p.substeps > 0 || p.error.is_some()) {
             let status = p.error.as_deref().map_or_else(|| format!("{} ω sub-steps", p.substeps), |e| format!("failed: {e}"));
             // Printed even where the bar is hidden (stderr not a terminal, a log file).
             bar.suspend(|| eprintln!("  point {what}; {status}"));

@@ -1,0 +1,275 @@
+//! The exact orbit of compliant contacts by shooting with switch detection, for `sweep --exact`'s
+//! next point: the unknown is the state at t = 0 (the same forcing phase at every ω, so the two
+//! previous orbits give a secant predictor); one period is flowed exactly phase by phase, each
+//! contact switching where its clearance changes sign (found on steps of a fraction of the
+//! phase's fastest period, then by the Illinois method to round-off), so the event signature is
+//! the flow's own and may change from one iteration (or point) to the next. A compliant switch
+//! has identity saltation (continuous force), so the derivative of the state at T by the state at
+//! 0 is the product of the phases' exponentials, as in validation/exact_flow.py's Newton shooting.
+//! At convergence the orbit is the polish's ([`PolishedOrbit`] on the detected signature) and is
+//! verified as the polish's is.
+use super::events::{self, Event, EventKind};
+use super::phase::Phase;
+use super::{PolishFailure, PolishedOrbit, verify};
+use crate::model::Model;
+use nalgebra::{DMatrix, DVector};
+
+/// Switch-search steps per radian of a phase's fastest motion (its balancing speed, ≥ ω_max):
+/// a sign change between steps is bracketed; a dip between two steps is left to the check.
+const STEPS_PER_RADIAN: f64 = 2.0;
+/// Newton iterations before the walk falls back to the signature-following polish.
+const MAX_ITERATIONS: usize = 10;
+
+thread_local! {
+    static PROFILE: bool = std::env::var_os("PERIODIC_CONTACT_PROFILE").is_some();
+}
+
+/// Phases by closed set at one ω, their eigendecompositions shared with `prev`'s (they do not
+/// depend on ω).
+struct Flows<'a> {
+    model: &'a Model,
+    prev: &'a PolishedOrbit,
+    phases: Vec<Phase>,
+    /// CPU spent building phases [s], under `PERIODIC_CONTACT_PROFILE`.
+    building: f64,
+}
+
+impl Flows<'_> {
+    fn phase(&mut self, closed: &[usize]) -> Result<usize, PolishFailure> {
+        if let Some(k) = self.phases.iter().position(|p| p.is_for(&[], closed)) {
+            return Ok(k);
+        }
+        let clock = PROFILE.with(|on| on.then(super::thread_cpu).flatten());
+        let mut p = Phase::new(self.model, &[], closed).ok_or_else(|| PolishFailure("a phase's operator is singular at a forcing harmonic".into()))?;
+        if let (Some(a), Some(b)) = (clock, super::thread_cpu()) {
+            self.building += b - a;
+        }
+        if let Some(o) = self.prev.phases.iter().find(|o| o.same_matrix(&p)) {
+            p.share_modes(o);
+        }
+        self.phases.push(p);
+        Ok(self.phases.len() - 1)
+    }
+}
+
+/// One period flowed from t = 0: the state at T, the switches (contact, kind, time, state there),
+/// the contacts closed at 0, and the exponentials' product over the period (massive free state).
+struct Shot {
+    end: DVector<f64>,
+    switches: Vec<(Event, DVector<f64>)>,
+    closed_at_start: Vec<usize>,
+    product: DMatrix<f64>,
+    last_phase: usize,
+}
+
+impl Shot {
+    /// The contacts closed all period (closed at 0, never switched).
+    fn always_closed(&self) -> Vec<usize> {
+        self.closed_at_start.iter().copied().filter(|i| !self.switches.iter().any(|(e, _)| e.contact == *i)).collect()
+    }
+}
+
+/// The orbit of `model` (a sweep's next ω) from the predicted state `start` at t = 0, by Newton
+/// shooting with switch detection (see the module); `prev` lends its phases' decompositions.
+/// Only for models whose contacts are all compliant (identity saltation, no stuck DOFs).
+pub fn follow_detected(model: &Model, prev: &PolishedOrbit, start: &[f64]) -> Result<PolishedOrbit, PolishFailure> {
+    let fail = |w: &str| PolishFailure(format!("switch-detecting shooting: {w}"));
+    if model.contacts.iter().any(|c| c.is_rigid()) || !model.frictions.is_empty() || !model.rubbing.is_empty() {
+        return Err(fail("only for compliant contacts"));
+    }
+    let carrier = PolishedOrbit::new(model, vec![], &[])?;
+    let mut flows = Flows { model, prev, phases: Vec::new(), building: 0.0 };
+    let clock = std::time::Instant::now();
+    let n2 = 2 * model.n();
+    let w = carrier.weights().rows(0, n2).into_owned();
+    let mut y = DVector::from_column_slice(start);
+    let size = y.component_mul(&w).amax().max(1e-300);
+    let floor = 1e-10 * size;
+    let mut shot = shoot(&carrier, &mut flows, &y)?;
+    let mut r = &shot.end - &y;
+    let mut iterations = 0;
+    let correction = loop {
+        if iterations == MAX_ITERATIONS {
+            // Near a grazing the flow's derivative is not Lipschitz and Newton may stall short
+            // of round-off: the polish's Newton on the detected signature, its times as seeds.
+            let why = format!("no convergence in {MAX_ITERATIONS} iterations (residual {:.2e})", r.component_mul(&w).amax());
+            return settle_detected(model, prev, &flows, shot).map_err(|e| fail(&format!("{why}; on its signature: {e}")));
+        }
+        // d y(T) / d y(0) = L_last (Π e^{A τ}) R: every phase shares the free basis (no stuck
+        // contact), so R L_j = I between phases (phase.rs's `transition`).
+        let m = flows.phases[shot.last_phase].transition(&shot.product);
+        let jac = m - DMatrix::identity(n2, n2);
+        let du = jac.lu().solve(&(-&r)).ok_or_else(|| fail("the monodromy has a multiplier 1"))?;
+        let before = r.component_mul(&w).amax();
+        let mut lambda = 1.0;
+        let (next, next_shot, rn) = loop {
+            let cand = &y + &du * lambda;
+            if let Ok(s) = shoot(&carrier, &mut flows, &cand) {
+                let rc = &s.end - &cand;
+                let merit = rc.component_mul(&w).amax();
+                if merit < before || merit < floor {
+                    break (cand, s, rc);
+                }
+            }
+            lambda *= 0.5;
+            if lambda < 1e-3 {
+                return Err(fail("Newton stalled"));
+            }
+        };
+        iterations += 1;
+        let correction = du.rows(0, model.n()).amax() * lambda;
+        let step = (&du * lambda).component_mul(&w).amax();
+        let stagnant = rn.component_mul(&w).amax() < floor && rn.component_mul(&w).amax() > 0.5 * before;
+        (y, shot, r) = (next, next_shot, rn);
+        if step < 1e-12 * size || stagnant {
+            break correction;
+        }
+    };
+    let residual = r.component_mul(&w).amax();
+    super::profile(&format!("switch detection: {iterations} iterations, {} phases built in {:.3} s CPU", flows.phases.len(), flows.building), clock);
+    let orbit = assemble(model, prev, &flows, shot, (iterations, residual, correction))?;
+    super::profile("the orbit on the detected signature", clock);
+    verify::check(&orbit)?;
+    super::profile("admissibility check", clock);
+    Ok(orbit)
+}
+
+/// The polish's Newton on the signature of `shot` (its switch times as seeds), then the check.
+fn settle_detected(model: &Model, prev: &PolishedOrbit, flows: &Flows, shot: Shot) -> Result<PolishedOrbit, PolishFailure> {
+    let always = shot.always_closed();
+    let evs = events::isolated_first(shot.switches.iter().map(|(e, _)| *e).collect(), model.period());
+    let mut orbit = PolishedOrbit::reusing(model, evs, &always, &flows.phases)?;
+    orbit.share_modes(prev);
+    orbit.newton()?;
+    verify::check(&orbit)?;
+    Ok(orbit)
+}
+
+/// The polish's orbit on the detected signature at the converged state.
+fn assemble(
+    model: &Model,
+    prev: &PolishedOrbit,
+    flows: &Flows,
+    shot: Shot,
+    (iterations, residual, correction): (usize, f64, f64),
+) -> Result<PolishedOrbit, PolishFailure> {
+    let period = model.period();
+    let always = shot.always_closed();
+    let mut orbit = if shot.switches.is_empty() {
+        let mut o = PolishedOrbit::reusing(model, vec![], &always, &flows.phases)?;
+        o.y0 = shot.end;
+        o
+    } else {
+        let evs: Vec<Event> = shot.switches.iter().map(|(e, _)| *e).collect();
+        let evs = events::isolated_first(evs, period);
+        // isolated_first shifts only the events before event 0 (by a period).
+        let first = shot.switches.iter().position(|(e, _)| *e == evs[0]).unwrap_or(0);
+        let mut o = PolishedOrbit::reusing(model, evs, &always, &flows.phases)?;
+        o.y0 = shot.switches[first].1.clone();
+        o
+    };
+    orbit.share_modes(prev);
+    orbit.finish()?;
+    orbit.iterations = iterations;
+    orbit.residual = residual;
+    orbit.correction = correction;
+    Ok(orbit)
+}
+
+/// Contact `i`'s clearance, signed so that it is positive until it switches (its penetration
+/// when closed).
+fn signed(carrier: &PolishedOrbit, closed: &[usize], i: usize, y: &DVector<f64>, t: f64) -> f64 {
+    let c = carrier.clearance(i, y, t);
+    if closed.contains(&i) { -c } else { c }
+}
+
+/// One period from `y0` at t = 0 with switch detection ([`Shot`]).
+fn shoot(carrier: &PolishedOrbit, flows: &mut Flows, y0: &DVector<f64>) -> Result<Shot, PolishFailure> {
+    let model = flows.model;
+    let period = model.period();
+    let m = model.contacts.len();
+    let mut closed: Vec<usize> = (0..m).filter(|&i| carrier.clearance(i, y0, 0.0) < 0.0).collect();
+    let closed_at_start = closed.clone();
+    let (mut t, mut y) = (0.0, y0.clone());
+    let mut switches = Vec::new();
+    let mut product: Option<DMatrix<f64>> = None;
+    let mut k = flows.phase(&closed)?;
+    let mut phase_start = 0.0;
+    loop {
+        let ph = &flows.phases[k];
+        let h = 1.0 / (STEPS_PER_RADIAN * ph.speed_hint().max(model.frequency));
+        let t1 = (t + h).min(period);
+        let y1 = ph.flow(t, &y, t1);
+        // The earliest contact whose signed clearance turns negative in [t, t1].
+        let mut first: Option<(usize, f64, DVector<f64>)> = None;
+        for i in 0..m {
+            if signed(carrier, &closed, i, &y1, t1) >= 0.0 {
+                continue;
+            }
+            let (ts, ys) = crossing(&|s| ph.flow(t, &y, s), &|s, ys| signed(carrier, &closed, i, ys, s), t, t1, &y1);
+            if first.as_ref().is_none_or(|f| ts < f.1) {
+                first = Some((i, ts, ys));
+            }
+        }
+        let Some((i, ts, ys)) = first else {
+            (t, y) = (t1, y1);
+            if t >= period {
+                let e = flows.phases[k].exp(t - phase_start);
+                product = Some(product.map_or_else(|| e.clone(), |p| &e * p));
+                break;
+            }
+            continue;
+        };
+        let e = flows.phases[k].exp(ts - phase_start);
+        product = Some(product.map_or_else(|| e.clone(), |p| &e * p));
+        let kind = if closed.contains(&i) { EventKind::Off } else { EventKind::On };
+        if kind == EventKind::On {
+            closed.push(i);
+            closed.sort_unstable();
+        } else {
+            closed.retain(|&c| c != i);
+        }
+        switches.push((Event { contact: i, kind, seed: ts }, ys.clone()));
+        (t, y, phase_start) = (ts, ys, ts);
+        k = flows.phase(&closed)?;
+        if switches.len() > 64 * m.max(1) {
+            return Err(PolishFailure("switch-detecting shooting: chattering (too many switches in one period)".into()));
+        }
+    }
+    Ok(Shot { end: y, switches, closed_at_start, product: product.expect("one phase at least"), last_phase: k })
+}
+
+/// Where `g` (≥ 0 at `a`, < 0 at `b`) along the flow `flow` changes sign: the Illinois method
+/// (regula falsi with halving, Dowell & Jarratt, BIT 11, 1971) to round-off; the time at the
+/// bracket's negative end, so that the contact has switched there, and the state.
+fn crossing(flow: &dyn Fn(f64) -> DVector<f64>, g: &dyn Fn(f64, &DVector<f64>) -> f64, a: f64, b: f64, yb: &DVector<f64>) -> (f64, DVector<f64>) {
+    let (mut lo, mut hi) = (a, b);
+    let (mut glo, mut ghi) = (g(a, &flow(a)), g(b, yb));
+    let mut yhi = yb.clone();
+    let mut side = 0;
+    for _ in 0..100 {
+        if hi - lo <= 4.0 * f64::EPSILON * hi.abs().max(1e-300) {
+            break;
+        }
+        let mut s = hi - ghi * (hi - lo) / (ghi - glo);
+        if !(s > lo && s < hi) {
+            s = 0.5 * (lo + hi);
+        }
+        let ys = flow(s);
+        let gs = g(s, &ys);
+        if gs < 0.0 {
+            (hi, ghi, yhi) = (s, gs, ys);
+            if side == -1 {
+                glo *= 0.5;
+            }
+            side = -1;
+        } else {
+            (lo, glo) = (s, gs);
+            if side == 1 {
+                ghi *= 0.5;
+            }
+            side = 1;
+        }
+    }
+    (hi, yhi)
+}
