@@ -14,6 +14,7 @@ mod continued;
 mod eigen_flow;
 pub mod events;
 pub mod friction;
+mod massive;
 mod orbit;
 mod phase;
 mod rigid;

@@ -153,6 +153,11 @@ impl PolishedOrbit {
     /// (src/formulation.md §5; [`Self::variation`]'s state columns).
     pub(super) fn state_map(&self, tau: &[f64]) -> Option<DMatrix<f64>> {
         let (n, ne) = (self.model.n(), self.events.len());
+        if ne > 0 && self.massive_reducible() {
+            let spans: Vec<f64> = (0..ne).map(|e| if e + 1 < ne { tau[e + 1] - tau[e] } else { tau[0] + self.period - tau[e] }).collect();
+            let map = self.massive_transition(&spans);
+            return map.iter().all(|v| v.is_finite()).then_some(map);
+        }
         let mut dy = DMatrix::identity(2 * n, 2 * n);
         for e in 0..ne.max(1) {
             let ph = &self.phases[e];
@@ -198,6 +203,10 @@ impl PolishedOrbit {
     /// Mechanical Systems", §7.1. `None` where a flow or a reset fails.
     pub(super) fn variation(&self, y0: &DVector<f64>, tau: &[f64], ret: f64) -> Option<Variation> {
         let (n, ne) = (self.model.n(), self.events.len());
+        // Massless DOFs: carried in the massive state (massive.rs), d = 40 rows on the real blade.
+        if ne > 0 && self.massive_reducible() {
+            return self.massive_variation(y0, tau, ret);
+        }
         let (n2, cols) = (2 * n, 2 * n + ne + 1);
         let field = |e: usize, y: &DVector<f64>, t: f64| {
             let mut f = DVector::zeros(n2);
