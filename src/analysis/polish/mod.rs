@@ -13,6 +13,7 @@
 mod continued;
 mod eigen_flow;
 pub mod events;
+mod forces;
 pub mod friction;
 mod massive;
 mod orbit;
