@@ -77,12 +77,7 @@ impl PolishedOrbit {
         // Columns: the start state's massive coordinates (the y0 columns are these times R),
         // then the ne + 1 times.
         let cols = d + ne + 1;
-        let field = |e: usize, y: &DVector<f64>, t: f64| {
-            let mut f = DVector::zeros(n2);
-            f.rows_mut(0, n).copy_from(&y.rows(n, n));
-            f.rows_mut(n, n).copy_from(&self.phases[e].acceleration(y, t));
-            f
-        };
+        let field = |e: usize, y: &DVector<f64>, t: f64| self.vector_field(e, y, t);
         let mut y = y0.clone();
         // z = R dy before the phase's event; the full variation at an event is L z + f₁ δ_endᵀ.
         let mut z = DMatrix::identity(d, cols);
@@ -104,17 +99,16 @@ impl PolishedOrbit {
             let c = ev.contact;
             if ev.kind == EventKind::Release {
                 // The held force is affine in y with the phase's gradient G = G' R (phase.rs), so
-                // G L = G': G's x and v columns times the lift; its t-derivative by central differences.
-                let force = |y: &DVector<f64>, t: f64| ph.stuck_forces(y, t).into_iter().find(|(k, _)| *k == c).map(|(_, z)| z);
-                let h = 1e-7 * self.period;
+                // G L = G': G's x and v columns times the lift.
                 let row = ph.stuck_contacts().position(|k| k == c)?;
                 let grad = ph.stuck_force_gradient().row(row).into_owned();
                 let mut reduced = RowDVector::zeros(d);
                 reduced.columns_mut(0, nf).copy_from(&(grad.columns(0, n) * &lift));
                 reduced.columns_mut(nf, nf).copy_from(&(grad.columns(n, n) * &lift));
-                g[next] = force(&ym, t1)?;
+                let (force, rate) = self.held_force(e, c, &ym, t1)?;
+                g[next] = force;
                 dg.row_mut(next).copy_from(&(reduced * &z));
-                dg[(next, end_col)] += (&grad * &f1)[0] + (force(&ym, t1 + h)? - force(&ym, t1 - h)?) / (2.0 * h);
+                dg[(next, end_col)] += (&grad * &f1)[0] + rate;
             } else {
                 let contact = &self.model.contacts[c];
                 let mut normal = RowDVector::zeros(nf);
