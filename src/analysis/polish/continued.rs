@@ -136,6 +136,10 @@ impl PolishedOrbit {
         }
         let n2 = 2 * self.model.n();
         let ne = self.events.len();
+        if ne > 0 && self.massive_reducible() {
+            let spans: Vec<f64> = (0..ne).map(|e| self.end_of(e) - self.times[e]).collect();
+            return Some(self.massive_transition(&spans));
+        }
         let mut m = DMatrix::identity(n2, n2);
         for e in 0..ne.max(1) {
             let span = if ne == 0 { self.period } else { self.end_of(e) - self.times[e] };

@@ -496,37 +496,6 @@ impl PolishedOrbit {
         out
     }
 
-    /// ∫ of every contact's force over [a, b] plus its impulses in [a, b), by 5-point
-    /// Gauss–Legendre on each piece between events (one state per node for all contacts).
-    fn force_integrals(&self, a: f64, b: f64) -> Vec<f64> {
-        const X: [f64; 5] = [0.0, -0.538_469_310_105_683, 0.538_469_310_105_683, -0.906_179_845_938_664, 0.906_179_845_938_664];
-        const W: [f64; 5] = [0.568_888_888_888_889, 0.478_628_670_499_366, 0.478_628_670_499_366, 0.236_926_885_056_189, 0.236_926_885_056_189];
-        let mut cuts = vec![a, b];
-        let mut total = vec![0.0; self.model.contacts.len()];
-        for (e, (&t, &p)) in self.times.iter().zip(&self.impulses).enumerate() {
-            for tk in [t - self.period, t, t + self.period] {
-                if tk >= a && tk < b {
-                    cuts.push(tk);
-                    if let Some(ev) = self.events.get(e) {
-                        total[ev.contact] += p;
-                    }
-                }
-            }
-        }
-        cuts.sort_by(f64::total_cmp);
-        for w in cuts.windows(2) {
-            let (c, h) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
-            if h > 0.0 {
-                for (x, wt) in X.iter().zip(W) {
-                    for (sum, f) in total.iter_mut().zip(self.contact_forces(c + h * x)) {
-                        *sum += h * wt * f;
-                    }
-                }
-            }
-        }
-        total
-    }
-
     /// Replaces `r`'s series by this orbit's at the same instants t_j: displacement, velocity and
     /// acceleration outputs, clearances, and forces (rigid: impulse per step divided by h,
     /// as the LCP reports them; compliant: the force at t_j).
@@ -537,7 +506,8 @@ impl PolishedOrbit {
         let accs: Vec<DVector<f64>> = if r.acceleration.is_empty() { vec![] } else { r.time.iter().map(|&t| self.acceleration(t)).collect() };
         write_kinematics(r, problem.output_map(), &states, &accs, n);
         let rigid = self.model.contacts.iter().any(|c| c.is_rigid());
-        let integrals: Vec<Vec<f64>> = if rigid { r.time.iter().map(|&t| self.force_integrals(t, t + h)).collect() } else { vec![] };
+        let forces = if rigid { self.all_phase_forces() } else { vec![] };
+        let integrals: Vec<Vec<f64>> = if rigid { r.time.iter().map(|&t| self.force_integrals(&forces, t, t + h)).collect() } else { vec![] };
         for (i, rc) in r.contacts.iter_mut().enumerate() {
             for (j, &t) in r.time.iter().enumerate() {
                 rc.gap[j] = self.clearance(i, &states[j], t);

@@ -19,6 +19,8 @@ use std::sync::{Arc, OnceLock};
 // module, for the phase's fields.
 mod particular;
 pub(super) use particular::Transient;
+// The massive coordinates' basis and lift, for the variation carried in them.
+mod massive;
 
 /// Complex amplitudes of a harmonic signal: value(t) = Re Σ_p amp_p e^{i p ω t}.
 pub(super) type Harmonics = Vec<(u32, DVector<C>)>;
@@ -159,7 +161,8 @@ impl Phase {
         let (nf, nb) = (massive.len(), massless.len());
         let k_bb = k_ff.select_rows(&massless).select_columns(&massless);
         let k_ba = k_ff.select_rows(&massless).select_columns(&massive);
-        let slave_map = if nb == 0 { DMatrix::zeros(0, nf) } else { -k_bb.lu().solve(&k_ba)? };
+        let k_bb_lu = k_bb.lu();
+        let slave_map = if nb == 0 { DMatrix::zeros(0, nf) } else { -k_bb_lu.solve(&k_ba)? };
         // K_aa − K_ab K_bb⁻¹ K_ba: the massive coordinates' condensed stiffness (Guyan's, exact
         // here since the condensed DOFs carry no inertia).
         let k_cond = k_ff.select_rows(&massive).select_columns(&massive) + k_ff.select_rows(&massive).select_columns(&massless) * &slave_map;
@@ -188,8 +191,27 @@ impl Phase {
             let xp = presc.iter().find(|(q, _)| *q == p).map_or_else(|| DVector::zeros(n), |(_, v)| v.clone());
             let dyn_op = cplx(&m, -w * w) + c.map(|v| C::new(0.0, w * v)) + cplx(&k, 1.0);
             let g = cplx(&all, 1.0).transpose() * (fp - dyn_op * xp);
-            let op = cplx(&m_ff, -w * w) + c_ff.map(|v| C::new(0.0, w * v)) + cplx(&k_ff, 1.0);
-            let x = if g.is_empty() { g } else { op.lu().solve(&g)? };
+            let x = if g.is_empty() {
+                g
+            } else if nb == 0 {
+                let op = cplx(&m_ff, -w * w) + c_ff.map(|v| C::new(0.0, w * v)) + cplx(&k_ff, 1.0);
+                op.lu().solve(&g)?
+            } else {
+                // The massless rows are static, K_ba x_a + K_bb x_b = g_b: x_b = K_bb⁻¹ g_b + S x_a,
+                // and the massive ones take the condensed operator −(pω)² M_aa + ipω C_aa + K_cond
+                // on g_a − K_ab K_bb⁻¹ g_b (a 2n_a-sized solve per harmonic, not the n-sized one).
+                let gb = g.select_rows(&massless);
+                let (re, im) = (k_bb_lu.solve(&gb.map(|z| z.re))?, k_bb_lu.solve(&gb.map(|z| z.im))?);
+                let yb = DVector::from_fn(nb, |i, _| C::new(re[i], im[i]));
+                let k_ab = cplx(&k_ff.select_rows(&massive).select_columns(&massless), 1.0);
+                let op = cplx(&sub(&m_ff), -w * w) + sub(&c_ff).map(|v| C::new(0.0, w * v)) + cplx(&k_cond, 1.0);
+                let xa = op.lu().solve(&(g.select_rows(&massive) - k_ab * &yb))?;
+                let xb = yb + cplx(&slave_map, 1.0) * &xa;
+                let mut x = DVector::zeros(all.ncols());
+                massive.iter().enumerate().for_each(|(r, &j)| x[j] = xa[r]);
+                massless.iter().enumerate().for_each(|(r, &j)| x[j] = xb[r]);
+                x
+            };
             if !x.iter().all(|v| v.re.is_finite() && v.im.is_finite()) {
                 return None;
             }

@@ -153,6 +153,11 @@ impl PolishedOrbit {
     /// (src/formulation.md §5; [`Self::variation`]'s state columns).
     pub(super) fn state_map(&self, tau: &[f64]) -> Option<DMatrix<f64>> {
         let (n, ne) = (self.model.n(), self.events.len());
+        if ne > 0 && self.massive_reducible() {
+            let spans: Vec<f64> = (0..ne).map(|e| if e + 1 < ne { tau[e + 1] - tau[e] } else { tau[0] + self.period - tau[e] }).collect();
+            let map = self.massive_transition(&spans);
+            return map.iter().all(|v| v.is_finite()).then_some(map);
+        }
         let mut dy = DMatrix::identity(2 * n, 2 * n);
         for e in 0..ne.max(1) {
             let ph = &self.phases[e];
@@ -198,13 +203,12 @@ impl PolishedOrbit {
     /// Mechanical Systems", §7.1. `None` where a flow or a reset fails.
     pub(super) fn variation(&self, y0: &DVector<f64>, tau: &[f64], ret: f64) -> Option<Variation> {
         let (n, ne) = (self.model.n(), self.events.len());
+        // Massless DOFs: carried in the massive state (massive.rs), d = 40 rows on the real blade.
+        if ne > 0 && self.massive_reducible() {
+            return self.massive_variation(y0, tau, ret);
+        }
         let (n2, cols) = (2 * n, 2 * n + ne + 1);
-        let field = |e: usize, y: &DVector<f64>, t: f64| {
-            let mut f = DVector::zeros(n2);
-            f.rows_mut(0, n).copy_from(&y.rows(n, n));
-            f.rows_mut(n, n).copy_from(&self.phases[e].acceleration(y, t));
-            f
-        };
+        let field = |e: usize, y: &DVector<f64>, t: f64| self.vector_field(e, y, t);
         let mut y = y0.clone();
         let mut dy = DMatrix::identity(n2, cols);
         let (mut g, mut dg) = (DVector::zeros(ne), DMatrix::zeros(ne, cols));
@@ -229,13 +233,12 @@ impl PolishedOrbit {
             let c = ev.contact;
             if ev.kind == EventKind::Release {
                 // The held force z(y, t) is affine in y: its y-gradient is the phase's
-                // (`stuck_force_gradient`); its explicit t-derivative by central differences.
-                let z = |y: &DVector<f64>, t: f64| ph.stuck_forces(y, t).into_iter().find(|(k, _)| *k == c).map(|(_, z)| z);
-                let h = 1e-7 * self.period;
+                // (`stuck_force_gradient`).
                 let row = ph.stuck_contacts().position(|k| k == c)?;
-                g[next] = z(&ym, t1)?;
+                let (z, rate) = self.held_force(e, c, &ym, t1)?;
+                g[next] = z;
                 dg.row_mut(next).copy_from(&(ph.stuck_force_gradient().row(row) * &dy));
-                dg[(next, end_col)] += (z(&ym, t1 + h)? - z(&ym, t1 - h)?) / (2.0 * h);
+                dg[(next, end_col)] += rate;
             } else {
                 g[next] = self.clearance(c, &ym, t1);
                 for col in 0..cols {
@@ -272,6 +275,23 @@ impl PolishedOrbit {
         }
         let all = y.iter().chain(g.iter()).chain(dy.iter()).chain(dg.iter()).all(|v| v.is_finite());
         all.then_some(Variation { end: y, conditions: g, d_end: dy, d_conditions: dg })
+    }
+
+    /// Stuck contact `c`'s force in phase `e`, state `y`, at `t`, and its explicit t-derivative by
+    /// central differences (the variation's release condition).
+    pub(super) fn held_force(&self, e: usize, c: usize, y: &DVector<f64>, t: f64) -> Option<(f64, f64)> {
+        let z = |t: f64| self.phases[e].stuck_forces(y, t).into_iter().find(|(k, _)| *k == c).map(|(_, z)| z);
+        let h = 1e-7 * self.period;
+        Some((z(t)?, (z(t + h)? - z(t - h)?) / (2.0 * h)))
+    }
+
+    /// ẏ = [v; a] of phase `e` in state `y` at `t` (the variation's time columns).
+    pub(super) fn vector_field(&self, e: usize, y: &DVector<f64>, t: f64) -> DVector<f64> {
+        let n = self.model.n();
+        let mut f = DVector::zeros(2 * n);
+        f.rows_mut(0, n).copy_from(&y.rows(n, n));
+        f.rows_mut(n, n).copy_from(&self.phases[e].acceleration(y, t));
+        f
     }
 
     /// The monodromy of a solved orbit with events whose state maps are not the identity: the
