@@ -2,10 +2,9 @@
 //! the closed-form impact oscillator of src/exact/rigid.rs (its impact map and multiplier, not
 //! the polish) and against long time integration (the explicit marcher of src/marching).
 use crate::common::family::{Chain, Draw};
+use crate::common::stop_march::{StopChain, Verdict, verdict, verdict_at};
 use periodic_contact::analysis::continuation::{self, ContinuationSettings, Parameter, Source};
-use periodic_contact::analysis::polish;
 use periodic_contact::exact::{Oscillator, RigidRegime, RigidStopOrbit};
-use periodic_contact::marching::{MarchSettings, march};
 use periodic_contact::periodic::PeriodicProblem;
 
 fn problem(text: &str) -> PeriodicProblem {
@@ -89,8 +88,9 @@ fn sticking_onset(osc: &Oscillator, gap: f64, a: f64, b: f64) -> f64 {
 /// A random oscillator of 1–3 DOFs (a grounded chain: masses 0.5–2, springs 0.5–2, Rayleigh
 /// damping of 2–6 % at the first mode) with a RIGID stop on a random DOF, forced on a random DOF;
 /// the gap is 0.3–0.8 of that DOF's linear peak near the first mode, so the branch over
-/// [0.6, 1.4]·ω₁ impacts and, where the gap is small, sticks. (scene, ω₁)
-fn random_rigid(d: &mut Draw, steps: usize) -> (String, f64) {
+/// [0.6, 1.4]·ω₁ impacts and, where the gap is small, sticks. (scene, ω₁, the same chain for the
+/// event-located reference)
+fn random_rigid(d: &mut Draw, steps: usize) -> (String, f64, StopChain) {
     let chain = Chain::draw(d);
     let (n, w1) = (chain.n, chain.w1);
     let alpha = 2.0 * d.range(0.02, 0.06) / w1;
@@ -98,58 +98,53 @@ fn random_rigid(d: &mut Draw, steps: usize) -> (String, f64) {
     let amp = 0.1;
     let peak = (0..400).map(|j| chain.linear_amplitude(alpha, fdof, cdof, amp, w1 * (0.6 + 0.8 * j as f64 / 400.0))).fold(0.0, f64::max);
     let gap = d.range(0.3, 0.8) * peak;
-    (chain.scene(alpha, (fdof, amp), &format!("dof = {cdof}\ngap = {gap:e}\n"), "bds1", steps, cdof), w1)
-}
-
-/// Long time integration started near the branch point `q`: the orbit at its λ (the grid's,
-/// polished; `None` when that is another branch than `q`'s: amplitudes differ by 1e-6), its state
-/// at t = 0 perturbed by 1e-3 of its size, marched 400 periods at N = 2048 steps per period.
-/// Stable when the march's last period comes back to the orbit within 1 % of the amplitude at
-/// every instant (the marcher's O(h) error is ~1e-3) and repeats the one before within 1e-5.
-/// (settled, that periodicity defect)
-fn settles_back(p: &PeriodicProblem, q: &continuation::BranchPoint) -> Option<(bool, f64)> {
-    let mut p = p.clone();
-    p.set_frequency(q.parameter).unwrap();
-    let n = p.model().n();
-    let r = p.solve().ok()?;
-    let orbit = polish::polish(&p, &r).ok()?;
-    let dof = p.outputs().displacement[0];
-    if (orbit.amplitude(None, dof)? - q.amplitude[0]).abs() > 1e-6 * q.amplitude[0] {
-        return None;
-    }
-    let y = orbit.state(0.0);
-    let size = y.amax().max(1e-12);
-    let y: Vec<f64> = y.iter().enumerate().map(|(i, v)| v + 1e-3 * size * if i % 2 == 0 { 1.0 } else { -1.0 }).collect();
-    let settings = MarchSettings {
-        steps_per_period: 2048,
-        max_periods: 400,
-        min_periods: 400,
-        tolerance: 1e-14,
-        initial_displacement: Some(y[..n].to_vec()),
-        initial_velocity: Some(y[n..].to_vec()),
+    let sys = StopChain {
+        mass: chain.mass.clone(),
+        stiffness: chain.stiffness.clone(),
+        damping: &chain.stiffness * alpha,
+        force: (0..n).map(|i| if i == fdof { amp } else { 0.0 }).collect(),
+        omega: 0.6 * w1,
+        dof: cdof,
+        gap,
+        contact_stiffness: None,
     };
-    let m = march(p.model(), &settings).ok()?;
-    // Instant by instant over the last period: past a period doubling the march settles on a
-    // period-2 orbit whose amplitude is close to the T orbit's, but not its path.
-    let off = m.time.iter().zip(&m.displacement).map(|(&t, x)| (x[dof] - orbit.state(t)[dof]).abs()).fold(0.0, f64::max);
-    // Close to a grazing an unstable impacting orbit's attractor (period 2 or more) stays within
-    // 1 % of it: settled means periodic too (a multiplier ≤ 0.98 leaves 1e-3·0.98⁴⁰⁰ ≈ 3e-7).
-    Some((off < 1e-2 * q.amplitude[0] && m.defect < 1e-5, m.defect))
+    (chain.scene(alpha, (fdof, amp), &format!("dof = {cdof}\ngap = {gap:e}\n"), "bds1", steps, cdof), w1, sys)
 }
 
-/// The random rigid family's members `seeds`, each over [0.6, 1.4]·ω₁ at k and 2k: (members that
-/// reached the end, on the exact orbit all along; largest event difference between k and 2k,
-/// kind by kind; stability labels compared with long time integration; disagreements). Prints
-/// each member.
-fn rigid_family(seeds: std::ops::Range<u64>, steps: usize, checks_per_member: usize) -> (usize, usize, f64, usize, usize) {
-    let (mut exact, mut reached, mut worst, mut compared, mut wrong) = (0, 0, 0.0f64, 0, 0);
+/// Long time integration started near the branch point `q`, by tests/common/stop_march.rs (exact
+/// flows between events located inside the step, plastic impacts and sticking; not the crate's
+/// marcher, polish or continuation): the orbit through `q`'s state (its time found by the return
+/// mismatch), the period map's fixed point by Newton, its finite-difference multipliers, and 400
+/// periods from it perturbed by 1e-3. `None` where that orbit is not `q`'s (amplitudes differ by
+/// 1e-4: the reference samples its minimum at T/1024) or is not found.
+fn settles_back(sys: &StopChain, q: &continuation::BranchPoint) -> Option<Verdict> {
+    let sys = StopChain { omega: q.parameter, ..sys.clone() };
+    verdict(&sys, &q.state, sys.dof, 400, |v| (v.amplitude - q.amplitude[0]).abs() <= 1e-4 * q.amplitude[0])
+}
+
+/// What the family gave: members that reached the end on the exact orbit all along, and that
+/// reached it; the largest event difference between k and 2k (kind by kind); stability labels
+/// compared with the event-located reference, how many disagree, those without a reference
+/// orbit, and the largest |μ| difference from the reference's.
+struct Family {
+    exact: usize,
+    reached: usize,
+    worst: f64,
+    compared: usize,
+    wrong: usize,
+    unresolved: usize,
+    worst_mu: f64,
+}
+
+/// The random rigid family's members `seeds`, each over [0.6, 1.4]·ω₁ at k and 2k. Prints each member.
+fn rigid_family(seeds: std::ops::Range<u64>, steps: usize, checks_per_member: usize) -> Family {
+    let (mut exact, mut reached, mut worst, mut compared, mut wrong, mut unresolved, mut worst_mu) = (0, 0, 0.0f64, 0, 0, 0, 0.0f64);
     for seed in seeds {
-        // The long time integrations start from the orbit on a fine grid, polished.
-        let fine = problem(&random_rigid(&mut Draw(seed), 4096).0);
+        let sys = random_rigid(&mut Draw(seed), steps).2;
         let runs: Vec<continuation::Branch> = [steps, 2 * steps]
             .iter()
             .map(|&k| {
-                let (text, w1) = random_rigid(&mut Draw(seed), k);
+                let (text, w1, _) = random_rigid(&mut Draw(seed), k);
                 let p = problem(&text);
                 continuation::run(&p, Parameter::Frequency, 0.6 * w1, 1.4 * w1, &ContinuationSettings::default(), &|_| {}).unwrap()
             })
@@ -174,10 +169,27 @@ fn rigid_family(seeds: std::ops::Range<u64>, steps: usize, checks_per_member: us
                 if (q.max_multiplier - 1.0).abs() < 0.02 {
                     continue;
                 }
-                let Some((settled, defect)) = settles_back(&fine, q) else { continue };
+                let Some(v) = settles_back(&sys, q) else {
+                    unresolved += 1;
+                    labels.push(format!("Ω {:.4}: stable {} / no reference orbit (|μ| {:.3})", q.parameter, q.stable, q.max_multiplier));
+                    continue;
+                };
                 compared += 1;
-                wrong += usize::from(settled != q.stable);
-                labels.push(format!("Ω {:.4}: stable {} / march {settled} (|μ| {:.3}, defect {defect:.1e})", q.parameter, q.stable, q.max_multiplier));
+                let agree = v.settled() == q.stable && (v.multiplier < 1.0) == q.stable;
+                wrong += usize::from(!agree);
+                worst_mu = worst_mu.max((v.multiplier - q.max_multiplier).abs());
+                labels.push(format!(
+                    "Ω {:.4}: stable {} / march {} (|μ| {:.4}, reference {:.4}; {} events, distance {:.1e}, defect {:.1e}){}",
+                    q.parameter,
+                    q.stable,
+                    v.settled(),
+                    q.max_multiplier,
+                    v.multiplier,
+                    v.events,
+                    v.distance,
+                    v.defect,
+                    if agree { "" } else { " DISAGREE" }
+                ));
             }
         }
         eprintln!(
@@ -196,7 +208,7 @@ fn rigid_family(seeds: std::ops::Range<u64>, steps: usize, checks_per_member: us
             }
         }
     }
-    (exact, reached, worst, compared, wrong)
+    Family { exact, reached, worst, compared, wrong, unresolved, worst_mu }
 }
 
 /// Two members of the random rigid family (issue 24) whose unstable impacting orbit from the fold
@@ -207,14 +219,22 @@ fn rigid_family(seeds: std::ops::Range<u64>, steps: usize, checks_per_member: us
 #[test]
 fn random_rigid_oscillators_give_the_same_exact_branch_at_k_and_2k() {
     let seeds = 2..4;
-    let (exact, reached, worst, compared, wrong) = rigid_family(seeds.clone(), 256, 1);
+    let f = rigid_family(seeds.clone(), 256, 1);
     eprintln!(
-        "{exact} of {} exact to the end, {reached} reached; k vs 2k: {worst:.1e}; stability vs march: {wrong} of {compared} disagree",
-        seeds.end - seeds.start
+        "{} of {} exact to the end, {} reached; k vs 2k: {:.1e}; stability vs the event-located reference: {} of {} disagree, {} without its orbit, |μ| within {:.1e}",
+        f.exact,
+        seeds.end - seeds.start,
+        f.reached,
+        f.worst,
+        f.wrong,
+        f.compared,
+        f.unresolved,
+        f.worst_mu
     );
-    assert_eq!(exact, (seeds.end - seeds.start) as usize);
-    assert!(worst <= 1e-5, "events at k and 2k differ by {worst:.1e}");
-    assert!(compared >= 1 && wrong == 0, "stability vs long time integration: {wrong} of {compared} disagree");
+    assert_eq!(f.exact, (seeds.end - seeds.start) as usize);
+    assert!(f.worst <= 1e-5, "events at k and 2k differ by {:.1e}", f.worst);
+    assert!(f.compared >= 1 && f.wrong == 0, "stability vs long time integration: {} of {} disagree", f.wrong, f.compared);
+    assert!(f.worst_mu < 1e-5, "|μ| off the reference's finite-difference Jacobian by {:.1e}", f.worst_mu);
 }
 
 /// The whole random rigid family (opt-in: `PC_RIGID_FAMILY=40 cargo test --release --test suite
@@ -227,10 +247,52 @@ fn random_rigid_oscillators_give_the_same_exact_branch_at_k_and_2k() {
 fn random_rigid_family() {
     let count: u64 = std::env::var("PC_RIGID_FAMILY").ok().and_then(|s| s.parse().ok()).unwrap_or(40);
     let first: u64 = std::env::var("PC_RIGID_FAMILY_FROM").ok().and_then(|s| s.parse().ok()).unwrap_or(100);
-    let (exact, reached, worst, compared, wrong) = rigid_family(first..first + count, 256, 1);
+    let f = rigid_family(first..first + count, 256, 1);
     eprintln!(
-        "random rigid family of {count}: {exact} exact to the end ({:.1} %), {reached} reached; worst k vs 2k event difference {worst:.1e}; stability vs long time integration: {wrong} of {compared} disagree",
-        100.0 * exact as f64 / count as f64
+        "random rigid family of {count}: {} exact to the end ({:.1} %), {} reached; worst k vs 2k event difference {:.1e}; stability vs the event-located reference: {} of {} disagree, {} without its orbit, largest |μ| difference {:.1e}",
+        f.exact,
+        100.0 * f.exact as f64 / count as f64,
+        f.reached,
+        f.worst,
+        f.wrong,
+        f.compared,
+        f.unresolved,
+        f.worst_mu
     );
-    assert!(100 * exact as u64 >= 95 * count, "{exact} of {count} exact to the end (target 95 %)");
+    assert!(100 * f.exact as u64 >= 95 * count, "{} of {count} exact to the end (target 95 %)", f.exact);
+}
+
+/// The event-located reference (tests/common/stop_march.rs) on a 1-DOF member of the rigid family
+/// against the closed-form impact map of src/exact/rigid.rs: at every pure-impact orbit over
+/// [0.6, 1.4]·ω₁ (unstable ones too) its finite-difference multiplier is the closed form's
+/// |μ| = |dt_next/dt0|, and its long simulation settles exactly when |μ| < 1 (seed 122 at
+/// Ω ≈ 1.28, μ ≈ −1.76, among them: the grid marcher held that orbit, the reference leaves it).
+#[test]
+fn the_event_located_reference_agrees_with_the_closed_form_impact_map() {
+    let (mut stable, mut unstable, mut worst_mu) = (0, 0, 0.0f64);
+    let seed = 122;
+    let (_, w1, sys) = random_rigid(&mut Draw(seed), 256);
+    assert_eq!(sys.mass.len(), 1, "seed {seed} is a 1-DOF member");
+    for j in 0..=40 {
+        let omega = w1 * (0.6 + 0.02 * j as f64);
+        let osc = Oscillator::new(sys.mass[0], sys.damping[(0, 0)], sys.stiffness[(0, 0)], sys.force[0], omega);
+        for (t0, mu) in RigidStopOrbit::pure_impacts(&osc, sys.gap).unwrap() {
+            if (mu.abs() - 1.0).abs() < 0.02 {
+                continue;
+            }
+            let v = verdict_at(&StopChain { omega, ..sys.clone() }, t0, &[sys.gap, 0.0], 0, 400).expect("the reference finds the orbit");
+            eprintln!(
+                "seed {seed} Ω {omega:.4}: closed form μ {mu:.6}, reference |μ| {:.6}, settled {} (distance {:.1e})",
+                v.multiplier,
+                v.settled(),
+                v.distance
+            );
+            worst_mu = worst_mu.max((v.multiplier - mu.abs()).abs() / mu.abs().max(1.0));
+            assert_eq!(v.settled(), mu.abs() < 1.0, "Ω {omega}: μ = {mu}, settled {}", v.settled());
+            if mu.abs() < 1.0 { stable += 1 } else { unstable += 1 }
+        }
+    }
+    eprintln!("{stable} stable and {unstable} unstable pure-impact orbits; |μ| within {worst_mu:.1e} (relative above 1)");
+    assert!(stable >= 1 && unstable >= 1, "{stable} stable, {unstable} unstable orbits compared");
+    assert!(worst_mu < 1e-6, "reference |μ| off the closed form by {worst_mu:.1e}");
 }

@@ -1,0 +1,408 @@
+//! Long time integration of a chain with one stop, its events located on exact flows: between
+//! events the motion is linear, y(t) = y_p(t) + e^{A(t − t0)} (y(t0) − y_p(t0)) (the harmonic
+//! particular solution of (K − Ω²M + iΩC) X = f); an impact or a release is found by binary descent
+//! on the flows over h/2^j (to h·2⁻⁵²); on a rigid stop impacts are plastic (e = 0) and the contact
+//! sticks while its holding force is compressive (Leine & Nijmeijer, "Dynamics and Bifurcations of
+//! Non-Smooth Mechanical Systems", §3.5); a compliant stop adds its stiffness while closed. No code of the crate is used (marcher, LCP, polish, continuation), so
+//! it can check their orbits and stability labels: the period map's fixed point, its
+//! finite-difference Jacobian's eigenvalues, and a long simulation started near the orbit.
+use nalgebra::{DMatrix, DVector};
+use num_complex::Complex64 as C;
+
+/// M x'' + C x' + K x = f cos Ωt − z e_c: rigid, x_c ≤ gap and z ≥ 0 (M diagonal: a plastic
+/// impact stops DOF c alone); compliant, z = k_c max(x_c − gap, 0).
+#[derive(Clone, Debug)]
+pub struct StopChain {
+    pub mass: Vec<f64>,
+    pub stiffness: DMatrix<f64>,
+    pub damping: DMatrix<f64>,
+    pub force: Vec<f64>,
+    pub omega: f64,
+    pub dof: usize,
+    pub gap: f64,
+    /// k_c of a compliant stop; `None`: rigid.
+    pub contact_stiffness: Option<f64>,
+}
+
+/// Flow steps per forcing period (events are located inside a step, so this only bounds the
+/// bracket: two crossings of the stop within T/1024 are taken as none).
+const STEPS: usize = 1024;
+
+/// A linear phase: the DOFs that move (all, or all but the stuck one) and their exact flow.
+struct Phase {
+    dofs: Vec<usize>,
+    a: DMatrix<f64>,
+    harmonic: Vec<C>,
+    fixed: Vec<f64>,
+    /// e^{A h/2^j}, j = 0..=52.
+    steps: Vec<DMatrix<f64>>,
+}
+
+impl Phase {
+    /// The phase with the contact open, or closed (stuck on a rigid stop, pressed into a compliant one).
+    fn new(s: &StopChain, closed: bool, h: f64) -> Phase {
+        let stuck = closed && s.contact_stiffness.is_none();
+        let pressed = if closed { s.contact_stiffness.unwrap_or(0.0) } else { 0.0 };
+        let dofs: Vec<usize> = (0..s.mass.len()).filter(|&i| !(stuck && i == s.dof)).collect();
+        let r = dofs.len();
+        let kc = |i: usize, j: usize| s.stiffness[(i, j)] + if i == s.dof && j == s.dof { pressed } else { 0.0 };
+        let (k, c) = (DMatrix::from_fn(r, r, |i, j| kc(dofs[i], dofs[j])), DMatrix::from_fn(r, r, |i, j| s.damping[(dofs[i], dofs[j])]));
+        let mut a = DMatrix::zeros(2 * r, 2 * r);
+        for i in 0..r {
+            a[(i, r + i)] = 1.0;
+            for j in 0..r {
+                a[(r + i, j)] = -k[(i, j)] / s.mass[dofs[i]];
+                a[(r + i, r + j)] = -c[(i, j)] / s.mass[dofs[i]];
+            }
+        }
+        let w = s.omega;
+        let dynamic = DMatrix::from_fn(r, r, |i, j| C::new(k[(i, j)] - if i == j { w * w * s.mass[dofs[i]] } else { 0.0 }, w * c[(i, j)]));
+        let f = DVector::from_iterator(r, dofs.iter().map(|&i| C::new(s.force[i], 0.0)));
+        let harmonic = if r == 0 { vec![] } else { dynamic.lu().solve(&f).expect("no resonance").iter().copied().collect() };
+        // The stuck DOF held at the gap pulls on the others through K: K_r x0 = −K_rc gap; a
+        // pressed compliant stop pushes by k_c (gap − x_c): (K + k_c e_c e_cᵀ) x0 = k_c gap e_c.
+        let pull = DVector::from_iterator(
+            r,
+            dofs.iter().map(|&i| {
+                if stuck {
+                    -s.stiffness[(i, s.dof)] * s.gap
+                } else if i == s.dof {
+                    pressed * s.gap
+                } else {
+                    0.0
+                }
+            }),
+        );
+        let fixed = if r == 0 { vec![] } else { k.clone().lu().solve(&pull).expect("grounded").iter().copied().collect() };
+        let steps = (0..=52).map(|j| if r == 0 { DMatrix::zeros(0, 0) } else { (&a * (h / 2f64.powi(j))).exp() }).collect();
+        Phase { dofs, a, harmonic, fixed, steps }
+    }
+
+    /// The particular solution's [x; v] of the moving DOFs at t.
+    fn particular(&self, w: f64, t: f64) -> DVector<f64> {
+        let r = self.dofs.len();
+        let e = C::new(0.0, w * t).exp();
+        DVector::from_fn(2 * r, |i, _| if i < r { (self.harmonic[i] * e).re + self.fixed[i] } else { (C::new(0.0, w) * self.harmonic[i - r] * e).re })
+    }
+
+    /// The full state `y` at t carried to t + τ by the flow `e` (e^{Aτ}).
+    fn flow(&self, w: f64, t: f64, y: &DVector<f64>, tau: f64, e: &DMatrix<f64>) -> DVector<f64> {
+        let (n, r) = (y.len() / 2, self.dofs.len());
+        let mut z = DVector::from_fn(2 * r, |i, _| if i < r { y[self.dofs[i]] } else { y[n + self.dofs[i - r]] });
+        z -= self.particular(w, t);
+        let z = e * z + self.particular(w, t + tau);
+        let mut out = y.clone();
+        for (i, &d) in self.dofs.iter().enumerate() {
+            out[d] = z[i];
+            out[n + d] = z[r + i];
+        }
+        out
+    }
+}
+
+/// An event of the orbit: its time and whether the contact is closed after it.
+#[derive(Clone, Copy, Debug)]
+pub struct Event {
+    pub time: f64,
+    pub closed_after: bool,
+}
+
+/// A simulation: the flows of both phases at one Ω.
+pub struct StopMarch {
+    pub sys: StopChain,
+    pub period: f64,
+    h: f64,
+    phases: [Phase; 2],
+}
+
+impl StopMarch {
+    pub fn new(sys: &StopChain) -> StopMarch {
+        let period = 2.0 * std::f64::consts::PI / sys.omega;
+        let h = period / STEPS as f64;
+        StopMarch { sys: sys.clone(), period, h, phases: [Phase::new(sys, false, h), Phase::new(sys, true, h)] }
+    }
+
+    fn n(&self) -> usize {
+        self.sys.mass.len()
+    }
+
+    /// The compressive force that holds DOF c on the stop (x_c = gap, v_c = 0): its equation of
+    /// motion with a_c = 0, z = f_c cos Ωt − (Kx)_c − (Cv)_c; and dz/dt.
+    fn holding(&self, t: f64, y: &DVector<f64>) -> (f64, f64) {
+        let (s, n) = (&self.sys, self.n());
+        let (c, w) = (s.dof, s.omega);
+        let accel = |i: usize| {
+            if i == c {
+                return 0.0;
+            }
+            let f = s.force[i] * (w * t).cos() - (0..n).map(|j| s.stiffness[(i, j)] * y[j] + s.damping[(i, j)] * y[n + j]).sum::<f64>();
+            f / s.mass[i]
+        };
+        let z = s.force[c] * (w * t).cos() - (0..n).map(|j| s.stiffness[(c, j)] * y[j] + s.damping[(c, j)] * y[n + j]).sum::<f64>();
+        let dz = -w * s.force[c] * (w * t).sin() - (0..n).map(|j| s.stiffness[(c, j)] * y[n + j] + s.damping[(c, j)] * accel(j)).sum::<f64>();
+        (z, dz)
+    }
+
+    /// The event function of a phase (an event where it reaches 0 from below) and its rate: the
+    /// penetration x_c − gap in flight, minus the holding force when stuck, the clearance when
+    /// pressed into a compliant stop.
+    fn event(&self, closed: bool, t: f64, y: &DVector<f64>) -> (f64, f64) {
+        let (p, v) = (y[self.sys.dof] - self.sys.gap, y[self.n() + self.sys.dof]);
+        match (closed, self.sys.contact_stiffness) {
+            (false, _) => (p, v),
+            (true, Some(_)) => (-p, -v),
+            (true, None) => {
+                let (z, dz) = self.holding(t, y);
+                (-z, -dz)
+            }
+        }
+    }
+
+    /// The latest time in [t, t + span] (to h·2⁻⁵²) from which `keep` still holds going by flows of
+    /// h/2^j from t (`keep` true at t): the root of a function that changes sign once there.
+    fn descend(&self, closed: bool, t: f64, y: &DVector<f64>, span: f64, keep: impl Fn(f64, &DVector<f64>) -> bool) -> (f64, DVector<f64>) {
+        let ph = &self.phases[usize::from(closed)];
+        let (mut t1, mut y1) = (t, y.clone());
+        for j in 1..=52 {
+            let d = self.h / 2f64.powi(j);
+            if t1 + d > t + span {
+                continue;
+            }
+            let cand = ph.flow(self.sys.omega, t1, &y1, d, &ph.steps[j as usize]);
+            if keep(t1 + d, &cand) {
+                t1 += d;
+                y1 = cand;
+            }
+        }
+        (t1, y1)
+    }
+
+    /// The state at the stop after a plastic impact (or at a start on the stop): x_c = gap, v_c = 0,
+    /// stuck when the holding force is compressive.
+    fn impact(&self, t: f64, y: &mut DVector<f64>) -> bool {
+        let (c, n) = (self.sys.dof, self.n());
+        y[c] = self.sys.gap;
+        y[n + c] = 0.0;
+        self.holding(t, y).0 > 0.0
+    }
+
+    /// Whether the contact is closed at a start from `y` at t: on a rigid stop (within 1e-10 of the
+    /// state's size), arriving or at rest, the start is taken as an impact; a compliant stop is
+    /// closed when penetrated, or on its surface and moving in.
+    pub fn starts_closed(&self, t: f64, y: &mut DVector<f64>) -> bool {
+        let (c, n) = (self.sys.dof, self.n());
+        let size = y.amax().max(self.sys.gap.abs());
+        let on = (self.sys.gap - y[c]).abs() <= 1e-10 * size;
+        match self.sys.contact_stiffness {
+            None => (on || y[c] > self.sys.gap) && y[n + c] >= -1e-10 * size && self.impact(t, y),
+            Some(_) => y[c] > self.sys.gap + 1e-10 * size || (on && y[n + c] > 0.0),
+        }
+    }
+
+    /// Marches `y` (phase `closed`) from t to `until`, calling `seen(t, y, event)` after every step
+    /// and event; returns the final state and phase.
+    pub fn run(
+        &self,
+        mut t: f64,
+        mut y: DVector<f64>,
+        mut closed: bool,
+        until: f64,
+        seen: &mut dyn FnMut(f64, &DVector<f64>, Option<Event>),
+    ) -> (DVector<f64>, bool) {
+        let w = self.sys.omega;
+        // Events that make no progress in time (a release into a state that sticks again at once):
+        // after a few, the step is taken as it is.
+        let mut stalled = 0;
+        while t < until {
+            let tau = self.h.min(until - t);
+            let ph = &self.phases[usize::from(closed)];
+            let y1 = match (ph.dofs.is_empty(), tau == self.h) {
+                (true, _) => y.clone(),
+                (false, true) => ph.flow(w, t, &y, tau, &ph.steps[0]),
+                (false, false) => ph.flow(w, t, &y, tau, &(&ph.a * tau).exp()),
+            };
+            let (_, d0) = self.event(closed, t, &y);
+            let (e1, d1) = self.event(closed, t + tau, &y1);
+            // The bracket of the first crossing: the step, or up to the event function's peak.
+            let bracket = if e1 >= 0.0 {
+                Some(tau)
+            } else if d0 > 0.0 && d1 < 0.0 {
+                let (tm, ym) = self.descend(closed, t, &y, tau, |s, x| self.event(closed, s, x).1 > 0.0);
+                (self.event(closed, tm, &ym).0 >= 0.0).then_some(tm - t + self.h * 2f64.powi(-52))
+            } else {
+                None
+            };
+            match bracket.filter(|_| stalled < 4) {
+                Some(span) => {
+                    let (te, mut ye) = self.descend(closed, t, &y, span, |s, x| self.event(closed, s, x).0 < 0.0);
+                    stalled = if te > t { 0 } else { stalled + 1 };
+                    closed = !closed && (self.sys.contact_stiffness.is_some() || self.impact(te, &mut ye));
+                    (t, y) = (te, ye);
+                    seen(t, &y, Some(Event { time: t, closed_after: closed }));
+                }
+                None => {
+                    stalled = 0;
+                    t = if tau == until - t { until } else { t + tau };
+                    y = y1;
+                    seen(t, &y, None);
+                }
+            }
+        }
+        (y, closed)
+    }
+
+    /// One period from (t, y): the state a period later and the events on the way.
+    pub fn period_map(&self, t: f64, y: &DVector<f64>) -> (DVector<f64>, Vec<Event>) {
+        let mut y = y.clone();
+        let closed = self.starts_closed(t, &mut y);
+        let mut events = Vec::new();
+        let (end, _) = self.run(t, y, closed, t + self.period, &mut |_, _, e| events.extend(e));
+        (end, events)
+    }
+}
+
+/// The independent verdict on an orbit of the chain: its fixed point's Floquet multiplier, the
+/// output's amplitude, and where a long simulation started near it goes.
+#[derive(Clone, Copy, Debug)]
+pub struct Verdict {
+    /// The largest |eigenvalue| of the period map's finite-difference Jacobian at the fixed point.
+    pub multiplier: f64,
+    /// Peak-to-peak/2 of DOF `out` over the orbit.
+    pub amplitude: f64,
+    /// The simulation's distance from the orbit after `periods` periods, and between its last two
+    /// periods (relative to the orbit's state size).
+    pub distance: f64,
+    pub defect: f64,
+    /// Events per period of the orbit.
+    pub events: usize,
+}
+
+impl Verdict {
+    /// Stable by the long simulation: back on the orbit within 1e-5 (a multiplier of 0.98 leaves
+    /// 1e-3·0.98⁴⁰⁰ ≈ 3e-7 of the start's 1e-3).
+    pub fn settled(&self) -> bool {
+        self.distance < 1e-5
+    }
+}
+
+/// The instants of the period at which `y0` (a branch point's state just after its event 0, its
+/// time unknown) lies on an orbit: the local minima of the one-period return mismatch over 256
+/// instants, refined by golden section, those returning `y0` within 1e-6 of its size; best first.
+/// (A 1-DOF orbit leaves a rigid stop at (gap, 0) whatever the orbit: several instants.)
+pub fn orbit_times(sys: &StopChain, y0: &[f64]) -> Vec<f64> {
+    let m = StopMarch::new(sys);
+    let tp = m.period;
+    let y0 = DVector::from_column_slice(y0);
+    let size = y0.amax().max(1e-12);
+    let mismatch = |t: f64| (m.period_map(t, &y0).0 - &y0).amax() / size;
+    let scan = 256;
+    let at = |i: usize| tp * i as f64 / scan as f64;
+    let sampled: Vec<f64> = (0..scan).map(|i| mismatch(at(i))).collect();
+    let mut found: Vec<(f64, f64)> = Vec::new();
+    for i in 0..scan {
+        let (before, after) = (sampled[(i + scan - 1) % scan], sampled[(i + 1) % scan]);
+        if sampled[i] > before || sampled[i] > after || sampled[i] > 0.5 {
+            continue;
+        }
+        let (mut a, mut b) = (at(i) - tp / scan as f64, at(i) + tp / scan as f64);
+        let g = 0.5 * (5f64.sqrt() - 1.0);
+        let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
+        let (mut fc, mut fd) = (mismatch(c), mismatch(d));
+        for _ in 0..80 {
+            if fc < fd {
+                (b, d, fd) = (d, c, fc);
+                c = b - g * (b - a);
+                fc = mismatch(c);
+            } else {
+                (a, c, fc) = (c, d, fd);
+                d = a + g * (b - a);
+                fd = mismatch(d);
+            }
+        }
+        let t0 = 0.5 * (a + b);
+        let r = mismatch(t0);
+        if r <= 1e-6 {
+            found.push((r, t0));
+        }
+    }
+    found.sort_by(|x, y| x.0.total_cmp(&y.0));
+    found.into_iter().map(|f| f.1).collect()
+}
+
+/// The orbit through `y0` at an unknown instant ([`orbit_times`]) that `wanted` accepts (e.g. its
+/// amplitude), by [`verdict_at`]; `None` when there is none.
+pub fn verdict(sys: &StopChain, y0: &[f64], out: usize, periods: usize, wanted: impl Fn(&Verdict) -> bool) -> Option<Verdict> {
+    orbit_times(sys, y0).into_iter().filter_map(|t0| verdict_at(sys, t0, y0, out, periods)).find(|v| wanted(v))
+}
+
+/// The orbit through `y0` at `t0`: the period map's fixed point by Newton with a central-difference
+/// Jacobian at a section in the longest free flight, its multipliers, and a march of `periods`
+/// periods from the fixed point perturbed by 1e-3 of its size. `None` where Newton fails.
+pub fn verdict_at(sys: &StopChain, t0: f64, y0: &[f64], out: usize, periods: usize) -> Option<Verdict> {
+    let m = StopMarch::new(sys);
+    let (n2, tp) = (y0.len(), m.period);
+    let y0 = DVector::from_column_slice(y0);
+    let size = y0.amax().max(1e-12);
+    // The section: the middle of the longest flight between events (any instant without events).
+    let (_, events) = m.period_map(t0, &y0);
+    let mut ts = t0 + 0.5 * tp;
+    if !events.is_empty() {
+        let mut longest = 0.0;
+        for (i, e) in events.iter().enumerate() {
+            let next = events.get(i + 1).map_or(events[0].time + tp, |x| x.time);
+            if !e.closed_after && next - e.time > longest {
+                (longest, ts) = (next - e.time, 0.5 * (e.time + next));
+            }
+        }
+    }
+    let mut y = {
+        let mut y = y0.clone();
+        let closed = m.starts_closed(t0, &mut y);
+        m.run(t0, y, closed, ts, &mut |_, _, _| {}).0
+    };
+    // Newton on P(y) − y, the Jacobian of P by central differences (the events keep their order).
+    let jacobian = |y: &DVector<f64>| {
+        let d = 1e-7 * size;
+        DMatrix::from_columns(
+            &(0..n2)
+                .map(|j| {
+                    let mut p = y.clone();
+                    p[j] += d;
+                    let mut q = y.clone();
+                    q[j] -= d;
+                    (m.period_map(ts, &p).0 - m.period_map(ts, &q).0) / (2.0 * d)
+                })
+                .collect::<Vec<_>>(),
+        )
+    };
+    for _ in 0..20 {
+        let r = m.period_map(ts, &y).0 - &y;
+        if r.amax() < 1e-13 * size {
+            break;
+        }
+        y -= (jacobian(&y) - DMatrix::identity(n2, n2)).lu().solve(&r)?;
+    }
+    if (m.period_map(ts, &y).0 - &y).amax() > 1e-10 * size {
+        return None;
+    }
+    let multiplier = jacobian(&y).complex_eigenvalues().iter().map(|z| z.norm()).fold(0.0, f64::max);
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    let mut count = 0;
+    m.run(ts, y.clone(), false, ts + tp, &mut |_, x, e| {
+        (lo, hi) = (lo.min(x[out]), hi.max(x[out]));
+        count += usize::from(e.is_some());
+    });
+    // The start, off the orbit by 1e-3 of its size, kept off a rigid stop.
+    let mut start = DVector::from_fn(n2, |i, _| y[i] + 1e-3 * size * if i % 2 == 0 { 1.0 } else { -1.0 });
+    if sys.contact_stiffness.is_none() && start[sys.dof] >= sys.gap {
+        start[sys.dof] = y[sys.dof] - 1e-3 * size;
+    }
+    let mut closed = m.starts_closed(ts, &mut start);
+    let (mut prev, mut end) = (start.clone(), start);
+    for k in 0..periods {
+        let t = ts + k as f64 * tp;
+        let (e, s) = m.run(t, end.clone(), closed, t + tp, &mut |_, _, _| {});
+        (prev, end, closed) = (end, e, s);
+    }
+    Some(Verdict { multiplier, amplitude: 0.5 * (hi - lo), distance: (&end - &y).amax() / size, defect: (&end - &prev).amax() / size, events: count })
+}
