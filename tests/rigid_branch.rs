@@ -1,8 +1,9 @@
 //! The exact walk on rigid stops (issue 24): plastic impacts (e = 0) and sticking arcs, against
 //! the closed-form impact oscillator of src/exact/rigid.rs (its impact map and multiplier, not
-//! the polish) and against long time integration (the explicit marcher of src/marching).
+//! the polish) and against long time integration (tests/common/stop_march.rs: exact flows, events
+//! located inside the step; not the grid marcher, whose impacts land on its grid).
 use crate::common::family::{Chain, Draw};
-use crate::common::stop_march::{StopChain, Verdict, verdict, verdict_at};
+use crate::common::stop_march::{Labels, StopChain, check_labels, verdict_at};
 use periodic_contact::analysis::continuation::{self, ContinuationSettings, Parameter, Source};
 use periodic_contact::exact::{Oscillator, RigidRegime, RigidStopOrbit};
 use periodic_contact::periodic::PeriodicProblem;
@@ -111,34 +112,19 @@ fn random_rigid(d: &mut Draw, steps: usize) -> (String, f64, StopChain) {
     (chain.scene(alpha, (fdof, amp), &format!("dof = {cdof}\ngap = {gap:e}\n"), "bds1", steps, cdof), w1, sys)
 }
 
-/// Long time integration started near the branch point `q`, by tests/common/stop_march.rs (exact
-/// flows between events located inside the step, plastic impacts and sticking; not the crate's
-/// marcher, polish or continuation): the orbit through `q`'s state (its time found by the return
-/// mismatch), the period map's fixed point by Newton, its finite-difference multipliers, and 400
-/// periods from it perturbed by 1e-3. `None` where that orbit is not `q`'s (amplitudes differ by
-/// 1e-4: the reference samples its minimum at T/1024) or is not found.
-fn settles_back(sys: &StopChain, q: &continuation::BranchPoint) -> Option<Verdict> {
-    let sys = StopChain { omega: q.parameter, ..sys.clone() };
-    verdict(&sys, &q.state, sys.dof, 400, |v| (v.amplitude - q.amplitude[0]).abs() <= 1e-4 * q.amplitude[0])
-}
-
 /// What the family gave: members that reached the end on the exact orbit all along, and that
 /// reached it; the largest event difference between k and 2k (kind by kind); stability labels
-/// compared with the event-located reference, how many disagree, those without a reference
-/// orbit, and the largest |μ| difference from the reference's.
+/// against the event-located reference.
 struct Family {
     exact: usize,
     reached: usize,
     worst: f64,
-    compared: usize,
-    wrong: usize,
-    unresolved: usize,
-    worst_mu: f64,
+    labels: Labels,
 }
 
 /// The random rigid family's members `seeds`, each over [0.6, 1.4]·ω₁ at k and 2k. Prints each member.
 fn rigid_family(seeds: std::ops::Range<u64>, steps: usize, checks_per_member: usize) -> Family {
-    let (mut exact, mut reached, mut worst, mut compared, mut wrong, mut unresolved, mut worst_mu) = (0, 0, 0.0f64, 0, 0, 0, 0.0f64);
+    let (mut exact, mut reached, mut worst, mut labels) = (0, 0, 0.0f64, Labels::default());
     for seed in seeds {
         let sys = random_rigid(&mut Draw(seed), steps).2;
         let runs: Vec<continuation::Branch> = [steps, 2 * steps]
@@ -156,47 +142,14 @@ fn rigid_family(seeds: std::ops::Range<u64>, steps: usize, checks_per_member: us
         let same_kinds = ev[0].iter().map(|e| e.0).eq(ev[1].iter().map(|e| e.0));
         let gap = if same_kinds { ev[0].iter().zip(&ev[1]).map(|(a, b)| (a.1 - b.1).abs()).fold(0.0, f64::max) } else { f64::INFINITY };
         worst = worst.max(gap);
-        // Stability at points drawn at random on the k branch (exact points, not at an event).
-        // As many from the unstable stretches as from the stable ones (most of a branch is stable).
-        let mut d = Draw(seed ^ 0x5eed);
-        let mut labels = Vec::new();
-        for label in [true, false] {
-            let plain: Vec<&continuation::BranchPoint> =
-                runs[0].points.iter().filter(|q| q.event.is_none() && q.source == Source::Exact && q.stable == label).collect();
-            for _ in 0..checks_per_member.min(plain.len()) {
-                let q = plain[(d.next() * plain.len() as f64) as usize];
-                // Not near a change of stability: the largest multiplier clear of the unit circle.
-                if (q.max_multiplier - 1.0).abs() < 0.02 {
-                    continue;
-                }
-                let Some(v) = settles_back(&sys, q) else {
-                    unresolved += 1;
-                    labels.push(format!("Ω {:.4}: stable {} / no reference orbit (|μ| {:.3})", q.parameter, q.stable, q.max_multiplier));
-                    continue;
-                };
-                compared += 1;
-                let agree = v.settled() == q.stable && (v.multiplier < 1.0) == q.stable;
-                wrong += usize::from(!agree);
-                worst_mu = worst_mu.max((v.multiplier - q.max_multiplier).abs());
-                labels.push(format!(
-                    "Ω {:.4}: stable {} / march {} (|μ| {:.4}, reference {:.4}; {} events, distance {:.1e}, defect {:.1e}){}",
-                    q.parameter,
-                    q.stable,
-                    v.settled(),
-                    q.max_multiplier,
-                    v.multiplier,
-                    v.events,
-                    v.distance,
-                    v.defect,
-                    if agree { "" } else { " DISAGREE" }
-                ));
-            }
-        }
+        // Stability at points drawn at random on the k branch, against long time integration.
+        let l = check_labels(&sys, &runs[0].points, seed, checks_per_member);
+        labels.absorb(&l);
         eprintln!(
             "seed {seed}: exact {all_exact}, {} events at k, {} at 2k, largest difference {gap:.1e}; {}; stop: {}",
             ev[0].len(),
             ev[1].len(),
-            labels.join(", "),
+            l.lines.join(", "),
             runs[0].stop
         );
         if std::env::var("PC_RIGID_EVENTS").is_ok() {
@@ -208,7 +161,7 @@ fn rigid_family(seeds: std::ops::Range<u64>, steps: usize, checks_per_member: us
             }
         }
     }
-    Family { exact, reached, worst, compared, wrong, unresolved, worst_mu }
+    Family { exact, reached, worst, labels }
 }
 
 /// Two members of the random rigid family (issue 24) whose unstable impacting orbit from the fold
@@ -221,20 +174,18 @@ fn random_rigid_oscillators_give_the_same_exact_branch_at_k_and_2k() {
     let seeds = 2..4;
     let f = rigid_family(seeds.clone(), 256, 1);
     eprintln!(
-        "{} of {} exact to the end, {} reached; k vs 2k: {:.1e}; stability vs the event-located reference: {} of {} disagree, {} without its orbit, |μ| within {:.1e}",
+        "{} of {} exact to the end, {} reached; k vs 2k: {:.1e}; stability vs the event-located reference: {}",
         f.exact,
         seeds.end - seeds.start,
         f.reached,
         f.worst,
-        f.wrong,
-        f.compared,
-        f.unresolved,
-        f.worst_mu
+        f.labels.summary()
     );
     assert_eq!(f.exact, (seeds.end - seeds.start) as usize);
     assert!(f.worst <= 1e-5, "events at k and 2k differ by {:.1e}", f.worst);
-    assert!(f.compared >= 1 && f.wrong == 0, "stability vs long time integration: {} of {} disagree", f.wrong, f.compared);
-    assert!(f.worst_mu < 1e-5, "|μ| off the reference's finite-difference Jacobian by {:.1e}", f.worst_mu);
+    let l = &f.labels;
+    assert!(l.compared >= 4 && l.wrong == 0 && l.unresolved == 0, "stability vs long time integration: {}", l.summary());
+    assert!(l.worst_mu < 1e-5, "|μ| off the reference's finite-difference Jacobian: {}", l.summary());
 }
 
 /// The whole random rigid family (opt-in: `PC_RIGID_FAMILY=40 cargo test --release --test suite
@@ -249,15 +200,12 @@ fn random_rigid_family() {
     let first: u64 = std::env::var("PC_RIGID_FAMILY_FROM").ok().and_then(|s| s.parse().ok()).unwrap_or(100);
     let f = rigid_family(first..first + count, 256, 1);
     eprintln!(
-        "random rigid family of {count}: {} exact to the end ({:.1} %), {} reached; worst k vs 2k event difference {:.1e}; stability vs the event-located reference: {} of {} disagree, {} without its orbit, largest |μ| difference {:.1e}",
+        "random rigid family of {count}: {} exact to the end ({:.1} %), {} reached; worst k vs 2k event difference {:.1e}; stability vs the event-located reference: {}",
         f.exact,
         100.0 * f.exact as f64 / count as f64,
         f.reached,
         f.worst,
-        f.wrong,
-        f.compared,
-        f.unresolved,
-        f.worst_mu
+        f.labels.summary()
     );
     assert!(100 * f.exact as u64 >= 95 * count, "{} of {count} exact to the end (target 95 %)", f.exact);
 }

@@ -8,6 +8,7 @@
 //! finite-difference Jacobian's eigenvalues, and a long simulation started near the orbit.
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64 as C;
+use periodic_contact::analysis::continuation::{BranchPoint, Source};
 
 /// M x'' + C x' + K x = f cos Ωt − z e_c: rigid, x_c ≤ gap and z ≥ 0 (M diagonal: a plastic
 /// impact stops DOF c alone); compliant, z = k_c max(x_c − gap, 0).
@@ -405,4 +406,73 @@ pub fn verdict_at(sys: &StopChain, t0: f64, y0: &[f64], out: usize, periods: usi
         (prev, end, closed) = (end, e, s);
     }
     Some(Verdict { multiplier, amplitude: 0.5 * (hi - lo), distance: (&end - &y).amax() / size, defect: (&end - &prev).amax() / size, events: count })
+}
+
+/// A branch's stability labels against [`verdict`]: how many points were compared, how many
+/// disagree (the label against the long simulation or the reference's |μ| < 1), how many had no
+/// reference orbit (amplitude not within 1e-4 of the point's), the largest |μ| difference (relative
+/// above 1), and one line per point.
+#[derive(Default)]
+pub struct Labels {
+    pub compared: usize,
+    pub wrong: usize,
+    pub unresolved: usize,
+    pub worst_mu: f64,
+    pub lines: Vec<String>,
+}
+
+impl Labels {
+    /// Adds a member's counts (not its lines).
+    pub fn absorb(&mut self, o: &Labels) {
+        (self.compared, self.wrong, self.unresolved) = (self.compared + o.compared, self.wrong + o.wrong, self.unresolved + o.unresolved);
+        self.worst_mu = self.worst_mu.max(o.worst_mu);
+    }
+
+    /// "w of c disagree, u without a reference orbit, |μ| within x".
+    pub fn summary(&self) -> String {
+        format!(
+            "{} of {} disagree, {} without a reference orbit, |μ| within {:.1e} (relative above 1)",
+            self.wrong, self.compared, self.unresolved, self.worst_mu
+        )
+    }
+}
+
+/// `per_label` points drawn at random (`Draw(seed ^ 0x5eed)`) from the branch's stable exact points
+/// and as many from its unstable ones (most of a branch is stable), not at an event nor within
+/// 0.02 of |μ| = 1, each checked by 400 periods of [`verdict`] (`sys` at the point's Ω, output 0 = DOF `sys.dof`).
+pub fn check_labels(sys: &StopChain, points: &[BranchPoint], seed: u64, per_label: usize) -> Labels {
+    let mut d = crate::common::family::Draw(seed ^ 0x5eed);
+    let mut l = Labels::default();
+    for label in [true, false] {
+        let plain: Vec<&BranchPoint> = points.iter().filter(|q| q.event.is_none() && q.source == Source::Exact && q.stable == label).collect();
+        for _ in 0..per_label.min(plain.len()) {
+            let q = plain[(d.next() * plain.len() as f64) as usize];
+            if (q.max_multiplier - 1.0).abs() < 0.02 {
+                continue;
+            }
+            let at = StopChain { omega: q.parameter, ..sys.clone() };
+            let Some(v) = verdict(&at, &q.state, sys.dof, 400, |v| (v.amplitude - q.amplitude[0]).abs() <= 1e-4 * q.amplitude[0]) else {
+                l.unresolved += 1;
+                l.lines.push(format!("Ω {:.4}: stable {} / no reference orbit (|μ| {:.3})", q.parameter, q.stable, q.max_multiplier));
+                continue;
+            };
+            l.compared += 1;
+            let agree = v.settled() == q.stable && (v.multiplier < 1.0) == q.stable;
+            l.wrong += usize::from(!agree);
+            l.worst_mu = l.worst_mu.max((v.multiplier - q.max_multiplier).abs() / q.max_multiplier.max(1.0));
+            l.lines.push(format!(
+                "Ω {:.4}: stable {} / march {} (|μ| {:.4}, reference {:.4}; {} events, distance {:.1e}, defect {:.1e}){}",
+                q.parameter,
+                q.stable,
+                v.settled(),
+                q.max_multiplier,
+                v.multiplier,
+                v.events,
+                v.distance,
+                v.defect,
+                if agree { "" } else { " DISAGREE" }
+            ));
+        }
+    }
+    l
 }
