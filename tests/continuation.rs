@@ -1,6 +1,7 @@
 //! Continuation of NLvib's Example 03 (src/formulation.md §7) against the independent reference of
 //! validation/nlvib03 (exact piecewise-linear flows, shooting, long time integration).
 use crate::common::family::{Chain, Draw};
+use crate::common::stop_march::{Labels, StopChain, check_labels};
 use periodic_contact::analysis::continuation::{self, ContinuationSettings, Parameter};
 use serde_json::Value;
 use std::time::Instant;
@@ -97,12 +98,16 @@ fn nlvib03_exact_branch_is_the_same_at_every_k() {
     eprintln!("worst event error over k = 256 … 4096: {worst_event:.1e}");
 }
 
+/// The contact DOF's linear amplitude |X_c(ω)|.
+type Linear = Box<dyn Fn(f64) -> f64>;
+
 /// A random oscillator of 1–3 DOFs (a grounded chain: masses 0.5–2, springs 0.5–2, Rayleigh
 /// damping of 1–4 % at the first mode) with a compliant stop (stiffness 5–100 × the chain's) on a
 /// random DOF, forced on a random DOF; the gap is 0.3–0.7 of that DOF's linear peak near the
 /// first mode, so the branch over [0.6, 1.6]·ω₁ spans a contact resonance. (scene, ω₁, the
-/// gap, the contact DOF's linear amplitude |X_c(ω)| from (K − ω²M + iωC) X = f).
-fn random_oscillator(d: &mut Draw, steps: usize) -> (String, f64, f64, Box<dyn Fn(f64) -> f64>) {
+/// gap, the contact DOF's linear amplitude |X_c(ω)| from (K − ω²M + iωC) X = f, the same chain
+/// for the event-located reference).
+fn random_oscillator(d: &mut Draw, steps: usize) -> (String, f64, f64, Linear, StopChain) {
     let chain = Chain::draw(d);
     let (n, w1) = (chain.n, chain.w1);
     let zeta = d.range(0.01, 0.04);
@@ -119,21 +124,23 @@ fn random_oscillator(d: &mut Draw, steps: usize) -> (String, f64, f64, Box<dyn F
     let gap = d.range(0.3, 0.7) * peak;
     let kc = d.range(5.0, 100.0) * chain.springs.iter().fold(0.0f64, |a, b| a.max(*b));
     let text = chain.scene(alpha, (fdof, amp), &format!("dof = {cdof}\ngap = {gap:e}\nstiffness = {kc:e}\n"), "cds", steps, cdof);
-    (text, w1, gap, Box::new(linear))
+    let sys = chain.stop(alpha, (fdof, amp), cdof, gap, Some(kc));
+    (text, w1, gap, Box::new(linear), sys)
 }
 
 /// The random family's members `seeds`: each branch over [0.6, 1.6]·ω₁ at k and 2k. Returns the
 /// members that reached the end on the exact orbit all along, those that reached it, the largest
 /// event disagreement between k and 2k (matched kind by kind, in order) and the largest relative
-/// error of a grazing from or onto the contact-free orbit against the closed form |X_c(ω)| = gap;
-/// prints each member.
-fn exact_family(seeds: std::ops::Range<u64>, steps: usize) -> (usize, usize, f64, f64) {
-    let (mut exact, mut reached, mut worst, mut graze) = (0, 0, 0.0f64, 0.0f64);
+/// error of a grazing from or onto the contact-free orbit against the closed form |X_c(ω)| = gap,
+/// and the stability labels at random points (one stable, one unstable per member) against the
+/// event-located reference of tests/common/stop_march.rs; prints each member.
+fn exact_family(seeds: std::ops::Range<u64>, steps: usize) -> (usize, usize, f64, f64, Labels) {
+    let (mut exact, mut reached, mut worst, mut graze, mut labels) = (0, 0, 0.0f64, 0.0f64, Labels::default());
     for seed in seeds.clone() {
         let runs: Vec<continuation::Branch> = [steps, 2 * steps]
             .iter()
             .map(|&k| {
-                let (text, w1, _, _) = random_oscillator(&mut Draw(seed), k);
+                let (text, w1, _, _, _) = random_oscillator(&mut Draw(seed), k);
                 let p = periodic_contact::scene::Scene::parse(&text, "family").unwrap().to_problem("family").unwrap();
                 continuation::run(&p, Parameter::Frequency, 0.6 * w1, 1.6 * w1, &ContinuationSettings::default(), &|_| {}).unwrap()
             })
@@ -144,7 +151,7 @@ fn exact_family(seeds: std::ops::Range<u64>, steps: usize) -> (usize, usize, f64
         let ev: Vec<Vec<(&str, f64)>> = runs.iter().map(|b| b.events().map(|e| (e.event.unwrap().name(), e.parameter)).collect()).collect();
         let same_kinds = ev[0].iter().map(|e| e.0).eq(ev[1].iter().map(|e| e.0));
         let gap = if same_kinds { ev[0].iter().zip(&ev[1]).map(|(a, b)| (a.1 - b.1).abs()).fold(0.0, f64::max) } else { f64::INFINITY };
-        let (_, _, clearance, linear) = random_oscillator(&mut Draw(seed), steps);
+        let (_, _, clearance, linear, sys) = random_oscillator(&mut Draw(seed), steps);
         // Grazings where the contact-free orbit (no events) touches: its peak is |X_c| (no static load).
         let free = runs[0].events().filter(|e| e.detail.contains("events per period 0 ->") || e.detail.contains("-> 0 "));
         let g = free.map(|e| (linear(e.parameter) - clearance).abs() / clearance).fold(0.0, f64::max);
@@ -152,40 +159,54 @@ fn exact_family(seeds: std::ops::Range<u64>, steps: usize) -> (usize, usize, f64
             worst = worst.max(gap);
             graze = graze.max(g);
         }
+        let l = check_labels(&sys, &runs[0].points, seed, 1);
+        labels.absorb(&l);
         eprintln!(
-            "seed {seed}: exact {all_exact}, {} events at k, {} at 2k, largest difference {gap:.1e}; grazing vs closed form {g:.1e}; stop: {}",
+            "seed {seed}: exact {all_exact}, {} events at k, {} at 2k, largest difference {gap:.1e}; grazing vs closed form {g:.1e}; {}; stop: {}",
             ev[0].len(),
             ev[1].len(),
+            l.lines.join(", "),
             runs[0].stop
         );
     }
-    (exact, reached, worst, graze)
+    (exact, reached, worst, graze, labels)
 }
 
 /// A few members of the random family of compliant oscillators (issue 24): each reaches the end
 /// on the exact orbit, with the same events at k = 256 and 512 within 1e-5, and its grazings on
-/// the contact-free orbit where the closed form puts them (|X_c(ω)| = gap) within 1e-8.
+/// the contact-free orbit where the closed form puts them (|X_c(ω)| = gap) within 1e-8; the
+/// stability labels at random points agree with the event-located reference (its long simulation
+/// and its finite-difference |μ|).
 #[test]
 fn random_compliant_oscillators_give_the_same_exact_branch_at_k_and_2k() {
     let seeds = 1..5;
-    let (exact, reached, worst, graze) = exact_family(seeds.clone(), 256);
-    eprintln!("{exact} of {} exact to the end, {reached} reached; k vs 2k: {worst:.1e}; grazings {graze:.1e}", seeds.end - seeds.start);
+    let (exact, reached, worst, graze, l) = exact_family(seeds.clone(), 256);
+    eprintln!(
+        "{exact} of {} exact to the end, {reached} reached; k vs 2k: {worst:.1e}; grazings {graze:.1e}; stability: {}",
+        seeds.end - seeds.start,
+        l.summary()
+    );
     assert_eq!(exact, (seeds.end - seeds.start) as usize);
     assert!(worst <= 1e-5, "events at k and 2k differ by {worst:.1e}");
     assert!(graze <= 1e-8, "a grazing off the closed form by {graze:.1e} (relative)");
+    assert!(l.compared >= 4 && l.wrong == 0 && l.unresolved == 0, "stability vs long time integration: {}", l.summary());
+    assert!(l.worst_mu < 1e-5, "|μ| off the reference's: {}", l.summary());
 }
 
 /// The whole random family (opt-in: `PC_FAMILY=100 cargo test --release --test suite continuation:: --
-/// --ignored random_family`): the fraction that reaches the end on the exact orbit and the worst
-/// k vs 2k event disagreement.
+/// --ignored random_family`; `PC_FAMILY_FROM` the first seed, 100 by default): the fraction that
+/// reaches the end on the exact orbit, the worst k vs 2k event disagreement, and the stability
+/// labels against the event-located reference.
 #[test]
 #[ignore]
 fn random_family() {
     let count: u64 = std::env::var("PC_FAMILY").ok().and_then(|s| s.parse().ok()).unwrap_or(50);
-    let (exact, reached, worst, graze) = exact_family(100..100 + count, 256);
+    let first: u64 = std::env::var("PC_FAMILY_FROM").ok().and_then(|s| s.parse().ok()).unwrap_or(100);
+    let (exact, reached, worst, graze, l) = exact_family(first..first + count, 256);
     eprintln!(
-        "random family of {count}: {exact} exact to the end ({:.1} %), {reached} reached; worst k vs 2k event difference {worst:.1e}; worst grazing vs closed form {graze:.1e}",
-        100.0 * exact as f64 / count as f64
+        "random family of {count}: {exact} exact to the end ({:.1} %), {reached} reached; worst k vs 2k event difference {worst:.1e}; worst grazing vs closed form {graze:.1e}; stability vs the event-located reference: {}",
+        100.0 * exact as f64 / count as f64,
+        l.summary()
     );
 }
 

@@ -1,11 +1,11 @@
 //! The exact walk on rigid stops (issue 24): plastic impacts (e = 0) and sticking arcs, against
 //! the closed-form impact oscillator of src/exact/rigid.rs (its impact map and multiplier, not
-//! the polish) and against long time integration (the explicit marcher of src/marching).
+//! the polish) and against long time integration (tests/common/stop_march.rs: exact flows, events
+//! located inside the step; not the grid marcher, whose impacts land on its grid).
 use crate::common::family::{Chain, Draw};
+use crate::common::stop_march::{Labels, StopChain, check_labels, verdict};
 use periodic_contact::analysis::continuation::{self, ContinuationSettings, Parameter, Source};
-use periodic_contact::analysis::polish;
 use periodic_contact::exact::{Oscillator, RigidRegime, RigidStopOrbit};
-use periodic_contact::marching::{MarchSettings, march};
 use periodic_contact::periodic::PeriodicProblem;
 
 fn problem(text: &str) -> PeriodicProblem {
@@ -89,8 +89,9 @@ fn sticking_onset(osc: &Oscillator, gap: f64, a: f64, b: f64) -> f64 {
 /// A random oscillator of 1–3 DOFs (a grounded chain: masses 0.5–2, springs 0.5–2, Rayleigh
 /// damping of 2–6 % at the first mode) with a RIGID stop on a random DOF, forced on a random DOF;
 /// the gap is 0.3–0.8 of that DOF's linear peak near the first mode, so the branch over
-/// [0.6, 1.4]·ω₁ impacts and, where the gap is small, sticks. (scene, ω₁)
-fn random_rigid(d: &mut Draw, steps: usize) -> (String, f64) {
+/// [0.6, 1.4]·ω₁ impacts and, where the gap is small, sticks. (scene, ω₁, the same chain for the
+/// event-located reference)
+fn random_rigid(d: &mut Draw, steps: usize) -> (String, f64, StopChain) {
     let chain = Chain::draw(d);
     let (n, w1) = (chain.n, chain.w1);
     let alpha = 2.0 * d.range(0.02, 0.06) / w1;
@@ -98,58 +99,29 @@ fn random_rigid(d: &mut Draw, steps: usize) -> (String, f64) {
     let amp = 0.1;
     let peak = (0..400).map(|j| chain.linear_amplitude(alpha, fdof, cdof, amp, w1 * (0.6 + 0.8 * j as f64 / 400.0))).fold(0.0, f64::max);
     let gap = d.range(0.3, 0.8) * peak;
-    (chain.scene(alpha, (fdof, amp), &format!("dof = {cdof}\ngap = {gap:e}\n"), "bds1", steps, cdof), w1)
+    let sys = chain.stop(alpha, (fdof, amp), cdof, gap, None);
+    (chain.scene(alpha, (fdof, amp), &format!("dof = {cdof}\ngap = {gap:e}\n"), "bds1", steps, cdof), w1, sys)
 }
 
-/// Long time integration started near the branch point `q`: the orbit at its λ (the grid's,
-/// polished; `None` when that is another branch than `q`'s: amplitudes differ by 1e-6), its state
-/// at t = 0 perturbed by 1e-3 of its size, marched 400 periods at N = 2048 steps per period.
-/// Stable when the march's last period comes back to the orbit within 1 % of the amplitude at
-/// every instant (the marcher's O(h) error is ~1e-3) and repeats the one before within 1e-5.
-/// (settled, that periodicity defect)
-fn settles_back(p: &PeriodicProblem, q: &continuation::BranchPoint) -> Option<(bool, f64)> {
-    let mut p = p.clone();
-    p.set_frequency(q.parameter).unwrap();
-    let n = p.model().n();
-    let r = p.solve().ok()?;
-    let orbit = polish::polish(&p, &r).ok()?;
-    let dof = p.outputs().displacement[0];
-    if (orbit.amplitude(None, dof)? - q.amplitude[0]).abs() > 1e-6 * q.amplitude[0] {
-        return None;
-    }
-    let y = orbit.state(0.0);
-    let size = y.amax().max(1e-12);
-    let y: Vec<f64> = y.iter().enumerate().map(|(i, v)| v + 1e-3 * size * if i % 2 == 0 { 1.0 } else { -1.0 }).collect();
-    let settings = MarchSettings {
-        steps_per_period: 2048,
-        max_periods: 400,
-        min_periods: 400,
-        tolerance: 1e-14,
-        initial_displacement: Some(y[..n].to_vec()),
-        initial_velocity: Some(y[n..].to_vec()),
-    };
-    let m = march(p.model(), &settings).ok()?;
-    // Instant by instant over the last period: past a period doubling the march settles on a
-    // period-2 orbit whose amplitude is close to the T orbit's, but not its path.
-    let off = m.time.iter().zip(&m.displacement).map(|(&t, x)| (x[dof] - orbit.state(t)[dof]).abs()).fold(0.0, f64::max);
-    // Close to a grazing an unstable impacting orbit's attractor (period 2 or more) stays within
-    // 1 % of it: settled means periodic too (a multiplier ≤ 0.98 leaves 1e-3·0.98⁴⁰⁰ ≈ 3e-7).
-    Some((off < 1e-2 * q.amplitude[0] && m.defect < 1e-5, m.defect))
+/// What the family gave: members that reached the end on the exact orbit all along, and that
+/// reached it; the largest event difference between k and 2k (kind by kind); stability labels
+/// against the event-located reference.
+struct Family {
+    exact: usize,
+    reached: usize,
+    worst: f64,
+    labels: Labels,
 }
 
-/// The random rigid family's members `seeds`, each over [0.6, 1.4]·ω₁ at k and 2k: (members that
-/// reached the end, on the exact orbit all along; largest event difference between k and 2k,
-/// kind by kind; stability labels compared with long time integration; disagreements). Prints
-/// each member.
-fn rigid_family(seeds: std::ops::Range<u64>, steps: usize, checks_per_member: usize) -> (usize, usize, f64, usize, usize) {
-    let (mut exact, mut reached, mut worst, mut compared, mut wrong) = (0, 0, 0.0f64, 0, 0);
+/// The random rigid family's members `seeds`, each over [0.6, 1.4]·ω₁ at k and 2k. Prints each member.
+fn rigid_family(seeds: std::ops::Range<u64>, steps: usize, checks_per_member: usize) -> Family {
+    let (mut exact, mut reached, mut worst, mut labels) = (0, 0, 0.0f64, Labels::default());
     for seed in seeds {
-        // The long time integrations start from the orbit on a fine grid, polished.
-        let fine = problem(&random_rigid(&mut Draw(seed), 4096).0);
+        let sys = random_rigid(&mut Draw(seed), steps).2;
         let runs: Vec<continuation::Branch> = [steps, 2 * steps]
             .iter()
             .map(|&k| {
-                let (text, w1) = random_rigid(&mut Draw(seed), k);
+                let (text, w1, _) = random_rigid(&mut Draw(seed), k);
                 let p = problem(&text);
                 continuation::run(&p, Parameter::Frequency, 0.6 * w1, 1.4 * w1, &ContinuationSettings::default(), &|_| {}).unwrap()
             })
@@ -161,30 +133,14 @@ fn rigid_family(seeds: std::ops::Range<u64>, steps: usize, checks_per_member: us
         let same_kinds = ev[0].iter().map(|e| e.0).eq(ev[1].iter().map(|e| e.0));
         let gap = if same_kinds { ev[0].iter().zip(&ev[1]).map(|(a, b)| (a.1 - b.1).abs()).fold(0.0, f64::max) } else { f64::INFINITY };
         worst = worst.max(gap);
-        // Stability at points drawn at random on the k branch (exact points, not at an event).
-        // As many from the unstable stretches as from the stable ones (most of a branch is stable).
-        let mut d = Draw(seed ^ 0x5eed);
-        let mut labels = Vec::new();
-        for label in [true, false] {
-            let plain: Vec<&continuation::BranchPoint> =
-                runs[0].points.iter().filter(|q| q.event.is_none() && q.source == Source::Exact && q.stable == label).collect();
-            for _ in 0..checks_per_member.min(plain.len()) {
-                let q = plain[(d.next() * plain.len() as f64) as usize];
-                // Not near a change of stability: the largest multiplier clear of the unit circle.
-                if (q.max_multiplier - 1.0).abs() < 0.02 {
-                    continue;
-                }
-                let Some((settled, defect)) = settles_back(&fine, q) else { continue };
-                compared += 1;
-                wrong += usize::from(settled != q.stable);
-                labels.push(format!("Ω {:.4}: stable {} / march {settled} (|μ| {:.3}, defect {defect:.1e})", q.parameter, q.stable, q.max_multiplier));
-            }
-        }
+        // Stability at points drawn at random on the k branch, against long time integration.
+        let l = check_labels(&sys, &runs[0].points, seed, checks_per_member);
+        labels.absorb(&l);
         eprintln!(
             "seed {seed}: exact {all_exact}, {} events at k, {} at 2k, largest difference {gap:.1e}; {}; stop: {}",
             ev[0].len(),
             ev[1].len(),
-            labels.join(", "),
+            l.lines.join(", "),
             runs[0].stop
         );
         if std::env::var("PC_RIGID_EVENTS").is_ok() {
@@ -196,7 +152,7 @@ fn rigid_family(seeds: std::ops::Range<u64>, steps: usize, checks_per_member: us
             }
         }
     }
-    (exact, reached, worst, compared, wrong)
+    Family { exact, reached, worst, labels }
 }
 
 /// Two members of the random rigid family (issue 24) whose unstable impacting orbit from the fold
@@ -207,14 +163,20 @@ fn rigid_family(seeds: std::ops::Range<u64>, steps: usize, checks_per_member: us
 #[test]
 fn random_rigid_oscillators_give_the_same_exact_branch_at_k_and_2k() {
     let seeds = 2..4;
-    let (exact, reached, worst, compared, wrong) = rigid_family(seeds.clone(), 256, 1);
+    let f = rigid_family(seeds.clone(), 256, 1);
     eprintln!(
-        "{exact} of {} exact to the end, {reached} reached; k vs 2k: {worst:.1e}; stability vs march: {wrong} of {compared} disagree",
-        seeds.end - seeds.start
+        "{} of {} exact to the end, {} reached; k vs 2k: {:.1e}; stability vs the event-located reference: {}",
+        f.exact,
+        seeds.end - seeds.start,
+        f.reached,
+        f.worst,
+        f.labels.summary()
     );
-    assert_eq!(exact, (seeds.end - seeds.start) as usize);
-    assert!(worst <= 1e-5, "events at k and 2k differ by {worst:.1e}");
-    assert!(compared >= 1 && wrong == 0, "stability vs long time integration: {wrong} of {compared} disagree");
+    assert_eq!(f.exact, (seeds.end - seeds.start) as usize);
+    assert!(f.worst <= 1e-5, "events at k and 2k differ by {:.1e}", f.worst);
+    let l = &f.labels;
+    assert!(l.compared >= 4 && l.wrong == 0 && l.unresolved == 0, "stability vs long time integration: {}", l.summary());
+    assert!(l.worst_mu < 1e-5, "|μ| off the reference's finite-difference Jacobian: {}", l.summary());
 }
 
 /// The whole random rigid family (opt-in: `PC_RIGID_FAMILY=40 cargo test --release --test suite
@@ -227,10 +189,49 @@ fn random_rigid_oscillators_give_the_same_exact_branch_at_k_and_2k() {
 fn random_rigid_family() {
     let count: u64 = std::env::var("PC_RIGID_FAMILY").ok().and_then(|s| s.parse().ok()).unwrap_or(40);
     let first: u64 = std::env::var("PC_RIGID_FAMILY_FROM").ok().and_then(|s| s.parse().ok()).unwrap_or(100);
-    let (exact, reached, worst, compared, wrong) = rigid_family(first..first + count, 256, 1);
+    let f = rigid_family(first..first + count, 256, 1);
     eprintln!(
-        "random rigid family of {count}: {exact} exact to the end ({:.1} %), {reached} reached; worst k vs 2k event difference {worst:.1e}; stability vs long time integration: {wrong} of {compared} disagree",
-        100.0 * exact as f64 / count as f64
+        "random rigid family of {count}: {} exact to the end ({:.1} %), {} reached; worst k vs 2k event difference {:.1e}; stability vs the event-located reference: {}",
+        f.exact,
+        100.0 * f.exact as f64 / count as f64,
+        f.reached,
+        f.worst,
+        f.labels.summary()
     );
-    assert!(100 * exact as u64 >= 95 * count, "{exact} of {count} exact to the end (target 95 %)");
+    assert!(100 * f.exact as u64 >= 95 * count, "{} of {count} exact to the end (target 95 %)", f.exact);
+}
+
+/// The event-located reference (tests/common/stop_march.rs) on a 1-DOF member of the rigid family
+/// against the closed-form impact map of src/exact/rigid.rs: at every pure-impact orbit over
+/// [0.6, 1.4]·ω₁ (unstable ones too) its finite-difference multiplier is the closed form's
+/// |μ| = |dt_next/dt0|, and its long simulation settles exactly when |μ| < 1 (seed 122 at
+/// Ω ≈ 1.28, μ ≈ −1.76, among them: the grid marcher held that orbit, the reference leaves it).
+#[test]
+fn the_event_located_reference_agrees_with_the_closed_form_impact_map() {
+    let (mut stable, mut unstable, mut worst_mu) = (0, 0, 0.0f64);
+    let seed = 122;
+    let (_, w1, sys) = random_rigid(&mut Draw(seed), 256);
+    assert_eq!(sys.mass.len(), 1, "seed {seed} is a 1-DOF member");
+    for j in 0..=40 {
+        let omega = w1 * (0.6 + 0.02 * j as f64);
+        let osc = Oscillator::new(sys.mass[0], sys.damping[(0, 0)], sys.stiffness[(0, 0)], sys.force[0], omega);
+        for (t0, mu) in RigidStopOrbit::pure_impacts(&osc, sys.gap).unwrap() {
+            if (mu.abs() - 1.0).abs() < 0.02 {
+                continue;
+            }
+            let v = verdict(&StopChain { omega, ..sys.clone() }, t0, &[sys.gap, 0.0], 0, 400, 1e-6).expect("the reference finds the orbit");
+            eprintln!(
+                "seed {seed} Ω {omega:.4}: closed form μ {mu:.6}, reference |μ| {:.6}, settled {} (distance {:.1e})",
+                v.multiplier,
+                v.settled(),
+                v.distance
+            );
+            worst_mu = worst_mu.max((v.multiplier - mu.abs()).abs() / mu.abs().max(1.0));
+            assert_eq!(v.settled(), mu.abs() < 1.0, "Ω {omega}: μ = {mu}, settled {}", v.settled());
+            if mu.abs() < 1.0 { stable += 1 } else { unstable += 1 }
+        }
+    }
+    eprintln!("{stable} stable and {unstable} unstable pure-impact orbits; |μ| within {worst_mu:.1e} (relative above 1)");
+    assert!(stable >= 1 && unstable >= 1, "{stable} stable, {unstable} unstable orbits compared");
+    assert!(worst_mu < 1e-5, "reference |μ| off the closed form by {worst_mu:.1e}");
 }

@@ -146,6 +146,18 @@ impl RigidStopOrbit {
         }
     }
 
+    /// Every one-impact orbit (pure impacts, unstable ones too, where [`Self::solve`] keeps the
+    /// first stable one): its impact instant t0 ∈ [0, T) and impact-map multiplier μ.
+    pub fn pure_impacts(osc: &Oscillator, gap: f64) -> Result<Vec<(f64, f64)>, ExactError> {
+        osc.validate()?;
+        osc.require_stiffness()?;
+        check_finite("gap", gap)?;
+        let linear = LinearOrbit::solve(osc)?;
+        let free = PhaseFlow::new(osc.mass, osc.damping, osc.stiffness, osc.force, osc.omega, 0.0)?;
+        let orbit = RigidStopOrbit { osc: *osc, gap, kind: Kind::NoContact, free, linear, min_x: 0.0, max_x: 0.0 };
+        Ok(orbit.impacting_candidates().into_iter().map(|(t0, _, mu)| (t0, mu)).collect())
+    }
+
     /// First return to the stop of the free flight from (g0, 0) at `t_d`, within two periods:
     /// (t_h, v(t_h⁻)).
     fn first_return(&self, t_d: f64) -> Option<(f64, f64)> {

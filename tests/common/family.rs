@@ -1,5 +1,6 @@
 //! The random 1–3-DOF oscillators the branch families draw (continuation.rs: compliant stops,
 //! rigid_branch.rs: rigid stops): one generator and one chain, so both families draw alike.
+use super::stop_march::StopChain;
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64 as C;
 
@@ -55,6 +56,21 @@ impl Chain {
         let mut f = DVector::zeros(n);
         f[fdof] = C::new(amp, 0.0);
         a.lu().solve(&f).map_or(0.0, |x| x[cdof].norm())
+    }
+
+    /// The same oscillator for tests/common/stop_march.rs at 0.6·ω₁: C = αK, the force `amp` at
+    /// `fdof`, a stop on `cdof` at `gap` (rigid without `contact_stiffness`).
+    pub fn stop(&self, alpha: f64, (fdof, amp): (usize, f64), cdof: usize, gap: f64, contact_stiffness: Option<f64>) -> StopChain {
+        StopChain {
+            mass: self.mass.clone(),
+            stiffness: self.stiffness.clone(),
+            damping: &self.stiffness * alpha,
+            force: (0..self.n).map(|i| if i == fdof { amp } else { 0.0 }).collect(),
+            omega: 0.6 * self.w1,
+            dof: cdof,
+            gap,
+            contact_stiffness,
+        }
     }
 
     /// The scene: C = αK, the force `amp` at `fdof`, the `[[contact]]` body `contact`, output `cdof`, at 0.6·ω₁.

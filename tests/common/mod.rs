@@ -1,6 +1,7 @@
 pub mod compare;
 pub mod family;
 pub mod host;
+pub mod stop_march;
 
 /// A 2-DOF chain (m = 1, springs 2/−1, c = 0.1) forced on the first mass at Ω = 1.2, with a
 /// compliant stop (gap 0.3, stiffness 20) on the second; cds, k = 256.

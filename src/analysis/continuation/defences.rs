@@ -77,6 +77,7 @@ mod tests {
             detail: String::new(),
             certified: true,
             state: vec![],
+            time: 0.0,
             masks: vec![],
             tangent: vec![],
             source: Source::Discrete,

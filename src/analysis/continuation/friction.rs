@@ -54,6 +54,7 @@ pub(super) fn walk(
             detail: String::new(),
             certified: true,
             state: Vec::new(),
+            time: 0.0,
             masks: Vec::new(),
             tangent: Vec::new(),
             source: Source::Discrete,

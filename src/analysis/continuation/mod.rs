@@ -98,8 +98,10 @@ pub struct BranchPoint {
     pub detail: String,
     /// The session's certified LCP solve from this point's active sets gave the same active set.
     pub certified: bool,
-    /// The orbit's initial state s_0 (the step map's state).
+    /// The orbit's initial state s_0 (the step map's state; the exact orbit's just after its event 0).
     pub state: Vec<f64>,
+    /// The instant of `state` [s]: 0 on the grid, event 0's time on the exact orbit (0 without events).
+    pub time: f64,
     /// The active sets of the orbit's steps (bit c: contact c), for a switch of branch here.
     pub(crate) masks: Vec<u64>,
     /// The branch's unit tangent in (s_0, λ/ρ) here, for a switch of branch.
@@ -509,6 +511,7 @@ fn point(fam: &Family, solver: &mut PeriodicSolver, node: &Node, event: Option<E
         detail,
         certified: got == set,
         state: node.solved.v[..node.solved.v.len() - 1].to_vec(),
+        time: 0.0,
         masks: node.solved.masks.clone(),
         tangent: node.tangent.clone(),
         source: Source::Discrete,

@@ -163,6 +163,7 @@ impl Walk<'_> {
             detail,
             certified: true,
             state: node.orbit.initial_state().to_vec(),
+            time: node.orbit.times().first().copied().unwrap_or(0.0),
             masks: Vec::new(),
             tangent: node.tangent.clone(),
             source: Source::Exact,
