@@ -130,7 +130,24 @@ fn grazing_model(omega: f64) -> Model {
 /// held-arc orbit, continued on the exact orbit (not restarted from the grid).
 #[test]
 fn a_massless_contact_grazing_starts_its_held_arc_on_the_exact_branch() {
-    let (lo, hi) = (0.6, 0.8);
+    check_grazing_walk(0.6, 0.8);
+}
+
+/// The same branch walked down, from 0.75 to 0.6 rad/s (at 0.8 the grid's cold solve settles on
+/// another orbit): the held arc shrinks to nothing at ω_g
+/// as √(ω − ω_g) (the free clearance's minimum is quadratic in time), so the held family's λ
+/// turns there (its tangent's λ component vanishes with the arc); the walk must not report that
+/// turn as a fold and turn back (the real blade at 2298.19 rad/s), but remove the closing and the
+/// release (the point flies free) and go on down on the linear orbit.
+#[test]
+fn a_massless_contact_held_arc_vanishing_ends_in_flight_on_the_exact_branch() {
+    check_grazing_walk(0.75, 0.6);
+}
+
+/// The walk from `from` to `to` over the grazing of [`grazing_model`]: one grazing at the closed
+/// form's ω_g, no fold, every point exact, amplitudes and multipliers the closed form's.
+fn check_grazing_walk(from: f64, to: f64) {
+    let (lo, hi) = (from.min(to), from.max(to));
     // (k1 − u)² + c²u − (F/g)² = 0, the root below resonance.
     let (b, c0) = (C * C - 2.0 * K1[0], K1[0] * K1[0] - (F / GRAZE_GAP).powi(2));
     let graze = ((-b - (b * b - 4.0 * c0).sqrt()) / 2.0).sqrt();
@@ -138,21 +155,22 @@ fn a_massless_contact_grazing_starts_its_held_arc_on_the_exact_branch() {
     assert!(linear(lo) < GRAZE_GAP && linear(hi) > GRAZE_GAP, "the grazing must lie in the range");
     let outputs = OutputSelection { displacement: vec![0], velocity: vec![], acceleration: vec![], contacts: true };
     let disc = Discretization { scheme: Scheme::Cds, steps: 256, pairing: None };
-    let p = PeriodicProblem::new(grazing_model(lo), disc, outputs, SolverSettings::default()).unwrap();
+    let p = PeriodicProblem::new(grazing_model(from), disc, outputs, SolverSettings::default()).unwrap();
     let start = std::time::Instant::now();
-    let b = continuation::run(&p, Parameter::Frequency, lo, hi, &ContinuationSettings::default(), &|_| {}).unwrap();
+    let b = continuation::run(&p, Parameter::Frequency, from, to, &ContinuationSettings::default(), &|_| {}).unwrap();
     eprintln!("{} points in {:.2} s: {}", b.points.len(), start.elapsed().as_secs_f64(), b.stop);
     for e in b.events() {
         eprintln!("event at ω = {}: {:?} {}", e.parameter, e.event, e.detail);
     }
     assert!(b.reached(), "{}", b.stop);
     assert!(b.points.iter().all(|q| q.source == Source::Exact), "{}", b.stop);
+    assert!(b.events().all(|e| e.event != Some(EventKind::Fold)), "no fold on this branch");
     let grazings: Vec<f64> = b.events().filter(|e| e.event == Some(EventKind::Grazing)).map(|e| e.parameter).collect();
     assert_eq!(grazings.len(), 1, "one grazing: {grazings:?}");
     eprintln!("grazing at {:.12} (closed form {graze:.12})", grazings[0]);
     assert!((grazings[0] - graze).abs() < 1e-8, "grazing at {} instead of {graze}", grazings[0]);
     assert!(b.events().all(|e| !e.detail.contains("not traced")), "the branch past the grazing is the exact orbit's");
-    let (mut amp, mut mult, mut held) = (0.0f64, 0.0f64, 0);
+    let (mut amp, mut mult, mut held, mut free) = (0.0f64, 0.0f64, 0, 0);
     // The closed form's held-arc orbits from hi down, each Newton seeded by the one before (past
     // the period doubling near ω_g the simulation that seeds it by default settles elsewhere).
     let mut points: Vec<&periodic_contact::analysis::continuation::BranchPoint> = b.points.iter().filter(|q| (q.parameter - graze).abs() > 1e-6).collect();
@@ -178,10 +196,12 @@ fn a_massless_contact_grazing_starts_its_held_arc_on_the_exact_branch() {
             assert_eq!(got.len(), 2, "ω = {w}: two nonzero multipliers, {got:?}");
             mult = mult.max(multiplier_distance(&got, &o.floquet_multipliers()));
             assert_eq!(q.stable, o.is_stable(), "ω = {w}: stability against the closed form's");
+        } else {
+            free += 1;
         }
     }
-    eprintln!("{held} points with the held arc; largest amplitude error {amp:.1e} (relative), multiplier error {mult:.1e}");
-    assert!(held >= 3, "the held arc's branch is walked");
+    eprintln!("{held} points with the held arc, {free} free; largest amplitude error {amp:.1e} (relative), multiplier error {mult:.1e}");
+    assert!(held >= 3 && free >= 3, "both sides of the grazing are walked");
     assert!(amp < 1e-9, "amplitudes off the closed form by {amp:.1e}");
     assert!(mult < 1e-7, "multipliers off the closed form by {mult:.1e}");
 }

@@ -8,6 +8,7 @@
 //! Continuation", ch. 19) with a fixed segment signature.
 use super::super::{Parameter, floquet};
 use super::metric::Metric;
+use super::profile::{Stage, timed};
 use crate::analysis::polish::{Event, EventKind, PolishedOrbit, Touch};
 use crate::model::{Compliance, Model};
 use nalgebra::{DMatrix, DVector};
@@ -166,6 +167,10 @@ impl Family {
         if !lambda.is_finite() {
             return None;
         }
+        timed(Stage::Build, || self.build(lambda))
+    }
+
+    fn build(&self, lambda: f64) -> Option<PolishedOrbit> {
         let mut orbit = PolishedOrbit::unsolved(&self.model_at(lambda), self.sig.events.clone(), &self.sig.always).ok()?;
         let key = self.signature_key();
         let mut modes = self.modes.borrow_mut();
@@ -187,7 +192,7 @@ impl Family {
 
     fn residual_with(&self, orbit: &PolishedOrbit, w: &[f64]) -> Option<DVector<f64>> {
         let (y, times) = self.unpack(w, orbit.period());
-        let mut r = orbit.shooting_residual(&y, &times)?;
+        let mut r = timed(Stage::Residual, || orbit.shooting_residual(&y, &times))?;
         r.iter_mut().enumerate().for_each(|(i, v)| *v *= self.row_scale(i));
         for (row, e, p, wrap) in self.reimpacts() {
             r[row] *= super::rigid::reimpact_factor(w[e] + wrap - w[p]);
@@ -241,7 +246,7 @@ impl Family {
         let d = self.dim();
         let (y, times) = self.unpack(w, here.period());
         let mut j = DMatrix::zeros(d - 1, d);
-        if let Some((_, dr)) = here.shooting_jacobian(&y, &times) {
+        if let Some((_, dr)) = timed(Stage::Variational, || here.shooting_jacobian(&y, &times)) {
             for c in 0..d - 1 {
                 let scale = if c < self.n2 { self.ys / self.weight[c] } else { here.period() };
                 j.set_column(c, &(dr.column(c) * scale));
@@ -265,7 +270,7 @@ impl Family {
             let (mut up, mut dn) = (w.to_vec(), w.to_vec());
             up[d - 1] += DIFF;
             dn[d - 1] -= DIFF;
-            let col = (self.residual(&up)? - self.residual(&dn)?) / (2.0 * DIFF);
+            let col = timed(Stage::LambdaColumn, || Some((self.residual(&up)? - self.residual(&dn)?) / (2.0 * DIFF)))?;
             j.set_column(d - 1, &col);
             return Some(j);
         }
@@ -372,6 +377,10 @@ impl Family {
     }
 
     pub fn node_with(&self, w: Vec<f64>, prev: &[f64], touches: bool) -> Option<Node> {
+        timed(Stage::Node, || self.solved(w, prev, touches))
+    }
+
+    fn solved(&self, w: Vec<f64>, prev: &[f64], touches: bool) -> Option<Node> {
         let lambda = w[w.len() - 1] * self.rho;
         let jac = match self.last_jacobian.take() {
             Some((at, j)) if at == w => j,

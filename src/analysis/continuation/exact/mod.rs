@@ -17,6 +17,7 @@
 //! there, from the grid LCP only where that fails ([`rigid`]).
 mod family;
 mod metric;
+mod profile;
 mod rigid;
 mod signature;
 
@@ -172,7 +173,8 @@ impl Walk<'_> {
 
     /// The touches and the outputs' amplitudes of `orbit`, from one sampling of its period.
     fn amplitudes(&self, orbit: &PolishedOrbit) -> (Vec<polish::Touch>, Vec<f64>) {
-        let (touches, amplitude) = orbit.touches_and_amplitudes(self.problem.output_map(), &self.problem.outputs().displacement);
+        let (touches, amplitude) =
+            profile::timed(profile::Stage::Amplitudes, || orbit.touches_and_amplitudes(self.problem.output_map(), &self.problem.outputs().displacement));
         (touches, amplitude.into_iter().map(|a| a.unwrap_or(f64::NAN)).collect())
     }
 
@@ -191,7 +193,9 @@ impl Walk<'_> {
     }
 
     fn follow(self, here: Node, from: f64, to: f64, settings: &ContinuationSettings, on_point: &dyn Fn(f64)) -> Walked {
-        self.follow_to(here, from, to, settings, on_point).0
+        let walked = self.follow_to(here, from, to, settings, on_point).0;
+        profile::report(walked.points.len());
+        walked
     }
 
     /// [`Self::follow`], with the fold it stopped at (when `stop_at_fold`) and the exact orbit
@@ -216,7 +220,7 @@ impl Walk<'_> {
             // A phase between two events of one contact shrinking to nothing: a grazing.
             // The step is measured in the metric: the tangent of unit metric length.
             let along = self.fam.metric.unit(&here.tangent);
-            let shrinking = self.shrinking(&here, &along);
+            let shrinking = signature::shrinking(&self.fam, &here.w, &along);
             if let Some(&(e, len, rate)) = shrinking.iter().find(|s| s.1 < VANISH) {
                 let _ = (len, rate);
                 let next = if self.rigid_event(e) { self.rigid_vanish(&here, e, to) } else { self.remove_pair(&here, e) };
@@ -387,7 +391,7 @@ impl Walk<'_> {
         let metric = &self.fam.metric;
         let drift = metric.norm(&n.w.iter().zip(&pred).map(|(a, b)| a - b).collect::<Vec<_>>());
         let turn = metric.dot(&metric.unit(&n.tangent), &along);
-        ((turn >= MIN_COS || step <= min_step) && drift <= MAX_DRIFT * step).then_some((n, passed))
+        ((turn >= MIN_COS || step <= min_step) && drift <= MAX_DRIFT * step && !signature::reversed(&self.fam, &n.w)).then_some((n, passed))
     }
 
     /// The predictor `pred` from `here` and, when events with identity state maps of different
@@ -418,23 +422,6 @@ impl Walk<'_> {
         }
         moved.w = w;
         (sectioned, Some(moved))
-    }
-
-    /// Phases between two events of one contact that shrink along the tangent: (phase, length,
-    /// rate of shrinking per unit arclength).
-    fn shrinking(&self, here: &Node, along: &[f64]) -> Vec<(usize, f64, f64)> {
-        let events = &self.fam.sig.events;
-        let ne = events.len();
-        let n2 = here.w.len() - 1 - ne;
-        (0..ne)
-            .filter(|&e| ne >= 2 && events[e].contact == events[(e + 1) % ne].contact)
-            .filter_map(|e| {
-                let b = (e + 1) % ne;
-                let len = here.w[n2 + b] - here.w[n2 + e] + if b == 0 { 1.0 } else { 0.0 };
-                let rate = along[n2 + e] - along[n2 + b];
-                (rate > 0.0).then_some((e, len, rate))
-            })
-            .collect()
     }
 
     /// The grazing at `here` where phase `e` has vanished: the point recorded, the pair of
@@ -568,6 +555,10 @@ fn detail_of(kind: EventKind, node: &Node) -> String {
 /// point is the orbit on the hyperplane through the bracket's midpoint normal to its secant.
 /// The last points on either side (with their touches when `touches`).
 fn bisect(fam: &Family, a: &Node, b: &Node, same: &dyn Fn(&Node) -> bool, touches: bool) -> Option<(Node, Node)> {
+    profile::timed(profile::Stage::Bisect, || bisect_on(fam, a, b, same, touches))
+}
+
+fn bisect_on(fam: &Family, a: &Node, b: &Node, same: &dyn Fn(&Node) -> bool, touches: bool) -> Option<(Node, Node)> {
     let (mut lo, mut hi) = (a.clone(), b.clone());
     for _ in 0..80 {
         let sec: Vec<f64> = hi.w.iter().zip(&lo.w).map(|(x, y)| x - y).collect();

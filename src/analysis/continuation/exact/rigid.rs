@@ -257,7 +257,13 @@ impl Walk<'_> {
         let mut list = timed(&here.orbit);
         let (rho, lambda) = (self.fam.rho, here.lambda(self.fam.rho));
         let sense = here.tangent[here.tangent.len() - 1].signum();
+        let massless = self.problem.model().contact_is_massless(&self.problem.model().contacts[ev.contact]);
         let (sig, guess) = match (ev.kind, next.kind) {
+            // A massless point's held arc vanishing: the free clearance's minimum touches zero (the
+            // arc is where it would be negative, √ long in λ), so the point flies free past it:
+            // closing and release removed, the orbit the same there (the inverse of
+            // `rigid_crossing`'s massless arm). A pure impact has no meaning without mass.
+            (Switch::Impact { stick: true }, Switch::Release) if massless => signature::remove(&self.fam, &here.orbit, e, wl)?,
             // Located on the orbit with a pure impact, where the force that would hold its contact
             // touches zero, a short way ahead; else that orbit's branch from here.
             (Switch::Impact { stick: true }, Switch::Release) => {

@@ -156,3 +156,35 @@ pub(super) fn toggled(fam: &Family, model: &Model, here: &[f64], pred: &[f64]) -
     }
     any.then_some(out)
 }
+
+/// The length (fraction of the period) of phase `e` of the unknowns `w` when it lies between two
+/// events of one contact (the pair a grazing adds or removes), else `None`.
+fn pair_phase(fam: &Family, w: &[f64], e: usize) -> Option<f64> {
+    let events = &fam.sig.events;
+    let ne = events.len();
+    let n2 = w.len() - 1 - ne;
+    let b = (e + 1) % ne;
+    (ne >= 2 && events[e].contact == events[b].contact).then(|| w[n2 + b] - w[n2 + e] + if b == 0 { 1.0 } else { 0.0 })
+}
+
+/// Phases between two events of one contact that shrink along the tangent `along` at the
+/// unknowns `w`: (phase, length, rate of shrinking per unit arclength).
+pub(super) fn shrinking(fam: &Family, w: &[f64], along: &[f64]) -> Vec<(usize, f64, f64)> {
+    let ne = fam.ne();
+    let n2 = w.len() - 1 - ne;
+    (0..ne)
+        .filter_map(|e| {
+            let len = pair_phase(fam, w, e)?;
+            let rate = along[n2 + e] - along[n2 + (e + 1) % ne];
+            (rate > 0.0).then_some((e, len, rate))
+        })
+        .collect()
+}
+
+/// Whether a phase between two events of one contact has a negative length in the unknowns
+/// `w`: the corrector went past its vanishing onto the formal continuation of the signature
+/// (a massless point's held arc is √ long in λ there, so that continuation turns back in λ:
+/// the real blade's false fold at 2298.19 rad/s), which is no orbit.
+pub(super) fn reversed(fam: &Family, w: &[f64]) -> bool {
+    (0..fam.ne()).any(|e| pair_phase(fam, w, e).is_some_and(|len| len <= 0.0))
+}

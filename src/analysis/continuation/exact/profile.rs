@@ -1,0 +1,67 @@
+//! Where the exact walk's time goes, under `PERIODIC_CONTACT_PROFILE`: the thread's CPU time
+//! (Linux: /proc/thread-self/schedstat, the figure to read on a loaded machine) summed per stage
+//! of the family and the walk, printed when the walk ends. Nothing is measured without it.
+use std::cell::RefCell;
+
+/// The stages measured, in the order printed.
+#[derive(Clone, Copy)]
+pub(super) enum Stage {
+    /// An orbit of the signature built at λ (its phases, modes shared).
+    Build,
+    /// A shooting residual.
+    Residual,
+    /// The state and time columns of a Jacobian (the variational flow of one period).
+    Variational,
+    /// A Jacobian's λ column (two residuals on orbits rebuilt at λ ± h).
+    LambdaColumn,
+    /// A point's orbit, multipliers and touches ([`super::family::Family::node_with`]).
+    Node,
+    /// The outputs' amplitudes and touches sampled over a period.
+    Amplitudes,
+    /// Bisections locating events.
+    Bisect,
+}
+
+const NAMES: [&str; 7] = ["orbit built", "residual", "variational flow", "λ column", "point (monodromy, touches)", "amplitudes", "bisections (inclusive)"];
+
+thread_local! {
+    static TOTALS: RefCell<Option<[(f64, usize); 7]>> = const { RefCell::new(None) };
+}
+
+fn enabled() -> bool {
+    std::env::var_os("PERIODIC_CONTACT_PROFILE").is_some()
+}
+
+/// The thread's CPU time so far [s].
+fn cpu() -> f64 {
+    std::fs::read_to_string("/proc/thread-self/schedstat").ok().and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok()).unwrap_or(f64::NAN) * 1e-9
+}
+
+/// `f`'s thread CPU time added to `stage` (when profiling).
+pub(super) fn timed<T>(stage: Stage, f: impl FnOnce() -> T) -> T {
+    if !enabled() {
+        return f();
+    }
+    let start = cpu();
+    let out = f();
+    let spent = cpu() - start;
+    TOTALS.with(|t| {
+        let mut t = t.borrow_mut();
+        let row = &mut t.get_or_insert([(0.0, 0); 7])[stage as usize];
+        row.0 += spent;
+        row.1 += 1;
+    });
+    out
+}
+
+/// Prints the totals (when profiling) with the number of points walked, and clears them.
+pub(super) fn report(points: usize) {
+    if !enabled() {
+        return;
+    }
+    let Some(totals) = TOTALS.with(|t| t.borrow_mut().take()) else { return };
+    eprintln!("exact walk profile: {points} points, thread CPU {:.1} s", cpu());
+    for (name, (s, n)) in NAMES.iter().zip(totals) {
+        eprintln!("exact walk profile: {name}: {s:.1} s CPU in {n} calls ({:.1} ms each)", 1e3 * s / n.max(1) as f64);
+    }
+}
