@@ -24,7 +24,7 @@ pub(super) fn walk(
     from: f64,
     to: f64,
     settings: &ContinuationSettings,
-    on_point: &dyn Fn(f64),
+    on_point: &dyn Fn(&BranchPoint),
 ) -> Result<Branch, Error> {
     let name = param.name();
     if problem.model().frictions.is_empty() {
@@ -64,8 +64,9 @@ pub(super) fn walk(
     let mut points = Vec::with_capacity(intervals + 1);
     for i in 0..=intervals {
         let lambda = if i == intervals { to } else { from + (to - from) * i as f64 / intervals as f64 };
-        points.push(solve_at(lambda)?);
-        on_point(lambda);
+        let p = solve_at(lambda)?;
+        on_point(&p);
+        points.push(p);
     }
     let mut stop = "reached".to_string();
     let least = |p: &BranchPoint| p.amplitude.first().copied().unwrap_or(0.0);

@@ -159,8 +159,15 @@ impl Branch {
 /// branch leaves [from, to] the other way: the exact orbit's branch where the polish applies
 /// (compliant contacts, one forcing period: [`exact`]), the discrete walk ([`run_discrete`])
 /// where it does not, and from where the exact walk stopped short. Each point says which
-/// ([`BranchPoint::source`]). `on_point(λ)` after each point (a progress bar).
-pub fn run(problem: &PeriodicProblem, param: Parameter, from: f64, to: f64, settings: &ContinuationSettings, on_point: &dyn Fn(f64)) -> Result<Branch, Error> {
+/// ([`BranchPoint::source`]). `on_point` with each point as it is added (progress).
+pub fn run(
+    problem: &PeriodicProblem,
+    param: Parameter,
+    from: f64,
+    to: f64,
+    settings: &ContinuationSettings,
+    on_point: &dyn Fn(&BranchPoint),
+) -> Result<Branch, Error> {
     check_range(from, to)?;
     if !problem.model().frictions.is_empty() || param == Parameter::NormalForce {
         return friction::walk(problem, param, from, to, settings, on_point);
@@ -212,7 +219,7 @@ pub fn run_discrete(
     from: f64,
     to: f64,
     settings: &ContinuationSettings,
-    on_point: &dyn Fn(f64),
+    on_point: &dyn Fn(&BranchPoint),
 ) -> Result<Branch, Error> {
     check_range(from, to)?;
     let rho = (to - from).abs();
@@ -259,7 +266,7 @@ fn walk_from(
     from: f64,
     to: f64,
     settings: &ContinuationSettings,
-    on_point: &dyn Fn(f64),
+    on_point: &dyn Fn(&BranchPoint),
 ) -> Result<Walked, Error> {
     let name = fam.name();
     let dir = (to - from).signum();
@@ -278,7 +285,7 @@ fn walk_from(
     let tangent = start.tangent(&border).ok_or_else(|| Error::solve(format!("continuation: singular Jacobian at {name} = {from}")))?;
     let here = Node::new(fam, start, tangent);
     let points = vec![point(fam, solver, &here, None, String::new())?];
-    on_point(from);
+    on_point(&points[0]);
     let walk = Walk { from, to, secant: false, settings, on_point };
     walk.follow(fam, solver, here, points, None)
 }
@@ -324,7 +331,7 @@ struct Walk<'a> {
     /// kernel points off the branch (NLvib 03, k = 4096: the 2T branch turned back at once).
     secant: bool,
     settings: &'a ContinuationSettings,
-    on_point: &'a dyn Fn(f64),
+    on_point: &'a dyn Fn(&BranchPoint),
 }
 
 impl Walk<'_> {
@@ -440,11 +447,12 @@ impl Walk<'_> {
                 }
                 from_node.tangent = turn;
             }
+            let added = points.len();
             for (kind, node, detail) in events::between(fam, &from_node, &last, m) {
                 points.push(point(fam, solver, &node, Some(kind), detail)?);
             }
             points.push(point(fam, solver, &last, None, detail.clone())?);
-            (self.on_point)(last.solved.parameter(rho));
+            points[added..].iter().for_each(|p| (self.on_point)(p));
             if !detail.is_empty() {
                 break format!("rejoined the T branch at {name} = {}", last.solved.parameter(rho));
             }

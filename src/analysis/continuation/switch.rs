@@ -35,7 +35,7 @@ pub fn run_switching(
     from: f64,
     to: f64,
     settings: &ContinuationSettings,
-    on_point: &dyn Fn(f64),
+    on_point: &dyn Fn(&BranchPoint),
 ) -> Result<(Vec<Branch>, Vec<String>), Error> {
     let t = run_discrete(problem, param, from, to, settings, on_point)?;
     let mut branches = vec![t];
@@ -71,7 +71,7 @@ pub fn switch_at(
     at: usize,
     (from, to): (f64, f64),
     settings: &ContinuationSettings,
-    on_point: &dyn Fn(f64),
+    on_point: &dyn Fn(&BranchPoint),
 ) -> Result<Branch, Error> {
     let pd = &branch.points[at];
     if pd.event != Some(EventKind::PeriodDoubling) || branch.period_multiple != 1 {
@@ -133,8 +133,9 @@ pub fn switch_at(
     rejoin.largest = norm_inf(&shift);
     rejoin.last = shift;
     let here = Node::new(&mut fam2, s1, tangent);
-    points.push(point(&fam2, &mut solver, &here, None, String::new())?);
-    on_point(here.solved.parameter(rho));
+    let first = point(&fam2, &mut solver, &here, None, String::new())?;
+    on_point(&first);
+    points.push(first);
     let walk = Walk { from, to, secant: true, settings, on_point };
     let super::Walked { points, stop, .. } = walk.follow(&mut fam2, &mut solver, here, points, Some(&mut rejoin))?;
     let marches = fam2.marches + fam1.marches;

@@ -50,7 +50,7 @@ pub struct Args {
     /// No PNG.
     #[arg(long)]
     pub no_plot: bool,
-    /// No progress bar.
+    /// No progress bar, and no line per point (λ, exact | discrete, max |μ|, the event found).
     #[arg(long)]
     pub quiet: bool,
 }
@@ -99,13 +99,22 @@ pub fn run(a: &Args) -> Result<(), Failure> {
     let bar = if a.quiet { ProgressBar::hidden() } else { ProgressBar::new(1000) };
     bar.set_style(ProgressStyle::with_template("{spinner} continue [{bar:40}] {msg}, {elapsed_precise} elapsed").unwrap().progress_chars("=> "));
     let (from, to) = (a.from, a.to);
-    let on_point = |v: f64| {
+    let on_value = |v: f64| {
         bar.set_position((((v - from) / (to - from)).clamp(0.0, 1.0) * 1000.0) as u64);
         bar.set_message(format!("{} = {v:.6}", a.param));
     };
+    // Each point on its own line (not with --quiet), also where the bar is hidden (a log file):
+    // a walk of minutes per point shows where it is and what it found.
+    let on_point = |p: &continuation::BranchPoint| {
+        on_value(p.parameter);
+        if !a.quiet {
+            let event = p.event.map_or(String::new(), |k| format!(", {}: {}", k.name(), p.detail));
+            bar.suspend(|| eprintln!("  point {} = {:.7}: {}, max |μ| = {:.6}{event}", a.param, p.parameter, p.source.name(), p.max_multiplier));
+        }
+    };
     if let Some(range) = peak_range {
         let curve =
-            continuation::optimal_load::optimal_load(problem, from, to, range, a.polish || built.polish, &settings, &on_point).map_err(Failure::from)?;
+            continuation::optimal_load::optimal_load(problem, from, to, range, a.polish || built.polish, &settings, &on_value).map_err(Failure::from)?;
         bar.finish_and_clear();
         write_output(&a.output, &continuation::optimal_load::to_csv(&curve, problem, &built.labels))?;
         let o = &curve.optimum;

@@ -67,6 +67,8 @@ struct Walk<'a> {
     fold: Option<f64>,
     /// The exact orbit where the walk reached `to`.
     end: Option<PolishedOrbit>,
+    /// How many of `points` went to the progress callback.
+    reported: usize,
 }
 
 /// The scenes the exact walk takes: orbits of one forcing period.
@@ -85,7 +87,7 @@ pub(super) fn walk(
     from: f64,
     to: f64,
     settings: &ContinuationSettings,
-    on_point: &dyn Fn(f64),
+    on_point: &dyn Fn(&BranchPoint),
 ) -> Result<Walked, Error> {
     check(problem)?;
     let mut start = problem.clone();
@@ -95,7 +97,7 @@ pub(super) fn walk(
     let orbit = polish::polish(&start, &r).map_err(|e| Error::solve(format!("no exact orbit at {} = {from}: {e}", param.name())))?;
     let (mut walk, here) = begin(problem, param, from, to, (to - from).abs(), &orbit)?;
     walk.push(&here, None, String::new());
-    on_point(from);
+    walk.report(on_point);
     Ok(walk.follow(here, from, to, settings, on_point))
 }
 
@@ -113,7 +115,7 @@ fn begin<'a>(problem: &'a PeriodicProblem, param: Parameter, from: f64, to: f64,
     let dir = (to - from).signum();
     let prev: Vec<f64> = e_l.iter().map(|x| x * dir).collect();
     let here = fam.node(w0, &prev).ok_or_else(|| Error::solve(format!("singular Jacobian at {} = {from}", param.name())))?;
-    Ok((Walk { problem, fam, points: Vec::new(), stop_at_fold: false, fold: None, end: None }, here))
+    Ok((Walk { problem, fam, points: Vec::new(), stop_at_fold: false, fold: None, end: None, reported: 0 }, here))
 }
 
 /// Where a front end's step along the exact branch ends ([`step`]).
@@ -149,6 +151,12 @@ pub(super) fn step(problem: &PeriodicProblem, param: Parameter, from: f64, to: f
 }
 
 impl Walk<'_> {
+    /// The points added since the last report, each to `on_point` (progress).
+    fn report(&mut self, on_point: &dyn Fn(&BranchPoint)) {
+        self.points[self.reported..].iter().for_each(on_point);
+        self.reported = self.points.len();
+    }
+
     fn push(&mut self, node: &Node, event: Option<EventKind>, detail: String) {
         let lambda = node.lambda(self.fam.rho);
         let amplitude = if node.amplitude.is_empty() { self.amplitudes(&node.orbit).1 } else { node.amplitude.clone() };
@@ -192,7 +200,7 @@ impl Walk<'_> {
         self.points.first().map_or("parameter", |_| "λ")
     }
 
-    fn follow(self, here: Node, from: f64, to: f64, settings: &ContinuationSettings, on_point: &dyn Fn(f64)) -> Walked {
+    fn follow(self, here: Node, from: f64, to: f64, settings: &ContinuationSettings, on_point: &dyn Fn(&BranchPoint)) -> Walked {
         let walked = self.follow_to(here, from, to, settings, on_point).0;
         profile::report(walked.points.len());
         walked
@@ -206,9 +214,12 @@ impl Walk<'_> {
         from: f64,
         to: f64,
         settings: &ContinuationSettings,
-        on_point: &dyn Fn(f64),
+        on_point: &dyn Fn(&BranchPoint),
     ) -> (Walked, Option<f64>, Option<PolishedOrbit>) {
-        let done = |w: Walk, stop: String, reached: bool, turned_back: bool| (Walked { points: w.points, stop, reached, turned_back }, w.fold, w.end);
+        let done = |mut w: Walk, stop: String, reached: bool, turned_back: bool| {
+            w.report(on_point);
+            (Walked { points: w.points, stop, reached, turned_back }, w.fold, w.end)
+        };
         let rho = self.fam.rho;
         let dir = (to - from).signum();
         let mut ds = settings.initial_step;
@@ -222,7 +233,9 @@ impl Walk<'_> {
             let along = self.fam.metric.unit(&here.tangent);
             let shrinking = signature::shrinking(&self.fam, &here.w, &along);
             if let Some(&(e, len, rate)) = shrinking.iter().find(|s| s.1 < VANISH) {
-                let _ = (len, rate);
+                let (ev, ne) = (self.fam.sig.events[e], self.fam.ne());
+                let which = format!("contact {}: {:?} → {:?}, {len:.1e} of the period", ev.contact, ev.kind, self.fam.sig.events[(e + 1) % ne].kind);
+                let _ = rate;
                 let next = if self.rigid_event(e) { self.rigid_vanish(&here, e, to) } else { self.remove_pair(&here, e) };
                 match next {
                     Some(next) if self.ends_here(&next, dir) => return done(self, "a fold at a grazing".into(), false, false),
@@ -232,7 +245,7 @@ impl Walk<'_> {
                         continue;
                     }
                     None => {
-                        let stop = format!("a phase of the orbit vanishes at λ = {} and the branch could not go on without it", here.lambda(rho));
+                        let stop = format!("a phase of the orbit vanishes at λ = {} ({which}) and the branch could not go on without it", here.lambda(rho));
                         return done(self, stop, false, false);
                     }
                 }
@@ -268,7 +281,7 @@ impl Walk<'_> {
                             if self.ends_here(&n, dir) {
                                 return done(self, "a fold at a grazing".into(), false, false);
                             }
-                            on_point(n.lambda(rho));
+                            self.report(on_point);
                             here = n;
                             ds = settings.initial_step;
                             continue;
@@ -301,7 +314,7 @@ impl Walk<'_> {
                 match self.rigid_crossing(&here, &next, to) {
                     Some(n) if self.ends_here(&n, dir) => return done(self, "a fold at a grazing".into(), false, false),
                     Some(n) => {
-                        on_point(n.lambda(rho));
+                        self.report(on_point);
                         here = n;
                         ds = settings.initial_step;
                         continue;
@@ -320,7 +333,7 @@ impl Walk<'_> {
             if crossed(&next) && !crossed(&here) {
                 match self.insert_pair(&here, &next, &crossed) {
                     Some(n) => {
-                        on_point(n.lambda(rho));
+                        self.report(on_point);
                         if self.ends_here(&n, dir) {
                             return done(self, "a fold at a grazing".into(), false, false);
                         }
@@ -342,7 +355,7 @@ impl Walk<'_> {
                 self.push(&node, Some(kind), detail);
             }
             self.push(&next, None, String::new());
-            on_point(next.lambda(rho));
+            self.report(on_point);
             if past_to {
                 self.end = Some(next.orbit);
                 return done(self, "reached".into(), true, false);
