@@ -195,7 +195,9 @@ fn check_grazing_walk(from: f64, to: f64) {
             let got: Vec<num_complex::Complex64> = q.multipliers.iter().copied().filter(|z| z.norm() > 1e-9).collect();
             assert_eq!(got.len(), 2, "ω = {w}: two nonzero multipliers, {got:?}");
             mult = mult.max(multiplier_distance(&got, &o.floquet_multipliers()));
-            assert_eq!(q.stable, o.is_stable(), "ω = {w}: stability against the closed form's");
+            // At the period doubling itself (|μ| = 1 within the multipliers' tolerance) either side is right.
+            let on_circle = o.floquet_multipliers().iter().any(|z| (z.norm() - 1.0).abs() < 1e-7);
+            assert!(on_circle || q.stable == o.is_stable(), "ω = {w}: stability against the closed form's");
         } else {
             free += 1;
         }

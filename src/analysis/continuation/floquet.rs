@@ -68,7 +68,12 @@ pub fn largest(mu: &[Complex64]) -> f64 {
 
 /// Sign of det(I + M) = Π(1 + μ): flips where a real multiplier crosses −1.
 pub fn doubling_sign(mu: &[Complex64]) -> bool {
-    mu.iter().fold(Complex64::new(1.0, 0.0), |a, m| a * (1.0 + m)).re > 0.0
+    doubling_test(mu) > 0.0
+}
+
+/// det(I + M) = Π(1 + μ_i): zero where a multiplier passes −1 (a period doubling's test function).
+pub fn doubling_test(mu: &[Complex64]) -> f64 {
+    mu.iter().fold(Complex64::new(1.0, 0.0), |a, m| a * (1.0 + m)).re
 }
 
 /// Non-real multipliers outside the unit circle (pairs counted twice). A multiplier counts as

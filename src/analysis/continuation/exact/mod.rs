@@ -16,6 +16,7 @@
 //! impact): their signature changes are located on the exact orbit and the branch goes on from
 //! there, from the grid LCP only where that fails ([`rigid`]).
 mod family;
+mod locate;
 mod metric;
 mod profile;
 mod rigid;
@@ -26,6 +27,7 @@ use crate::analysis::polish::{self, EventKind as Switch, PolishedOrbit};
 use crate::error::Error;
 use crate::periodic::{PeriodicProblem, PeriodicSolver};
 use family::{Family, Node, Signature};
+use locate::{Test, locate};
 
 /// A phase shorter than this (fraction of the period) and shrinking has vanished: a grazing.
 const VANISH: f64 = 1e-6;
@@ -331,7 +333,7 @@ impl Walk<'_> {
             let tol = TOUCH_TOL * self.fam.ys;
             let crossed = |n: &Node| n.touches.iter().any(|t| t.value < -tol);
             if crossed(&next) && !crossed(&here) {
-                match self.insert_pair(&here, &next, &crossed) {
+                match self.insert_pair(&here, &next) {
                     Some(n) => {
                         self.report(on_point);
                         if self.ends_here(&n, dir) {
@@ -464,8 +466,10 @@ impl Walk<'_> {
     /// The grazing between `here` and `next` where a contact's clearance first crosses zero
     /// between its events: located, recorded, the pair of events inserted around the touch, and
     /// the first point of the branch with its phase [`NEW_PAIR`] long.
-    fn insert_pair(&mut self, here: &Node, next: &Node, crossed: &dyn Fn(&Node) -> bool) -> Option<Node> {
-        let (lo, _) = bisect(&self.fam, here, next, &|n| !crossed(n), true)?;
+    fn insert_pair(&mut self, here: &Node, next: &Node) -> Option<Node> {
+        // The least touch over the state scale, continuous through the grazing.
+        let least = |n: &Node| n.touches.iter().map(|t| t.value).fold(f64::INFINITY, f64::min) / self.fam.ys + TOUCH_TOL;
+        let (lo, _) = locate(&self.fam, here, next, Test::Value(&least), true)?;
         for (kind, node, detail) in self.events_between(here, &lo) {
             self.push(&node, Some(kind), detail);
         }
@@ -530,7 +534,10 @@ impl Walk<'_> {
                 continue;
             }
             let s = side(a, kind);
-            let node = bisect(&self.fam, a, b, &|n| side(n, kind) == s, false).map_or_else(|| b.clone(), |(_, hi)| hi);
+            let value = |n: &Node| if side(n, kind) == s { 1.0 } else { -1.0 } * test_value(n, kind).abs();
+            let same = |n: &Node| side(n, kind) == s;
+            let test = if kind == EventKind::NeimarkSacker { Test::Side(&same) } else { Test::Value(&value) };
+            let node = locate(&self.fam, a, b, test, false).map_or_else(|| b.clone(), |(_, hi)| hi);
             // det(I + M) also changes sign when a multiplier passes through ∞ (an impact's
             // velocity fading at a grazing, Nordmark 1991): no multiplier at −1, no doubling.
             if kind == EventKind::PeriodDoubling && !node.mu.iter().any(|m| (m + 1.0).norm() < 1e-3) {
@@ -560,38 +567,16 @@ fn side(n: &Node, kind: EventKind) -> i64 {
     }
 }
 
+/// A fold's and a period doubling's test function, whose sign is [`side`]'s: the tangent's λ
+/// component, det(I + M) (Seydel 2010, §7.4). The others: 1.
+fn test_value(n: &Node, kind: EventKind) -> f64 {
+    match kind {
+        EventKind::Fold => n.tangent[n.tangent.len() - 1],
+        EventKind::PeriodDoubling => floquet::doubling_test(&n.mu),
+        _ => 1.0,
+    }
+}
+
 fn detail_of(kind: EventKind, node: &Node) -> String {
     super::floquet::event_detail(kind, &node.mu)
-}
-
-/// Bisection on the arc between `a` (where `same` holds) and `b` (where it does not): each trial
-/// point is the orbit on the hyperplane through the bracket's midpoint normal to its secant.
-/// The last points on either side (with their touches when `touches`).
-fn bisect(fam: &Family, a: &Node, b: &Node, same: &dyn Fn(&Node) -> bool, touches: bool) -> Option<(Node, Node)> {
-    profile::timed(profile::Stage::Bisect, || bisect_on(fam, a, b, same, touches))
-}
-
-fn bisect_on(fam: &Family, a: &Node, b: &Node, same: &dyn Fn(&Node) -> bool, touches: bool) -> Option<(Node, Node)> {
-    let (mut lo, mut hi) = (a.clone(), b.clone());
-    for _ in 0..80 {
-        let sec: Vec<f64> = hi.w.iter().zip(&lo.w).map(|(x, y)| x - y).collect();
-        let len = sec.iter().map(|x| x * x).sum::<f64>().sqrt();
-        if len <= BRACKET {
-            break;
-        }
-        let normal: Vec<f64> = sec.iter().map(|x| x / len).collect();
-        let pred: Vec<f64> = lo.w.iter().zip(&sec).map(|(x, s)| x + 0.5 * s).collect();
-        let target = dot(&normal, &pred);
-        // A bracket within the corrector's accuracy is the event: the coarse blade's fold at
-        // 2795.947 rad/s, bracketed to 5e-11, lost its next midpoint to Newton's noise (≈1e-10).
-        let Some(node) = fam.correct(&pred, &normal, target).and_then(|w| fam.node_with(w, &lo.tangent, touches)) else {
-            return (len <= NEWTON_NOISE).then_some((lo, hi));
-        };
-        if same(&node) {
-            lo = node;
-        } else {
-            hi = node;
-        }
-    }
-    Some((lo, hi))
 }

@@ -20,12 +20,23 @@ pub(super) enum Stage {
     Amplitudes,
     /// Bisections locating events.
     Bisect,
+    /// One trial point of a bisection (a correction and a point).
+    Trial,
 }
 
-const NAMES: [&str; 7] = ["orbit built", "residual", "variational flow", "λ column", "point (monodromy, touches)", "amplitudes", "bisections (inclusive)"];
+const NAMES: [&str; 8] = [
+    "orbit built",
+    "residual",
+    "variational flow",
+    "λ column",
+    "point (monodromy, touches)",
+    "amplitudes",
+    "bisections (inclusive)",
+    "bisection trial points (inclusive)",
+];
 
 thread_local! {
-    static TOTALS: RefCell<Option<[(f64, usize); 7]>> = const { RefCell::new(None) };
+    static TOTALS: RefCell<Option<[(f64, usize); 8]>> = const { RefCell::new(None) };
 }
 
 fn enabled() -> bool {
@@ -47,7 +58,7 @@ pub(super) fn timed<T>(stage: Stage, f: impl FnOnce() -> T) -> T {
     let spent = cpu() - start;
     TOTALS.with(|t| {
         let mut t = t.borrow_mut();
-        let row = &mut t.get_or_insert([(0.0, 0); 7])[stage as usize];
+        let row = &mut t.get_or_insert([(0.0, 0); 8])[stage as usize];
         row.0 += spent;
         row.1 += 1;
     });

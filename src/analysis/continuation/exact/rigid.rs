@@ -16,7 +16,8 @@
 //!
 //! [`PolishedOrbit::rigid_margin`]: crate::analysis::polish::PolishedOrbit::rigid_margin
 use super::family::{Family, Node, Signature};
-use super::{BRACKET, EventKind, NEW_PAIR, Walk, bisect, signature};
+use super::locate::{Test, locate};
+use super::{BRACKET, EventKind, NEW_PAIR, Walk, signature};
 use crate::analysis::polish::{self, Event, EventKind as Switch, Touch};
 use crate::periodic::{PeriodicProblem, PeriodicSolver};
 use crate::time::Discretization;
@@ -67,7 +68,7 @@ impl Walk<'_> {
     /// multiplier events before it recorded, and the first point of the branch past it.
     pub(super) fn rigid_crossing(&mut self, here: &Node, next: &Node, to: f64) -> Option<Node> {
         // Where the bisection's corrector fails (close to a singular event), from the bracket itself.
-        let (lo, hi) = bisect(&self.fam, here, next, &|n| margin(n) >= -TOL, false).unwrap_or_else(|| (here.clone(), next.clone()));
+        let (lo, hi) = locate(&self.fam, here, next, Test::Value(&|n| margin(n) + TOL), false).unwrap_or_else(|| (here.clone(), next.clone()));
         for (kind, node, detail) in self.events_between(here, &lo) {
             self.push(&node, Some(kind), detail);
         }
