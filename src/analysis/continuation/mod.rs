@@ -110,6 +110,9 @@ pub struct BranchPoint {
     pub source: Source,
 }
 
+/// The progress callback of a walk: each point as it is added.
+pub type OnPoint<'a> = dyn Fn(&BranchPoint) + 'a;
+
 /// What produced a point of the branch.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Source {
@@ -160,14 +163,7 @@ impl Branch {
 /// (compliant contacts, one forcing period: [`exact`]), the discrete walk ([`run_discrete`])
 /// where it does not, and from where the exact walk stopped short. Each point says which
 /// ([`BranchPoint::source`]). `on_point` with each point as it is added (progress).
-pub fn run(
-    problem: &PeriodicProblem,
-    param: Parameter,
-    from: f64,
-    to: f64,
-    settings: &ContinuationSettings,
-    on_point: &dyn Fn(&BranchPoint),
-) -> Result<Branch, Error> {
+pub fn run(problem: &PeriodicProblem, param: Parameter, from: f64, to: f64, settings: &ContinuationSettings, on_point: &OnPoint) -> Result<Branch, Error> {
     check_range(from, to)?;
     if !problem.model().frictions.is_empty() || param == Parameter::NormalForce {
         return friction::walk(problem, param, from, to, settings, on_point);
