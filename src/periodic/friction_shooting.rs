@@ -480,7 +480,7 @@ fn shoot_to(map: &impl FrictionMarch, start: Option<Vec<f64>>, tol: f64) -> Resu
         let p = tangent.at(map, &march.modes);
         let i_minus_p = Mat::from_fn(d, d, |a, b| if a == b { 1.0 } else { 0.0 } - p[(a, b)]);
         let r: Vec<f64> = march.end.iter().zip(&y).map(|(e, s)| e - s).collect();
-        let mut delta = DenseLu::new(&i_minus_p).solve(&r);
+        let mut delta = if std::env::var_os("PC_LU").is_some() { DenseLu::new(&i_minus_p).solve(&r) } else { truncated_step(&i_minus_p, &r).0 };
         let size = y.iter().chain(&march.end).fold(f64::MIN_POSITIVE, |a, v| a.max(v.abs()));
         if delta.iter().any(|v| !v.is_finite() || v.abs() > NEAR_SINGULAR * size) {
             // A family of periodic orbits (eigenvalue 1 of P: the half steps' relay on an undamped
@@ -506,6 +506,14 @@ fn shoot_to(map: &impl FrictionMarch, start: Option<Vec<f64>>, tol: f64) -> Resu
             }
             length *= 0.5;
         };
+        if std::env::var_os("PC_TRACE").is_some() {
+            let flips = next.modes.iter().zip(&march.modes).filter(|(a, b)| a != b).count();
+            let na = nalgebra::DMatrix::from_fn(d, d, |a, b| i_minus_p[(a, b)]);
+            let mut sv: Vec<f64> = na.singular_values().iter().copied().collect();
+            sv.sort_by(f64::total_cmp);
+            let dn = delta.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+            eprintln!("k={} it={iteration} res={res:.2e} len={length} flips={flips} |delta|={dn:.2e} sv={:.2e} {:.2e} {:.2e} {:.2e} max {:.2e}", map.instants(), sv[0], sv[1], sv[2], sv[3], sv[d-1]);
+        }
         unchanged = length == 1.0 && next.modes == march.modes;
         y = next_y;
         march = next;
@@ -513,6 +521,22 @@ fn shoot_to(map: &impl FrictionMarch, start: Option<Vec<f64>>, tol: f64) -> Resu
     }
     let last = FrictionShot { state: y, forces: march.forces, velocity: march.velocity, iterations: MAX_ITERATIONS, residual: res };
     Err(ShotFailure { iterations: MAX_ITERATIONS, residual: res, why: "the stick/slip sets kept changing", last: Some(last) })
+}
+
+/// Relative singular value of I − P below which its direction is a family of periodic orbits.
+const FAMILY_RANK_TOL: f64 = 1e-11;
+
+/// The minimum-norm least-squares δ of A δ = r with A's singular values below
+/// [`FAMILY_RANK_TOL`] of the largest dropped, and how many were dropped.
+fn truncated_step(a: &Mat<f64>, r: &[f64]) -> (Vec<f64>, usize) {
+    let d = a.nrows();
+    let svd = nalgebra::DMatrix::from_fn(d, d, |i, l| a[(i, l)]).svd(true, true);
+    let tol = FAMILY_RANK_TOL * svd.singular_values.max();
+    let dropped = svd.singular_values.iter().filter(|&&s| s <= tol).count();
+    match svd.solve(&nalgebra::DVector::from_column_slice(r), tol) {
+        Ok(x) => (x.iter().copied().collect(), dropped),
+        Err(_) => (vec![f64::NAN; d], dropped),
+    }
 }
 
 /// δ of least norm for A δ = r (A square, singular): (AᵀA + μI) δ = Aᵀr with μ at round-off of
