@@ -16,6 +16,7 @@
 //! The answer is certified by the caller on the full periodic LCP (FFT products).
 use super::{NoStepMap, PeriodicProblem, SHOOTING_WORK_MAX};
 use crate::lcp::{DenseLu, DenseMatrix, LcpOutcome, Lemke, LemkeSettings, dense_product};
+use super::friction_family::family_step;
 use faer::Mat;
 use std::ops::Range;
 
@@ -461,6 +462,7 @@ fn shoot_to(map: &impl FrictionMarch, start: Option<Vec<f64>>, tol: f64) -> Resu
     let mut unchanged = false;
     let mut tangent = PeriodTangent::new();
     let mut marches = 1;
+    let mut least = None;
     for iteration in 0..MAX_ITERATIONS {
         if !res.is_finite() {
             return Err(ShotFailure { iterations: iteration, residual: res, why: "the march overflowed", last: None });
@@ -480,7 +482,9 @@ fn shoot_to(map: &impl FrictionMarch, start: Option<Vec<f64>>, tol: f64) -> Resu
         let p = tangent.at(map, &march.modes);
         let i_minus_p = Mat::from_fn(d, d, |a, b| if a == b { 1.0 } else { 0.0 } - p[(a, b)]);
         let r: Vec<f64> = march.end.iter().zip(&y).map(|(e, s)| e - s).collect();
-        let mut delta = if std::env::var_os("PC_LU").is_some() { DenseLu::new(&i_minus_p).solve(&r) } else { truncated_step(&i_minus_p, &r).0 };
+        let step = family_step(&i_minus_p, &r, least);
+        least = Some(step.least);
+        let mut delta = step.plain;
         let size = y.iter().chain(&march.end).fold(f64::MIN_POSITIVE, |a, v| a.max(v.abs()));
         if delta.iter().any(|v| !v.is_finite() || v.abs() > NEAR_SINGULAR * size) {
             // A family of periodic orbits (eigenvalue 1 of P: the half steps' relay on an undamped
@@ -496,47 +500,38 @@ fn shoot_to(map: &impl FrictionMarch, start: Option<Vec<f64>>, tol: f64) -> Resu
                 last: None,
             });
         }
-        let mut length = 1.0;
-        let (next_y, next) = loop {
-            let cand: Vec<f64> = y.iter().zip(&delta).map(|(s, dl)| s + length * dl).collect();
+        // A closing direction's overshoot first, kept when it lowers the residual.
+        let overshot = step.closing.filter(|c| c.iter().all(|v| v.is_finite())).and_then(|c| {
+            let cand: Vec<f64> = y.iter().zip(&c).map(|(s, dl)| s + dl).collect();
             let m = map.march(&cand, Some(&march.modes));
             marches += 1;
-            if residual(&cand, &m) < res || length < 0.5f64.powi(HALVINGS) {
-                break (cand, m);
-            }
-            length *= 0.5;
+            (residual(&cand, &m) < res).then_some((cand, m))
+        });
+        let mut length = 1.0;
+        let closed = overshot.is_some();
+        let (next_y, next) = match overshot {
+            Some(found) => found,
+            None => loop {
+                let cand: Vec<f64> = y.iter().zip(&delta).map(|(s, dl)| s + length * dl).collect();
+                let m = map.march(&cand, Some(&march.modes));
+                marches += 1;
+                if residual(&cand, &m) < res || length < 0.5f64.powi(HALVINGS) {
+                    break (cand, m);
+                }
+                length *= 0.5;
+            },
         };
         if std::env::var_os("PC_TRACE").is_some() {
             let flips = next.modes.iter().zip(&march.modes).filter(|(a, b)| a != b).count();
-            let na = nalgebra::DMatrix::from_fn(d, d, |a, b| i_minus_p[(a, b)]);
-            let mut sv: Vec<f64> = na.singular_values().iter().copied().collect();
-            sv.sort_by(f64::total_cmp);
-            let dn = delta.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-            eprintln!("k={} it={iteration} res={res:.2e} len={length} flips={flips} |delta|={dn:.2e} sv={:.2e} {:.2e} {:.2e} {:.2e} max {:.2e}", map.instants(), sv[0], sv[1], sv[2], sv[3], sv[d-1]);
+            eprintln!("k={} it={iteration} res={res:.2e} len={length} closed={closed} flips={flips} family={} least={:.2e}", map.instants(), step.family, step.least);
         }
-        unchanged = length == 1.0 && next.modes == march.modes;
+        unchanged = length == 1.0 && !closed && next.modes == march.modes;
         y = next_y;
         march = next;
         res = residual(&y, &march);
     }
     let last = FrictionShot { state: y, forces: march.forces, velocity: march.velocity, iterations: MAX_ITERATIONS, residual: res };
     Err(ShotFailure { iterations: MAX_ITERATIONS, residual: res, why: "the stick/slip sets kept changing", last: Some(last) })
-}
-
-/// Relative singular value of I − P below which its direction is a family of periodic orbits.
-const FAMILY_RANK_TOL: f64 = 1e-11;
-
-/// The minimum-norm least-squares δ of A δ = r with A's singular values below
-/// [`FAMILY_RANK_TOL`] of the largest dropped, and how many were dropped.
-fn truncated_step(a: &Mat<f64>, r: &[f64]) -> (Vec<f64>, usize) {
-    let d = a.nrows();
-    let svd = nalgebra::DMatrix::from_fn(d, d, |i, l| a[(i, l)]).svd(true, true);
-    let tol = FAMILY_RANK_TOL * svd.singular_values.max();
-    let dropped = svd.singular_values.iter().filter(|&&s| s <= tol).count();
-    match svd.solve(&nalgebra::DVector::from_column_slice(r), tol) {
-        Ok(x) => (x.iter().copied().collect(), dropped),
-        Err(_) => (vec![f64::NAN; d], dropped),
-    }
 }
 
 /// δ of least norm for A δ = r (A square, singular): (AᵀA + μI) δ = Aᵀr with μ at round-off of

@@ -5,6 +5,7 @@ mod cache;
 mod friction;
 mod friction_coupled;
 mod friction_events;
+mod friction_family;
 mod friction_half_steps;
 mod friction_shooting;
 pub mod limits;
