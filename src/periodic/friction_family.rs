@@ -28,8 +28,6 @@ pub(super) struct FamilyStep {
     pub plain: Vec<f64>,
     /// The step with its closing directions overshot, when one is closing.
     pub closing: Option<Vec<f64>>,
-    /// Dimension of the family (singular values of I − P at round-off).
-    pub family: usize,
     /// The least kept singular value relative to the largest (for the next iteration).
     pub least: f64,
 }
@@ -39,7 +37,7 @@ pub(super) fn family_step(a: &Mat<f64>, r: &[f64], previous: Option<f64>) -> Fam
     let d = a.nrows();
     let svd = DMatrix::from_fn(d, d, |i, l| a[(i, l)]).svd(true, true);
     let (Some(u), Some(v_t)) = (&svd.u, &svd.v_t) else {
-        return FamilyStep { plain: vec![f64::NAN; d], closing: None, family: 0, least: 1.0 };
+        return FamilyStep { plain: vec![f64::NAN; d], closing: None, least: 1.0 };
     };
     let sigma = &svd.singular_values;
     let top = sigma.max().max(f64::MIN_POSITIVE);
@@ -60,7 +58,16 @@ pub(super) fn family_step(a: &Mat<f64>, r: &[f64], previous: Option<f64>) -> Fam
             }
         }
     }
-    let closing = (std::env::var_os("PC_NOCLOSE").is_none() && least < CLOSING_MAX && previous.is_some_and(|p| least < CLOSING_RATIO * p))
-        .then(|| plain.iter().zip(&near).map(|(p, n)| p + (std::env::var("PC_OVER").ok().and_then(|v| v.parse::<f64>().ok()).unwrap_or(CLOSING_OVERSHOOT) - 1.0) * n).collect());
-    FamilyStep { plain, closing, family: d - kept.len(), least }
+    let closing = (least < CLOSING_MAX && previous.is_some_and(|p| least < CLOSING_RATIO * p))
+        .then(|| plain.iter().zip(&near).map(|(p, n)| p + (CLOSING_OVERSHOOT - 1.0) * n).collect());
+    FamilyStep { plain, closing, least }
+}
+
+/// Dimension of the family of periodic orbits through a converged state: singular values of
+/// I − P (`p`: the period's tangent with the last march's modes) at round-off.
+pub(super) fn family_dimension(p: &Mat<f64>) -> usize {
+    let d = p.nrows();
+    let sigma = DMatrix::from_fn(d, d, |i, l| if i == l { 1.0 } else { 0.0 } - p[(i, l)]).singular_values();
+    let top = sigma.max().max(f64::MIN_POSITIVE);
+    sigma.iter().filter(|&&s| s <= FAMILY_RANK_TOL * top).count()
 }
