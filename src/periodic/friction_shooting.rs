@@ -85,7 +85,7 @@ pub(super) struct ShotFailure {
     pub residual: f64,
     pub why: &'static str,
     /// Newton's last iterate (not periodic) when the iterations ran out, for a refit.
-    pub last: Option<FrictionShot>,
+    pub last: Option<Box<FrictionShot>>,
 }
 
 /// One march over the period: the end state, each instant's modes, forces and slip velocities
@@ -456,7 +456,7 @@ fn shoot_to(map: &impl FrictionMarch, start: Option<Vec<f64>>, tol: f64) -> Resu
         res = residual(&y, &march);
     }
     let last = FrictionShot { state: y, forces: march.forces, velocity: march.velocity, iterations: MAX_ITERATIONS, residual: res, family: 0 };
-    Err(ShotFailure { iterations: MAX_ITERATIONS, residual: res, why: "the stick/slip sets kept changing", last: Some(last) })
+    Err(ShotFailure { iterations: MAX_ITERATIONS, residual: res, why: "the stick/slip sets kept changing", last: Some(Box::new(last)) })
 }
 
 /// δ of least norm for A δ = r (A square, singular): (AᵀA + μI) δ = Aᵀr with μ at round-off of
