@@ -103,3 +103,41 @@ fn friction_with_a_unilateral_contact_beyond_the_dense_limit_is_refused_with_the
     let e = problem(64, LcpMethod::Shooting).solve().unwrap_err().to_string();
     assert!(e.contains("solver.method") && e.contains("unilateral"), "{e}");
 }
+
+/// Harmonic `h` of samples `s` over one period: (2/k) Σ s_j e^(−2πi h j/k).
+fn harmonic(s: &[f64], h: usize) -> num_complex::Complex64 {
+    let k = s.len() as f64;
+    s.iter().enumerate().map(|(j, &v)| v * num_complex::Complex64::from_polar(2.0 / k, -std::f64::consts::TAU * (h * j) as f64 / k)).sum()
+}
+
+#[test]
+fn a_contact_stuck_all_period_leaves_a_family_whose_velocities_are_the_held_chains_closed_form() {
+    // Ground–k1–m1–k2–m2, the load on m2, rigid Coulomb on m1 with μN = 4: the periodic state
+    // holds m1 (its largest static force ≈ 3.6 < μN), at any offset c with |mean force c| ≤ μN −
+    // 3.6, so I − P is singular along c. From rest the transient slips (up to ≈ 7 > μN), so Newton
+    // starts outside the family. Reference: with m1 held, m2 is a linear oscillator (m2, c22, k22),
+    // and bds1's periodic answer to F cos Ωt has the closed transfer
+    // X = F / (m2 (1 − z⁻¹)²/h² + c22 (1 − z⁻¹)/h + k22), z = e^(iΩh) (implicit Euler, z-transform),
+    // velocity V = X (1 − z⁻¹)/h.
+    let (k, omega) = (512, 1.2);
+    let o = FrictionOscillator { force: vec![0.0, 1.0], dof: 0, slip_force: 4.0, ..chain_oscillator(omega) };
+    let r = solve(o.model(), k, LcpMethod::Shooting);
+    println!("{}", r.lcp.path);
+    assert!(r.lcp.residual < 1e-8, "certified: residual {}", r.lcp.residual);
+    assert!(r.lcp.path.contains("1-parameter family"), "the family is named: {}", r.lcp.path);
+    assert!(r.lcp.pivots <= 6, "Newton took {} iterations", r.lcp.pivots);
+    let held = &r.friction[0];
+    assert!(held.stuck.iter().all(|s| *s) && held.slip_velocity.iter().all(|v| v.abs() < 1e-12), "m1 is held all period");
+    let x = &r.displacement["1"];
+    assert_eq!(x.len(), k);
+    let h = o.period() / k as f64;
+    let v: Vec<f64> = (0..k).map(|j| (x[j] - x[(j + k - 1) % k]) / h).collect();
+    let z_inv = num_complex::Complex64::from_polar(1.0, -omega * h);
+    let d = (1.0 - z_inv) / h;
+    let exact = (d / (0.5 * d * d + 0.02 * d + 1.0)).norm();
+    let got = harmonic(&v, 1).norm();
+    let others = (2..k / 2).map(|m| harmonic(&v, m).norm()).fold(harmonic(&v, 0).norm(), f64::max);
+    println!("velocity amplitude of m2: {got:.15} (closed form {exact:.15}), other harmonics ≤ {others:.1e}");
+    assert!((got - exact).abs() < 1e-9 * exact, "velocity amplitude {got} against the closed form {exact}");
+    assert!(others < 1e-9 * exact, "m2 moves at the forcing harmonic only: {others:.3e}");
+}

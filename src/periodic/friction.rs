@@ -284,8 +284,14 @@ pub(super) fn solve(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, 
             let hint = "the shooting orbit does not satisfy the periodic friction LCP to solver.tolerance (a set change the march missed); reduce discretization.steps or use solver.method = \"lemke\" where the dense LCP fits".to_string();
             return Err(SolveError::Lcp { outcome: sol.outcome, info: sol.info, hint });
         }
+        let family = match shot.family {
+            0 => String::new(),
+            r => format!(
+                "; the positions are one member of a {r}-parameter family of periodic orbits (stuck contacts hold a static offset: I − P has rank {r} less; the velocities are unique)"
+            ),
+        };
         let path = format!(
-            "friction by shooting (N = {nn}: the box LCP of the friction rows, src/formulation.md §9): Newton on the bds1 period map, {} iterations (periodicity {:.1e}), certified on the full LCP by FFT products (residual {:.1e}), {lcp_time:.3} s → {}",
+            "friction by shooting (N = {nn}: the box LCP of the friction rows, src/formulation.md §9): Newton on the bds1 period map, {} iterations (periodicity {:.1e}), certified on the full LCP by FFT products (residual {:.1e}), {lcp_time:.3} s → {}{family}",
             shot.iterations,
             shot.residual,
             sol.info.residual,

@@ -268,7 +268,7 @@ impl HalfStepMap {
                 Ok(shot) => (shot, None),
                 Err(e) => match e.last {
                     Some(last) if !relay_only && refits < MAX_ROUNDS && e.residual <= REFIT_STALLED => {
-                        (last, Some(ShotFailure { iterations: iterations + e.iterations, last: None, ..e }))
+                        (*last, Some(ShotFailure { iterations: iterations + e.iterations, last: None, ..e }))
                     }
                     last => return Err(ShotFailure { iterations: iterations + e.iterations, last, ..e }),
                 },

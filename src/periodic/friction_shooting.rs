@@ -14,8 +14,10 @@
 //! and the march re-checks the sets, as shooting does for unilateral contacts.
 //!
 //! The answer is certified by the caller on the full periodic LCP (FFT products).
+use super::friction_family::{family_dimension, family_step};
+pub(super) use super::friction_relay::Relay;
 use super::{NoStepMap, PeriodicProblem, SHOOTING_WORK_MAX};
-use crate::lcp::{DenseLu, DenseMatrix, LcpOutcome, Lemke, LemkeSettings, dense_product};
+use crate::lcp::{DenseLu, dense_product};
 use faer::Mat;
 use std::ops::Range;
 
@@ -35,6 +37,10 @@ const NEAR_SINGULAR: f64 = 1e6;
 /// Fewest instants of a coarse grid worth solving first ([`coarse_start`]). Why: below, Newton
 /// from rest costs less than the coarse solve saves.
 const COARSE_MIN: usize = 256;
+
+/// Shortest run of equal modes whose tangent is taken as a power ([`FrictionStepMap`]'s
+/// `tangent_over`). Why: a step tangent costs about one product, so squaring pays from 3 steps.
+const RUN_POWER_MIN: usize = 3;
 
 /// The bds1 step map of a problem whose only nonsmooth rows are friction contacts.
 pub(super) struct FrictionStepMap {
@@ -68,6 +74,9 @@ pub(super) struct FrictionShot {
     pub iterations: usize,
     /// max |y_end − y| / max(|y|, tiny) of the last march.
     pub residual: f64,
+    /// Dimension of the family of periodic orbits this one belongs to (0: unique). Stuck contacts
+    /// hold a static offset: the velocities are unique, the positions one member.
+    pub family: usize,
 }
 
 /// Why the shooting did not converge (a typed outcome for the caller).
@@ -76,7 +85,7 @@ pub(super) struct ShotFailure {
     pub residual: f64,
     pub why: &'static str,
     /// Newton's last iterate (not periodic) when the iterations ran out, for a refit.
-    pub last: Option<FrictionShot>,
+    pub last: Option<Box<FrictionShot>>,
 }
 
 /// One march over the period: the end state, each instant's modes, forces and slip velocities
@@ -322,118 +331,36 @@ impl FrictionMarch for FrictionStepMap {
         TANGENT_BLOCKS
     }
 
+    /// A run of m steps with the same modes has one step tangent S, so it contributes S^m, by
+    /// squaring. Why: measured on the bench case `friction` (k = 4096), rebuilding tangent blocks
+    /// step by step was most of a Newton iteration, and modes change every ≈ 60 steps.
     fn tangent_over(&self, modes: &[i8], steps: Range<usize>) -> Mat<f64> {
-        let d = self.state_size();
+        let (d, mf) = (self.state_size(), self.mf);
         let mut p = Mat::<f64>::identity(d, d);
-        for j in steps {
-            p = self.step_tangent(&p, &modes[j * self.mf..(j + 1) * self.mf]);
-        }
-        p
-    }
-}
-
-/// One instant's box problem σ = s⁰ − T f, f ∈ [−μN, μN] ⊥ σ (T row-major, mf × mf; μN per row).
-pub(super) struct Relay<'a> {
-    pub t: &'a [f64],
-    pub slip: &'a [f64],
-}
-
-impl Relay<'_> {
-    /// Solves from the guessed modes by a primal–dual active set (mode updates from the
-    /// violations), else Lemke on the relay LCP; `mode` and `f` hold the answer.
-    pub(super) fn box_step(&self, s0: &[f64], mode: &mut [i8], f: &mut [f64]) {
-        let mf = self.slip.len();
-        for _ in 0..2 * mf + 2 {
-            self.solve_modes(s0, mode, f);
-            if !self.update_modes(s0, mode, f) {
-                return;
-            }
-        }
-        // relay_to_lcp: z₁ = f + μN, slack α; w₁ = T z₁ + α − s⁰ − T μN, w₂ = 2μN − z₁.
-        let nn = 2 * mf;
-        let mut data = vec![0.0; nn * nn];
-        let mut q = vec![0.0; nn];
-        for i in 0..mf {
-            for l in 0..mf {
-                data[i * nn + l] = self.t[i * mf + l];
-            }
-            data[i * nn + mf + i] = 1.0;
-            data[(mf + i) * nn + i] = -1.0;
-            q[i] = -s0[i] - (0..mf).map(|l| self.t[i * mf + l] * self.slip[l]).sum::<f64>();
-            q[mf + i] = 2.0 * self.slip[i];
-        }
-        let sol = Lemke::new(LemkeSettings::default()).solve(&DenseMatrix::from_row_major(nn, data), &q);
-        if sol.outcome != LcpOutcome::Solved {
-            return; // the march's end state shows the failure to Newton (no convergence)
-        }
-        for i in 0..mf {
-            let fi = sol.z[i] - self.slip[i];
-            mode[i] = if fi.abs() < self.slip[i] * (1.0 - 1e-9) { 0 } else { fi.signum() as i8 };
-        }
-        self.solve_modes(s0, mode, f);
-        if self.update_modes(s0, mode, f) {
-            // Lemke's own forces when the modes it names do not reproduce them (degenerate ties).
-            (0..mf).for_each(|i| f[i] = sol.z[i] - self.slip[i]);
-        }
-    }
-
-    /// f with the modes fixed: slipping rows at ±μN, stuck rows from T_SS f_S = s⁰_S − T_SL f_L.
-    fn solve_modes(&self, s0: &[f64], mode: &[i8], f: &mut [f64]) {
-        let mf = self.slip.len();
-        let stuck: Vec<usize> = (0..mf).filter(|&i| mode[i] == 0).collect();
-        for i in 0..mf {
-            f[i] = f64::from(mode[i]) * self.slip[i];
-        }
-        if stuck.is_empty() {
-            return;
-        }
-        let rhs: Vec<f64> = stuck.iter().map(|&i| s0[i] - (0..mf).filter(|&l| mode[l] != 0).map(|l| self.t[i * mf + l] * f[l]).sum::<f64>()).collect();
-        let ts = Mat::from_fn(stuck.len(), stuck.len(), |a, b| self.t[stuck[a] * mf + stuck[b]]);
-        let fs = DenseLu::new(&ts).solve(&rhs);
-        for (a, &i) in stuck.iter().enumerate() {
-            f[i] = fs[a];
-        }
-    }
-
-    /// Moves violated rows to their other mode; whether any moved.
-    fn update_modes(&self, s0: &[f64], mode: &mut [i8], f: &[f64]) -> bool {
-        let mf = self.slip.len();
-        let scale = s0.iter().fold(0.0f64, |a, v| a.max(v.abs()))
-            + (0..mf).map(|i| (0..mf).map(|l| self.t[i * mf + l].abs() * self.slip[l]).sum::<f64>()).fold(0.0, f64::max);
-        let tol = 1e-12 * scale.max(f64::MIN_POSITIVE);
-        let mut moved = false;
-        for i in 0..mf {
-            let sigma = s0[i] - (0..mf).map(|l| self.t[i * mf + l] * f[l]).sum::<f64>();
-            let next = match mode[i] {
-                0 if f[i] > self.slip[i] * (1.0 + 1e-12) => 1,
-                0 if f[i] < -self.slip[i] * (1.0 + 1e-12) => -1,
-                1 if sigma < -tol => 0,
-                -1 if sigma > tol => 0,
-                other => other,
-            };
-            moved |= next != mode[i] || !f[i].is_finite();
-            mode[i] = next;
-        }
-        moved
-    }
-
-    /// df (mf × d) with the modes fixed: stuck rows solve T_SS df_S = ds⁰_S (`ds0(i, c)`), slipping
-    /// rows keep their force.
-    pub(super) fn stuck_tangent(&self, mode: &[i8], ds0: impl Fn(usize, usize) -> f64, d: usize) -> Mat<f64> {
-        let mf = self.slip.len();
-        let stuck: Vec<usize> = (0..mf).filter(|&i| mode[i] == 0).collect();
-        let mut df = Mat::<f64>::zeros(mf, d);
-        if !stuck.is_empty() {
-            let ts = Mat::from_fn(stuck.len(), stuck.len(), |a, b| self.t[stuck[a] * mf + stuck[b]]);
-            let lu = DenseLu::new(&ts);
-            for c in 0..d {
-                let col = lu.solve(&stuck.iter().map(|&i| ds0(i, c)).collect::<Vec<_>>());
-                for (a, &i) in stuck.iter().enumerate() {
-                    df[(i, c)] = col[a];
+        let mut j = steps.start;
+        while j < steps.end {
+            let mode = &modes[j * mf..(j + 1) * mf];
+            let run = (j..steps.end).take_while(|&l| &modes[l * mf..(l + 1) * mf] == mode).count();
+            if run < RUN_POWER_MIN {
+                for _ in 0..run {
+                    p = self.step_tangent(&p, mode);
+                }
+            } else {
+                let mut base = self.step_tangent(&Mat::<f64>::identity(d, d), mode);
+                let mut left = run;
+                while left > 0 {
+                    if left & 1 == 1 {
+                        p = dense_product(&base, &p);
+                    }
+                    left >>= 1;
+                    if left > 0 {
+                        base = dense_product(&base, &base);
+                    }
                 }
             }
+            j += run;
         }
-        df
+        p
     }
 }
 
@@ -461,26 +388,31 @@ fn shoot_to(map: &impl FrictionMarch, start: Option<Vec<f64>>, tol: f64) -> Resu
     let mut unchanged = false;
     let mut tangent = PeriodTangent::new();
     let mut marches = 1;
+    let mut least = None;
+    let mut closings = 0;
     for iteration in 0..MAX_ITERATIONS {
         if !res.is_finite() {
             return Err(ShotFailure { iterations: iteration, residual: res, why: "the march overflowed", last: None });
         }
         // Round-off, or the sets of the affine solve came back unchanged (its fixed point).
         if res <= tol || (unchanged && res <= 1e-8) {
+            let family = family_dimension(&tangent.at(map, &march.modes));
             if let Some(clock) = profile {
                 eprintln!(
-                    "friction shooting profile: k = {}: {iteration} iterations, {marches} marches, {} tangent blocks rebuilt, {:.3} s, periodicity {res:.1e}",
+                    "friction shooting profile: k = {}: {iteration} iterations ({closings} closing overshoots), {marches} marches, {} tangent blocks rebuilt, {:.3} s, periodicity {res:.1e}, family dimension {family}",
                     map.instants(),
                     tangent.rebuilt,
                     clock.elapsed().as_secs_f64()
                 );
             }
-            return Ok(FrictionShot { state: y, forces: march.forces, velocity: march.velocity, iterations: iteration, residual: res });
+            return Ok(FrictionShot { state: y, forces: march.forces, velocity: march.velocity, iterations: iteration, residual: res, family });
         }
         let p = tangent.at(map, &march.modes);
         let i_minus_p = Mat::from_fn(d, d, |a, b| if a == b { 1.0 } else { 0.0 } - p[(a, b)]);
         let r: Vec<f64> = march.end.iter().zip(&y).map(|(e, s)| e - s).collect();
-        let mut delta = DenseLu::new(&i_minus_p).solve(&r);
+        let step = family_step(&i_minus_p, &r, least);
+        least = Some(step.least);
+        let mut delta = step.plain;
         let size = y.iter().chain(&march.end).fold(f64::MIN_POSITIVE, |a, v| a.max(v.abs()));
         if delta.iter().any(|v| !v.is_finite() || v.abs() > NEAR_SINGULAR * size) {
             // A family of periodic orbits (eigenvalue 1 of P: the half steps' relay on an undamped
@@ -496,23 +428,35 @@ fn shoot_to(map: &impl FrictionMarch, start: Option<Vec<f64>>, tol: f64) -> Resu
                 last: None,
             });
         }
-        let mut length = 1.0;
-        let (next_y, next) = loop {
-            let cand: Vec<f64> = y.iter().zip(&delta).map(|(s, dl)| s + length * dl).collect();
+        // A closing direction's overshoot first, kept when it lowers the residual.
+        let overshot = step.closing.filter(|c| c.iter().all(|v| v.is_finite())).and_then(|c| {
+            let cand: Vec<f64> = y.iter().zip(&c).map(|(s, dl)| s + dl).collect();
             let m = map.march(&cand, Some(&march.modes));
             marches += 1;
-            if residual(&cand, &m) < res || length < 0.5f64.powi(HALVINGS) {
-                break (cand, m);
-            }
-            length *= 0.5;
+            (residual(&cand, &m) < res).then_some((cand, m))
+        });
+        let mut length = 1.0;
+        let closed = overshot.is_some();
+        let (next_y, next) = match overshot {
+            Some(found) => found,
+            None => loop {
+                let cand: Vec<f64> = y.iter().zip(&delta).map(|(s, dl)| s + length * dl).collect();
+                let m = map.march(&cand, Some(&march.modes));
+                marches += 1;
+                if residual(&cand, &m) < res || length < 0.5f64.powi(HALVINGS) {
+                    break (cand, m);
+                }
+                length *= 0.5;
+            },
         };
-        unchanged = length == 1.0 && next.modes == march.modes;
+        closings += usize::from(closed);
+        unchanged = length == 1.0 && !closed && next.modes == march.modes;
         y = next_y;
         march = next;
         res = residual(&y, &march);
     }
-    let last = FrictionShot { state: y, forces: march.forces, velocity: march.velocity, iterations: MAX_ITERATIONS, residual: res };
-    Err(ShotFailure { iterations: MAX_ITERATIONS, residual: res, why: "the stick/slip sets kept changing", last: Some(last) })
+    let last = FrictionShot { state: y, forces: march.forces, velocity: march.velocity, iterations: MAX_ITERATIONS, residual: res, family: 0 };
+    Err(ShotFailure { iterations: MAX_ITERATIONS, residual: res, why: "the stick/slip sets kept changing", last: Some(Box::new(last)) })
 }
 
 /// δ of least norm for A δ = r (A square, singular): (AᵀA + μI) δ = Aᵀr with μ at round-off of

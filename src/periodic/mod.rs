@@ -5,7 +5,9 @@ mod cache;
 mod friction;
 mod friction_coupled;
 mod friction_events;
+mod friction_family;
 mod friction_half_steps;
+mod friction_relay;
 mod friction_shooting;
 pub mod limits;
 use crate::linalg::fft; // the crate's one FFT plan type, shared with lcp
