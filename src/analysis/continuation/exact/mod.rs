@@ -391,7 +391,11 @@ impl Walk<'_> {
         let metric = &self.fam.metric;
         let drift = metric.norm(&n.w.iter().zip(&pred).map(|(a, b)| a - b).collect::<Vec<_>>());
         let turn = metric.dot(&metric.unit(&n.tangent), &along);
-        ((turn >= MIN_COS || step <= min_step) && drift <= MAX_DRIFT * step && !signature::reversed(&self.fam, &n.w)).then_some((n, passed))
+        ((turn >= MIN_COS || step <= min_step)
+            && drift <= MAX_DRIFT * step
+            && !signature::reversed(&self.fam, &n.w)
+            && !signature::collapsed(&self.fam, &pred, &n.w))
+        .then_some((n, passed))
     }
 
     /// The predictor `pred` from `here` and, when events with identity state maps of different
