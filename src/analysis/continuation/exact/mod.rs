@@ -318,7 +318,18 @@ impl Walk<'_> {
             let tol = TOUCH_TOL * self.fam.ys;
             let crossed = |n: &Node| n.touches.iter().any(|t| t.value < -tol);
             if crossed(&next) && !crossed(&here) {
-                match self.insert_pair(&here, &next, &crossed) {
+                // The corrector failing on the bracket's midpoints: the step jumped across a
+                // change it cannot resolve (seed 138: a closed phase swallowed the open one
+                // after it in a step of 0.1); tried again shorter.
+                let Some((lo, _)) = bisect(&self.fam, &here, &next, &|n| !crossed(n), true) else {
+                    if step > settings.min_step {
+                        ds = step / 2.0;
+                        continue;
+                    }
+                    let stop = format!("a grazing near λ = {}: it could not be located on the arc", here.lambda(rho));
+                    return done(self, stop, false, false);
+                };
+                match self.insert_pair(&here, &lo) {
                     Some(n) => {
                         on_point(n.lambda(rho));
                         if self.ends_here(&n, dir) {
@@ -452,12 +463,12 @@ impl Walk<'_> {
         self.fam.node(w, &prev)
     }
 
-    /// The grazing between `here` and `next` where a contact's clearance first crosses zero
-    /// between its events: located, recorded, the pair of events inserted around the touch, and
-    /// the first point of the branch with its phase [`NEW_PAIR`] long.
-    fn insert_pair(&mut self, here: &Node, next: &Node, crossed: &dyn Fn(&Node) -> bool) -> Option<Node> {
-        let (lo, _) = bisect(&self.fam, here, next, &|n| !crossed(n), true)?;
-        for (kind, node, detail) in self.events_between(here, &lo) {
+    /// The grazing at `lo`, the last point after `here` where no contact's clearance has crossed
+    /// zero between its events (located by bisection): recorded with the events between, the
+    /// pair of events inserted around the touch, and the first point of the branch with its phase
+    /// [`NEW_PAIR`] long.
+    fn insert_pair(&mut self, here: &Node, lo: &Node) -> Option<Node> {
+        for (kind, node, detail) in self.events_between(here, lo) {
             self.push(&node, Some(kind), detail);
         }
         let touch = *lo.worst_touch()?;
@@ -471,9 +482,9 @@ impl Walk<'_> {
             sig.events.len(),
             if touch.closed { "open" } else { "closed" }
         );
-        self.push(&lo, Some(EventKind::Grazing), detail);
+        self.push(lo, Some(EventKind::Grazing), detail);
         let first = self.open_phase(sig, &guess, pair)?;
-        self.multipliers_across(&lo, &first);
+        self.multipliers_across(lo, &first);
         Some(first)
     }
 
