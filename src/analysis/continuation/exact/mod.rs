@@ -333,7 +333,20 @@ impl Walk<'_> {
             let tol = TOUCH_TOL * self.fam.ys;
             let crossed = |n: &Node| n.touches.iter().any(|t| t.value < -tol);
             if crossed(&next) && !crossed(&here) {
-                match self.insert_pair(&here, &next) {
+                // The corrector failing on the bracket's midpoints: the step jumped across a
+                // change it cannot resolve (seed 138: a closed phase swallowed the open one
+                // after it in a step of 0.1); tried again shorter.
+                // The least touch over the state scale, continuous through the grazing.
+                let least = |n: &Node| n.touches.iter().map(|t| t.value).fold(f64::INFINITY, f64::min) / self.fam.ys + TOUCH_TOL;
+                let Some((lo, _)) = locate(&self.fam, &here, &next, Test::Value(&least), true) else {
+                    if step > settings.min_step {
+                        ds = step / 2.0;
+                        continue;
+                    }
+                    let stop = format!("a grazing near λ = {}: it could not be located on the arc", here.lambda(rho));
+                    return done(self, stop, false, false);
+                };
+                match self.insert_pair(&here, &lo) {
                     Some(n) => {
                         self.report(on_point);
                         if self.ends_here(&n, dir) {
@@ -406,7 +419,11 @@ impl Walk<'_> {
         let metric = &self.fam.metric;
         let drift = metric.norm(&n.w.iter().zip(&pred).map(|(a, b)| a - b).collect::<Vec<_>>());
         let turn = metric.dot(&metric.unit(&n.tangent), &along);
-        ((turn >= MIN_COS || step <= min_step) && drift <= MAX_DRIFT * step && !signature::reversed(&self.fam, &n.w)).then_some((n, passed))
+        ((turn >= MIN_COS || step <= min_step)
+            && drift <= MAX_DRIFT * step
+            && !signature::reversed(&self.fam, &n.w)
+            && !signature::collapsed(&self.fam, &pred, &n.w))
+        .then_some((n, passed))
     }
 
     /// The predictor `pred` from `here` and, when events with identity state maps of different
@@ -463,14 +480,12 @@ impl Walk<'_> {
         self.fam.node(w, &prev)
     }
 
-    /// The grazing between `here` and `next` where a contact's clearance first crosses zero
-    /// between its events: located, recorded, the pair of events inserted around the touch, and
-    /// the first point of the branch with its phase [`NEW_PAIR`] long.
-    fn insert_pair(&mut self, here: &Node, next: &Node) -> Option<Node> {
-        // The least touch over the state scale, continuous through the grazing.
-        let least = |n: &Node| n.touches.iter().map(|t| t.value).fold(f64::INFINITY, f64::min) / self.fam.ys + TOUCH_TOL;
-        let (lo, _) = locate(&self.fam, here, next, Test::Value(&least), true)?;
-        for (kind, node, detail) in self.events_between(here, &lo) {
+    /// The grazing at `lo`, the last point after `here` where no contact's clearance has crossed
+    /// zero between its events (located on the arc): recorded with the events between, the
+    /// pair of events inserted around the touch, and the first point of the branch with its phase
+    /// [`NEW_PAIR`] long.
+    fn insert_pair(&mut self, here: &Node, lo: &Node) -> Option<Node> {
+        for (kind, node, detail) in self.events_between(here, lo) {
             self.push(&node, Some(kind), detail);
         }
         let touch = *lo.worst_touch()?;
@@ -484,9 +499,9 @@ impl Walk<'_> {
             sig.events.len(),
             if touch.closed { "open" } else { "closed" }
         );
-        self.push(&lo, Some(EventKind::Grazing), detail);
+        self.push(lo, Some(EventKind::Grazing), detail);
         let first = self.open_phase(sig, &guess, pair)?;
-        self.multipliers_across(&lo, &first);
+        self.multipliers_across(lo, &first);
         Some(first)
     }
 
