@@ -33,12 +33,27 @@ impl Phase {
         if nf == 0 {
             return Some(Transient { lambda: vec![], q: DMatrix::zeros(0, 0), lift });
         }
+        let (lambda, q) = self.modes_of(&self.homogeneous(a, y))?;
+        Some(Transient { lambda, q, lift })
+    }
+
+    /// The massive free state's deviation from the particular solution at `t`, z = N_aᵀ y − p(t)
+    /// (what e^{Aτ} carries: [`Self::flow`]).
+    pub fn homogeneous(&self, t: f64, y: &DVector<f64>) -> DVector<f64> {
+        self.free_state(y) - eval(&self.part, self.omega, t, 0, 2 * self.free.ncols())
+    }
+
+    /// Â's eigenvalues λ_j and the columns q_j (in [x_a; v_a]) with e^{Aτ} z = Re Σ_j q_j e^{λ_j τ}
+    /// (V weighted by the modal coordinates of D⁻¹z, scaled back by D: see [`Self::exp`]); `None`
+    /// where Â has no accepted eigendecomposition.
+    pub fn modes_of(&self, z: &DVector<f64>) -> Option<(Vec<C>, DMatrix<C>)> {
+        let nf = self.free.ncols();
         let f = self.eigen()?;
-        let mut u = self.free_state(y) - eval(&self.part, self.omega, a, 0, 2 * nf);
+        let mut u = z.clone();
         u.rows_mut(nf, nf).scale_mut(1.0 / self.speed);
         let (lambda, mut q) = f.modal(&u);
         q.rows_mut(nf, nf).iter_mut().for_each(|z| *z *= self.speed);
-        Some(Transient { lambda, q, lift })
+        Some((lambda, q))
     }
 
     /// The periodic particular solution of every DOF, P(t) = Re Σ_p P̂_p e^{ipωt} (full state
