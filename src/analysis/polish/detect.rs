@@ -28,11 +28,13 @@ thread_local! {
     static PROFILE: bool = std::env::var_os("PERIODIC_CONTACT_PROFILE").is_some();
 }
 
-/// Phases by closed set at one ω, their eigendecompositions shared with `prev`'s (they do not
-/// depend on ω).
+/// Phases by closed set at one ω: `prev`'s re-tuned where it has the set (only the particular
+/// solution depends on ω), else made and given `prev`'s eigendecomposition of the same matrix.
 struct Flows<'a> {
     model: &'a Model,
     prev: &'a PolishedOrbit,
+    /// Whether `model` is `prev`'s at another frequency (the same structure and contacts).
+    retune: bool,
     phases: Vec<Phase>,
     /// Each phase's switch-search grid.
     grids: Vec<Grid>,
@@ -46,12 +48,19 @@ impl Flows<'_> {
             return Ok(k);
         }
         let clock = PROFILE.with(|on| on.then(super::thread_cpu).flatten());
-        let mut p = Phase::new(self.model, &[], closed).ok_or_else(|| PolishFailure("a phase's operator is singular at a forcing harmonic".into()))?;
+        let old = self.prev.phases.iter().find(|o| self.retune && o.is_for(&[], closed));
+        let p = match old {
+            Some(o) => o.retuned(self.model),
+            None => Phase::new(self.model, &[], closed).map(|mut p| {
+                if let Some(o) = self.prev.phases.iter().find(|o| o.same_matrix(&p)) {
+                    p.share_modes(o);
+                }
+                p
+            }),
+        };
+        let p = p.ok_or_else(|| PolishFailure("a phase's operator is singular at a forcing harmonic".into()))?;
         if let (Some(a), Some(b)) = (clock, super::thread_cpu()) {
             self.building += b - a;
-        }
-        if let Some(o) = self.prev.phases.iter().find(|o| o.same_matrix(&p)) {
-            p.share_modes(o);
         }
         let h = 1.0 / (STEPS_PER_RADIAN * p.speed_hint().max(self.model.frequency));
         self.grids.push(Grid::new(self.model, &p, h));
@@ -86,7 +95,7 @@ pub fn follow_detected(model: &Model, prev: &PolishedOrbit, start: &[f64]) -> Re
         return Err(fail("only for compliant contacts"));
     }
     let carrier = PolishedOrbit::new(model, vec![], &[])?;
-    let mut flows = Flows { model, prev, phases: Vec::new(), grids: Vec::new(), building: 0.0 };
+    let mut flows = Flows { model, prev, retune: same_system(model, &prev.model), phases: Vec::new(), grids: Vec::new(), building: 0.0 };
     let clock = std::time::Instant::now();
     let n2 = 2 * model.n();
     let w = carrier.weights().rows(0, n2).into_owned();
@@ -140,6 +149,12 @@ pub fn follow_detected(model: &Model, prev: &PolishedOrbit, start: &[f64]) -> Re
     verify::check(&orbit)?;
     super::profile("admissibility check", clock);
     Ok(orbit)
+}
+
+/// Whether `a` and `b` differ at most in frequency (the same M, C, K and contacts).
+fn same_system(a: &Model, b: &Model) -> bool {
+    let (s, t) = (&a.structure, &b.structure);
+    s.mass == t.mass && s.stiffness == t.stiffness && s.damping == t.damping && a.contacts == b.contacts
 }
 
 /// The polish's Newton on the signature of `shot` (its switch times as seeds), then the check.
