@@ -70,6 +70,10 @@ pub(super) struct Phase {
     eigen: Arc<OnceLock<Option<EigenFlow>>>,
     /// [`Phase::stuck_force_gradient`], made at its first use.
     force_gradient: Arc<OnceLock<DMatrix<f64>>>,
+    /// The lift L = N_a + N_b S and e^{Ah} at one step h, made at their first use and shared by
+    /// the phase's clones and re-tunings (neither depends on ω).
+    lift: Arc<OnceLock<DMatrix<f64>>>,
+    grid_step: Arc<OnceLock<(f64, DMatrix<f64>)>>,
 }
 
 /// The longest span ‖Â τ‖₁ that [`Phase::flow`] takes by the Taylor action rather than the
@@ -206,6 +210,8 @@ impl Phase {
             tuning,
             eigen: Arc::default(),
             force_gradient: Arc::default(),
+            lift: Arc::default(),
+            grid_step: Arc::default(),
         };
         phase.tune()?;
         Some(phase)
@@ -228,6 +234,8 @@ impl Phase {
         if self.same_matrix(other) && self.m == other.m && self.c == other.c && self.k == other.k {
             self.eigen = Arc::clone(&other.eigen);
             self.force_gradient = Arc::clone(&other.force_gradient);
+            self.lift = Arc::clone(&other.lift);
+            self.grid_step = Arc::clone(&other.grid_step);
         }
     }
 
@@ -406,10 +414,10 @@ impl Phase {
         if self.plain() {
             return e.clone();
         }
-        let lift = &self.free + &self.slave * &self.slave_map;
+        let lift = self.lifted();
         let mut out = DMatrix::zeros(2 * n, 2 * n);
         for (r, c) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
-            let block = &lift * e.view((r * nf, c * nf), (nf, nf)) * self.free.transpose();
+            let block = lift * e.view((r * nf, c * nf), (nf, nf)) * self.free.transpose();
             out.view_mut((r * n, c * n), (n, n)).copy_from(&block);
         }
         out
@@ -426,10 +434,10 @@ impl Phase {
         reduced.rows_mut(0, nf).copy_from(&self.free.tr_mul(&dy.rows(0, n)));
         reduced.rows_mut(nf, nf).copy_from(&self.free.tr_mul(&dy.rows(n, n)));
         let moved = e * reduced;
-        let lift = &self.free + &self.slave * &self.slave_map;
+        let lift = self.lifted();
         let mut out = DMatrix::zeros(2 * n, dy.ncols());
-        out.rows_mut(0, n).copy_from(&(&lift * moved.rows(0, nf)));
-        out.rows_mut(n, n).copy_from(&(&lift * moved.rows(nf, nf)));
+        out.rows_mut(0, n).copy_from(&(lift * moved.rows(0, nf)));
+        out.rows_mut(n, n).copy_from(&(lift * moved.rows(nf, nf)));
         out
     }
 
@@ -479,10 +487,10 @@ impl Phase {
     pub fn stuck_force_gradient(&self) -> &DMatrix<f64> {
         self.force_gradient.get_or_init(|| {
             let n = self.n;
-            let lift = &self.free + &self.slave * &self.slave_map;
-            let ml = &self.m * &lift;
+            let lift = self.lifted();
+            let ml = &self.m * lift;
             let block = |a: &DMatrix<f64>| {
-                let al = a * &lift;
+                let al = a * lift;
                 let acc = &self.mff_inv * (self.free.transpose() * &al);
                 -(&self.b_stuck * (al - &ml * acc)) * self.free.transpose()
             };

@@ -29,30 +29,24 @@ pub(super) struct Grid {
 impl Grid {
     /// The grid of `ph` with step `h`.
     pub fn new(model: &Model, ph: &Phase, h: f64) -> Grid {
-        let (n, m, w) = (model.n(), model.contacts.len(), model.frequency);
-        let lift = ph.lift();
+        let (m, w) = (model.contacts.len(), model.frequency);
+        let lift = ph.lifted();
         let na = lift.ncols();
-        let part = ph.particular();
+        // Each contact's gap and B_i P̂_p per harmonic, on the union of their orders.
         let gaps: Vec<phase::Harmonics> = (0..m).map(|i| phase::gap_harmonics(model, i)).collect();
-        let mut orders: Vec<u32> = part.iter().map(|(p, _)| *p).chain(gaps.iter().flat_map(|g| g.iter().map(|(p, _)| *p))).collect();
+        let along: Vec<Vec<(u32, C)>> = model.contacts.iter().map(|c| ph.particular_along(&c.row)).collect();
+        let mut orders: Vec<u32> = along.iter().flat_map(|a| a.iter().map(|(p, _)| *p)).chain(gaps.iter().flat_map(|g| g.iter().map(|(p, _)| *p))).collect();
         orders.sort_unstable();
         orders.dedup();
-        let mut periodic = DMatrix::zeros(m, orders.len());
-        let mut rows = DMatrix::zeros(m, na);
-        for (i, c) in model.contacts.iter().enumerate() {
-            for (col, p) in orders.iter().enumerate() {
-                let gap = gaps[i].iter().find(|(q, _)| q == p).map_or(C::new(0.0, 0.0), |(_, g)| g[0]);
-                let x = part.iter().find(|(q, _)| q == p).map_or(C::new(0.0, 0.0), |(_, y)| c.along(|d| y[d]));
-                periodic[(i, col)] = gap - x;
-            }
-            for k in 0..na {
-                rows[(i, k)] = c.along(|d| lift[(d, k)]);
-            }
-        }
-        debug_assert_eq!(lift.nrows(), n);
+        let periodic = DMatrix::from_fn(m, orders.len(), |i, col| {
+            let p = orders[col];
+            let gap = gaps[i].iter().find(|(q, _)| *q == p).map_or(C::new(0.0, 0.0), |(_, g)| g[0]);
+            gap - along[i].iter().find(|(q, _)| *q == p).map_or(C::new(0.0, 0.0), |(_, x)| *x)
+        });
+        let rows = DMatrix::from_fn(m, na, |i, k| model.contacts[i].along(|d| lift[(d, k)]));
         let rates: Vec<f64> = orders.iter().map(|&p| p as f64 * w).collect();
         let turn = rates.iter().map(|r| C::from_polar(1.0, r * h)).collect();
-        Grid { h, step: ph.exp(h), rates, turn, periodic, rows }
+        Grid { h, step: ph.grid_step(h), rates, turn, periodic, rows }
     }
 
     /// Each contact's clearance at `t` from the deviation `z` (2n_a) and e^{ipωt} (`phasors`).
