@@ -41,7 +41,7 @@ fn walk(template: &PeriodicProblem, chunk: &[f64], on_point: &(dyn Fn(&SweepPoin
     let mut out = Vec::with_capacity(chunk.len());
     let (mut prev, mut linear): (Option<PolishedOrbit>, Option<PolishedOrbit>) = (None, None);
     let mut active: Option<Vec<usize>> = None;
-    // (ω, state at t = 0) of the last three exact or polished orbits in a row: the predictor's points.
+    // (ω, state at t = 0) of the last exact or polished orbits in a row: the predictor's points.
     let mut trail: Vec<(f64, Vec<f64>)> = Vec::new();
     for &f in chunk {
         let t0 = Instant::now();
@@ -76,7 +76,7 @@ fn walk(template: &PeriodicProblem, chunk: &[f64], on_point: &(dyn Fn(&SweepPoin
             Some(_) => {}
             None => trail.clear(),
         }
-        if trail.len() > 3 {
+        if trail.len() > 2 {
             trail.remove(0);
         }
         point.time_s = t0.elapsed().as_secs_f64();
@@ -86,18 +86,10 @@ fn walk(template: &PeriodicProblem, chunk: &[f64], on_point: &(dyn Fn(&SweepPoin
     out
 }
 
-/// The state at t = 0 predicted at `f`: the parabola through the last three orbits' (Lagrange's
-/// form), the secant through two, one orbit's own state (the forcing phase at t = 0 is the same
-/// at every ω): an error of O(Δω³) where the secant's is O(Δω²), one Newton shot fewer where the
-/// state is smooth in ω.
+/// The state at t = 0 predicted at `f`: the secant through the last two orbits' (one orbit's
+/// own state when there is one; the forcing phase at t = 0 is the same at every ω).
 fn predicted(trail: &[(f64, Vec<f64>)], f: f64) -> Vec<f64> {
     match trail {
-        [.., (f0, y0), (f1, y1), (f2, y2)] => {
-            let l0 = (f - f1) * (f - f2) / ((f0 - f1) * (f0 - f2));
-            let l1 = (f - f0) * (f - f2) / ((f1 - f0) * (f1 - f2));
-            let l2 = (f - f0) * (f - f1) / ((f2 - f0) * (f2 - f1));
-            y0.iter().zip(y1).zip(y2).map(|((a, b), c)| l0 * a + l1 * b + l2 * c).collect()
-        }
         [.., (f0, y0), (f1, y1)] => {
             let s = (f - f1) / (f1 - f0);
             y1.iter().zip(y0).map(|(a, b)| a + s * (a - b)).collect()
