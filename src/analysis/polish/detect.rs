@@ -70,16 +70,27 @@ impl Flows<'_> {
 }
 
 /// One period flowed from t = 0: the state at T, the switches (contact, kind, time, state there),
-/// the contacts closed at 0, and the exponentials' product over the period (massive free state).
+/// the contacts closed at 0, and the phases flowed with their spans (for the exponentials'
+/// product over the period, made only for the shots whose Jacobian Newton takes: [`Shot::product`]).
 struct Shot {
     end: DVector<f64>,
     switches: Vec<(Event, DVector<f64>)>,
     closed_at_start: Vec<usize>,
-    product: DMatrix<f64>,
+    spans: Vec<(usize, f64)>,
     last_phase: usize,
 }
 
 impl Shot {
+    /// Π e^{A τ} over the shot's phases (massive free state), last phase leftmost.
+    fn product(&self, phases: &[Phase]) -> DMatrix<f64> {
+        let mut out: Option<DMatrix<f64>> = None;
+        for &(k, tau) in &self.spans {
+            let e = phases[k].exp(tau);
+            out = Some(out.map_or_else(|| e.clone(), |p| &e * p));
+        }
+        out.expect("one phase at least")
+    }
+
     /// The contacts closed all period (closed at 0, never switched).
     fn always_closed(&self) -> Vec<usize> {
         self.closed_at_start.iter().copied().filter(|i| !self.switches.iter().any(|(e, _)| e.contact == *i)).collect()
@@ -114,7 +125,7 @@ pub fn follow_detected(model: &Model, prev: &PolishedOrbit, start: &[f64]) -> Re
         }
         // d y(T) / d y(0) = L_last (Π e^{A τ}) R: every phase shares the free basis (no stuck
         // contact), so R L_j = I between phases (phase.rs's `transition`).
-        let m = flows.phases[shot.last_phase].transition(&shot.product);
+        let m = flows.phases[shot.last_phase].transition(&shot.product(&flows.phases));
         let jac = m - DMatrix::identity(n2, n2);
         let du = jac.lu().solve(&(-&r)).ok_or_else(|| fail("the monodromy has a multiplier 1"))?;
         let before = r.component_mul(&w).amax();
@@ -209,18 +220,16 @@ fn shoot(carrier: &PolishedOrbit, flows: &mut Flows, y0: &DVector<f64>) -> Resul
     let closed_at_start = closed.clone();
     let (mut a, mut ya) = (0.0, y0.clone());
     let mut switches = Vec::new();
-    let mut product: Option<DMatrix<f64>> = None;
+    let mut spans = Vec::new();
     let mut k = flows.phase(&closed)?;
     loop {
         let found = grid::first_switch(model, &flows.phases[k], &flows.grids[k], &closed, (a, &ya), period);
         let Some((i, ts, ys)) = found else {
-            let e = flows.phases[k].exp(period - a);
-            product = Some(product.map_or_else(|| e.clone(), |p| &e * p));
+            spans.push((k, period - a));
             let end = flows.phases[k].flow(a, &ya, period);
-            return Ok(Shot { end, switches, closed_at_start, product: product.expect("one phase at least"), last_phase: k });
+            return Ok(Shot { end, switches, closed_at_start, spans, last_phase: k });
         };
-        let e = flows.phases[k].exp(ts - a);
-        product = Some(product.map_or_else(|| e.clone(), |p| &e * p));
+        spans.push((k, ts - a));
         let kind = if closed.contains(&i) { EventKind::Off } else { EventKind::On };
         if kind == EventKind::On {
             closed.push(i);
