@@ -14,6 +14,10 @@ use super::{PolishFailure, PolishedOrbit, verify};
 use crate::model::Model;
 use nalgebra::{DMatrix, DVector};
 
+// The switch search on a phase's grid without a flow per step.
+mod grid;
+use grid::Grid;
+
 /// Switch-search steps per radian of a phase's fastest motion (its balancing speed, ≥ ω_max):
 /// a sign change between steps is bracketed; a dip between two steps is left to the check.
 const STEPS_PER_RADIAN: f64 = 2.0;
@@ -24,12 +28,16 @@ thread_local! {
     static PROFILE: bool = std::env::var_os("PERIODIC_CONTACT_PROFILE").is_some();
 }
 
-/// Phases by closed set at one ω, their eigendecompositions shared with `prev`'s (they do not
-/// depend on ω).
+/// Phases by closed set at one ω: `prev`'s re-tuned where it has the set (only the particular
+/// solution depends on ω), else made and given `prev`'s eigendecomposition of the same matrix.
 struct Flows<'a> {
     model: &'a Model,
     prev: &'a PolishedOrbit,
+    /// Whether `model` is `prev`'s at another frequency (the same structure and contacts).
+    retune: bool,
     phases: Vec<Phase>,
+    /// Each phase's switch-search grid.
+    grids: Vec<Grid>,
     /// CPU spent building phases [s], under `PERIODIC_CONTACT_PROFILE`.
     building: f64,
 }
@@ -40,29 +48,49 @@ impl Flows<'_> {
             return Ok(k);
         }
         let clock = PROFILE.with(|on| on.then(super::thread_cpu).flatten());
-        let mut p = Phase::new(self.model, &[], closed).ok_or_else(|| PolishFailure("a phase's operator is singular at a forcing harmonic".into()))?;
+        let old = self.prev.phases.iter().find(|o| self.retune && o.is_for(&[], closed));
+        let p = match old {
+            Some(o) => o.retuned(self.model),
+            None => Phase::new(self.model, &[], closed).map(|mut p| {
+                if let Some(o) = self.prev.phases.iter().find(|o| o.same_matrix(&p)) {
+                    p.share_modes(o);
+                }
+                p
+            }),
+        };
+        let p = p.ok_or_else(|| PolishFailure("a phase's operator is singular at a forcing harmonic".into()))?;
         if let (Some(a), Some(b)) = (clock, super::thread_cpu()) {
             self.building += b - a;
         }
-        if let Some(o) = self.prev.phases.iter().find(|o| o.same_matrix(&p)) {
-            p.share_modes(o);
-        }
+        let h = 1.0 / (STEPS_PER_RADIAN * p.speed_hint().max(self.model.frequency));
+        self.grids.push(Grid::new(self.model, &p, h));
         self.phases.push(p);
         Ok(self.phases.len() - 1)
     }
 }
 
 /// One period flowed from t = 0: the state at T, the switches (contact, kind, time, state there),
-/// the contacts closed at 0, and the exponentials' product over the period (massive free state).
+/// the contacts closed at 0, and the phases flowed with their spans (for the exponentials'
+/// product over the period, made only for the shots whose Jacobian Newton takes: [`Shot::product`]).
 struct Shot {
     end: DVector<f64>,
     switches: Vec<(Event, DVector<f64>)>,
     closed_at_start: Vec<usize>,
-    product: DMatrix<f64>,
+    spans: Vec<(usize, f64)>,
     last_phase: usize,
 }
 
 impl Shot {
+    /// Π e^{A τ} over the shot's phases (massive free state), last phase leftmost.
+    fn product(&self, phases: &[Phase]) -> DMatrix<f64> {
+        let mut out: Option<DMatrix<f64>> = None;
+        for &(k, tau) in &self.spans {
+            let e = phases[k].exp(tau);
+            out = Some(out.map_or_else(|| e.clone(), |p| &e * p));
+        }
+        out.expect("one phase at least")
+    }
+
     /// The contacts closed all period (closed at 0, never switched).
     fn always_closed(&self) -> Vec<usize> {
         self.closed_at_start.iter().copied().filter(|i| !self.switches.iter().any(|(e, _)| e.contact == *i)).collect()
@@ -78,7 +106,7 @@ pub fn follow_detected(model: &Model, prev: &PolishedOrbit, start: &[f64]) -> Re
         return Err(fail("only for compliant contacts"));
     }
     let carrier = PolishedOrbit::new(model, vec![], &[])?;
-    let mut flows = Flows { model, prev, phases: Vec::new(), building: 0.0 };
+    let mut flows = Flows { model, prev, retune: same_system(model, &prev.model), phases: Vec::new(), grids: Vec::new(), building: 0.0 };
     let clock = std::time::Instant::now();
     let n2 = 2 * model.n();
     let w = carrier.weights().rows(0, n2).into_owned();
@@ -97,7 +125,7 @@ pub fn follow_detected(model: &Model, prev: &PolishedOrbit, start: &[f64]) -> Re
         }
         // d y(T) / d y(0) = L_last (Π e^{A τ}) R: every phase shares the free basis (no stuck
         // contact), so R L_j = I between phases (phase.rs's `transition`).
-        let m = flows.phases[shot.last_phase].transition(&shot.product);
+        let m = flows.phases[shot.last_phase].transition(&shot.product(&flows.phases));
         let jac = m - DMatrix::identity(n2, n2);
         let du = jac.lu().solve(&(-&r)).ok_or_else(|| fail("the monodromy has a multiplier 1"))?;
         let before = r.component_mul(&w).amax();
@@ -132,6 +160,12 @@ pub fn follow_detected(model: &Model, prev: &PolishedOrbit, start: &[f64]) -> Re
     verify::check(&orbit)?;
     super::profile("admissibility check", clock);
     Ok(orbit)
+}
+
+/// Whether `a` and `b` differ at most in frequency (the same M, C, K and contacts).
+fn same_system(a: &Model, b: &Model) -> bool {
+    let (s, t) = (&a.structure, &b.structure);
+    s.mass == t.mass && s.stiffness == t.stiffness && s.damping == t.damping && a.contacts == b.contacts
 }
 
 /// The polish's Newton on the signature of `shot` (its switch times as seeds), then the check.
@@ -176,52 +210,26 @@ fn assemble(
     Ok(orbit)
 }
 
-/// Contact `i`'s clearance, signed so that it is positive until it switches (its penetration
-/// when closed).
-fn signed(carrier: &PolishedOrbit, closed: &[usize], i: usize, y: &DVector<f64>, t: f64) -> f64 {
-    let c = carrier.clearance(i, y, t);
-    if closed.contains(&i) { -c } else { c }
-}
-
-/// One period from `y0` at t = 0 with switch detection ([`Shot`]).
+/// One period from `y0` at t = 0 with switch detection ([`Shot`]): each phase searched on its
+/// grid of steps of 1/([`STEPS_PER_RADIAN`]·its fastest rate) from its start ([`grid::first_switch`]).
 fn shoot(carrier: &PolishedOrbit, flows: &mut Flows, y0: &DVector<f64>) -> Result<Shot, PolishFailure> {
     let model = flows.model;
     let period = model.period();
     let m = model.contacts.len();
     let mut closed: Vec<usize> = (0..m).filter(|&i| carrier.clearance(i, y0, 0.0) < 0.0).collect();
     let closed_at_start = closed.clone();
-    let (mut t, mut y) = (0.0, y0.clone());
+    let (mut a, mut ya) = (0.0, y0.clone());
     let mut switches = Vec::new();
-    let mut product: Option<DMatrix<f64>> = None;
+    let mut spans = Vec::new();
     let mut k = flows.phase(&closed)?;
-    let mut phase_start = 0.0;
     loop {
-        let ph = &flows.phases[k];
-        let h = 1.0 / (STEPS_PER_RADIAN * ph.speed_hint().max(model.frequency));
-        let t1 = (t + h).min(period);
-        let y1 = ph.flow(t, &y, t1);
-        // The earliest contact whose signed clearance turns negative in [t, t1].
-        let mut first: Option<(usize, f64, DVector<f64>)> = None;
-        for i in 0..m {
-            if signed(carrier, &closed, i, &y1, t1) >= 0.0 {
-                continue;
-            }
-            let (ts, ys) = crossing(&|s| ph.flow(t, &y, s), &|s, ys| signed(carrier, &closed, i, ys, s), t, t1, &y1);
-            if first.as_ref().is_none_or(|f| ts < f.1) {
-                first = Some((i, ts, ys));
-            }
-        }
-        let Some((i, ts, ys)) = first else {
-            (t, y) = (t1, y1);
-            if t >= period {
-                let e = flows.phases[k].exp(t - phase_start);
-                product = Some(product.map_or_else(|| e.clone(), |p| &e * p));
-                break;
-            }
-            continue;
+        let found = grid::first_switch(model, &flows.phases[k], &flows.grids[k], &closed, (a, &ya), period);
+        let Some((i, ts, ys)) = found else {
+            spans.push((k, period - a));
+            let end = flows.phases[k].flow(a, &ya, period);
+            return Ok(Shot { end, switches, closed_at_start, spans, last_phase: k });
         };
-        let e = flows.phases[k].exp(ts - phase_start);
-        product = Some(product.map_or_else(|| e.clone(), |p| &e * p));
+        spans.push((k, ts - a));
         let kind = if closed.contains(&i) { EventKind::Off } else { EventKind::On };
         if kind == EventKind::On {
             closed.push(i);
@@ -230,46 +238,10 @@ fn shoot(carrier: &PolishedOrbit, flows: &mut Flows, y0: &DVector<f64>) -> Resul
             closed.retain(|&c| c != i);
         }
         switches.push((Event { contact: i, kind, seed: ts }, ys.clone()));
-        (t, y, phase_start) = (ts, ys, ts);
+        (a, ya) = (ts, ys);
         k = flows.phase(&closed)?;
         if switches.len() > 64 * m.max(1) {
             return Err(PolishFailure("switch-detecting shooting: chattering (too many switches in one period)".into()));
         }
     }
-    Ok(Shot { end: y, switches, closed_at_start, product: product.expect("one phase at least"), last_phase: k })
-}
-
-/// Where `g` (≥ 0 at `a`, < 0 at `b`) along the flow `flow` changes sign: the Illinois method
-/// (regula falsi with halving, Dowell & Jarratt, BIT 11, 1971) to round-off; the time at the
-/// bracket's negative end, so that the contact has switched there, and the state.
-fn crossing(flow: &dyn Fn(f64) -> DVector<f64>, g: &dyn Fn(f64, &DVector<f64>) -> f64, a: f64, b: f64, yb: &DVector<f64>) -> (f64, DVector<f64>) {
-    let (mut lo, mut hi) = (a, b);
-    let (mut glo, mut ghi) = (g(a, &flow(a)), g(b, yb));
-    let mut yhi = yb.clone();
-    let mut side = 0;
-    for _ in 0..100 {
-        if hi - lo <= 4.0 * f64::EPSILON * hi.abs().max(1e-300) {
-            break;
-        }
-        let mut s = hi - ghi * (hi - lo) / (ghi - glo);
-        if !(s > lo && s < hi) {
-            s = 0.5 * (lo + hi);
-        }
-        let ys = flow(s);
-        let gs = g(s, &ys);
-        if gs < 0.0 {
-            (hi, ghi, yhi) = (s, gs, ys);
-            if side == -1 {
-                glo *= 0.5;
-            }
-            side = -1;
-        } else {
-            (lo, glo) = (s, gs);
-            if side == 1 {
-                ghi *= 0.5;
-            }
-            side = 1;
-        }
-    }
-    (hi, yhi)
 }

@@ -21,6 +21,9 @@ mod particular;
 pub(super) use particular::Transient;
 // The massive coordinates' basis and lift, for the variation carried in them.
 mod massive;
+// The particular solution at a frequency, and a phase re-tuned to another one.
+mod tuning;
+use tuning::{Tuning, loads};
 
 /// Complex amplitudes of a harmonic signal: value(t) = Re Σ_p amp_p e^{i p ω t}.
 pub(super) type Harmonics = Vec<(u32, DVector<C>)>;
@@ -59,12 +62,18 @@ pub(super) struct Phase {
     slave: DMatrix<f64>,
     slave_map: DMatrix<f64>,
     slave_part: Harmonics,
+    /// What the particular solution needs at any ω (tuning.rs), shared by the phase's clones.
+    tuning: Arc<Tuning>,
     /// Â's eigendecomposition, made at the first flow and shared by the phase's clones (a
     /// reordered orbit's, a continuation step's); `None` inside where Â is refused
     /// ([`EigenFlow::new`]): the Padé and Taylor paths then.
     eigen: Arc<OnceLock<Option<EigenFlow>>>,
     /// [`Phase::stuck_force_gradient`], made at its first use.
     force_gradient: Arc<OnceLock<DMatrix<f64>>>,
+    /// The lift L = N_a + N_b S and e^{Ah} at one step h, made at their first use and shared by
+    /// the phase's clones and re-tunings (neither depends on ω).
+    lift: Arc<OnceLock<DMatrix<f64>>>,
+    grid_step: Arc<OnceLock<(f64, DMatrix<f64>)>>,
 }
 
 /// The longest span ‖Â τ‖₁ that [`Phase::flow`] takes by the Taylor action rather than the
@@ -122,8 +131,7 @@ impl Phase {
         let m = dense(&s.mass, n);
         let c = s.damping.as_ref().map_or_else(|| DMatrix::zeros(n, n), |d| dense(d, n));
         let mut k = dense(&s.stiffness, n);
-        let mut force = force_harmonics(model);
-        // A closed compliant contact adds k_c B_iᵀ B_i to K and k_c B_iᵀ gap_i(t) to f.
+        // A closed compliant contact adds k_c B_iᵀ B_i to K (and k_c B_iᵀ gap_i(t) to f: `loads`).
         for &i in closed {
             let ct = &model.contacts[i];
             let Compliance::Compliant { stiffness } = ct.compliance else { continue };
@@ -132,20 +140,8 @@ impl Phase {
                     k[(a, b)] += stiffness * ca * cb;
                 }
             }
-            for (p, g) in gap_harmonics(model, i) {
-                for &(d, cd) in &ct.row {
-                    add(&mut force, p, d, g[0] * stiffness * cd, n);
-                }
-            }
         }
-        let mut presc: Harmonics = Vec::new();
-        for &i in stuck {
-            for (p, g) in gap_harmonics(model, i) {
-                for &(d, cd) in &model.contacts[i].row {
-                    add(&mut presc, p, d, g[0] * cd, n);
-                }
-            }
-        }
+        let (force, presc) = loads(model, stuck, closed);
         let b_stuck = DMatrix::from_fn(stuck.len(), n, |r, d| model.contacts[stuck[r]].row.iter().find(|e| e.0 == d).map_or(0.0, |e| e.1));
         let all = null_basis(model, stuck);
         let ff = |a: &DMatrix<f64>| all.transpose() * a * &all;
@@ -178,57 +174,20 @@ impl Phase {
             a.view_mut((nf, 0), (nf, nf)).copy_from(&mk);
             a.view_mut((nf, nf), (nf, nf)).copy_from(&(-&mff_inv * sub(&c_ff)));
         }
-        // Free forcing per harmonic: g = Nᵀ(f − (−(pω)² M + ipω C + K) x_presc); the free
-        // coordinates' periodic answer X solves (−(pω)² M_ff + ipω C_ff + K_ff) X = g.
-        let mut ps: Vec<u32> = force.iter().chain(&presc).map(|(p, _)| *p).collect();
-        ps.sort_unstable();
-        ps.dedup();
-        let (mut part, mut slave_part) = (Vec::new(), Vec::new());
-        let cplx = |a: &DMatrix<f64>, s: f64| a.map(|v| C::new(s * v, 0.0));
-        for p in ps {
-            let w = p as f64 * omega;
-            let fp = force.iter().find(|(q, _)| *q == p).map_or_else(|| DVector::zeros(n), |(_, v)| v.clone());
-            let xp = presc.iter().find(|(q, _)| *q == p).map_or_else(|| DVector::zeros(n), |(_, v)| v.clone());
-            let dyn_op = cplx(&m, -w * w) + c.map(|v| C::new(0.0, w * v)) + cplx(&k, 1.0);
-            let g = cplx(&all, 1.0).transpose() * (fp - dyn_op * xp);
-            let x = if g.is_empty() {
-                g
-            } else if nb == 0 {
-                let op = cplx(&m_ff, -w * w) + c_ff.map(|v| C::new(0.0, w * v)) + cplx(&k_ff, 1.0);
-                op.lu().solve(&g)?
-            } else {
-                // The massless rows are static, K_ba x_a + K_bb x_b = g_b: x_b = K_bb⁻¹ g_b + S x_a,
-                // and the massive ones take the condensed operator −(pω)² M_aa + ipω C_aa + K_cond
-                // on g_a − K_ab K_bb⁻¹ g_b (a 2n_a-sized solve per harmonic, not the n-sized one).
-                let gb = g.select_rows(&massless);
-                let (re, im) = (k_bb_lu.solve(&gb.map(|z| z.re))?, k_bb_lu.solve(&gb.map(|z| z.im))?);
-                let yb = DVector::from_fn(nb, |i, _| C::new(re[i], im[i]));
-                let k_ab = cplx(&k_ff.select_rows(&massive).select_columns(&massless), 1.0);
-                let op = cplx(&sub(&m_ff), -w * w) + sub(&c_ff).map(|v| C::new(0.0, w * v)) + cplx(&k_cond, 1.0);
-                let xa = op.lu().solve(&(g.select_rows(&massive) - k_ab * &yb))?;
-                let xb = yb + cplx(&slave_map, 1.0) * &xa;
-                let mut x = DVector::zeros(all.ncols());
-                massive.iter().enumerate().for_each(|(r, &j)| x[j] = xa[r]);
-                massless.iter().enumerate().for_each(|(r, &j)| x[j] = xb[r]);
-                x
-            };
-            if !x.iter().all(|v| v.re.is_finite() && v.im.is_finite()) {
-                return None;
-            }
-            let xa = x.select_rows(&massive);
-            let mut y = DVector::zeros(2 * nf);
-            y.rows_mut(0, nf).copy_from(&xa);
-            y.rows_mut(nf, nf).copy_from(&(xa * C::new(0.0, w)));
-            part.push((p, y));
-            slave_part.push((p, x.select_rows(&massless)));
-        }
         // A was built in [x; v]; the exponential takes the balanced one (see `exp`).
         if nf > 0 {
             a.view_mut((0, nf), (nf, nf)).scale_mut(speed);
             a.view_mut((nf, 0), (nf, nf)).scale_mut(1.0 / speed);
         }
         let a_norm = a.column_iter().map(|c| c.iter().map(|v| v.abs()).sum::<f64>()).fold(0.0, f64::max);
-        Some(Phase {
+        let tuning = Arc::new(Tuning {
+            k_bb: (nb > 0).then_some(k_bb_lu),
+            k_ab: k_ff.select_rows(&massive).select_columns(&massless),
+            m_aa: sub(&m_ff),
+            c_aa: sub(&c_ff),
+            k_cond,
+        });
+        let mut phase = Phase {
             n,
             omega,
             free,
@@ -244,13 +203,18 @@ impl Phase {
             speed,
             a_norm,
             mff_inv,
-            part,
+            part: Vec::new(),
             slave,
             slave_map,
-            slave_part,
+            slave_part: Vec::new(),
+            tuning,
             eigen: Arc::default(),
             force_gradient: Arc::default(),
-        })
+            lift: Arc::default(),
+            grid_step: Arc::default(),
+        };
+        phase.tune()?;
+        Some(phase)
     }
 
     /// Whether this is the phase of the stuck contacts `stuck` and the closed compliant ones
@@ -270,6 +234,8 @@ impl Phase {
         if self.same_matrix(other) && self.m == other.m && self.c == other.c && self.k == other.k {
             self.eigen = Arc::clone(&other.eigen);
             self.force_gradient = Arc::clone(&other.force_gradient);
+            self.lift = Arc::clone(&other.lift);
+            self.grid_step = Arc::clone(&other.grid_step);
         }
     }
 
@@ -448,10 +414,10 @@ impl Phase {
         if self.plain() {
             return e.clone();
         }
-        let lift = &self.free + &self.slave * &self.slave_map;
+        let lift = self.lifted();
         let mut out = DMatrix::zeros(2 * n, 2 * n);
         for (r, c) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
-            let block = &lift * e.view((r * nf, c * nf), (nf, nf)) * self.free.transpose();
+            let block = lift * e.view((r * nf, c * nf), (nf, nf)) * self.free.transpose();
             out.view_mut((r * n, c * n), (n, n)).copy_from(&block);
         }
         out
@@ -468,10 +434,10 @@ impl Phase {
         reduced.rows_mut(0, nf).copy_from(&self.free.tr_mul(&dy.rows(0, n)));
         reduced.rows_mut(nf, nf).copy_from(&self.free.tr_mul(&dy.rows(n, n)));
         let moved = e * reduced;
-        let lift = &self.free + &self.slave * &self.slave_map;
+        let lift = self.lifted();
         let mut out = DMatrix::zeros(2 * n, dy.ncols());
-        out.rows_mut(0, n).copy_from(&(&lift * moved.rows(0, nf)));
-        out.rows_mut(n, n).copy_from(&(&lift * moved.rows(nf, nf)));
+        out.rows_mut(0, n).copy_from(&(lift * moved.rows(0, nf)));
+        out.rows_mut(n, n).copy_from(&(lift * moved.rows(nf, nf)));
         out
     }
 
@@ -521,10 +487,10 @@ impl Phase {
     pub fn stuck_force_gradient(&self) -> &DMatrix<f64> {
         self.force_gradient.get_or_init(|| {
             let n = self.n;
-            let lift = &self.free + &self.slave * &self.slave_map;
-            let ml = &self.m * &lift;
+            let lift = self.lifted();
+            let ml = &self.m * lift;
             let block = |a: &DMatrix<f64>| {
-                let al = a * &lift;
+                let al = a * lift;
                 let acc = &self.mff_inv * (self.free.transpose() * &al);
                 -(&self.b_stuck * (al - &ml * acc)) * self.free.transpose()
             };

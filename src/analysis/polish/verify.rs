@@ -164,8 +164,9 @@ fn what(o: &PolishedOrbit, e: usize, i: usize) -> (&'static str, f64) {
 fn closed_form(o: &PolishedOrbit, e: usize, transient: &Transient, (a, b): (f64, f64), (xs, fs): (f64, f64)) -> Lowest {
     let (model, ph) = (&o.model, &o.phases[e]);
     let (n, w) = (model.n(), model.frequency);
-    let part = ph.particular();
     let stuck: Vec<usize> = ph.stuck_contacts().collect();
+    // The full particular solution only for the stuck contacts' forces; a clearance needs its row.
+    let part = if stuck.is_empty() { vec![] } else { ph.particular() };
     let held = if stuck.is_empty() { vec![] } else { ph.stuck_force_particular(&part) };
     let mut out = Vec::new();
     for (i, c) in model.contacts.iter().enumerate() {
@@ -178,7 +179,11 @@ fn closed_form(o: &PolishedOrbit, e: usize, transient: &Transient, (a, b): (f64,
             let mut rho = DVector::zeros(2 * n);
             c.row.iter().for_each(|&(d, cd)| rho[d] = -sign * cd);
             let mut h: Vec<(f64, C)> = o.gaps[i].iter().map(|(p, g)| (*p as f64 * w, g[0] * sign)).collect();
-            h.extend(part.iter().map(|(p, y)| (*p as f64 * w, -c.along(|d| y[d]) * sign)));
+            if stuck.is_empty() {
+                h.extend(ph.particular_along(&c.row).into_iter().map(|(p, x)| (p as f64 * w, -x * sign)));
+            } else {
+                h.extend(part.iter().map(|(p, y)| (*p as f64 * w, -c.along(|d| y[d]) * sign)));
+            }
             (rho, h, xs)
         };
         let signal = Signal::new(a, transient.lambda.clone(), transient.coefficients(&rho), harmonics);

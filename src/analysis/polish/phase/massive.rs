@@ -13,6 +13,18 @@ impl Phase {
     /// coordinates' deviation from the particular solution (the stuck DOFs' rows zero, the
     /// massless DOFs' condensed, src/formulation.md §4.1); N_aᵀ L = I.
     pub fn lift(&self) -> DMatrix<f64> {
-        &self.free + &self.slave * &self.slave_map
+        self.lifted().clone()
+    }
+
+    /// [`Self::lift`], made once per phase (shared by its clones and re-tunings).
+    pub fn lifted(&self) -> &DMatrix<f64> {
+        self.lift.get_or_init(|| &self.free + &self.slave * &self.slave_map)
+    }
+
+    /// e^{Ah} for the switch search's grid step `h` (detect/grid.rs), made once per phase for
+    /// the first h asked (the same at every ω of a sweep while the phase's fastest rate exceeds ω).
+    pub fn grid_step(&self, h: f64) -> DMatrix<f64> {
+        let (h0, e) = self.grid_step.get_or_init(|| (h, self.exp(h)));
+        if *h0 == h { e.clone() } else { self.exp(h) }
     }
 }

@@ -29,16 +29,31 @@ impl Phase {
     /// [`Self::exp`]). `None` where Â has no accepted eigendecomposition (the Padé path).
     pub fn transient(&self, a: f64, y: &DVector<f64>) -> Option<Transient> {
         let nf = self.free.ncols();
-        let lift = &self.free + &self.slave * &self.slave_map;
+        let lift = self.lifted().clone();
         if nf == 0 {
             return Some(Transient { lambda: vec![], q: DMatrix::zeros(0, 0), lift });
         }
+        let (lambda, q) = self.modes_of(&self.homogeneous(a, y))?;
+        Some(Transient { lambda, q, lift })
+    }
+
+    /// The massive free state's deviation from the particular solution at `t`, z = N_aᵀ y − p(t)
+    /// (what e^{Aτ} carries: [`Self::flow`]).
+    pub fn homogeneous(&self, t: f64, y: &DVector<f64>) -> DVector<f64> {
+        self.free_state(y) - eval(&self.part, self.omega, t, 0, 2 * self.free.ncols())
+    }
+
+    /// Â's eigenvalues λ_j and the columns q_j (in [x_a; v_a]) with e^{Aτ} z = Re Σ_j q_j e^{λ_j τ}
+    /// (V weighted by the modal coordinates of D⁻¹z, scaled back by D: see [`Self::exp`]); `None`
+    /// where Â has no accepted eigendecomposition.
+    pub fn modes_of(&self, z: &DVector<f64>) -> Option<(Vec<C>, DMatrix<C>)> {
+        let nf = self.free.ncols();
         let f = self.eigen()?;
-        let mut u = self.free_state(y) - eval(&self.part, self.omega, a, 0, 2 * nf);
+        let mut u = z.clone();
         u.rows_mut(nf, nf).scale_mut(1.0 / self.speed);
         let (lambda, mut q) = f.modal(&u);
         q.rows_mut(nf, nf).iter_mut().for_each(|z| *z *= self.speed);
-        Some(Transient { lambda, q, lift })
+        Some((lambda, q))
     }
 
     /// The periodic particular solution of every DOF, P(t) = Re Σ_p P̂_p e^{ipωt} (full state
@@ -61,6 +76,36 @@ impl Phase {
                 y.rows_mut(n, n).copy_from(&(&x * C::new(0.0, p as f64 * self.omega)));
                 y.rows_mut(0, n).copy_from(&x);
                 (p, y)
+            })
+            .collect()
+    }
+
+    /// B P̂_p of the row `row` (a contact's) on the particular solution's displacement, per
+    /// harmonic ([`Self::particular`]'s orders), from the rows of N_a, N_b and the prescribed
+    /// motion at the row's DOFs only (O(n_a + n_b) per harmonic where the full P̂_p is O(n n_a)).
+    pub fn particular_along(&self, row: &[(usize, f64)]) -> Vec<(u32, C)> {
+        let (nf, nb) = (self.free.ncols(), self.slave.ncols());
+        let mut orders: Vec<u32> = self.part.iter().chain(&self.presc).map(|(p, _)| *p).collect();
+        orders.sort_unstable();
+        orders.dedup();
+        fn find(h: &Harmonics, p: u32) -> Option<&DVector<C>> {
+            h.iter().find(|(q, _)| *q == p).map(|(_, v)| v)
+        }
+        orders
+            .into_iter()
+            .map(|p| {
+                let (xa, xb, xp) = (find(&self.part, p), find(&self.slave_part, p), find(&self.presc, p));
+                let at = |d: usize| {
+                    let mut v = xp.map_or(C::new(0.0, 0.0), |x| x[d]);
+                    if let Some(xa) = xa {
+                        v += (0..nf).map(|k| xa[k] * self.free[(d, k)]).sum::<C>();
+                    }
+                    if let Some(xb) = xb {
+                        v += (0..nb).map(|k| xb[k] * self.slave[(d, k)]).sum::<C>();
+                    }
+                    v
+                };
+                (p, row.iter().map(|&(d, c)| at(d) * c).sum())
             })
             .collect()
     }
