@@ -215,15 +215,6 @@ impl PolishedOrbit {
         // Above the clearance's round-off (the state's scale times 1e-13) counts as open.
         let floor = 1e-13 * self.model.contacts[c].along(|i| y0[i]).abs().max(f64::MIN_POSITIVE);
         let mut open: Option<f64> = None;
-        if std::env::var_os("PC_TRACE_UNMERGE").is_some() {
-            let hold = ph.stuck_forces(y0, t0).into_iter().find(|(k, _)| *k == c).map_or(f64::NAN, |(_, z)| z) / self.force_scale();
-            eprintln!("free_return: T {:.4e} fast {:.3e} floor {floor:.2e} hold {hold:.3e}", self.period, fast);
-            for &d in steps.iter().take(60) {
-                let y = ph.flow(t0, y0, t0 + d);
-                let z = ph.stuck_forces(&y, t0 + d).into_iter().find(|(k, _)| *k == c).map_or(f64::NAN, |(_, z)| z) / self.force_scale();
-                eprintln!("  Δ/T {:.3e} g {:.4e} stuck {:.4e}", d / self.period, g(d), z);
-            }
-        }
         for &d in &steps {
             let v = g(d);
             match open {
