@@ -34,6 +34,10 @@ const RESEED: [f64; 6] = [1e-4, 1e-3, 3e-3, 1e-2, 3e-2, 0.1];
 const REFINE: usize = 4;
 const REFINE_DOFS: usize = 64;
 
+/// How far past a sticking arc's grazing start (fractions of ρ) the flight after its landing is
+/// first sought, in turn ([`Walk::unmerge`]).
+const UNMERGE: [f64; 5] = [1e-6, 1e-5, 1e-4, 1e-3, 1e-2];
+
 /// The flight (fraction of the period) below which a re-impact's condition is divided by the
 /// flight²: after a plastic impact the contact's clearance and its rate are zero, so the
 /// clearance at the re-impact Δ later is ½aΔ² + ⅙jΔ³ (a, j its acceleration and jerk after the
@@ -121,6 +125,10 @@ impl Walk<'_> {
             // from a release to a sticking impact (of zero impulse), grows on the exact orbit.
             (polish::STUCK, None) if land.is_some() => {
                 let e = land.expect("guarded");
+                let sense = (next.lambda(self.fam.rho) - here.lambda(self.fam.rho)).signum();
+                if let Some(n) = self.unmerge(&lo, e, sense, &what) {
+                    return Some(n);
+                }
                 // The force touches zero where the sticking impact lands: the impact turns pure,
                 // and a flight of zero length leads to the sticking impact.
                 list[e].1.kind = Switch::Impact { stick: false };
@@ -149,6 +157,63 @@ impl Walk<'_> {
             }
         }
         self.reseed(&lo, &what, to)
+    }
+
+    /// The force holding the contact of the sticking impact `e` reaches zero where it lands at
+    /// `lo` (the sticking arc's start grazes): past it (λ's `sense`) the impact is pure and the
+    /// contact flies until its clearance comes back to zero, where it sticks. The flight grows
+    /// like −3a/j, or like √(12a/|s|) where the clearance's jerk j at the landing is nil (a, s its
+    /// acceleration and snap; rigid.rs of polish), so a first flight of fixed length (1e-5 of
+    /// the period) lies a distance ∝ Δ² away in λ that the linear start misses, and a shorter
+    /// one (1e-7 … 1e-8) has a clearance ½aΔ² below its round-off. Started instead at λ fixed a
+    /// short way past `lo` ([`UNMERGE`] of ρ in turn): the old signature's orbit there (no longer
+    /// admissible), its flight from the exact free flow's return
+    /// ([`polish::PolishedOrbit::free_return`]), the new signature corrected at that λ.
+    fn unmerge(&mut self, lo: &Node, e: usize, sense: f64, what: &str) -> Option<Node> {
+        let (rho, d) = (self.fam.rho, self.fam.dim());
+        let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
+        let before = self.fam.ne();
+        for f in UNMERGE {
+            let l = lo.lambda(rho) + sense * f * rho;
+            let mut g = lo.w.clone();
+            g[d - 1] = l / rho;
+            let Some(merged) = self.fam.correct(&g, &e_l, l / rho).and_then(|w| self.fam.node_with(w, &e_l, false)) else { continue };
+            let (o, t) = (&merged.orbit, merged.orbit.period());
+            let ne = o.times().len();
+            let arc = if e + 1 < ne { o.times()[e + 1] - o.times()[e] } else { o.times()[0] + t - o.times()[e] };
+            let flight = o.free_return(e, arc);
+            trace(format_args!("unmerge: λ {l:.10} ({f:e} of ρ): flight {:?} of the period", flight.map(|x| x / t)));
+            let Some(flight) = flight else { continue };
+            let mut list = timed(o);
+            let base = list[0].0;
+            list[e].1.kind = Switch::Impact { stick: false };
+            let at = list[e].0 + flight / t;
+            list.push((if at >= base + 1.0 { at - 1.0 } else { at }, Event { contact: list[e].1.contact, kind: Switch::Impact { stick: true }, seed: 0.0 }));
+            list.sort_by(|x, y| x.0.total_cmp(&y.0));
+            let sig = Signature { events: list.iter().map(|l| l.1).collect(), always: o.always_closed().to_vec() };
+            let guess = signature::guess(&self.fam, o, &list, l / rho);
+            let old = std::mem::replace(&mut self.fam.sig, sig);
+            // One more unknown (the new event's time): λ is the last.
+            let mut e_l1 = vec![0.0; guess.len()];
+            e_l1[guess.len() - 1] = 1.0;
+            let prev1: Vec<f64> = e_l1.iter().map(|x| x * sense).collect();
+            let first = self.fam.correct(&guess, &e_l1, l / rho).and_then(|w| self.fam.node(w, &prev1));
+            trace(format_args!("unmerge: corrected {}, margin {:?}", first.is_some(), first.as_ref().map(margin)));
+            match first {
+                Some(n) if margin(&n) >= -TOL => {
+                    let detail = format!(
+                        "{what}; events per period {before} -> {} (the flight after the landing started at λ = {l:.10}, {:.2e} of the period, from the free flow's return)",
+                        self.fam.ne(),
+                        flight / t
+                    );
+                    self.push(lo, Some(EventKind::Grazing), detail);
+                    self.multipliers_across(lo, &n);
+                    return Some(n);
+                }
+                _ => self.fam.sig = old,
+            }
+        }
+        None
     }
 
     /// [`Self::start_phase`] for the time-ordered `list` (fractions of the period) of the orbit at `at`.
@@ -360,6 +425,13 @@ impl Walk<'_> {
             }
         }
         None
+    }
+}
+
+/// A line of the un-merge's trace on stderr when `PC_TRACE_UNMERGE` is set.
+fn trace(line: std::fmt::Arguments) {
+    if std::env::var_os("PC_TRACE_UNMERGE").is_some() {
+        eprintln!("{line}");
     }
 }
 
