@@ -141,6 +141,19 @@ impl PolishedOrbit {
 }
 
 impl PolishedOrbit {
+    /// The force holding the contact of the sticking impact `e` just after it lands, over the
+    /// force scale (signed: negative where the held orbit is not the true one, which lifts off),
+    /// or `None` for other events and massless contacts. The test function of a sticking arc's
+    /// start grazing: its zero is where the landing turns into a pure impact and a micro-flight.
+    pub fn landing_force(&self, e: usize) -> Option<f64> {
+        let ev = self.events.get(e)?;
+        if ev.kind != (EventKind::Impact { stick: true }) || self.model.contact_is_massless(&self.model.contacts[ev.contact]) {
+            return None;
+        }
+        let hold = self.phases[e].stuck_forces(&self.after[e], self.times[e]).into_iter().find(|(k, _)| *k == ev.contact)?.1;
+        Some(hold / self.force_scale())
+    }
+
     /// Event `e` is contact `c`'s sticking impact and the force holding c just after it is
     /// negative while rising: the true orbit lifts off there and lands again at once (a
     /// micro-flight). With a, j the free clearance's acceleration and jerk after the impact
