@@ -69,6 +69,24 @@ fn impact_oscillator_branches_match_the_closed_form() {
     }
 }
 
+/// The same sticking oscillator walked down, 0.8 → 0.55: the merged orbit (one sticking impact)
+/// un-merges where the force holding the mass at its landing reaches zero (the landing turns
+/// into a pure impact and a micro-flight, issue 24's coarse rigid blade at 2217.54 rad/s). The
+/// change is recorded where that force crosses zero, against the closed form's change of regime
+/// (bisection on its own flows), and the walk stays on the exact orbit to the end.
+#[test]
+fn sticking_oscillator_unmerges_where_the_closed_form_changes() {
+    let (m, c, k, f, gap) = (1.0, 0.1, 1.0, 1.0, 0.5);
+    let p = problem(&impact_oscillator(&Oscillator::new(m, c, k, f, 0.8), gap, 512));
+    let b = continuation::run(&p, Parameter::Frequency, 0.8, 0.55, &ContinuationSettings::default(), &|_| {}).unwrap();
+    assert!(b.reached(), "{}", b.stop);
+    assert!(b.points.iter().all(|q| q.source == Source::Exact), "{}", b.stop);
+    let onset = sticking_onset(&Oscillator::new(m, c, k, f, 0.55), gap, 0.55, 0.8);
+    let at = b.events().map(|e| e.parameter).min_by(|x, y| (x - onset).abs().total_cmp(&(y - onset).abs())).unwrap();
+    eprintln!("un-merge walking down: walk {at:.10}, closed form {onset:.10}");
+    assert!((at - onset).abs() < 1e-6, "the un-merge at Ω = {at}, the closed form's change at {onset}");
+}
+
 /// The frequency in [a, b] where the closed form's orbit changes between a sticking arc and pure
 /// impacts (the sticking arc Ω t ∈ [Ω t_h, 2π + Ω t_d] shrinking to nothing), by bisection on its regime.
 fn sticking_onset(osc: &Oscillator, gap: f64, a: f64, b: f64) -> f64 {

@@ -22,6 +22,8 @@ use crate::analysis::polish::{self, Event, EventKind as Switch, Touch};
 use crate::periodic::{PeriodicProblem, PeriodicSolver};
 use crate::time::Discretization;
 
+mod landing;
+
 /// Margins above −this are admissible (the relative tolerance of the polish's own checks).
 const TOL: f64 = 1e-9;
 /// The trial steps that orient a restarted branch (scaled unknowns), in turn: past an impact
@@ -34,6 +36,10 @@ const RESEED: [f64; 6] = [1e-4, 1e-3, 3e-3, 1e-2, 3e-2, 0.1];
 /// arc a few instants long near the change), for models of at most [`REFINE_DOFS`] DOFs.
 const REFINE: usize = 4;
 const REFINE_DOFS: usize = 64;
+
+/// How far past a sticking arc's grazing start (fractions of ρ) the flight after its landing is
+/// first sought, in turn ([`Walk::unmerge`]).
+const UNMERGE: [f64; 5] = [1e-6, 1e-5, 1e-4, 1e-3, 1e-2];
 
 /// The flight (fraction of the period) below which a re-impact's condition is divided by the
 /// flight²: after a plastic impact the contact's clearance and its rate are zero, so the
@@ -122,6 +128,15 @@ impl Walk<'_> {
             // from a release to a sticking impact (of zero impulse), grows on the exact orbit.
             (polish::STUCK, None) if land.is_some() => {
                 let e = land.expect("guarded");
+                let (rho, l0) = (self.fam.rho, lo.lambda(self.fam.rho));
+                let sense = (next.lambda(rho) - here.lambda(rho)).signum();
+                // The held orbit went on while its micro-flight was below resolution: the change
+                // is where the landing force crosses zero, back towards `here` (or just behind).
+                let back = if (here.lambda(rho) - l0).abs() > 1e-9 * rho { here.lambda(rho) } else { l0 - sense * 1e-4 * rho };
+                let zero = landing::landing_zero(&self.fam, &lo.w, e, (l0, back), sense).map(|z| z.0);
+                if let Some(n) = self.unmerge(&lo, zero.as_ref(), e, sense, &what) {
+                    return Some(n);
+                }
                 // The force touches zero where the sticking impact lands: the impact turns pure,
                 // and a flight of zero length leads to the sticking impact.
                 list[e].1.kind = Switch::Impact { stick: false };
@@ -150,6 +165,78 @@ impl Walk<'_> {
             }
         }
         self.reseed(&lo, &what, to)
+    }
+
+    /// The force holding the contact of the sticking impact `e` reaches zero where it lands at
+    /// `lo` (the sticking arc's start grazes): past it (λ's `sense`) the impact is pure and the
+    /// contact flies until its clearance comes back to zero, where it sticks. The flight grows
+    /// like −3a/j, or like √(12a/|s|) where the clearance's jerk j at the landing is nil (a, s its
+    /// acceleration and snap; rigid.rs of polish), so a first flight of fixed length (1e-5 of
+    /// the period) lies a distance ∝ Δ² away in λ that the linear start misses, and a shorter
+    /// one (1e-7 … 1e-8) has a clearance ½aΔ² below its round-off. Started instead at λ fixed a
+    /// short way past `lo` ([`UNMERGE`] of ρ in turn): the old signature's orbit there (no longer
+    /// admissible), its flight from the exact free flow's return
+    /// ([`polish::PolishedOrbit::free_return`]), the new signature corrected at that λ.
+    /// The grazing is recorded at `zero` (the landing force's zero, [`landing::landing_zero`]), in
+    /// λ's order among the points of the held orbit walked past it, or at `lo` without it.
+    fn unmerge(&mut self, lo: &Node, zero: Option<&Node>, e: usize, sense: f64, what: &str) -> Option<Node> {
+        let (rho, d) = (self.fam.rho, self.fam.dim());
+        let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
+        let before = self.fam.ne();
+        for f in UNMERGE {
+            let l = lo.lambda(rho) + sense * f * rho;
+            let mut g = lo.w.clone();
+            g[d - 1] = l / rho;
+            let Some(merged) = self.fam.correct(&g, &e_l, l / rho).and_then(|w| self.fam.node_with(w, &e_l, false)) else { continue };
+            let (o, t) = (&merged.orbit, merged.orbit.period());
+            let ne = o.times().len();
+            let arc = if e + 1 < ne { o.times()[e + 1] - o.times()[e] } else { o.times()[0] + t - o.times()[e] };
+            let flight = o.free_return(e, arc);
+            trace(format_args!("unmerge: λ {l:.10} ({f:e} of ρ): flight {:?} of the period", flight.map(|x| x / t)));
+            let Some(flight) = flight else { continue };
+            let mut list = timed(o);
+            let base = list[0].0;
+            list[e].1.kind = Switch::Impact { stick: false };
+            let at = list[e].0 + flight / t;
+            list.push((if at >= base + 1.0 { at - 1.0 } else { at }, Event { contact: list[e].1.contact, kind: Switch::Impact { stick: true }, seed: 0.0 }));
+            list.sort_by(|x, y| x.0.total_cmp(&y.0));
+            let sig = Signature { events: list.iter().map(|l| l.1).collect(), always: o.always_closed().to_vec() };
+            let guess = signature::guess(&self.fam, o, &list, l / rho);
+            let old = std::mem::replace(&mut self.fam.sig, sig);
+            // One more unknown (the new event's time): λ is the last.
+            let mut e_l1 = vec![0.0; guess.len()];
+            e_l1[guess.len() - 1] = 1.0;
+            let prev1: Vec<f64> = e_l1.iter().map(|x| x * sense).collect();
+            let first = self.fam.correct(&guess, &e_l1, l / rho).and_then(|w| self.fam.node(w, &prev1));
+            trace(format_args!("unmerge: corrected {}, margin {:?}", first.is_some(), first.as_ref().map(margin)));
+            match first {
+                Some(n) if margin(&n) >= -TOL => {
+                    let held = zero.map_or(String::new(), |_| format!("; the landing force crosses zero here, the held orbit traced on to λ = {:.10} (its micro-flight below 1e-9 of the clearance scale)", lo.lambda(rho)));
+                    let detail = format!(
+                        "{what}{held}; events per period {before} -> {} (the flight after the landing started at λ = {l:.10}, {:.2e} of the period, from the free flow's return)",
+                        self.fam.ne(),
+                        flight / t
+                    );
+                    self.push_in_order(zero.unwrap_or(lo), EventKind::Grazing, detail, sense);
+                    self.multipliers_across(lo, &n);
+                    return Some(n);
+                }
+                _ => self.fam.sig = old,
+            }
+        }
+        None
+    }
+
+    /// Records the event `kind` at `node`, before the last points that lie past it along λ's
+    /// `sense` (walked on past the change before it was seen).
+    fn push_in_order(&mut self, node: &Node, kind: EventKind, detail: String, sense: f64) {
+        self.push(node, Some(kind), detail);
+        let Some(p) = self.points.pop() else { return };
+        let mut i = self.points.len();
+        while i > 0 && self.points[i - 1].event.is_none() && (self.points[i - 1].parameter - p.parameter) * sense > 0.0 {
+            i -= 1;
+        }
+        self.points.insert(i, p);
     }
 
     /// [`Self::start_phase`] for the time-ordered `list` (fractions of the period) of the orbit at `at`.
@@ -299,6 +386,10 @@ impl Walk<'_> {
                 if let Some(n) = reach.into_iter().find_map(|f| self.fade((lambda, lambda + sense * f * rho), here, list.clone(), what, "the impact")) {
                     return Some(n);
                 }
+                // The sticking impact, after the pure one removed.
+                if let Some(n) = self.held_merge(here, &list, if e + 1 < ne { e } else { 0 }, what) {
+                    return Some(n);
+                }
                 let sig = Signature { events: list.iter().map(|l| l.1).collect(), always: here.orbit.always_closed().to_vec() };
                 (sig, signature::guess(&self.fam, &here.orbit, &list, wl))
             }
@@ -364,6 +455,13 @@ impl Walk<'_> {
     }
 }
 
+/// A line of the un-merge's trace on stderr when `PC_TRACE_UNMERGE` is set.
+fn trace(line: std::fmt::Arguments) {
+    if std::env::var_os("PC_TRACE_UNMERGE").is_some() {
+        eprintln!("{line}");
+    }
+}
+
 /// The orbit's events with their times as fractions of the period.
 fn timed(orbit: &polish::PolishedOrbit) -> Vec<(f64, Event)> {
     let t = orbit.period();
@@ -397,35 +495,52 @@ fn grid_orbit(problem: &PeriodicProblem, param: super::Parameter, lambda: f64) -
 /// The point between λ = `la` and `lb` where the orbit of the family's signature (corrected at λ
 /// fixed from `guess`'s unknowns) stops being admissible: bisection in λ on the sign of its
 /// rigid margin, to [`BRACKET`] of the range; the node on the admissible side, its tangent
-/// pointing away from the inadmissible one. `None` without a sign change or where the corrector fails.
+/// pointing away from the inadmissible one. Where the margin there is a landing's lift-off (its
+/// micro-flight just visible), the point is where that landing's force crosses zero
+/// ([`landing::landing_zero`]). `None` without a sign change or where the corrector fails.
 fn touch_point(fam: &mut Family, guess: &[f64], la: f64, lb: f64) -> Option<Node> {
     let (rho, d) = (fam.rho, fam.dim());
     let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
-    // The orbit at λ from the unknowns `from`: (unknowns, admissible).
-    let at = |fam: &mut Family, from: &[f64], lambda: f64| -> Option<(Vec<f64>, bool)> {
+    // The orbit at λ from the unknowns `from`: (node, admissible).
+    let at = |fam: &mut Family, from: &[f64], lambda: f64| -> Option<(Node, bool)> {
         let mut g = from.to_vec();
         g[d - 1] = lambda / rho;
         let w = correct_far(fam, &g, &e_l, lambda / rho)?;
         let n = fam.node_with(w, &e_l, false)?;
         let ok = margin(&n) >= -TOL;
-        Some((n.w, ok))
+        Some((n, ok))
     };
     let a = at(fam, guess, la)?;
-    let b = at(fam, &a.0, lb)?;
-    let (mut ok, mut lok, mut lbad) = match (a.1, b.1) {
-        (true, false) => (a.0, la, lb),
-        (false, true) => (b.0, lb, la),
+    let b = at(fam, &a.0.w, lb)?;
+    let (mut ok, mut bad, mut lok, mut lbad) = match (a.1, b.1) {
+        (true, false) => (a.0, b.0, la, lb),
+        (false, true) => (b.0, a.0, lb, la),
         _ => return None,
     };
     while (lok - lbad).abs() > BRACKET * rho {
         let mid = 0.5 * (lok + lbad);
-        match at(fam, &ok, mid)? {
-            (w, true) => (ok, lok) = (w, mid),
-            (_, false) => lbad = mid,
+        match at(fam, &ok.w, mid)? {
+            (n, true) => (ok, lok) = (n, mid),
+            (n, false) => (bad, lbad) = (n, mid),
         }
     }
-    let prev: Vec<f64> = e_l.iter().map(|x| x * (lok - lbad).signum()).collect();
-    fam.node(ok, &prev)
+    let away = (lok - lbad).signum();
+    trace(format_args!(
+        "touch point: {lok:.10} admissible, {lbad:.10} not: {:?}, lifted {:?}; landing forces {:?} / {:?}",
+        bad.orbit.rigid_margin().map(|m| (m.what, m.value, m.contact, m.time / bad.orbit.period(), m.event)),
+        landing::lifted(&bad),
+        (0..ok.orbit.events().len()).filter_map(|e| ok.orbit.landing_force(e).map(|h| (e, ok.orbit.times()[e] / ok.orbit.period(), h))).collect::<Vec<_>>(),
+        (0..bad.orbit.events().len()).filter_map(|e| bad.orbit.landing_force(e).map(|h| (e, h))).collect::<Vec<_>>()
+    ));
+    if let Some(e) = landing::lifted(&bad) {
+        // The zero lies on the admissible side of the visible lift-off: bracketed a short way on.
+        let on = lok + away * 1e-4 * rho;
+        if let Some((n, _)) = landing::landing_zero(fam, &bad.w, e, (lbad, on), away) {
+            return Some(n);
+        }
+    }
+    let prev: Vec<f64> = e_l.iter().map(|x| x * away).collect();
+    fam.node(ok.w, &prev)
 }
 
 /// [`Family::correct`] from a guess whose state may lie further than the state scale from the
