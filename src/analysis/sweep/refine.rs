@@ -29,7 +29,7 @@ pub(super) fn refine(
 ) {
     let Some(tolerance) = settings.tolerance else { return };
     let (below, skipped) = match below {
-        Below::Solved(r) => (Some(r), false),
+        Below::Solved(r) => (Some(*r), false),
         Below::None => (None, false),
         Below::Skipped => (None, true),
     };
@@ -123,7 +123,7 @@ pub(super) type Coarser = Vec<(PeriodicSolver, Option<f64>)>;
 /// The first grid's k/2 answer for [`refine`]: solved, none, or skipped ([`estimate`]'s
 /// `predicted`).
 pub(super) enum Below {
-    Solved(Response),
+    Solved(Box<Response>),
     None,
     Skipped,
 }
@@ -186,7 +186,7 @@ pub(super) fn estimate(
     let a = accuracy::estimate_from(problem, r, &half, quarter.as_ref(), &note);
     let skipped = if coarser && refined_anyway { "; k/4 not solved: even Richardson at the scheme's order from k/2 exceeds the tolerance" } else { "" };
     (point.estimate_relative, point.estimate_method) = (settings.measure.of(&a), a.method + skipped);
-    if coarser { Below::Solved(half) } else { Below::None }
+    if coarser { Below::Solved(Box::new(half)) } else { Below::None }
 }
 
 /// The second solve of a point's error estimate, in the chunk's session for that grid (made on
