@@ -7,7 +7,6 @@ mod friction_coupled;
 mod friction_events;
 mod friction_half_steps;
 mod friction_shooting;
-mod gaps;
 pub mod limits;
 use crate::linalg::fft; // the crate's one FFT plan type, shared with lcp
 mod pilot;

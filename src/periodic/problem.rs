@@ -28,8 +28,6 @@ pub struct PeriodicProblem {
     /// p: the orbit's period is p·T, discretised by p·k instants (k = `disc.steps` per forcing
     /// period); the forcing keeps ω (harmonic p of the base 2π/(pT)).
     period_multiple: usize,
-    /// Each contact's gap samples per grid ([`Self::gap_samples`]).
-    pub(super) gaps: super::gaps::GapSamples,
 }
 
 /// Fewest instants per period that any scheme needs.
@@ -87,18 +85,7 @@ impl PeriodicProblem {
             None => model.omega_max()?,
         };
         limits::check_stability(&model, &disc, omega_max)?;
-        Ok(PeriodicProblem {
-            model,
-            disc,
-            outputs,
-            solver,
-            output_map: None,
-            omega_max,
-            auto_steps,
-            contact_pairing: Vec::new(),
-            period_multiple: 1,
-            gaps: Default::default(),
-        })
+        Ok(PeriodicProblem { model, disc, outputs, solver, output_map: None, omega_max, auto_steps, contact_pairing: Vec::new(), period_multiple: 1 })
     }
 
     /// The orbit's period in forcing periods, p (1: T-periodic).

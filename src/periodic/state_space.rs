@@ -178,7 +178,7 @@ pub fn step_map(problem: &PeriodicProblem) -> Result<StepMapLcp, NoStepMap> {
     let mut r = vec![0.0; k * m];
     // The contacts' forces enter through Ẽᵀ (rubbing: Ẽ ≠ B̃, S non-symmetric), their gaps through B̃.
     let wb = dense_product(&w, &cond.force_rows.transpose().to_owned());
-    let gaps = problem.gap_samples();
+    let angles = crate::model::GridAngles::new(k);
     for (ci, contact) in model.contacts.iter().enumerate() {
         // Implicit (s = L) reads x_(j+L), y's first block; explicit (s = L − 1) reads
         // x_(j+L−1) = x_(j+L) − ∇x_(j+L), known before the step (Γ's blocks are equal: HΓ = 0).
@@ -196,7 +196,7 @@ pub fn step_map(problem: &PeriodicProblem) -> Result<StepMapLcp, NoStepMap> {
         if let Compliance::Compliant { stiffness } = contact.compliance {
             flexibility[ci * m + ci] += 1.0 / stiffness;
         }
-        let gap = &gaps[ci];
+        let gap = contact.gap_samples(&angles, problem.period_multiple());
         for j in 0..k {
             let at = (j + offsets[ci]) % k;
             r[j * m + ci] = gap[at] + gap_shift[at * m + ci];
