@@ -165,6 +165,9 @@ impl BlockCirculant {
     pub fn max_abs_bound(&self) -> (f64, bool) {
         let (Some(spectrum), None) = (self.spectrum.as_deref(), self.blocks.get()) else { return self.max_abs() };
         let (k, mm) = (self.k, self.m * self.m);
+        if mm == 0 {
+            return (0.0, true);
+        }
         let mut sums = vec![0.0f64; mm];
         for (p, block) in spectrum.chunks_exact(mm).enumerate() {
             // The bins 1..k/2 (but Nyquist) stand for their conjugates too.
