@@ -512,3 +512,40 @@ fn the_skipped_quarter_grid_could_not_have_kept_a_point_within_the_tolerance() {
         assert!(floor > 0.0 && floor <= with * (1.0 + 1e-12) && floor <= without * (1.0 + 1e-12), "ω = {f}: floor {floor:e}, {with:e}, {without:e}");
     }
 }
+
+/// A point after one that needed 4k or more skips its own k/2 and k/4 solves and is refined at
+/// once (`refine::estimate`'s prediction; issue 23). The reference is the same point swept alone
+/// (no previous point: the full climb from k = 256): the swept point ends at the same k with the
+/// same estimate and amplitudes (to the LCP's tolerance), or, where the climb stops at k, at 2k
+/// within the tolerance.
+#[test]
+fn a_point_after_a_finely_refined_one_skips_the_first_grid_estimate_and_ends_where_the_climb_does() {
+    let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("fmu/scenes/chain-3dof-two-stops.toml")).unwrap();
+    let p = Scene::parse(&text, "chain").unwrap().to_problem("chain").unwrap();
+    let k0 = p.discretization().steps;
+    let settings = SweepSettings { threads: 1, chunks_per_thread: 1, estimate: true, tolerance: Some(1e-3), max_steps: 8192, ..Default::default() };
+    let freqs = sweep::linspace(0.5, 0.9, 21);
+    let swept = sweep::run(&p, &freqs, &settings, &|_| {}).unwrap();
+    let mut skipped = 0;
+    for i in 1..freqs.len() {
+        if swept[i - 1].steps < 4 * k0 {
+            continue;
+        }
+        skipped += 1;
+        let alone = &sweep::run(&p, &freqs[i..=i], &settings, &|_| {}).unwrap()[0];
+        let (s, a) = (&swept[i], alone);
+        let (es, ea) = (s.estimate_relative.unwrap(), a.estimate_relative.unwrap());
+        eprintln!("ω = {:.2}: swept k = {} ({es:.3e}), alone k = {} ({ea:.3e})", freqs[i], s.steps, a.steps);
+        if a.steps == k0 && s.steps == 2 * k0 {
+            assert!(es <= 1e-3, "ω = {}: {es:e} ({})", freqs[i], s.estimate_method);
+            continue;
+        }
+        assert_eq!(s.steps, a.steps, "ω = {}: {} against {}", freqs[i], s.estimate_method, a.estimate_method);
+        assert!((es - ea).abs() <= 1e-6 * ea, "ω = {}: {es:e} against {ea:e}", freqs[i]);
+        let big = a.amplitude.iter().copied().fold(0.0, f64::max);
+        for (x, y) in s.amplitude.iter().zip(&a.amplitude) {
+            assert!((x - y).abs() <= 1e-8 * big, "ω = {}: amplitude {x:e} against {y:e}", freqs[i]);
+        }
+    }
+    assert!(skipped >= 5, "{skipped} points followed one at 4k or more");
+}

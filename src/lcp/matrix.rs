@@ -96,8 +96,9 @@ impl LcpMatrix for DenseMatrix {
 pub struct BlockCirculant {
     k: usize,
     m: usize,
-    /// blocks[(d·m + a)·m + b]
-    blocks: Vec<f64>,
+    /// blocks[(d·m + a)·m + b]; formed from `spectrum` on first use when the matrix was made from
+    /// its spectrum ([`BlockCirculant::from_spectrum`]).
+    blocks: std::sync::OnceLock<Vec<f64>>,
     /// The blocks' DFT when the caller had it (Ĝ_p row-major m×m, p = 0..=k/2): the FFT
     /// products then skip the m² transforms of [`super::CirculantOperator`].
     spectrum: Option<Vec<num_complex::Complex64>>,
@@ -106,14 +107,21 @@ pub struct BlockCirculant {
 /// Equal blocks are equal matrices, whether a spectrum came with them or not.
 impl PartialEq for BlockCirculant {
     fn eq(&self, other: &Self) -> bool {
-        (self.k, self.m) == (other.k, other.m) && self.blocks == other.blocks
+        (self.k, self.m) == (other.k, other.m) && self.blocks() == other.blocks()
     }
 }
 
 impl BlockCirculant {
     pub fn new(k: usize, m: usize, blocks: Vec<f64>) -> Self {
         assert_eq!(blocks.len(), k * m * m, "BlockCirculant: {} values for k={k}, m={m}", blocks.len());
-        BlockCirculant { k, m, blocks, spectrum: None }
+        BlockCirculant { k, m, blocks: blocks.into(), spectrum: None }
+    }
+    /// The matrix of block spectrum Ĝ_p (as [`Self::with_spectrum`]), its blocks formed by inverse
+    /// FFT only when something asks for them ([`Self::blocks`]). Why: a shooting solve needs
+    /// only the spectrum (the FFT products) and a bound of max|A|; forming the k·m² blocks was
+    /// a tenth of the real blade's 200-point sweep (issue 23).
+    pub fn from_spectrum(k: usize, m: usize, spectrum: Vec<num_complex::Complex64>) -> Self {
+        BlockCirculant { k, m, blocks: std::sync::OnceLock::new(), spectrum: None }.with_spectrum(spectrum)
     }
     /// The same matrix with its block spectrum Ĝ_p = Σ_d blocks[d] e^(−2πi pd/k) (row-major m×m,
     /// p = 0..=k/2), e.g. from the frequency-domain assembly it was transformed from.
@@ -134,13 +142,53 @@ impl BlockCirculant {
     }
     /// The first block column: block d is blocks()[d·m²..(d+1)·m²], row-major.
     pub fn blocks(&self) -> &[f64] {
-        &self.blocks
+        self.blocks.get_or_init(|| self.blocks_from_spectrum())
+    }
+    /// The blocks by inverse FFT of the spectrum, entry by entry (a, b).
+    fn blocks_from_spectrum(&self) -> Vec<f64> {
+        let (k, m) = (self.k, self.m);
+        let spectrum = self.spectrum.as_deref().expect("a BlockCirculant without blocks has its spectrum");
+        let fft = crate::linalg::fft::PeriodFft::new(k);
+        let mut blocks = vec![0.0; k * m * m];
+        let mut column = vec![num_complex::Complex64::ZERO; k / 2 + 1];
+        for e in 0..m * m {
+            column.iter_mut().enumerate().for_each(|(p, v)| *v = spectrum[p * m * m + e]);
+            for (d, v) in fft.inverse(&column).into_iter().enumerate() {
+                blocks[d * m * m + e] = v;
+            }
+        }
+        blocks
+    }
+    /// An upper bound of max |a_ij| and whether every entry is finite, without forming the blocks
+    /// when they are not formed: |a_d| ≤ (1/k)·Σ_p |Ĝ_p| over the full (Hermitian) spectrum.
+    /// Exact once the blocks are formed; the blocks are formed where the bound overflows.
+    pub fn max_abs_bound(&self) -> (f64, bool) {
+        let (Some(spectrum), None) = (self.spectrum.as_deref(), self.blocks.get()) else { return self.max_abs() };
+        let (k, mm) = (self.k, self.m * self.m);
+        if mm == 0 {
+            return (0.0, true);
+        }
+        let mut sums = vec![0.0f64; mm];
+        for (p, block) in spectrum.chunks_exact(mm).enumerate() {
+            // The bins 1..k/2 (but Nyquist) stand for their conjugates too.
+            let weight = if p == 0 || 2 * p == k { 1.0 } else { 2.0 };
+            // |re| + |im| ≥ |g|: a bound still, without hypot's cost.
+            sums.iter_mut().zip(block).for_each(|(s, g)| *s += weight * (g.re.abs() + g.im.abs()));
+        }
+        let sum = sums.iter().fold(0.0f64, |a, s| a.max(*s));
+        // Near overflow the inverse FFT's own sums may not be finite: the blocks decide.
+        if !sum.is_finite() {
+            return self.max_abs();
+        }
+        (sum / k as f64, true)
     }
     /// Adds diag(values) (length m) to every diagonal block: A + I_k ⊗ diag(values).
     pub fn add_block_diagonal(&mut self, values: &[f64]) {
         let m = self.m;
         for (a, v) in values.iter().enumerate() {
-            self.blocks[a * m + a] += v;
+            if let Some(blocks) = self.blocks.get_mut() {
+                blocks[a * m + a] += v;
+            }
             // Block 0 alone changes: every harmonic's diagonal by the same value.
             if let Some(s) = self.spectrum.as_mut() {
                 s.chunks_exact_mut(m * m).for_each(|block| block[a * m + a] += v);
@@ -149,7 +197,7 @@ impl BlockCirculant {
     }
     #[inline]
     fn block_entry(&self, d: usize, a: usize, b: usize) -> f64 {
-        self.blocks[(d * self.m + a) * self.m + b]
+        self.blocks()[(d * self.m + a) * self.m + b]
     }
 }
 
@@ -188,7 +236,7 @@ impl BlockCirculant {
                         }
                     }
                 }
-                return Some(BlockCirculant { k, m, blocks, spectrum: None });
+                return Some(BlockCirculant::new(k, m, blocks));
             }
         }
         None
@@ -231,8 +279,9 @@ impl LcpMatrix for BlockCirculant {
         }
     }
     fn max_abs(&self) -> (f64, bool) {
-        let finite = self.blocks.iter().all(|v| v.is_finite());
-        (self.blocks.iter().fold(0.0f64, |m, v| m.max(v.abs())), finite)
+        let blocks = self.blocks();
+        let finite = blocks.iter().all(|v| v.is_finite());
+        (blocks.iter().fold(0.0f64, |m, v| m.max(v.abs())), finite)
     }
     /// Lag by lag: block d (in cache, and transposed once) meets every non-zero z_(l, b), an
     /// axpy of length m into step l + d, or the selected rows of that step alone. The same
@@ -250,7 +299,7 @@ impl LcpMatrix for BlockCirculant {
             .collect();
         let mut transposed = vec![0.0; m * m];
         for lag in 0..k {
-            let block = &self.blocks[lag * m * m..(lag + 1) * m * m];
+            let block = &self.blocks()[lag * m * m..(lag + 1) * m * m];
             if block.iter().all(|&v| v == 0.0) {
                 continue;
             }

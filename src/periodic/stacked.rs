@@ -4,26 +4,17 @@ use super::{Assembly, PeriodFft, PeriodicProblem};
 use crate::lcp::BlockCirculant;
 
 impl PeriodicProblem {
-    /// The LCP of the period: A block-circulant from the inverse FFT of Ĝ, and q = gap − B xlin,
-    /// each contact row shifted by its pairing offset (λ_j ⊥ gap(t_{j+s})).
+    /// The LCP of the period: A block-circulant of spectrum Ĝ (its blocks, the inverse FFT, formed
+    /// when a solver asks for them), and q = gap − B xlin, each contact row shifted by its pairing
+    /// offset (λ_j ⊥ gap(t_{j+s})).
     pub fn lcp(&self, asm: &Assembly, fft: &PeriodFft) -> (BlockCirculant, Vec<f64>) {
         let (k, m) = (asm.k, asm.m);
         let nh = k / 2 + 1;
-        let mut blocks = vec![0.0; k * m * m];
         let mut q = vec![0.0; k * m];
         let mut spec = vec![num_complex::Complex64::ZERO; nh];
         let angles = crate::model::GridAngles::new(k);
         for (a, ca) in self.model().contacts.iter().enumerate() {
             let s = self.pairing_of(ca).offset();
-            for b in 0..m {
-                for (p, v) in spec.iter_mut().enumerate() {
-                    *v = asm.g_hat[(p * m + a) * m + b];
-                }
-                let col = fft.inverse(&spec);
-                for d in 0..k {
-                    blocks[(d * m + a) * m + b] = col[(d + s) % k];
-                }
-            }
             for (p, v) in spec.iter_mut().enumerate() {
                 *v = asm.bxlin_hat[p * m + a];
             }
@@ -33,11 +24,9 @@ impl PeriodicProblem {
                 let jj = (j + s) % k;
                 q[j * m + a] = gap[jj] - bx[jj];
             }
-            if let crate::model::Compliance::Compliant { stiffness } = ca.compliance {
-                blocks[a * m + a] += 1.0 / stiffness;
-            }
         }
-        (BlockCirculant::new(k, m, blocks).with_spectrum(self.lcp_spectrum(asm)), q)
+        // The blocks are formed from the spectrum only if a solver asks for them.
+        (BlockCirculant::from_spectrum(k, m, self.lcp_spectrum(asm)), q)
     }
 
     /// The DFT of [`Self::lcp`]'s blocks from Ĝ directly: row a shifted by its pairing offset s
@@ -77,9 +66,11 @@ mod tests {
     use crate::model::Compliance;
     use crate::time::{Discretization, Pairing, Scheme};
 
-    /// The block spectrum taken from Ĝ (shifted by the pairing, with a compliance) gives the same
-    /// products as the blocks' own: the FFT product on the spectrum against the direct product
-    /// on the blocks, under both pairings (offsets 0 and 1) and with a compliant contact.
+    /// The blocks of the LCP, formed from its spectrum on demand, equal the blocks built directly
+    /// (each column of Ĝ transformed back, its row shifted by the pairing offset in time, the
+    /// compliance on block 0's diagonal), under both pairings and with a compliant contact; the
+    /// FFT product on the spectrum equals the direct product on those blocks; and the spectrum's
+    /// bound of max|A| is at least the blocks' max|A|.
     #[test]
     fn the_spectrum_from_the_assembly_gives_the_blocks_products() {
         let mut model = chain_with_massless_boundary();
@@ -90,22 +81,53 @@ mod tests {
             let fft = PeriodFft::new(64);
             let (a, _) = p.assemble_lcp(&fft).unwrap();
             assert!(a.spectrum().is_some(), "the LCP carries its spectrum");
+            let bound = a.max_abs_bound();
+            let direct_blocks = blocks_by_time_shift(&p, &fft);
+            let plain = BlockCirculant::new(a.k(), a.m(), direct_blocks);
+            let block_scale = plain.max_abs().0;
+            let block_gap = a.blocks().iter().zip(plain.blocks()).fold(0.0f64, |w, (x, y)| w.max((x - y).abs()));
             let z: Vec<f64> = (0..a.dim()).map(|i| ((i * 37 % 11) as f64 - 3.0).max(0.0)).collect();
             let (mut fast, mut direct) = (vec![0.0; a.dim()], vec![0.0; a.dim()]);
             CirculantOperator::new(&a).mul_into(&z, &mut fast);
-            a.mul_into(&z, &mut direct);
-            let plain = BlockCirculant::new(a.k(), a.m(), a.blocks().to_vec());
+            plain.mul_into(&z, &mut direct);
             let mut refft = vec![0.0; a.dim()];
             CirculantOperator::new(&plain).mul_into(&z, &mut refft);
             let scale = direct.iter().fold(0.0f64, |s, v| s.max(v.abs()));
             let worst = fast.iter().zip(&direct).fold(0.0f64, |w, (x, y)| w.max((x - y).abs()));
             let against_fft = fast.iter().zip(&refft).fold(0.0f64, |w, (x, y)| w.max((x - y).abs()));
             eprintln!(
-                "{pairing:?}: spectrum product against the direct one {:.1e}, against the blocks' FFT {:.1e} (of {scale:.2e})",
+                "{pairing:?}: blocks from the spectrum against the shifted ones {:.1e}; spectrum product against the direct one {:.1e}, against the blocks' FFT {:.1e} (of {scale:.2e}); bound {:.3e} ≥ max|A| {block_scale:.3e}",
+                block_gap / block_scale,
                 worst / scale,
-                against_fft / scale
+                against_fft / scale,
+                bound.0
             );
+            assert!(block_gap <= 1e-12 * block_scale, "{pairing:?}: blocks differ by {block_gap:e} of {block_scale:e}");
             assert!(scale > 0.0 && worst <= 1e-12 * scale && against_fft <= 1e-12 * scale, "{pairing:?}: {worst:e}, {against_fft:e} of {scale:e}");
+            assert!(bound.1 && bound.0 >= block_scale, "{pairing:?}: bound {:e} below max|A| {block_scale:e}", bound.0);
+            assert_eq!(a.max_abs_bound(), a.max_abs(), "{pairing:?}: once the blocks are formed the bound is their max|A|");
         }
+    }
+
+    /// The LCP's blocks built in time: column (a, b) of Ĝ transformed back, row a read s_a
+    /// instants later (its pairing offset), 1/k_c added to block 0's diagonal.
+    fn blocks_by_time_shift(p: &PeriodicProblem, fft: &PeriodFft) -> Vec<f64> {
+        let asm = p.assemble(fft).unwrap();
+        let (k, m) = (asm.k, asm.m);
+        let mut blocks = vec![0.0; k * m * m];
+        for (a, ca) in p.model().contacts.iter().enumerate() {
+            let s = p.pairing_of(ca).offset();
+            for b in 0..m {
+                let spec: Vec<_> = (0..=k / 2).map(|q| asm.g_hat[(q * m + a) * m + b]).collect();
+                let col = fft.inverse(&spec);
+                for d in 0..k {
+                    blocks[(d * m + a) * m + b] = col[(d + s) % k];
+                }
+            }
+            if let Compliance::Compliant { stiffness } = ca.compliance {
+                blocks[a * m + a] += 1.0 / stiffness;
+            }
+        }
+        blocks
     }
 }

@@ -208,6 +208,8 @@ pub fn run(
                 // Guarded: the last solved frequency, kept past a failure with its active sets
                 // (the next point sub-steps from there instead of starting cold).
                 let mut last_solved: Option<f64> = None;
+                // The k the last point ended at (a tolerance's refinement): the next point's guess.
+                let mut predicted: Option<usize> = None;
                 // A large LCP's sweep never waits for the dense fallback (see `solve_guarded`); its
                 // ω sub-steps follow the branch, and the branch check's continuation, which can
                 // reach the dense fallback, is not run there.
@@ -244,9 +246,10 @@ pub fn run(
                     point.warm_start_used = r.is_ok() && solver.last_start() == WarmStart::Used;
                     point.cold_fallback = solver.last_start() == WarmStart::ColdFallback;
                     if let Ok(r) = &r {
-                        let below = refine::estimate(&mut point, &solver, r, &mut second, settings);
-                        refine::refine(&mut point, solver.problem(), r, below, &mut levels, settings);
+                        let below = refine::estimate(&mut point, solver.problem(), r, &mut second, settings, predicted);
+                        refine::refine(&mut point, solver.problem(), r, below, (&mut levels, &mut second), settings);
                     }
+                    predicted = r.is_ok().then_some(point.steps);
                     point.time_s = t.elapsed().as_secs_f64();
                     match r {
                         Ok(r) => {

@@ -53,8 +53,8 @@ pub(super) fn refilled_point(
     let f = solver.problem().model().frequency;
     let mut point = SweepPoint::from_response(solver.problem(), f, r);
     (point.substeps, point.warm_start_used) = (substeps, solver.last_start() == WarmStart::Used);
-    let below = refine::estimate(&mut point, solver, r, second, settings);
-    refine::refine(&mut point, solver.problem(), r, below, levels, settings);
+    let below = refine::estimate(&mut point, solver.problem(), r, second, settings, None);
+    refine::refine(&mut point, solver.problem(), r, below, (levels, second), settings);
     point
 }
 

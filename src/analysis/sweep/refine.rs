@@ -7,7 +7,7 @@
 use super::{ColdTry, SweepPoint, SweepSettings, guarded, solve_guarded};
 use crate::analysis::accuracy;
 use crate::periodic::{PeriodicProblem, PeriodicSolver, SolveError};
-use crate::response::Response;
+use crate::response::{Accuracy, Response};
 use crate::time::Discretization;
 
 /// The chunk's sessions of the refined grids: `levels[l]` solves at 2^(l+1)·k, warm-started
@@ -15,19 +15,24 @@ use crate::time::Discretization;
 pub(super) type Levels = Vec<PeriodicSolver>;
 
 /// Refines `point`, the answer `first` of `problem` (the chunk's first grid at the point's
-/// frequency; `below`, its estimate's k/2 answer when there is one), while its estimate exceeds
-/// the tolerance and the doubled k stays within `settings.max_steps`. The point keeps its
+/// frequency; `below`, its estimate's k/2 answer, or why there is none), while its estimate
+/// exceeds the tolerance and the doubled k stays within `settings.max_steps`. The point keeps its
 /// coarser answer where a refined solve fails (a large LCP's refined try is Newton from the
 /// carried set alone, [`solve_guarded`]); the failure is noted in its `estimate_method`.
 pub(super) fn refine(
     point: &mut SweepPoint,
     problem: &PeriodicProblem,
     first: &Response,
-    below: Option<Response>,
-    levels: &mut Levels,
+    below: Below,
+    (levels, second): (&mut Levels, &mut Coarser),
     settings: &SweepSettings,
 ) {
     let Some(tolerance) = settings.tolerance else { return };
+    let (below, skipped) = match below {
+        Below::Solved(r) => (Some(*r), false),
+        Below::None => (None, false),
+        Below::Skipped => (None, true),
+    };
     let f = point.frequency;
     let m = problem.model().contacts.len().max(1);
     // The two grids below the next one, coarse to fine: Richardson and the observed order.
@@ -35,7 +40,7 @@ pub(super) fn refine(
     for level in 0.. {
         let prev = coarse.as_ref().unwrap_or(first);
         let steps = problem.discretization().steps << (level + 1);
-        if !point.estimate_relative.is_some_and(|e| e > tolerance) || steps > settings.max_steps {
+        if !((skipped && level == 0) || point.estimate_relative.is_some_and(|e| e > tolerance)) || steps > settings.max_steps {
             return;
         }
         if levels.len() == level {
@@ -54,13 +59,22 @@ pub(super) fn refine(
         let r = match r {
             Ok(r) => r,
             Err(e) => {
+                if skipped && level == 0 {
+                    // The first grid keeps its answer: its own estimate after all.
+                    estimate(point, problem, first, second, settings, None);
+                }
                 point.estimate_method.push_str(&format!("; refinement to k = {steps} failed ({}), k = {} kept", first_clause(&e), steps / 2));
                 return;
             }
         };
         // Richardson between this grid and the one below, the observed order from the one
         // below that: both answers are at hand.
-        let a = accuracy::estimate_from(solver.problem(), &r, prev, third.as_ref().filter(|t| t.steps * 4 == steps), &format!("k/2 = {}", steps / 2));
+        let note = format!("k/2 = {}", steps / 2);
+        let a = if skipped && level == 0 {
+            first_skipped(solver.problem(), &r, (problem, first), second, settings, tolerance, &note)
+        } else {
+            accuracy::estimate_from(solver.problem(), &r, prev, third.as_ref().filter(|t| t.steps * 4 == steps), &note)
+        };
         let Some(relative) = settings.measure.of(&a) else {
             point.estimate_method.push_str(&format!("; refined to k = {steps} without an estimate ({}), k = {} kept", a.method, steps / 2));
             return;
@@ -76,46 +90,103 @@ pub(super) fn refine(
     }
 }
 
+/// The estimate at 2k of a point whose first grid (k, `first` of `problem`) was not estimated
+/// ([`Below::Skipped`]): where even Richardson at the scheme's order from k exceeds the tolerance
+/// ([`accuracy::least_estimate`], a floor of the three-grid estimate) the point goes on to 4k
+/// and k/2 is never solved; otherwise k/2 is solved now (carried from `first`) for the
+/// three-grid estimate, the one the climb from k would have given.
+fn first_skipped(
+    refined: &PeriodicProblem,
+    r: &Response,
+    (problem, first): (&PeriodicProblem, &Response),
+    second: &mut Coarser,
+    settings: &SweepSettings,
+    tolerance: f64,
+    note: &str,
+) -> Accuracy {
+    if settings.measure.of(&accuracy::least_estimate(refined, r, first, note)).is_some_and(|e| e > tolerance) {
+        let mut a = accuracy::estimate_from(refined, r, first, None, note);
+        a.method.push_str(&format!("; k/4 = {} not solved: even Richardson at the scheme's order from k/2 exceeds the tolerance", r.steps / 4));
+        return a;
+    }
+    let quarter = accuracy::second_grid(problem, first)
+        .ok()
+        .filter(|(g, _)| g.instants() < problem.instants())
+        .and_then(|(g, _)| second_solve(second, &g, first, settings.warm_start, ColdTry::Full).ok());
+    accuracy::estimate_from(refined, r, first, quarter.as_ref(), note)
+}
+
 /// The chunk's sessions of the estimates' coarser grids (k/2 and k/4, or 2k), each with the
 /// frequency it last solved.
 pub(super) type Coarser = Vec<(PeriodicSolver, Option<f64>)>;
 
+/// The first grid's k/2 answer for [`refine`]: solved, none, or skipped ([`estimate`]'s
+/// `predicted`).
+pub(super) enum Below {
+    Solved(Box<Response>),
+    None,
+    Skipped,
+}
+
+/// The previous point needed at least this many times the first grid's k for the next point to
+/// skip the first grid's estimate ([`estimate`]): its k/2 and k/4 solves (a point needs one
+/// coarser level than its neighbour 3 rad/s away at most).
+const SKIP_FROM: usize = 4;
+
 /// The point's error estimate ([`SweepSettings::estimate`]): a second solve on the other grid and
 /// a third at k/4 for the observed order ([`accuracy::estimate_from`]), in the chunk's sessions
-/// for those grids. Returns the k/2 answer (the refinement's third grid).
-pub(super) fn estimate(point: &mut SweepPoint, solver: &PeriodicSolver, r: &Response, second: &mut Coarser, settings: &SweepSettings) -> Option<Response> {
+/// for those grids. Returns the k/2 answer (the refinement's third grid). `predicted`: the k the
+/// previous point of the chunk ended at; from [`SKIP_FROM`] times this k on, with a tolerance,
+/// the estimate is skipped and the point refined at once ([`Below::Skipped`], [`first_skipped`]).
+/// Why: the real blade's 1e-3 sweep (issue 23) needs k = 4096–8192 at 84 of 200 points, whose
+/// k/2 and k/4 solves of the first grid served only to find k = 1024 short.
+pub(super) fn estimate(
+    point: &mut SweepPoint,
+    problem: &PeriodicProblem,
+    r: &Response,
+    second: &mut Coarser,
+    settings: &SweepSettings,
+    predicted: Option<usize>,
+) -> Below {
     if !settings.estimate {
-        return None;
+        return Below::None;
     }
-    let (grid, note) = match accuracy::second_grid(solver.problem(), r) {
+    let (grid, note) = match accuracy::second_grid(problem, r) {
         Ok(g) => g,
         Err(a) => {
             (point.estimate_relative, point.estimate_method) = (settings.measure.of(&a), a.method);
-            return None;
+            return Below::None;
         }
     };
+    let steps = problem.discretization().steps;
+    if let Some(before) = predicted.filter(|&p| p >= SKIP_FROM * steps && settings.tolerance.is_some() && 2 * steps <= settings.max_steps)
+        && grid.instants() < problem.instants()
+    {
+        (point.estimate_relative, point.estimate_method) = (None, format!("none at k = {steps}: the previous point needed k = {before}, refined at once"));
+        return Below::Skipped;
+    }
     let half = match second_solve(second, &grid, r, settings.warm_start, ColdTry::Full) {
         Ok(h) => h,
         Err(e) => {
             point.estimate_method = format!("none: the second solve at {note} failed: {}", e.to_string().split(':').next().unwrap_or_default());
-            return None;
+            return Below::None;
         }
     };
-    let coarser = grid.instants() < solver.problem().instants();
+    let coarser = grid.instants() < problem.instants();
     // A point refined whatever k/4 says skips it (`accuracy::least_estimate`).
-    let refinable = 2 * solver.problem().discretization().steps <= settings.max_steps;
-    let refined_anyway = refinable
-        && settings.tolerance.is_some_and(|t| settings.measure.of(&accuracy::least_estimate(solver.problem(), r, &half, &note)).is_some_and(|e| e > t));
+    let refinable = 2 * steps <= settings.max_steps;
+    let refined_anyway =
+        refinable && settings.tolerance.is_some_and(|t| settings.measure.of(&accuracy::least_estimate(problem, r, &half, &note)).is_some_and(|e| e > t));
     // Newton from the carried set alone: a k/4 grid near its stability limit can miss, and
     // then the estimate has two grids (a cold try there cost seconds per point).
     let quarter = (coarser && !refined_anyway)
         .then(|| accuracy::third_grid(&grid))
         .flatten()
         .and_then(|g| second_solve(second, &g, r, settings.warm_start, ColdTry::No).ok());
-    let a = accuracy::estimate_from(solver.problem(), r, &half, quarter.as_ref(), &note);
+    let a = accuracy::estimate_from(problem, r, &half, quarter.as_ref(), &note);
     let skipped = if coarser && refined_anyway { "; k/4 not solved: even Richardson at the scheme's order from k/2 exceeds the tolerance" } else { "" };
     (point.estimate_relative, point.estimate_method) = (settings.measure.of(&a), a.method + skipped);
-    coarser.then_some(half)
+    if coarser { Below::Solved(Box::new(half)) } else { Below::None }
 }
 
 /// The second solve of a point's error estimate, in the chunk's session for that grid (made on

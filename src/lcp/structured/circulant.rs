@@ -115,7 +115,9 @@ impl LcpMatrix for CirculantOperator<'_> {
             Err(_) => self.product(z, out, &mut Work::new(&self.fft, self.a.m())),
         }
     }
+    /// An upper bound where the blocks were not formed ([`BlockCirculant::max_abs_bound`]): its
+    /// callers (the certification's round-off bound, finiteness checks) need no more.
     fn max_abs(&self) -> (f64, bool) {
-        self.a.max_abs()
+        self.a.max_abs_bound()
     }
 }
