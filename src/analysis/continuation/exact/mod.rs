@@ -494,10 +494,10 @@ impl Walk<'_> {
         let kinds = if touch.closed { (Switch::Off, Switch::On) } else { (Switch::On, Switch::Off) };
         let (sig, guess, pair) = signature::insert(&self.fam, &lo.orbit, &touch, kinds, NEW_PAIR, wl);
         let detail = format!(
-            "contact {}: events per period {before} -> {} (a {} phase begins)",
+            "contact {}: events per period {before} -> {} ({} phase begins)",
             touch.contact,
             sig.events.len(),
-            if touch.closed { "open" } else { "closed" }
+            if touch.closed { "an open" } else { "a closed" }
         );
         self.push(lo, Some(EventKind::Grazing), detail);
         let first = self.open_phase(sig, &guess, pair)?;
