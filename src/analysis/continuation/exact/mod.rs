@@ -333,10 +333,10 @@ impl Walk<'_> {
             let tol = TOUCH_TOL * self.fam.ys;
             let crossed = |n: &Node| n.touches.iter().any(|t| t.value < -tol);
             if crossed(&next) && !crossed(&here) {
-                // The corrector failing on the bracket's midpoints: the step jumped across a
-                // change it cannot resolve (seed 138: a closed phase swallowed the open one
-                // after it in a step of 0.1); tried again shorter.
-                // The least touch over the state scale, continuous through the grazing.
+                // Located on the least touch over the state scale (continuous through the grazing).
+                // Where the corrector fails inside the bracket the step jumped across a change it
+                // cannot resolve (seed 138: a closed phase swallowed the open one after it in a
+                // step of 0.1): tried again shorter.
                 let least = |n: &Node| n.touches.iter().map(|t| t.value).fold(f64::INFINITY, f64::min) / self.fam.ys + TOUCH_TOL;
                 let Some((lo, _)) = locate(&self.fam, &here, &next, Test::Value(&least), true) else {
                     if step > settings.min_step {
