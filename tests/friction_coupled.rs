@@ -317,4 +317,5 @@ fn the_k_continuation_follows_the_pressed_orbit_where_cold_lemke_takes_the_bounc
         "member 3, cold Lemke at k = 512: error {to_pressed:.3e} against the pressed orbit, {to_bouncing:.3e} against the bouncing one; lifted off {free:.3} (exact 0.561)"
     );
     assert!(to_bouncing < to_pressed && (free - 0.561).abs() < 0.05, "cold Lemke's solution at k = 512");
+    assert!(cold.lcp.path.contains("several periodic orbits"), "the cold path says so: {}", cold.lcp.path);
 }

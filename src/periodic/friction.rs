@@ -315,7 +315,12 @@ pub(super) fn solve(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, 
         let (mut sol, continued) = if is_coupled && method == LcpMethod::Auto {
             super::friction_coupled::continued(problem, (&a, &q), &settings)?
         } else {
-            (Lemke::new(settings.clone()).solve(&a, &q), String::new())
+            let cold = if is_coupled {
+                "; cold at k alone (\"lemke\"): the coupled LCP can hold several periodic orbits, \"auto\" continues the coarse grid's"
+            } else {
+                ""
+            };
+            (Lemke::new(settings.clone()).solve(&a, &q), cold.to_string())
         };
         if sol.outcome != LcpOutcome::Solved {
             return Err(if is_coupled { super::friction_coupled::no_solution(problem, asm, sol) } else { lcp_failure(sol) });

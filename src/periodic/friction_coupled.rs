@@ -76,7 +76,7 @@ pub(super) fn continued(problem: &PeriodicProblem, (a_k, q_k): (&DenseMatrix, &[
     let disc = problem.discretization();
     let mut grids = vec![disc.steps];
     while let Some(&s) = grids.last()
-        && s % 2 == 0
+        && s.is_multiple_of(2)
         && s / 2 >= CONTINUATION_COARSEST
     {
         grids.push(s / 2);
@@ -95,13 +95,12 @@ pub(super) fn continued(problem: &PeriodicProblem, (a_k, q_k): (&DenseMatrix, &[
         let (a, q, k) = if fine {
             (a_k, q_k, problem.instants())
         } else {
-            let mut p = problem.clone();
-            p.set_discretization(Discretization { steps, ..disc })?;
-            let fft = PeriodFft::new(p.instants());
-            let asm = p.assemble(&fft)?;
-            let grid = FrictionGrid::new(disc.scheme, asm.k, p.period())?;
-            owned = friction_lcp(&p, &asm, &fft, &grid);
-            (&owned.0, owned.1.as_slice(), asm.k)
+            match coarse_lcp(problem, steps) {
+                Ok(lcp) => owned = lcp,
+                // A grid the problem refuses (size, stability): the fine grid cold, said in the note.
+                Err(e) => return Ok((cold(a_k, q_k), format!("; k-continuation abandoned at {steps} steps ({e}), so cold Lemke at k = {}", disc.steps))),
+            }
+            (&owned.0, owned.1.as_slice(), owned.2)
         };
         let warm = coarse.take().map(|(c, kc)| {
             let active = prolonged(&c.z, &Layout { k: kc, mc, mf }, &Layout { k, mc, mf });
@@ -133,6 +132,17 @@ pub(super) fn continued(problem: &PeriodicProblem, (a_k, q_k): (&DenseMatrix, &[
         steps_done.join(", then ")
     );
     Ok((sol, note))
+}
+
+/// The dense LCP of `problem` on `steps` steps per forcing period, with its instants.
+fn coarse_lcp(problem: &PeriodicProblem, steps: usize) -> Result<(DenseMatrix, Vec<f64>, usize), SolveError> {
+    let mut p = problem.clone();
+    p.set_discretization(Discretization { steps, ..problem.discretization() })?;
+    let fft = PeriodFft::new(p.instants());
+    let asm = p.assemble(&fft)?;
+    let grid = FrictionGrid::new(p.discretization().scheme, asm.k, p.period())?;
+    let (a, q) = friction_lcp(&p, &asm, &fft, &grid);
+    Ok((a, q, asm.k))
 }
 
 /// The complementary basis at k instants from a solution `z` at k/2: fine instants 2j − 1 and 2j
