@@ -151,3 +151,171 @@ fn coupled_friction_scene_keys_are_checked() {
     let e = Scene::parse(&SCENE.replacen("contact = 0\n", "contact = 3\n", 1), "c.toml").unwrap().to_problem("c.toml").unwrap_err().to_string();
     assert!(e.contains("friction[0].contact") && e.contains('3'), "{e}");
 }
+
+/// Member 3 of the random family of README "Friction" (`coupled_family.py 2031`): k_xy −0.633,
+/// k_c 23.95, μ 0.450, N0 1.496, N1 1.190, drive 0.496, Ω 1.778 (κ 0.229), at `steps` instants.
+fn member_3(steps: usize, method: &str) -> Result<Response, SolveError> {
+    let text = format!(
+        "[structure]\nmass = [[1.0, 0.0], [0.0, 1.0]]\nstiffness = [[1.2154554809953746, -0.6333612913271878], [-0.6333612913271878, 0.9230558344173412]]\n\
+         [damping]\nmatrix = [[0.0537599634228028, 0.0], [0.0, 0.3290668897126871]]\n[excitation]\nfrequency = 1.7781499846080084\n\
+         [[force]]\ndof = 1\namplitude = -1.4958370127908591\nharmonic = 0\n[[force]]\ndof = 1\namplitude = -1.1901095446349745\n\
+         [[force]]\ndof = 0\namplitude = 0.4960366656681321\nphase = -1.5707963267948966\n\
+         [[contact]]\ndof = 1\ndirection = -1\ngap = 0.0\nstiffness = 23.9484460780964\n\
+         [[friction]]\ndof = 0\ncoefficient = 0.4497335632928946\ncontact = 0\n\
+         [discretization]\nscheme = \"bds1\"\nsteps = {steps}\nerror_estimate = \"none\"\n[solver]\nmethod = \"{method}\"\n[output]\ndisplacement = [0, 1]\n"
+    );
+    Scene::parse(&text, "member3.toml").unwrap().to_problem("member3.toml").unwrap().solve()
+}
+
+/// Member 3's two exact periodic orbits, x, y and λ_n at t = iT/16, by the event-driven simulation
+/// (validation/peers/coupled_exact.py, shooting residual ≤ 4e-15): `PRESSED`, reached by marching
+/// from the static equilibrium (always pressed, stuck 50 %: events at t/T = 0.30605 slip+,
+/// 0.57215 slip−, 0.80366 stick), and `BOUNCING`, reached by marching from cold Lemke's k = 1024
+/// state (lifted off 56 % in two flights: 8 events from t/T = 0.09702 to 0.94855).
+const PRESSED: [[f64; 16]; 3] = [
+    [
+        -2.562475270731e-02,
+        -2.562475270731e-02,
+        -2.562475270731e-02,
+        -2.562475270731e-02,
+        -2.562475270731e-02,
+        -2.562324290907e-02,
+        -2.408541916383e-02,
+        -1.726046697164e-02,
+        -6.453500679441e-03,
+        1.128126820474e-03,
+        -9.371467445632e-04,
+        -9.531763717177e-03,
+        -2.073259520296e-02,
+        -2.562475270731e-02,
+        -2.562475270731e-02,
+        -2.562475270731e-02,
+    ],
+    [
+        -1.153504188495e-01,
+        -1.113572509294e-01,
+        -1.002475731716e-01,
+        -8.340683053965e-02,
+        -6.282366902537e-02,
+        -4.141373369766e-02,
+        -2.277804586098e-02,
+        -1.020768908360e-02,
+        -5.607980746963e-03,
+        -9.258830361919e-03,
+        -2.038608321416e-02,
+        -3.760658945079e-02,
+        -5.872808442039e-02,
+        -8.053426309673e-02,
+        -9.914815843483e-02,
+        -1.112879233709e-01,
+    ],
+    [
+        2.762463285904e+00,
+        2.666833119288e+00,
+        2.400773600559e+00,
+        1.997463983724e+00,
+        1.504529250082e+00,
+        9.917945683511e-01,
+        5.454988030661e-01,
+        2.444582916007e-01,
+        1.343024245257e-01,
+        2.217345996687e-01,
+        4.882150145978e-01,
+        9.006193796434e-01,
+        1.406446363012e+00,
+        1.928670457211e+00,
+        2.374444326019e+00,
+        2.665172831991e+00,
+    ],
+];
+const BOUNCING: [[f64; 16]; 3] = [
+    [
+        -1.967264837919e-01,
+        -1.967264837919e-01,
+        -1.951736754765e-01,
+        -1.698490169908e-01,
+        -1.097881924786e-01,
+        -1.778108925934e-02,
+        8.265700949126e-02,
+        1.327039320574e-01,
+        1.343485992265e-01,
+        1.294917995048e-01,
+        1.115031024957e-01,
+        7.682261091641e-02,
+        2.411018323081e-02,
+        -4.547182358997e-02,
+        -1.286074672326e-01,
+        -1.946344769321e-01,
+    ],
+    [
+        -3.105143190186e-01,
+        -1.625964018076e-01,
+        3.214425120266e-02,
+        1.151213289334e-01,
+        9.129961305557e-02,
+        -7.934609646623e-03,
+        -1.206938598930e-01,
+        -1.241214831195e-01,
+        -1.016203713827e-02,
+        1.151682452132e-01,
+        2.112655041527e-01,
+        2.634869812221e-01,
+        2.537210664903e-01,
+        1.640889206960e-01,
+        -1.902938925827e-02,
+        -2.444528334459e-01,
+    ],
+    [
+        7.436335425495e+00,
+        3.893931161181e+00,
+        0.0,
+        0.0,
+        0.0,
+        1.900215712729e-01,
+        2.890430395604e+00,
+        2.972516645622e+00,
+        2.433649984494e-01,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        4.557243025508e-01,
+        5.854265500418e+00,
+    ],
+];
+
+/// The largest of the relative errors of x, y, λ_n at t = iT/16 against an exact orbit's samples.
+fn worst_error(r: &Response, exact: &[[f64; 16]; 3]) -> f64 {
+    let k = r.displacement["0"].len();
+    let series = [&r.displacement["0"], &r.displacement["1"], &r.contacts[0].force];
+    (0..3)
+        .map(|s| {
+            let scale = exact[s].iter().fold(0.0f64, |a, v| a.max(v.abs()));
+            (0..16).map(|i| (series[s][i * k / 16] - exact[s][i]).abs()).fold(0.0, f64::max) / scale
+        })
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn the_k_continuation_follows_the_pressed_orbit_where_cold_lemke_takes_the_bouncing_one() {
+    // "auto": the orbit continued from k = 128, pressed all period, converging at first order
+    // onto the exact pressed orbit (coupled_family.py: x 1.01e-1 → 4.20e-2, k = 256 → 512).
+    let (r256, r512) = (member_3(256, "auto").expect("k = 256"), member_3(512, "auto").expect("k = 512"));
+    let (e256, e512) = (worst_error(&r256, &PRESSED), worst_error(&r512, &PRESSED));
+    let order = (e256 / e512).log2();
+    println!("member 3, auto: error against the pressed orbit {e256:.3e} (k = 256), {e512:.3e} (k = 512), order {order:.2}; {}", r512.lcp.path);
+    assert!(e512 < 6e-2 && (0.7..1.6).contains(&order), "errors {e256:.3e}, {e512:.3e}");
+    assert!(r512.contacts[0].force.iter().all(|l| *l > 0.0), "pressed all period, as the exact orbit");
+    assert!(r512.lcp.path.contains("k-continuation") && r512.lcp.path.contains("warm at 512"), "{}", r512.lcp.path);
+    // Cold Lemke at k = 512 ends on the discretisation of the second exact orbit (bouncing), a
+    // certified solution too: the coupled LCP holds both.
+    let cold = member_3(512, "lemke").expect("cold Lemke at k = 512");
+    let (to_pressed, to_bouncing) = (worst_error(&cold, &PRESSED), worst_error(&cold, &BOUNCING));
+    let free = cold.contacts[0].force.iter().filter(|l| **l == 0.0).count() as f64 / 512.0;
+    println!(
+        "member 3, cold Lemke at k = 512: error {to_pressed:.3e} against the pressed orbit, {to_bouncing:.3e} against the bouncing one; lifted off {free:.3} (exact 0.561)"
+    );
+    assert!(to_bouncing < to_pressed && (free - 0.561).abs() < 0.05, "cold Lemke's solution at k = 512");
+    assert!(cold.lcp.path.contains("several periodic orbits"), "the cold path says so: {}", cold.lcp.path);
+}

@@ -29,6 +29,8 @@ pub mod io;
 
 pub use io::dat;
 pub use io::dat::{DatError, parse_dat, read_dat, write_dat};
+/// Lemke from a given complementary basis (a coarse grid's prolonged active set, a pivoting's guess).
+pub(crate) use lemke::warm::solve_from_basis;
 pub use lemke::{Lemke, LemkeSettings};
 pub use matrix::{BlockCirculant, DenseMatrix, LcpMatrix};
 pub use pivoting::{BlockPivoting, PivotingSettings};

@@ -129,17 +129,17 @@ impl FrictionGrid {
 
 /// Index of unknown (row `a`, instant `j`): contact rows first (time-major), then z₁ of the
 /// friction rows, then their slacks α.
-struct Layout {
-    k: usize,
-    mc: usize,
-    mf: usize,
+pub(super) struct Layout {
+    pub(super) k: usize,
+    pub(super) mc: usize,
+    pub(super) mf: usize,
 }
 
 impl Layout {
-    fn row(&self, a: usize, j: usize) -> usize {
+    pub(super) fn row(&self, a: usize, j: usize) -> usize {
         if a < self.mc { j * self.mc + a } else { self.k * self.mc + j * self.mf + (a - self.mc) }
     }
-    fn slack(&self, t: usize, j: usize) -> usize {
+    pub(super) fn slack(&self, t: usize, j: usize) -> usize {
         self.k * (self.mc + self.mf) + j * self.mf + t
     }
 }
@@ -310,9 +310,20 @@ pub(super) fn solve(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, 
         let t_lcp = Instant::now();
         let settings =
             LemkeSettings { certify_tol: problem.solver_settings().tolerance, max_pivots_per_dim: FRICTION_PIVOTS_PER_DIM, ..LemkeSettings::default() };
-        let mut sol = Lemke::new(settings.clone()).solve(&a, &q);
+        let is_coupled = coupled.iter().any(Option::is_some);
+        // Coupled rows under "auto": the orbit continued from a coarse grid (several may coexist).
+        let (mut sol, continued) = if is_coupled && method == LcpMethod::Auto {
+            super::friction_coupled::continued(problem, (&a, &q), &settings)?
+        } else {
+            let cold = if is_coupled {
+                "; cold at k alone (\"lemke\"): the coupled LCP can hold several periodic orbits, \"auto\" continues the coarse grid's"
+            } else {
+                ""
+            };
+            (Lemke::new(settings.clone()).solve(&a, &q), cold.to_string())
+        };
         if sol.outcome != LcpOutcome::Solved {
-            return Err(if coupled.iter().any(Option::is_some) { super::friction_coupled::no_solution(problem, asm, sol) } else { lcp_failure(sol) });
+            return Err(if is_coupled { super::friction_coupled::no_solution(problem, asm, sol) } else { lcp_failure(sol) });
         }
         let mut rounds = 0;
         if grid.half_steps() && !relay_only {
@@ -322,7 +333,7 @@ pub(super) fn solve(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, 
         sol.info.path = vec![LcpStep { method: LcpMethod::Lemke, size: nn, pivots: sol.info.pivots, outcome: sol.outcome, time_s: lcp_time }];
         let fitted = if rounds > 0 { format!(", event-fitted half steps after {rounds} refits") } else { String::new() };
         let path = format!(
-            "friction (N = {nn}: contacts and the box LCP of the friction rows, src/formulation.md §9): dense lexicographic Lemke, {} pivots{fitted}, {lcp_time:.3} s → {}",
+            "friction (N = {nn}: contacts and the box LCP of the friction rows, src/formulation.md §9): dense lexicographic Lemke, {} pivots{fitted}{continued}, {lcp_time:.3} s → {}",
             sol.info.pivots,
             sol.outcome.name()
         );

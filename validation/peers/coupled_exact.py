@@ -186,14 +186,22 @@ class CoupledOrbit:
 
 def solve(s: CoupledSystem, substeps: int = 800, march_tol: float = 1e-8, max_periods: int = 400,
           tol: float = 1e-13) -> CoupledOrbit:
+    """The orbit reached from the static equilibrium under F0 on the plane (x with it, through
+    the coupling), at rest."""
+    Kc = s.K + np.diag([0.0, s.plane])
+    return solve_from(s, np.linalg.solve(Kc, s.F0), np.zeros(2), substeps, march_tol, max_periods, tol)
+
+
+def solve_from(s: CoupledSystem, q0, v0, substeps: int = 800, march_tol: float = 1e-8,
+               max_periods: int = 400, tol: float = 1e-13) -> CoupledOrbit:
+    """The orbit reached by marching from positions q0 and velocities v0 at t = 0, then shooting
+    (a coupled system can hold several periodic orbits: each start reaches one)."""
     fl = Flows(s)
     T = s.period
     fl.set_step(T / substeps)
     y = np.zeros(DIM)
     y[IC], y[I1] = 1.0, 1.0
-    # Static equilibrium under F0 on the plane (x with it, through the coupling).
-    Kc = s.K + np.diag([0.0, s.plane])
-    y[:2] = np.linalg.solve(Kc, s.F0)
+    y[:2], y[2:4] = q0, v0
     phase = fl.initial_phase(y)
     prev = y.copy()
     periods = 0
