@@ -14,6 +14,8 @@ mod bad_input;
 mod blade;
 #[path = "blade_fold.rs"]
 mod blade_fold;
+#[path = "blade_margin.rs"]
+mod blade_margin;
 #[path = "blade_scene.rs"]
 mod blade_scene;
 #[path = "boundary_stress.rs"]

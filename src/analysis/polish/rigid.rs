@@ -10,52 +10,8 @@ use super::orbit::PolishedOrbit;
 use super::phase::Phase;
 use nalgebra::{DMatrix, DVector};
 
-/// Samples per radian of the phase's fastest rate (its balancing speed, ≥ ω_max). A plastic
-/// impact rings the stiff modes: on the coarse blade the tip comes back to the casing 9e-6 s
-/// after an impact (one period of its 6e5 rad/s constraint modes), a dip that 200 samples per
-/// phase (1.4e-5 s apart there) stepped over, so the walk went on past the second impact.
-const PER_RADIAN: f64 = 4.0;
-const MIN_SAMPLES: usize = 200;
-/// The smallest sampled local minima refined by golden section, per contact and phase.
-const REFINED: usize = 4;
-
-/// The phase's states from `a` (state `y0`) to `b`, equally spaced at [`PER_RADIAN`] of its
-/// fastest rate: one exponential, then a matrix-vector product per sample.
-fn sample(ph: &Phase, a: f64, b: f64, y0: &DVector<f64>, omega: f64) -> Vec<(f64, DVector<f64>)> {
-    let count = (((b - a) * ph.speed_hint().max(omega) * PER_RADIAN).ceil() as usize).max(MIN_SAMPLES);
-    let h = (b - a) / count as f64;
-    let step = ph.exp(h);
-    let mut out = Vec::with_capacity(count + 1);
-    let mut y = y0.clone();
-    for j in 0..=count {
-        let t = a + h * j as f64;
-        let next = if j < count { Some(ph.flow_with(&step, t, &y, t + h)) } else { None };
-        out.push((t, y));
-        match next {
-            Some(n) => y = n,
-            None => break,
-        }
-    }
-    out
-}
-
-/// The smallest value of `f(y, t)` over the sampled phase, and where: the [`REFINED`] smallest
-/// sampled local minima refined by golden section, each from its neighbouring sample's state.
-fn smallest(ph: &Phase, samples: &[(f64, DVector<f64>)], f: &dyn Fn(&DVector<f64>, f64) -> f64) -> (f64, f64) {
-    let vs: Vec<f64> = samples.iter().map(|(t, y)| f(y, *t)).collect();
-    let mut best = vs.iter().zip(samples).map(|(&v, s)| (v, s.0)).fold((f64::INFINITY, 0.0), |m, x| if x.0 < m.0 { x } else { m });
-    let mut minima: Vec<usize> = (1..vs.len().saturating_sub(1)).filter(|&i| vs[i] <= vs[i - 1] && vs[i] <= vs[i + 1]).collect();
-    minima.sort_by(|&x, &y| vs[x].total_cmp(&vs[y]));
-    for &i in minima.iter().take(REFINED) {
-        let (t0, y0) = (samples[i - 1].0, &samples[i - 1].1);
-        let at = |t: f64| f(&ph.flow(t0, y0, t), t);
-        let (t, v) = super::verify::golden(t0, samples[i + 1].0, 40, &at);
-        if v < best.0 {
-            best = (v, t);
-        }
-    }
-    best
-}
+// The phases' part of the margin: the contacts' signals sampled and refined.
+mod margin;
 
 /// A margin of a rigid-contact orbit: its value (over the clearance or force scale), the contact
 /// and what is measured, for the branch point's detail.
@@ -77,6 +33,15 @@ pub const STUCK: &str = "force of the stuck contact";
 /// where that force reaches zero).
 pub const HOLD: &str = "force that would hold the contact after its impact";
 
+impl RigidMargin {
+    /// Keeps the margin if it is below this one.
+    fn keep(&mut self, value: f64, contact: usize, what: &'static str, time: f64, event: Option<usize>) {
+        if value < self.value {
+            *self = RigidMargin { value, contact, what, time, event };
+        }
+    }
+}
+
 impl PolishedOrbit {
     /// The smallest rigid margin of the orbit ([`RigidMargin`]); `None` without rigid contacts.
     pub fn rigid_margin(&self) -> Option<RigidMargin> {
@@ -88,17 +53,12 @@ impl PolishedOrbit {
         let xs = self.after.iter().flat_map(|y| model.contacts.iter().map(move |c| c.along(|d| y[d]).abs())).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
         let fs = self.force_scale();
         let mut best = RigidMargin { value: f64::INFINITY, contact: 0, what: "", time: 0.0, event: None };
-        let mut keep = |value: f64, contact: usize, what: &'static str, time: f64, event: Option<usize>| {
-            if value < best.value {
-                best = RigidMargin { value, contact, what, time, event };
-            }
-        };
         for (e, (&p, ev)) in self.impulses.iter().zip(&self.events).enumerate() {
             // A massless contact closes without impulse: its margins are its clearance and force.
             if let EventKind::Impact { stick } = ev.kind
                 && !model.contact_is_massless(&model.contacts[ev.contact])
             {
-                keep(p * model.frequency / fs, ev.contact, "impulse of the impact", self.times[e], Some(e));
+                best.keep(p * model.frequency / fs, ev.contact, "impulse of the impact", self.times[e], Some(e));
                 if !stick {
                     // The force that would hold the contact just after a pure impact (≤ 0 for a pure impact).
                     let mut stuck: Vec<usize> = self.phases[e].stuck_contacts().collect();
@@ -106,36 +66,12 @@ impl PolishedOrbit {
                     let closed: Vec<usize> = (0..model.contacts.len()).filter(|&i| self.phases[e].closed(i)).collect();
                     if let Some(hold) = Phase::new(model, &stuck, &closed) {
                         let z = hold.stuck_forces(&self.after[e], self.times[e]).into_iter().find(|(k, _)| *k == ev.contact).map_or(0.0, |(_, z)| z);
-                        keep(-z / fs, ev.contact, HOLD, self.times[e], Some(e));
+                        best.keep(-z / fs, ev.contact, HOLD, self.times[e], Some(e));
                     }
                 }
             }
         }
-        let ne = self.events.len().max(1);
-        for e in 0..ne {
-            let (a, b) = (self.times[e], if e + 1 < self.events.len() { self.times[e + 1] } else { self.times[0] + self.period });
-            let ph = &self.phases[e];
-            let samples = sample(ph, a, b, &self.after[e], model.frequency);
-            let stuck: Vec<usize> = ph.stuck_contacts().collect();
-            for i in (0..model.contacts.len()).filter(|&i| model.contacts[i].is_rigid()) {
-                if stuck.contains(&i) {
-                    // A landing whose holding force is just negative but rising: its lift-off
-                    // (the orbit's distance from the true one), and the arc after the micro-flight.
-                    let lift = self.lift_off(e, i);
-                    let from = lift.map_or(0, |(_, flight)| samples.iter().position(|s| s.0 >= a + flight).unwrap_or(samples.len()));
-                    if let Some((height, _)) = lift {
-                        keep(-height / xs, i, STUCK, a, None);
-                    }
-                    if samples.len() - from >= 3 {
-                        let (v, t) = smallest(ph, &samples[from..], &|y, t| ph.stuck_forces(y, t).into_iter().find(|(k, _)| *k == i).map_or(0.0, |(_, z)| z));
-                        keep(v / fs, i, STUCK, t, None);
-                    }
-                } else {
-                    let (v, t) = smallest(ph, &samples, &|y, t| self.clearance(i, y, t));
-                    keep(v / xs, i, CLEARANCE, t, None);
-                }
-            }
-        }
+        self.phase_margins((xs, fs), &mut best);
         Some(best)
     }
 }
@@ -204,7 +140,7 @@ impl PolishedOrbit {
     /// the impact), whose return Δ ≈ −3a/j grows like √(12a/|s|) where j ≈ 0: found here on the
     /// exact flow, not from the expansion (its terms cancel to round-off at small Δ). Samples at
     /// Δ doubling from 1e-12 of the period up to a quarter of the phase's fastest period, then
-    /// [`PER_RADIAN`] per radian of it, the crossing refined by bisection.
+    /// four samples per radian of it, the crossing refined by bisection.
     pub fn free_return(&self, e: usize, horizon: f64) -> Option<f64> {
         let c = self.events.get(e)?.contact;
         let ph = &self.phases[e];

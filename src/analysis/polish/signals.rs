@@ -29,6 +29,41 @@ impl Signal {
         Signal { start, lambda, modal, harmonics }
     }
 
+    /// The signal's value at `t`.
+    pub fn value(&self, t: f64) -> f64 {
+        self.jet(t).1
+    }
+
+    /// The values of `signals` (one phase's: the same start and λ_j) at the times `ts`, the
+    /// exponentials e^{λ_j (t − a)} and e^{iwt} made once per time for all of them.
+    pub fn values(signals: &[Signal], ts: &[f64]) -> Vec<Vec<f64>> {
+        let Some(first) = signals.first() else { return Vec::new() };
+        let mut freqs: Vec<f64> = signals.iter().flat_map(|s| s.harmonics.iter().map(|h| h.0)).collect();
+        freqs.sort_by(f64::total_cmp);
+        freqs.dedup();
+        // Each signal's harmonics summed per distinct frequency.
+        let coefficients: Vec<Vec<C>> = signals
+            .iter()
+            .map(|s| {
+                let mut c = vec![C::new(0.0, 0.0); freqs.len()];
+                for &(w, h) in &s.harmonics {
+                    c[freqs.partition_point(|&f| f < w)] += h;
+                }
+                c
+            })
+            .collect();
+        let mut out = vec![Vec::with_capacity(ts.len()); signals.len()];
+        for &t in ts {
+            let modes: Vec<C> = first.lambda.iter().map(|l| (l * (t - first.start)).exp()).collect();
+            let waves: Vec<C> = freqs.iter().map(|&w| C::from_polar(1.0, w * t)).collect();
+            for ((s, c), o) in signals.iter().zip(&coefficients).zip(&mut out) {
+                let re = |a: &C, b: &C| a.re * b.re - a.im * b.im;
+                o.push(s.modal.iter().zip(&modes).map(|(m, e)| re(m, e)).sum::<f64>() + c.iter().zip(&waves).map(|(h, e)| re(h, e)).sum::<f64>());
+            }
+        }
+        out
+    }
+
     /// (t, value, slope).
     fn jet(&self, t: f64) -> (f64, f64, f64) {
         let tau = t - self.start;
@@ -47,7 +82,7 @@ impl Signal {
     }
 
     /// A bound on |s''| over [t0, t1] (see the module).
-    fn bend(&self, t0: f64, t1: f64) -> f64 {
+    pub fn bend(&self, t0: f64, t1: f64) -> f64 {
         let (a, b) = (t0 - self.start, t1 - self.start);
         let modal: f64 = self.lambda.iter().zip(&self.modal).map(|(l, m)| m.norm() * l.norm_sqr() * (l.re * a).exp().max((l.re * b).exp())).sum();
         modal + self.harmonics.iter().map(|(w, h)| h.norm() * w * w).sum::<f64>()

@@ -7,7 +7,7 @@
 use super::PolishFailure;
 use super::events::{Event, EventKind};
 use super::orbit::PolishedOrbit;
-use super::phase::{Phase, Transient};
+use super::phase::{Harmonics, Phase, Transient};
 use super::signals::Signal;
 use nalgebra::DVector;
 use num_complex::Complex64 as C;
@@ -162,35 +162,56 @@ fn what(o: &PolishedOrbit, e: usize, i: usize) -> (&'static str, f64) {
 /// [`Lowest`] from the signals in closed form (signals.rs): the phase's transient from its start
 /// state and its particular solution, each contact's row on them.
 fn closed_form(o: &PolishedOrbit, e: usize, transient: &Transient, (a, b): (f64, f64), (xs, fs): (f64, f64)) -> Lowest {
-    let (model, ph) = (&o.model, &o.phases[e]);
-    let (n, w) = (model.n(), model.frequency);
-    let stuck: Vec<usize> = ph.stuck_contacts().collect();
-    // The full particular solution only for the stuck contacts' forces; a clearance needs its row.
-    let part = if stuck.is_empty() { vec![] } else { ph.particular() };
-    let held = if stuck.is_empty() { vec![] } else { ph.stuck_force_particular(&part) };
+    let along = Along::new(o, e, transient);
     let mut out = Vec::new();
-    for (i, c) in model.contacts.iter().enumerate() {
+    for i in 0..o.model.contacts.len() {
         let (what, sign) = what(o, e, i);
-        let (rho, harmonics, scale) = if let Some(s) = stuck.iter().position(|&k| k == i) {
-            let rho = ph.stuck_force_gradient().row(s).transpose();
-            (rho, held.iter().map(|(p, z)| (*p as f64 * w, z[s])).collect::<Vec<_>>(), fs)
-        } else {
-            // sign·(gap(t) − B_i x(t)).
-            let mut rho = DVector::zeros(2 * n);
-            c.row.iter().for_each(|&(d, cd)| rho[d] = -sign * cd);
-            let mut h: Vec<(f64, C)> = o.gaps[i].iter().map(|(p, g)| (*p as f64 * w, g[0] * sign)).collect();
-            if stuck.is_empty() {
-                h.extend(ph.particular_along(&c.row).into_iter().map(|(p, x)| (p as f64 * w, -x * sign)));
-            } else {
-                h.extend(part.iter().map(|(p, y)| (*p as f64 * w, -c.along(|d| y[d]) * sign)));
-            }
-            (rho, h, xs)
-        };
-        let signal = Signal::new(a, transient.lambda.clone(), transient.coefficients(&rho), harmonics);
-        let (v, t) = signal.lowest(a, b, -TOL * scale);
+        let scale = if along.stuck.contains(&i) { fs } else { xs };
+        let (v, t) = along.signal(o, i, sign).lowest(a, b, -TOL * scale);
         out.push((i, v / scale, t, what));
     }
     out
+}
+
+/// A phase's signals in closed form (signals.rs): its transient from its start state, its stuck
+/// contacts, and its particular solution (the full one and its stuck forces) where it has stuck
+/// contacts (a clearance needs only its row's).
+pub(super) struct Along<'a> {
+    e: usize,
+    a: f64,
+    transient: &'a Transient,
+    pub stuck: Vec<usize>,
+    part: Harmonics,
+    held: Harmonics,
+}
+
+impl<'a> Along<'a> {
+    pub fn new(o: &PolishedOrbit, e: usize, transient: &'a Transient) -> Self {
+        let ph = &o.phases[e];
+        let stuck: Vec<usize> = ph.stuck_contacts().collect();
+        let part = if stuck.is_empty() { vec![] } else { ph.particular() };
+        let held = if stuck.is_empty() { vec![] } else { ph.stuck_force_particular(&part) };
+        Along { e, a: o.times[e], transient, stuck, part, held }
+    }
+
+    /// Contact `i`'s held force if it is stuck, else sign·(gap(t) − B_i x(t)).
+    pub fn signal(&self, o: &PolishedOrbit, i: usize, sign: f64) -> Signal {
+        let (ph, c, w, n) = (&o.phases[self.e], &o.model.contacts[i], o.model.frequency, o.model.n());
+        let (rho, harmonics) = if let Some(s) = self.stuck.iter().position(|&k| k == i) {
+            (ph.stuck_force_gradient().row(s).transpose(), self.held.iter().map(|(p, z)| (*p as f64 * w, z[s])).collect::<Vec<_>>())
+        } else {
+            let mut rho = DVector::zeros(2 * n);
+            c.row.iter().for_each(|&(d, cd)| rho[d] = -sign * cd);
+            let mut h: Vec<(f64, C)> = o.gaps[i].iter().map(|(p, g)| (*p as f64 * w, g[0] * sign)).collect();
+            if self.stuck.is_empty() {
+                h.extend(ph.particular_along(&c.row).into_iter().map(|(p, x)| (p as f64 * w, -x * sign)));
+            } else {
+                h.extend(self.part.iter().map(|(p, y)| (*p as f64 * w, -c.along(|d| y[d]) * sign)));
+            }
+            (rho, h)
+        };
+        Signal::new(self.a, self.transient.lambda.clone(), self.transient.coefficients(&rho), harmonics)
+    }
 }
 
 /// [`Lowest`] by [`SAMPLES`] flows over the phase and a golden section around each sampled local
@@ -231,7 +252,7 @@ impl PolishedOrbit {
     /// load, impulse × ω, or stuck contact's force at the events. The held forces count because a
     /// casing-driven blade has no load, and its rigid contacts on massless DOFs no impulse: without
     /// them the scale was f64::MIN_POSITIVE and a −2e-12 N round-off read as −1e296.
-    pub(super) fn force_scale(&self) -> f64 {
+    pub fn force_scale(&self) -> f64 {
         let loads: f64 = self.model.forces.iter().map(|f| f.term.amplitude.abs()).sum();
         let held =
             self.after.iter().zip(&self.times).zip(&self.phases).flat_map(|((y, &t), ph)| ph.stuck_forces(y, t)).fold(0.0f64, |m, (_, z)| m.max(z.abs()));
