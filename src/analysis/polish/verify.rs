@@ -8,7 +8,7 @@ use super::PolishFailure;
 use super::events::{Event, EventKind};
 use super::orbit::PolishedOrbit;
 use super::phase::{Phase, Transient};
-use super::signals::Signal;
+use super::signals::{Samples, Signal};
 use nalgebra::DVector;
 use num_complex::Complex64 as C;
 
@@ -168,7 +168,7 @@ fn closed_form(o: &PolishedOrbit, e: usize, transient: &Transient, (a, b): (f64,
     // The full particular solution only for the stuck contacts' forces; a clearance needs its row.
     let part = if stuck.is_empty() { vec![] } else { ph.particular() };
     let held = if stuck.is_empty() { vec![] } else { ph.stuck_force_particular(&part) };
-    let mut out = Vec::new();
+    let mut parts = Vec::new();
     for (i, c) in model.contacts.iter().enumerate() {
         let (what, sign) = what(o, e, i);
         let (rho, harmonics, scale) = if let Some(s) = stuck.iter().position(|&k| k == i) {
@@ -186,11 +186,17 @@ fn closed_form(o: &PolishedOrbit, e: usize, transient: &Transient, (a, b): (f64,
             }
             (rho, h, xs)
         };
-        let signal = Signal::new(a, transient.lambda.clone(), transient.coefficients(&rho), harmonics);
-        let (v, t) = signal.lowest(a, b, -TOL * scale);
-        out.push((i, v / scale, t, what));
+        parts.push((i, Signal::new(a, transient.lambda.clone(), transient.coefficients(&rho), harmonics), scale, what));
     }
-    out
+    let rates = parts.iter().flat_map(|(_, s, _, _)| s.rates()).collect::<Vec<f64>>();
+    let samples = Samples::new(a, &transient.lambda, (a, b), rates.into_iter());
+    parts
+        .into_iter()
+        .map(|(i, signal, scale, what)| {
+            let (v, t) = signal.lowest(&samples, -TOL * scale);
+            (i, v / scale, t, what)
+        })
+        .collect()
 }
 
 /// [`Lowest`] by [`SAMPLES`] flows over the phase and a golden section around each sampled local
