@@ -101,9 +101,7 @@ impl Signal {
     /// `s` from their exponentials.
     fn bend(&self, (t0, t1): (f64, f64), first: Option<(&Samples, usize)>) -> f64 {
         let modal: f64 = match first {
-            Some((s, k)) => {
-                self.lambda.iter().zip(&self.sizes).enumerate().map(|(j, (l, m))| m * l.norm_sqr() * s.decay[k][j].max(s.decay[k + 1][j])).sum()
-            }
+            Some((s, k)) => self.lambda.iter().zip(&self.sizes).enumerate().map(|(j, (l, m))| m * l.norm_sqr() * s.decay[k][j].max(s.decay[k + 1][j])).sum(),
             None => {
                 let (a, b) = (t0 - self.start, t1 - self.start);
                 self.lambda.iter().zip(&self.sizes).map(|(l, m)| m * l.norm_sqr() * (l.re * a).exp().max((l.re * b).exp())).sum()
