@@ -10,6 +10,9 @@ use crate::model::Model;
 use crate::periodic::OutputMap;
 use nalgebra::{DMatrix, DVector};
 
+// The outputs' samples in closed form, for the amplitudes.
+mod outputs;
+
 /// Where a compliant contact's clearance comes closest to switching inside a phase: the signed
 /// clearance (clearance in an open phase, penetration in a closed one) at its smallest interior
 /// local minimum; negative when the orbit has crossed the contact's surface between events.
@@ -153,7 +156,7 @@ impl PolishedOrbit {
     /// contact's force is zero at both (clearance 0 when it closes, force 0 when it releases), so
     /// the condensed massless DOFs are the same either side and the massive vector field is
     /// continuous. An impact on a massive DOF resets velocities (not the identity).
-    fn identity_saltation(&self) -> bool {
+    pub(super) fn identity_saltation(&self) -> bool {
         let massless = |i: usize| self.model.contact_is_massless(&self.model.contacts[i]);
         let events = self.events.iter().all(|e| match e.kind {
             EventKind::On | EventKind::Off => true,
@@ -175,9 +178,7 @@ impl PolishedOrbit {
         let ne = self.events.len();
         let mut out = Sampled { samples: Vec::new(), states: Vec::new(), ends: Vec::new() };
         for e in 0..ne.max(1) {
-            let (a, b) = (self.times[e], self.end_of(e));
-            let count = (((b - a) * self.phases[e].speed_hint().max(self.model.frequency) * SAMPLES_PER_RADIAN).ceil() as usize).max(MIN_SAMPLES);
-            let h = (b - a) / count as f64;
+            let (a, b, h, count) = self.sample_grid(e);
             let states = self.phases[e].samples(a, &self.after[e], h, count);
             out.samples.extend((0..count).map(|j| (a + h * j as f64, e)));
             // The phase's end flowed from its last sample, as the last interval is.
@@ -185,6 +186,13 @@ impl PolishedOrbit {
             out.states.extend(states);
         }
         out
+    }
+
+    /// Phase `e`'s samples for [`Self::sampled`]: its start and end, the step and the count.
+    fn sample_grid(&self, e: usize) -> (f64, f64, f64, usize) {
+        let (a, b) = (self.times[e], self.end_of(e));
+        let count = (((b - a) * self.phases[e].speed_hint().max(self.model.frequency) * SAMPLES_PER_RADIAN).ceil() as usize).max(MIN_SAMPLES);
+        (a, b, (b - a) / count as f64, count)
     }
 
     /// Each compliant contact's smallest local minimum of its signed clearance between its own
@@ -277,6 +285,9 @@ impl PolishedOrbit {
 
     /// [`Self::amplitude`] of each of `dofs`, from one sampling of the period.
     pub fn amplitudes(&self, map: Option<&OutputMap>, dofs: &[usize]) -> Vec<Option<f64>> {
+        if let Some(out) = self.output_amplitudes(map, dofs) {
+            return out;
+        }
         self.amplitudes_in(&self.sampled(), map, dofs)
     }
 
@@ -297,6 +308,9 @@ impl PolishedOrbit {
         dofs.iter().map(|&d| one(d)).collect()
     }
 }
+
+/// A signal's (value, slope) at the samples, or at the phases' ends.
+type Jets<'a> = &'a [(f64, f64)];
 
 /// A signal's value, slope and curvature at a state and time of a phase.
 type Jet<'a> = &'a dyn Fn(usize, &DVector<f64>, f64) -> (f64, f64, f64);
@@ -323,8 +337,25 @@ impl Sampled {
     /// signal's own event, and the samples themselves when `samples_count`. `quick` gives value
     /// and slope, `full` also the curvature (for Newton).
     fn smallest(&self, orbit: &PolishedOrbit, quick: Jet, full: Jet, own: &dyn Fn(usize) -> bool, samples_count: bool) -> Option<(f64, f64)> {
+        // Value and slope once per sample and per phase end (each is an interval's start and the
+        // interval before's end, and a phase's end also feeds the kink test after it).
+        let at: Vec<(f64, f64)> = self.samples.iter().zip(&self.states).map(|(&(t, e), y)| quick(e, y, t)).map(|(v, d, _)| (v, d)).collect();
+        let at_end: Vec<(f64, f64)> = self.ends.iter().enumerate().map(|(e, y)| quick(e, y, orbit.end_of(e))).map(|(v, d, _)| (v, d)).collect();
+        self.smallest_of(orbit, (&at, &at_end), full, own, samples_count)
+    }
+
+    /// [`Self::smallest`] from the signal's value and slope at the samples and the phases' ends
+    /// (`at`, `at_end`); without the states (`states` empty) a refinement flows from its phase's start.
+    fn smallest_of(
+        &self,
+        orbit: &PolishedOrbit,
+        (at, at_end): (Jets, Jets),
+        full: Jet,
+        own: &dyn Fn(usize) -> bool,
+        samples_count: bool,
+    ) -> Option<(f64, f64)> {
         let len = self.samples.len();
-        let phases = self.ends.len();
+        let phases = at_end.len();
         let mut best: Option<(f64, f64)> = None;
         let keep = |best: &mut Option<(f64, f64)>, v: f64, t: f64| {
             if best.is_none_or(|b| v < b.0) {
@@ -332,10 +363,6 @@ impl Sampled {
             }
         };
         let (mut vmin, mut vmax) = (f64::MAX, f64::MIN);
-        // Value and slope once per sample and per phase end (each is an interval's start and the
-        // interval before's end, and a phase's end also feeds the kink test after it).
-        let at: Vec<(f64, f64)> = self.samples.iter().zip(&self.states).map(|(&(t, e), y)| quick(e, y, t)).map(|(v, d, _)| (v, d)).collect();
-        let at_end: Vec<(f64, f64)> = self.ends.iter().enumerate().map(|(e, y)| quick(e, y, orbit.end_of(e))).map(|(v, d, _)| (v, d)).collect();
         // Per interval: (Hermite estimate, its place in [0, 1], start sample, end time).
         let mut candidates: Vec<(f64, f64, usize, f64)> = Vec::new();
         for j in 0..len {
@@ -364,8 +391,8 @@ impl Sampled {
                 continue;
             }
             let (t0, e) = self.samples[j];
-            let y0 = &self.states[j];
-            let (t, v) = refine(t0, t1, t0 + s * (t1 - t0), &|t| full(e, &orbit.phases[e].flow(t0, y0, t), t));
+            let (ts, y0) = if self.states.is_empty() { (orbit.times[e], &orbit.after[e]) } else { (t0, &self.states[j]) };
+            let (t, v) = refine(t0, t1, t0 + s * (t1 - t0), &|t| full(e, &orbit.phases[e].flow(ts, y0, t), t));
             keep(&mut best, v, t);
         }
         best

@@ -17,6 +17,9 @@ use nalgebra::{DMatrix, DVector};
 // The switch search on a phase's grid without a flow per step.
 mod grid;
 use grid::Grid;
+// The phases kept across a sweep's points.
+mod bank;
+pub use bank::PhaseBank;
 
 /// Switch-search steps per radian of a phase's fastest motion (its balancing speed, ≥ ω_max):
 /// a sign change between steps is bracketed; a dip between two steps is left to the check.
@@ -33,6 +36,8 @@ thread_local! {
 struct Flows<'a> {
     model: &'a Model,
     prev: &'a PolishedOrbit,
+    /// The sets met at earlier points.
+    bank: &'a PhaseBank,
     /// Whether `model` is `prev`'s at another frequency (the same structure and contacts).
     retune: bool,
     phases: Vec<Phase>,
@@ -48,7 +53,7 @@ impl Flows<'_> {
             return Ok(k);
         }
         let clock = PROFILE.with(|on| on.then(super::thread_cpu).flatten());
-        let old = self.prev.phases.iter().find(|o| self.retune && o.is_for(&[], closed));
+        let old = self.prev.phases.iter().find(|o| self.retune && o.is_for(&[], closed)).or_else(|| self.bank.find(self.model, closed));
         let p = match old {
             Some(o) => o.retuned(self.model),
             None => Phase::new(self.model, &[], closed).map(|mut p| {
@@ -101,19 +106,34 @@ impl Shot {
 /// shooting with switch detection (see the module); `prev` lends its phases' decompositions.
 /// Only for models whose contacts are all compliant (identity saltation, no stuck DOFs).
 pub fn follow_detected(model: &Model, prev: &PolishedOrbit, start: &[f64]) -> Result<PolishedOrbit, PolishFailure> {
-    let fail = |w: &str| PolishFailure(format!("switch-detecting shooting: {w}"));
+    follow_detected_with(model, prev, start, &mut PhaseBank::default())
+}
+
+/// [`follow_detected`] with the phases of the sets met at earlier points (`bank`, which keeps
+/// this point's too).
+pub fn follow_detected_with(model: &Model, prev: &PolishedOrbit, start: &[f64], bank: &mut PhaseBank) -> Result<PolishedOrbit, PolishFailure> {
     if model.contacts.iter().any(|c| c.is_rigid()) || !model.frictions.is_empty() || !model.rubbing.is_empty() {
-        return Err(fail("only for compliant contacts"));
+        return Err(PolishFailure("switch-detecting shooting: only for compliant contacts".into()));
     }
+    let mut flows = Flows { model, prev, bank, retune: same_system(model, &prev.model), phases: Vec::new(), grids: Vec::new(), building: 0.0 };
+    let out = newton(&mut flows, start);
+    let phases = std::mem::take(&mut flows.phases);
+    bank.keep(model, phases);
+    out
+}
+
+/// The Newton shooting of [`follow_detected`] on `flows`.
+fn newton(flows: &mut Flows, start: &[f64]) -> Result<PolishedOrbit, PolishFailure> {
+    let (model, prev) = (flows.model, flows.prev);
+    let fail = |w: &str| PolishFailure(format!("switch-detecting shooting: {w}"));
     let carrier = PolishedOrbit::new(model, vec![], &[])?;
-    let mut flows = Flows { model, prev, retune: same_system(model, &prev.model), phases: Vec::new(), grids: Vec::new(), building: 0.0 };
     let clock = std::time::Instant::now();
     let n2 = 2 * model.n();
     let w = carrier.weights().rows(0, n2).into_owned();
     let mut y = DVector::from_column_slice(start);
     let size = y.component_mul(&w).amax().max(1e-300);
     let floor = 1e-10 * size;
-    let mut shot = shoot(&carrier, &mut flows, &y)?;
+    let mut shot = shoot(&carrier, flows, &y)?;
     let mut r = &shot.end - &y;
     let mut iterations = 0;
     let correction = loop {
@@ -121,7 +141,7 @@ pub fn follow_detected(model: &Model, prev: &PolishedOrbit, start: &[f64]) -> Re
             // Near a grazing the flow's derivative is not Lipschitz and Newton may stall short
             // of round-off: the polish's Newton on the detected signature, its times as seeds.
             let why = format!("no convergence in {MAX_ITERATIONS} iterations (residual {:.2e})", r.component_mul(&w).amax());
-            return settle_detected(model, prev, &flows, shot).map_err(|e| fail(&format!("{why}; on its signature: {e}")));
+            return settle_detected(model, prev, flows, shot).map_err(|e| fail(&format!("{why}; on its signature: {e}")));
         }
         // d y(T) / d y(0) = L_last (Π e^{A τ}) R: every phase shares the free basis (no stuck
         // contact), so R L_j = I between phases (phase.rs's `transition`).
@@ -132,7 +152,7 @@ pub fn follow_detected(model: &Model, prev: &PolishedOrbit, start: &[f64]) -> Re
         let mut lambda = 1.0;
         let (next, next_shot, rn) = loop {
             let cand = &y + &du * lambda;
-            if let Ok(s) = shoot(&carrier, &mut flows, &cand) {
+            if let Ok(s) = shoot(&carrier, flows, &cand) {
                 let rc = &s.end - &cand;
                 let merit = rc.component_mul(&w).amax();
                 if merit < before || merit < floor {
@@ -155,7 +175,7 @@ pub fn follow_detected(model: &Model, prev: &PolishedOrbit, start: &[f64]) -> Re
     };
     let residual = r.component_mul(&w).amax();
     super::profile(&format!("switch detection: {iterations} iterations, {} phases built in {:.3} s CPU", flows.phases.len(), flows.building), clock);
-    let orbit = assemble(model, prev, &flows, shot, (iterations, residual, correction))?;
+    let orbit = assemble(model, prev, flows, shot, (iterations, residual, correction))?;
     super::profile("the orbit on the detected signature", clock);
     verify::check(&orbit)?;
     super::profile("admissibility check", clock);

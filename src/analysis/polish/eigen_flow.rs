@@ -76,6 +76,24 @@ impl EigenFlow {
         (self.lambda.clone(), q)
     }
 
+    /// The eigenvalues λ_j.
+    pub fn eigenvalues(&self) -> &[C] {
+        &self.lambda
+    }
+
+    /// The modal coordinates c = V⁻¹ u.
+    pub fn coordinates(&self, u: &DVector<f64>) -> Vec<C> {
+        let (re, im) = (&self.inv_re * u, &self.inv_im * u);
+        re.iter().zip(im.iter()).map(|(a, b)| C::new(*a, *b)).collect()
+    }
+
+    /// r V₁ for the rows `r` on V's first r.ncols() rows.
+    pub fn rows_on_modes(&self, r: &DMatrix<f64>) -> DMatrix<C> {
+        let k = r.ncols();
+        let (re, im) = (r * self.v_re.rows(0, k), r * self.v_im.rows(0, k));
+        re.zip_map(&im, C::new)
+    }
+
     /// e^{Âτ} u in O(n_a²): V (e^{Λτ} ⊙ V⁻¹ u).
     pub fn apply(&self, tau: f64, u: &DVector<f64>) -> DVector<f64> {
         let (w_re, w_im) = (&self.inv_re * u, &self.inv_im * u);

@@ -24,7 +24,7 @@ mod signals;
 mod verify;
 
 pub use continued::Touch;
-pub use detect::follow_detected;
+pub use detect::{PhaseBank, follow_detected, follow_detected_with};
 pub use events::{Event, EventKind};
 pub use orbit::{OrbitParts, PolishedOrbit, user_value};
 pub use rigid::{CLEARANCE, HOLD, RigidMargin, STUCK};

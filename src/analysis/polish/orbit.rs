@@ -49,7 +49,9 @@ pub struct PolishedOrbit {
     pub(super) iterations: usize,
     pub(super) residual: f64,
     pub(super) correction: f64,
-    monodromy: DMatrix<f64>,
+    /// Made at its first use where the saltations are the identity (the phases' product: a
+    /// sweep's point never asks for it), else by [`Self::finish`].
+    monodromy: std::sync::OnceLock<DMatrix<f64>>,
 }
 
 impl PolishedOrbit {
@@ -129,7 +131,7 @@ impl PolishedOrbit {
             iterations: 0,
             residual: f64::INFINITY,
             correction: f64::INFINITY,
-            monodromy: DMatrix::zeros(2 * n, 2 * n),
+            monodromy: std::sync::OnceLock::new(),
         })
     }
 
@@ -380,10 +382,11 @@ impl PolishedOrbit {
         let shot = self.shoot(&self.y0, &self.times).ok_or_else(|| fail("the converged orbit cannot be flowed"))?;
         self.after = shot.after;
         self.impulses = shot.impulses;
-        self.monodromy = match self.flow_product() {
-            Some(m) => m,
-            None => self.event_monodromy().ok_or_else(|| fail("the monodromy could not be formed (an event condition is singular in its time: grazing)"))?,
-        };
+        self.monodromy = std::sync::OnceLock::new();
+        if !self.identity_saltation() {
+            let m = self.event_monodromy().ok_or_else(|| fail("the monodromy could not be formed (an event condition is singular in its time: grazing)"))?;
+            self.monodromy = m.into();
+        }
         Ok(())
     }
 
@@ -405,7 +408,7 @@ impl PolishedOrbit {
     /// variational flow of `rigid.rs`). Its eigenvalues are the orbit's Floquet
     /// multipliers (a plastic impact adds zeros).
     pub fn monodromy(&self) -> &DMatrix<f64> {
-        &self.monodromy
+        self.monodromy.get_or_init(|| self.flow_product().expect("identity saltations (finish made the others)"))
     }
 
     /// The period T [s].
@@ -480,18 +483,39 @@ impl PolishedOrbit {
         }
     }
 
-    /// Every contact's [`Self::contact_force`] at `t`, from one state.
+    /// Every contact's [`Self::contact_force`] at `t`, from one state (and one e^{ipωt} per
+    /// gap harmonic p for all contacts; the stuck forces only in a phase with stuck contacts).
     pub fn contact_forces(&self, t: f64) -> Vec<f64> {
         let (e, tt) = self.locate(t);
         let y = self.state(tt);
+        let w = self.model.frequency;
+        let mut turns: Vec<(u32, num_complex::Complex64)> = Vec::new();
         let mut out: Vec<f64> = (0..self.model.contacts.len())
             .map(|i| match self.model.contacts[i].compliance {
-                crate::model::Compliance::Compliant { stiffness } => stiffness * (-self.clearance(i, &y, tt)).max(0.0),
+                crate::model::Compliance::Compliant { stiffness } => {
+                    let gap: f64 = self.gaps[i]
+                        .iter()
+                        .map(|(p, a)| {
+                            let turn = match turns.iter().find(|(q, _)| q == p) {
+                                Some(&(_, z)) => z,
+                                None => {
+                                    let z = num_complex::Complex64::from_polar(1.0, *p as f64 * w * tt);
+                                    turns.push((*p, z));
+                                    z
+                                }
+                            };
+                            (a[0] * turn).re
+                        })
+                        .sum();
+                    stiffness * (self.model.contacts[i].along(|d| y[d]) - gap).max(0.0)
+                }
                 crate::model::Compliance::Rigid => 0.0,
             })
             .collect();
-        for (i, z) in self.phases[e].stuck_forces(&y, tt) {
-            out[i] = z;
+        if self.phases[e].stuck_contacts().next().is_some() {
+            for (i, z) in self.phases[e].stuck_forces(&y, tt) {
+                out[i] = z;
+            }
         }
         out
     }

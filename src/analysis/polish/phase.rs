@@ -40,10 +40,11 @@ pub(super) struct Phase {
     b_stuck: DMatrix<f64>,
     /// Closed compliant contacts.
     closed: Vec<usize>,
-    /// The full-model matrices of this phase (K with the closed compliant springs).
-    m: DMatrix<f64>,
-    c: DMatrix<f64>,
-    k: DMatrix<f64>,
+    /// The full-model matrices of this phase (K with the closed compliant springs), shared by
+    /// its clones and re-tunings (a sweep re-tunes ~37 phases per point).
+    m: Arc<DMatrix<f64>>,
+    c: Arc<DMatrix<f64>>,
+    k: Arc<DMatrix<f64>>,
     /// f(t) with the closed springs' obstacle terms, full model.
     force: Harmonics,
     /// Prescribed displacement of every DOF (nonzero only at stuck DOFs).
@@ -194,9 +195,9 @@ impl Phase {
             stuck: stuck.to_vec(),
             b_stuck,
             closed: closed.to_vec(),
-            m,
-            c,
-            k,
+            m: Arc::new(m),
+            c: Arc::new(c),
+            k: Arc::new(k),
             force,
             presc,
             a,
@@ -451,7 +452,7 @@ impl Phase {
         let n = self.n;
         let (x, v) = (y.rows(0, n).into_owned(), y.rows(n, n).into_owned());
         let acc = eval(&self.presc, self.omega, t, 2, n);
-        let rhs = eval(&self.force, self.omega, t, 0, n) - &self.c * &v - &self.k * &x - &self.m * &acc;
+        let rhs = eval(&self.force, self.omega, t, 0, n) - &*self.c * &v - &*self.k * &x - &*self.m * &acc;
         let af = &self.mff_inv * (self.free.transpose() * rhs);
         let mut out = acc + &self.free * &af;
         if self.slave.ncols() > 0 {
@@ -470,7 +471,7 @@ impl Phase {
         let y = self.condensed(y, t);
         let acc = self.acceleration_condensed(&y, t);
         let (x, v) = (y.rows(0, n).into_owned(), y.rows(n, n).into_owned());
-        let r = eval(&self.force, self.omega, t, 0, n) - &self.m * acc - &self.c * v - &self.k * x;
+        let r = eval(&self.force, self.omega, t, 0, n) - &*self.m * acc - &*self.c * v - &*self.k * x;
         let z = &self.b_stuck * r;
         self.stuck.iter().enumerate().map(|(a, &i)| (i, z[a])).collect()
     }
@@ -488,7 +489,7 @@ impl Phase {
         self.force_gradient.get_or_init(|| {
             let n = self.n;
             let lift = self.lifted();
-            let ml = &self.m * lift;
+            let ml = &*self.m * lift;
             let block = |a: &DMatrix<f64>| {
                 let al = a * lift;
                 let acc = &self.mff_inv * (self.free.transpose() * &al);

@@ -17,16 +17,51 @@ pub(super) struct Signal {
     start: f64,
     lambda: Vec<C>,
     modal: Vec<C>,
+    /// |m_j| (for [`Self::bend`]).
+    sizes: Vec<f64>,
     /// (pω, ĥ_p).
     harmonics: Vec<(f64, C)>,
 }
 
-/// An interval between two evaluated times: (t, value, slope) at both ends and its depth.
-type Interval = ((f64, f64, f64), (f64, f64, f64), u32);
+/// The first samples of one phase on [a, b] ([`FIRST`] + 1 times), shared by the signals of its
+/// contacts (the same times and eigenvalues): e^{λ_j τ_k}, e^{Re λ_j τ_k} and e^{iwt_k} per rate
+/// w, each made once per phase instead of once per contact (the check's time went to them).
+pub(super) struct Samples {
+    times: Vec<f64>,
+    modes: Vec<Vec<C>>,
+    decay: Vec<Vec<f64>>,
+    turns: Vec<(f64, Vec<C>)>,
+}
+
+impl Samples {
+    /// The samples of [a, b] for the transient's eigenvalues `lambda` from `start` and the rates `rates`.
+    pub fn new(start: f64, lambda: &[C], (a, b): (f64, f64), rates: impl Iterator<Item = f64>) -> Self {
+        let times: Vec<f64> = (0..=FIRST).map(|j| if j == FIRST { b } else { a + (b - a) * j as f64 / FIRST as f64 }).collect();
+        let modes = times.iter().map(|t| lambda.iter().map(|l| (l * (t - start)).exp()).collect()).collect();
+        let decay = times.iter().map(|t| lambda.iter().map(|l| (l.re * (t - start)).exp()).collect()).collect();
+        let mut turns: Vec<(f64, Vec<C>)> = Vec::new();
+        for w in rates {
+            if !turns.iter().any(|(v, _)| *v == w) {
+                turns.push((w, times.iter().map(|t| C::from_polar(1.0, w * t)).collect()));
+            }
+        }
+        Samples { times, modes, decay, turns }
+    }
+}
+
+/// An interval between two evaluated times: (t, value, slope) at both ends, its depth, and its
+/// index among the first samples' intervals (depth 0).
+type Interval = ((f64, f64, f64), (f64, f64, f64), u32, Option<usize>);
 
 impl Signal {
     pub fn new(start: f64, lambda: Vec<C>, modal: Vec<C>, harmonics: Vec<(f64, C)>) -> Self {
-        Signal { start, lambda, modal, harmonics }
+        let sizes = modal.iter().map(|m| m.norm()).collect();
+        Signal { start, lambda, modal, sizes, harmonics }
+    }
+
+    /// The signal's harmonic rates pω.
+    pub fn rates(&self) -> impl Iterator<Item = f64> + '_ {
+        self.harmonics.iter().map(|(w, _)| *w)
     }
 
     /// The signal's value at `t`.
@@ -81,24 +116,49 @@ impl Signal {
         (t, v, d)
     }
 
-    /// A bound on |s''| over [t0, t1] (see the module).
-    pub fn bend(&self, t0: f64, t1: f64) -> f64 {
-        let (a, b) = (t0 - self.start, t1 - self.start);
-        let modal: f64 = self.lambda.iter().zip(&self.modal).map(|(l, m)| m.norm() * l.norm_sqr() * (l.re * a).exp().max((l.re * b).exp())).sum();
+    /// [`Self::jet`] at the first sample `k` of `s` (its exponentials made once per phase).
+    fn jet_at(&self, s: &Samples, turns: &[usize], k: usize) -> (f64, f64, f64) {
+        let (mut v, mut d) = (0.0, 0.0);
+        for ((l, m), e) in self.lambda.iter().zip(&self.modal).zip(&s.modes[k]) {
+            let z = m * e;
+            v += z.re;
+            d += (l * z).re;
+        }
+        for (&(w, h), &r) in self.harmonics.iter().zip(turns) {
+            let z = h * s.turns[r].1[k];
+            v += z.re;
+            d -= w * z.im;
+        }
+        (s.times[k], v, d)
+    }
+
+    /// A bound on |s''| over [t0, t1] (see the module); over the first samples' interval `k` of
+    /// `s` from their exponentials.
+    pub fn bend(&self, (t0, t1): (f64, f64), first: Option<(&Samples, usize)>) -> f64 {
+        let modal: f64 = match first {
+            Some((s, k)) => self.lambda.iter().zip(&self.sizes).enumerate().map(|(j, (l, m))| m * l.norm_sqr() * s.decay[k][j].max(s.decay[k + 1][j])).sum(),
+            None => {
+                let (a, b) = (t0 - self.start, t1 - self.start);
+                self.lambda.iter().zip(&self.sizes).map(|(l, m)| m * l.norm_sqr() * (l.re * a).exp().max((l.re * b).exp())).sum()
+            }
+        };
         modal + self.harmonics.iter().map(|(w, h)| h.norm() * w * w).sum::<f64>()
     }
 
-    /// The smallest value of the signal on [a, b] and its time, exact where it is below `floor`
-    /// (to 1e-9 of itself), else any value ≥ `floor` met: bisection of every interval whose lower
-    /// bound from the values, slopes and [`Self::bend`] (each end's Taylor bound over its half,
-    /// s(t0 + τ) ≥ s0 + s0'τ − Mτ²/2) is below the floor, or below the lowest value met once that
-    /// is below the floor.
-    pub fn lowest(&self, a: f64, b: f64, floor: f64) -> (f64, f64) {
-        let pts: Vec<(f64, f64, f64)> = (0..=FIRST).map(|j| self.jet(if j == FIRST { b } else { a + (b - a) * j as f64 / FIRST as f64 })).collect();
+    /// The smallest value of the signal on the span of `samples` and its time, exact where it is
+    /// below `floor` (to 1e-9 of itself), else any value ≥ `floor` met: bisection of every
+    /// interval whose lower bound from the values, slopes and [`Self::bend`] (each end's Taylor
+    /// bound over its half, s(t0 + τ) ≥ s0 + s0'τ − Mτ²/2) is below the floor, or below the lowest
+    /// value met once that is below the floor. The samples' rates must hold the signal's.
+    pub fn lowest(&self, samples: &Samples, floor: f64) -> (f64, f64) {
+        let turns: Vec<usize> =
+            self.harmonics.iter().map(|(w, _)| samples.turns.iter().position(|(v, _)| v == w).expect("the samples hold every rate")).collect();
+        let pts: Vec<(f64, f64, f64)> = (0..=FIRST).map(|k| self.jet_at(samples, &turns, k)).collect();
+        let a = samples.times[0];
         let mut best = pts.iter().map(|&(t, v, _)| (v, t)).fold((f64::INFINITY, a), |m, x| if x.0 < m.0 { x } else { m });
-        let mut stack: Vec<Interval> = pts.windows(2).map(|w| (w[0], w[1], 0)).collect();
-        while let Some(((t0, v0, d0), (t1, v1, d1), depth)) = stack.pop() {
-            let (h, m) = (t1 - t0, self.bend(t0, t1));
+        let mut stack: Vec<Interval> = pts.windows(2).enumerate().map(|(k, w)| (w[0], w[1], 0, Some(k))).collect();
+        while let Some(((t0, v0, d0), (t1, v1, d1), depth, first)) = stack.pop() {
+            let (h, m) = (t1 - t0, self.bend((t0, t1), first.map(|k| (samples, k))));
             let lower = v0.min(v1).min(v0 + 0.5 * d0 * h - m * h * h / 8.0).min(v1 - 0.5 * d1 * h - m * h * h / 8.0);
             let target = if best.0 < floor { best.0 - 1e-9 * best.0.abs() } else { floor };
             if lower >= target || depth >= DEPTH {
@@ -108,8 +168,8 @@ impl Signal {
             if mid.1 < best.0 {
                 best = (mid.1, mid.0);
             }
-            stack.push(((t0, v0, d0), mid, depth + 1));
-            stack.push((mid, (t1, v1, d1), depth + 1));
+            stack.push(((t0, v0, d0), mid, depth + 1, None));
+            stack.push((mid, (t1, v1, d1), depth + 1, None));
         }
         best
     }

@@ -8,7 +8,7 @@ use super::PolishFailure;
 use super::events::{Event, EventKind};
 use super::orbit::PolishedOrbit;
 use super::phase::{Harmonics, Phase, Transient};
-use super::signals::Signal;
+use super::signals::{Samples, Signal};
 use nalgebra::DVector;
 use num_complex::Complex64 as C;
 
@@ -163,14 +163,21 @@ fn what(o: &PolishedOrbit, e: usize, i: usize) -> (&'static str, f64) {
 /// state and its particular solution, each contact's row on them.
 fn closed_form(o: &PolishedOrbit, e: usize, transient: &Transient, (a, b): (f64, f64), (xs, fs): (f64, f64)) -> Lowest {
     let along = Along::new(o, e, transient);
-    let mut out = Vec::new();
+    let mut parts = Vec::new();
     for i in 0..o.model.contacts.len() {
         let (what, sign) = what(o, e, i);
         let scale = if along.stuck.contains(&i) { fs } else { xs };
-        let (v, t) = along.signal(o, i, sign).lowest(a, b, -TOL * scale);
-        out.push((i, v / scale, t, what));
+        parts.push((i, along.signal(o, i, sign), scale, what));
     }
-    out
+    let rates = parts.iter().flat_map(|(_, s, _, _)| s.rates()).collect::<Vec<f64>>();
+    let samples = Samples::new(a, &transient.lambda, (a, b), rates.into_iter());
+    parts
+        .into_iter()
+        .map(|(i, signal, scale, what)| {
+            let (v, t) = signal.lowest(&samples, -TOL * scale);
+            (i, v / scale, t, what)
+        })
+        .collect()
 }
 
 /// A phase's signals in closed form (signals.rs): its transient from its start state, its stuck

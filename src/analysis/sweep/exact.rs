@@ -43,6 +43,8 @@ fn walk(template: &PeriodicProblem, chunk: &[f64], on_point: &(dyn Fn(&SweepPoin
     let mut active: Option<Vec<usize>> = None;
     // (ω, state at t = 0) of the last exact or polished orbits in a row: the predictor's points.
     let mut trail: Vec<(f64, Vec<f64>)> = Vec::new();
+    // The phases of the contact sets met so far, re-tuned at each point rather than made again.
+    let mut bank = polish::PhaseBank::default();
     for &f in chunk {
         let t0 = Instant::now();
         let mut problem = template.clone();
@@ -50,10 +52,15 @@ fn walk(template: &PeriodicProblem, chunk: &[f64], on_point: &(dyn Fn(&SweepPoin
             Err(e) => failed(f, e.to_string()),
             Ok(()) => {
                 let model = problem.model();
-                linear = polish::linear(model, linear.as_ref()).ok();
+                // Without loads the contact-free orbit is rest (a casing drives the blade only
+                // through contact): its amplitudes are 0, and the orbit is not solved.
+                let rest = model.forces.is_empty();
+                if !rest {
+                    linear = polish::linear(model, linear.as_ref()).ok();
+                }
                 let followed = prev.as_ref().map(|p| {
                     let start = predicted(&trail, f);
-                    polish::follow_detected(model, p, &start).or_else(|e| {
+                    polish::follow_detected_with(model, p, &start, &mut bank).or_else(|e| {
                         polish::profile(&format!("switch detection failed at {f}: {e}"), t0);
                         polish::follow_across(model, p)
                     })
@@ -61,7 +68,7 @@ fn walk(template: &PeriodicProblem, chunk: &[f64], on_point: &(dyn Fn(&SweepPoin
                 match followed {
                     Some(Ok(orbit)) => {
                         polish::profile(&format!("exact at {f}: {} Newton iterations, {} events", orbit.iterations(), orbit.events().len()), t0);
-                        let point = exact_point(&problem, f, &orbit, linear.as_ref());
+                        let point = exact_point(&problem, f, &orbit, if rest { Err(()) } else { Ok(linear.as_ref()) });
                         polish::profile("the point's amplitudes, forces and fractions", t0);
                         prev = Some(orbit);
                         point
@@ -105,12 +112,16 @@ fn failed(f: f64, why: String) -> SweepPoint {
 
 /// The point of an exact orbit: amplitudes at the orbit's own extrema, contact fractions from the
 /// phases' durations, the largest force at [`FORCE_SAMPLES`] instants; the estimate is the last
-/// Newton correction over the largest peak-to-peak amplitude.
-fn exact_point(problem: &PeriodicProblem, f: f64, orbit: &PolishedOrbit, linear: Option<&PolishedOrbit>) -> SweepPoint {
+/// Newton correction over the largest peak-to-peak amplitude. `linear` is the contact-free orbit
+/// (`Err` where it is rest: no loads).
+fn exact_point(problem: &PeriodicProblem, f: f64, orbit: &PolishedOrbit, linear: Result<Option<&PolishedOrbit>, ()>) -> SweepPoint {
     let dofs = &problem.outputs().displacement;
     let map = problem.output_map();
     let amplitude: Vec<f64> = orbit.amplitudes(map, dofs).into_iter().map(|a| a.unwrap_or(f64::NAN)).collect();
-    let linear_amplitude = linear.map_or_else(|| vec![f64::NAN; dofs.len()], |l| l.amplitudes(map, dofs).into_iter().map(|a| a.unwrap_or(f64::NAN)).collect());
+    let linear_amplitude = match linear {
+        Err(()) => vec![0.0; dofs.len()],
+        Ok(linear) => linear.map_or_else(|| vec![f64::NAN; dofs.len()], |l| l.amplitudes(map, dofs).into_iter().map(|a| a.unwrap_or(f64::NAN)).collect()),
+    };
     let scale = 2.0 * amplitude.iter().copied().filter(|a| a.is_finite()).fold(0.0, f64::max);
     let estimate = orbit.correction().max(f64::EPSILON * scale);
     SweepPoint {

@@ -22,8 +22,9 @@ pub(super) struct Grid {
     turn: Vec<C>,
     /// Contact i's clearance's periodic part at each harmonic (rows: contacts): gap_i − B_i P̂_p.
     periodic: DMatrix<C>,
-    /// B_i L (rows: contacts, columns: the massive coordinates x_a).
+    /// B_i L (rows: contacts, columns: the massive coordinates x_a), and on Â's modes (B_i L V_x).
     rows: DMatrix<f64>,
+    modal_rows: Option<DMatrix<C>>,
 }
 
 impl Grid {
@@ -46,7 +47,8 @@ impl Grid {
         let rows = DMatrix::from_fn(m, na, |i, k| model.contacts[i].along(|d| lift[(d, k)]));
         let rates: Vec<f64> = orders.iter().map(|&p| p as f64 * w).collect();
         let turn = rates.iter().map(|r| C::from_polar(1.0, r * h)).collect();
-        Grid { h, step: ph.grid_step(h), rates, turn, periodic, rows }
+        let modal_rows = ph.rows_on_modes(&rows);
+        Grid { h, step: ph.grid_step(h), rates, turn, periodic, rows, modal_rows }
     }
 
     /// Each contact's clearance at `t` from the deviation `z` (2n_a) and e^{ipωt} (`phasors`).
@@ -60,7 +62,7 @@ impl Grid {
     }
 
     /// Contact `i`'s clearance at `s` in closed form from the deviation's modes at `t0`
-    /// ([`Phase::modes_of`]: `lambda`, and `modal` = B_i L's row on them).
+    /// ([`Phase::modal_coordinates`]: `lambda`, and `modal` = B_i L V_x c, its row on them).
     fn clearance_at(&self, i: usize, s: f64, t0: f64, lambda: &[C], modal: &[C]) -> f64 {
         let periodic: f64 = self.rates.iter().enumerate().map(|(p, r)| (self.periodic[(i, p)] * C::from_polar(1.0, r * s)).re).sum();
         let transient: f64 = lambda.iter().zip(modal).map(|(l, m)| (m * (l * (s - t0)).exp()).re).sum();
@@ -131,14 +133,13 @@ fn earliest(
     if negative.is_empty() {
         return None;
     }
-    let modes = ph.modes_of(z0);
-    let na = grid.rows.ncols();
+    // The deviation's modal coordinates at t0, and each crossing contact's row on them.
+    let modes = ph.modal_coordinates(z0).zip(grid.modal_rows.as_ref());
     let mut first: Option<(usize, f64)> = None;
     for &i in &negative {
         let ts = match &modes {
-            Some((lambda, q)) => {
-                let row = grid.rows.row(i);
-                let modal: Vec<C> = (0..lambda.len()).map(|j| (0..na).map(|k| q[(k, j)] * row[k]).sum()).collect();
+            Some(((lambda, c), rows)) => {
+                let modal: Vec<C> = c.iter().enumerate().map(|(j, c)| rows[(i, j)] * c).collect();
                 let g = |s: f64| sign[i] * grid.clearance_at(i, s, t0, lambda, &modal);
                 illinois(&g, t0, t1, c1[i])
             }

@@ -115,7 +115,7 @@ impl PolishedOrbit {
                 let index = s.from + i;
                 // Between samples h apart a signal with |s''| ≤ M is above the lower sample − M h²/8.
                 let lower = match values {
-                    Values::Closed(signals) => (vs[i] - signals[k - first].bend(ts[index - 1], ts[index + 1]) * h * h / 8.0) / s.scale,
+                    Values::Closed(signals) => (vs[i] - signals[k - first].bend((ts[index - 1], ts[index + 1]), None) * h * h / 8.0) / s.scale,
                     Values::Flowed(..) => f64::NEG_INFINITY,
                 };
                 candidates.push(Candidate { sought: k, index, lower });

@@ -1,0 +1,46 @@
+//! The phases of every contact set a sweep has met, kept across its points: a set absent from the
+//! previous orbit (an iterate's, or one met some points before) is then re-tuned to the new ω
+//! (its particular solution only) instead of made again with its eigendecomposition (on the
+//! compliant real blade 1199 phases were made anew over 200 points, of 297 sets).
+use super::super::phase::Phase;
+use crate::model::Model;
+
+/// The most sets kept (~0.25 MB each on the 69-DOF blade); the least recently used goes first.
+const CAPACITY: usize = 512;
+
+/// The phases kept, by closed set, for one system (`model` up to its frequency).
+#[derive(Default)]
+pub struct PhaseBank {
+    model: Option<Model>,
+    /// (last use, closed set, phase).
+    phases: Vec<(u64, Vec<usize>, Phase)>,
+    clock: u64,
+}
+
+impl PhaseBank {
+    /// The phase of the closed set `closed` kept for `model`'s system, at the ω it was made.
+    pub(super) fn find(&self, model: &Model, closed: &[usize]) -> Option<&Phase> {
+        let same = self.model.as_ref().is_some_and(|m| super::same_system(model, m));
+        same.then(|| self.phases.iter().find(|(_, set, _)| set == closed).map(|(_, _, p)| p)).flatten()
+    }
+
+    /// Keeps `phases` (of `model`), replacing those of the same sets; a new system empties the bank.
+    pub(super) fn keep(&mut self, model: &Model, phases: Vec<Phase>) {
+        if !self.model.as_ref().is_some_and(|m| super::same_system(model, m)) {
+            self.model = Some(model.clone());
+            self.phases.clear();
+        }
+        self.clock += 1;
+        for p in phases {
+            let set: Vec<usize> = (0..model.contacts.len()).filter(|&i| p.closed(i)).collect();
+            match self.phases.iter_mut().find(|(_, s, _)| *s == set) {
+                Some(slot) => *slot = (self.clock, set, p),
+                None => self.phases.push((self.clock, set, p)),
+            }
+        }
+        while self.phases.len() > CAPACITY {
+            let oldest = self.phases.iter().enumerate().min_by_key(|(_, (t, _, _))| *t).map(|(k, _)| k).expect("over capacity");
+            self.phases.swap_remove(oldest);
+        }
+    }
+}
