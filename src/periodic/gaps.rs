@@ -10,9 +10,12 @@ use std::sync::{Arc, Mutex};
 /// gap and motion (amplitude, harmonic, phase) as bits.
 type Key = (usize, usize, Vec<(u64, Vec<(u64, u32, u64)>)>);
 
+/// Every contact's samples (model order), shared by the problem's clones.
+type Samples = Arc<Vec<Vec<f64>>>;
+
 /// The last samples computed, with their key.
 #[derive(Debug, Default)]
-pub(super) struct GapSamples(Mutex<Option<(Key, Arc<Vec<Vec<f64>>>)>>);
+pub(super) struct GapSamples(Mutex<Option<(Key, Samples)>>);
 
 impl Clone for GapSamples {
     fn clone(&self) -> Self {
@@ -28,7 +31,7 @@ fn key(contacts: &[Contact], instants: usize, periods: usize) -> Key {
 impl PeriodicProblem {
     /// [`Contact::gap_samples`] of every contact (model order) at `instants` instants over the
     /// problem's periods, computed once per grid and model.
-    pub(super) fn gap_samples(&self, instants: usize) -> Arc<Vec<Vec<f64>>> {
+    pub(super) fn gap_samples(&self, instants: usize) -> Samples {
         let contacts = &self.model().contacts;
         let periods = self.period_multiple();
         let wanted = key(contacts, instants, periods);

@@ -293,15 +293,19 @@ mod tests {
     use super::*;
     use crate::lcp::structured::StepMapData;
 
+    /// Uniform draws in [−½, ½) from a linear congruential generator seeded with `seed`.
+    fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        }
+    }
+
     /// The blocked product (register blocks, AVX2/AVX-512 where the CPU has them) equals the
     /// textbook triple loop bit for bit, on sizes with and without remainder rows and columns.
     #[test]
     fn the_blocked_product_equals_the_triple_loop_bit_for_bit() {
-        let mut seed = 5u64;
-        let mut draw = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut draw = uniform(5);
         for (n, inner, m) in [(41, 41, 41), (1, 1, 1), (8, 3, 4), (13, 7, 9), (95, 40, 17)] {
             let a = Mat::from_fn(n, inner, |_, _| draw());
             let b = Mat::from_fn(inner, m, |_, _| draw());
@@ -323,11 +327,7 @@ mod tests {
     /// at both ends.
     #[test]
     fn the_runs_product_equals_the_step_by_step_product() {
-        let mut seed = 11u64;
-        let mut draw = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut draw = uniform(11);
         for (d, m, k) in [(7, 3, 300), (40, 6, 1000), (120, 5, 1000)] {
             // Φ near the identity (a damped step) with a carry on its diagonal, as the schemes'.
             let phi: Vec<f64> = (0..d * d).map(|e| if e / d == e % d { -0.002 } else { 0.02 / d as f64 } * (1.0 + draw())).collect();
