@@ -413,33 +413,33 @@ fn assemble_modal(
         m,
         dofs: rows.iter().map(|r| r.0).collect(),
         symbols,
-        g_hat: Vec::with_capacity(nh * m * m),
-        xlin_hat: Vec::with_capacity(nh * nd),
-        bxlin_hat: Vec::with_capacity(nh * m),
-        h_hat: Vec::with_capacity(nh * nd * m),
+        g_hat: vec![C::ZERO; nh * m * m],
+        xlin_hat: vec![C::ZERO; nh * nd],
+        bxlin_hat: vec![C::ZERO; nh * m],
+        h_hat: vec![C::ZERO; nh * nd * m],
         tangential: Vec::new(),
     };
     for p in 0..nh {
-        asm.xlin_hat.extend((0..nd).map(|r| C::new(xre[(r, p)], xim[(r, p)])));
-        asm.bxlin_hat.extend((0..m).map(|a| C::new(bre[(a, p)], bim[(a, p)])));
-    }
-    // Column b of every harmonic's Ĝ_p and Ẑ_p⁻¹Bᵀ, then both written in storage order. Why:
-    // written column by column they took m strided passes over nh·m² numbers (9.5 MB at k = 4096,
-    // the real blade's 17 contacts, issue 23).
-    let columns: Vec<[Mat<f64>; 4]> = (0..m)
-        .map(|b| {
-            // v_b = D ∘ (BΦ)[b, :]ᵀ, then Φ_out v_b and BΦ v_b.
-            let vre = Mat::<f64>::from_fn(n, nh, |i, p| dre[(i, p)] * bphi[(b, i)]);
-            let vim = Mat::<f64>::from_fn(n, nh, |i, p| dim[(i, p)] * bphi[(b, i)]);
-            [&phio * &vre, &phio * &vim, &bphi * &vre, &bphi * &vim]
-        })
-        .collect();
-    for p in 0..nh {
         for r in 0..nd {
-            asm.h_hat.extend(columns.iter().map(|[hre, him, ..]| C::new(hre[(r, p)], him[(r, p)])));
+            asm.xlin_hat[p * nd + r] = C::new(xre[(r, p)], xim[(r, p)]);
         }
         for a in 0..m {
-            asm.g_hat.extend(columns.iter().map(|[.., gre, gim]| C::new(gre[(a, p)], gim[(a, p)])));
+            asm.bxlin_hat[p * m + a] = C::new(bre[(a, p)], bim[(a, p)]);
+        }
+    }
+    for b in 0..m {
+        // v_b = D ∘ (BΦ)[b, :]ᵀ, then Φ_out v_b and BΦ v_b.
+        let vre = Mat::<f64>::from_fn(n, nh, |i, p| dre[(i, p)] * bphi[(b, i)]);
+        let vim = Mat::<f64>::from_fn(n, nh, |i, p| dim[(i, p)] * bphi[(b, i)]);
+        let (hre, him) = (&phio * &vre, &phio * &vim);
+        let (gre, gim) = (&bphi * &vre, &bphi * &vim);
+        for p in 0..nh {
+            for r in 0..nd {
+                asm.h_hat[(p * nd + r) * m + b] = C::new(hre[(r, p)], him[(r, p)]);
+            }
+            for a in 0..m {
+                asm.g_hat[(p * m + a) * m + b] = C::new(gre[(a, p)], gim[(a, p)]);
+            }
         }
     }
     let finite = asm.g_hat.iter().chain(&asm.xlin_hat).chain(&asm.h_hat).all(|v| v.re.is_finite() && v.im.is_finite());
