@@ -9,6 +9,7 @@ mod friction_family;
 mod friction_half_steps;
 mod friction_relay;
 mod friction_shooting;
+mod gaps;
 pub mod limits;
 use crate::linalg::fft; // the crate's one FFT plan type, shared with lcp
 mod pilot;

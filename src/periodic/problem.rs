@@ -28,6 +28,8 @@ pub struct PeriodicProblem {
     /// p: the orbit's period is p·T, discretised by p·k instants (k = `disc.steps` per forcing
     /// period); the forcing keeps ω (harmonic p of the base 2π/(pT)).
     period_multiple: usize,
+    /// Each contact's gap samples on the grid, computed once ([`super::gaps`]).
+    pub(super) gaps: super::gaps::GapSamples,
 }
 
 /// Fewest instants per period that any scheme needs.
@@ -85,7 +87,18 @@ impl PeriodicProblem {
             None => model.omega_max()?,
         };
         limits::check_stability(&model, &disc, omega_max)?;
-        Ok(PeriodicProblem { model, disc, outputs, solver, output_map: None, omega_max, auto_steps, contact_pairing: Vec::new(), period_multiple: 1 })
+        Ok(PeriodicProblem {
+            model,
+            disc,
+            outputs,
+            solver,
+            output_map: None,
+            omega_max,
+            auto_steps,
+            contact_pairing: Vec::new(),
+            period_multiple: 1,
+            gaps: Default::default(),
+        })
     }
 
     /// The orbit's period in forcing periods, p (1: T-periodic).

@@ -63,7 +63,7 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
 
     let mut contacts = Vec::new();
     if out.contacts {
-        let angles = crate::model::GridAngles::new(k);
+        let gaps = problem.gap_samples(k);
         for (a, ca) in model.contacts.iter().enumerate() {
             for p in 0..nh {
                 let mut v = asm.bxlin_hat[p * m + a];
@@ -73,7 +73,7 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
                 tmp[p] = v;
             }
             let bx = fft.inverse(&tmp);
-            let gap: Vec<f64> = ca.gap_samples(&angles, problem.period_multiple()).iter().zip(&bx).map(|(&g, &b)| g - b).collect();
+            let gap: Vec<f64> = gaps[a].iter().zip(&bx).map(|(&g, &b)| g - b).collect();
             let force: Vec<f64> = (0..k).map(|j| sol.z[j * m + a]).collect();
             let gap = finite(gap, "contact gap", a)?;
             let normal_displacement = finite(bx, "contact normal displacement", a)?;

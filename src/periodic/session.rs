@@ -36,13 +36,28 @@ pub struct PeriodicSolver {
     pub(super) cache: Option<AssemblyCache>,
     /// Assemblies built by this session (the others were reused).
     assemblies: usize,
+    /// Shooting tries that failed on this problem ([`Self::solve_by_shooting_with`]), newest
+    /// last; cleared when anything but ω changes.
+    misses: Vec<(Try, SolveError)>,
 }
+
+/// One shooting try of a session: ω (its bits), the warm start it started from (none: cold),
+/// and whether a cold try may follow the offset homotopy.
+#[derive(Clone, Debug, PartialEq)]
+struct Try {
+    frequency: u64,
+    warm: Option<Vec<usize>>,
+    homotopy: bool,
+}
+
+/// Failed tries a session remembers (a guarded sweep's sub-steps across a fold repeat a few).
+const MISSES_KEPT: usize = 32;
 
 impl PeriodicSolver {
     /// Plans the FFT of the problem's k; the first solve is cold.
     pub fn new(problem: PeriodicProblem) -> Self {
         let fft = PeriodFft::new(problem.instants());
-        PeriodicSolver { problem, fft, warm_start: None, warm_starts: true, last_start: WarmStart::Cold, cache: None, assemblies: 0 }
+        PeriodicSolver { problem, fft, warm_start: None, warm_starts: true, last_start: WarmStart::Cold, cache: None, assemblies: 0, misses: Vec::new() }
     }
 
     /// Whether solves start from the previous active set (default true).
@@ -83,6 +98,7 @@ impl PeriodicSolver {
         }
         model.contacts.iter_mut().zip(gaps).for_each(|(c, &g)| c.gap = g);
         self.problem = self.problem.with_model(model, self.problem.discretization())?;
+        self.misses.clear();
         Ok(())
     }
 
@@ -96,6 +112,7 @@ impl PeriodicSolver {
         }
         model.forces.iter_mut().zip(amplitudes).for_each(|(f, &a)| f.term.amplitude = a);
         self.problem = self.problem.with_model(model, self.problem.discretization())?;
+        self.misses.clear();
         Ok(())
     }
 
@@ -124,6 +141,7 @@ impl PeriodicSolver {
 
     /// After a change of the grid from `old_k` instants: a new plan, and no warm start.
     fn replan(&mut self, old_k: usize) {
+        self.misses.clear();
         if self.problem.instants() != old_k {
             self.fft = PeriodFft::new(self.problem.instants());
             self.warm_start = None;
@@ -142,6 +160,7 @@ impl PeriodicSolver {
             self.warm_start = None;
         }
         self.problem = problem;
+        self.misses.clear();
     }
 
     /// Forgets the active set: the next solve is cold.
@@ -199,10 +218,17 @@ impl PeriodicSolver {
     }
 
     /// [`Self::solve_by_shooting`]; `homotopy` off: a cold try ends where Newton from the
-    /// contact-free orbit misses (no offset homotopy, which can cost seconds).
+    /// contact-free orbit misses (no offset homotopy, which can cost seconds). A try this session
+    /// already missed (the same ω, warm start and homotopy on the same problem) returns its error
+    /// at once: shooting is deterministic, and a guarded sweep's sub-steps past a fold repeat
+    /// failed tries (issue 23: a third of the real blade's fold tries).
     pub fn solve_by_shooting_with(&mut self, warm: bool, homotopy: bool) -> Result<Response, SolveError> {
         let settings = self.problem.solver_settings().clone();
         let guess = self.warm_start.clone().filter(|_| warm && self.warm_starts);
+        let attempt = Try { frequency: self.problem.model().frequency.to_bits(), warm: guess.clone(), homotopy };
+        if let Some((_, e)) = self.misses.iter().find(|(t, _)| *t == attempt) {
+            return Err(e.clone());
+        }
         let quick = super::SolverSettings {
             method: crate::lcp::LcpMethod::Shooting,
             shooting_warm_only: guess.is_some(),
@@ -212,6 +238,12 @@ impl PeriodicSolver {
         self.problem.set_solver_settings(quick)?;
         let result = self.solve_cached(guess.as_deref());
         self.problem.set_solver_settings(settings)?;
+        if let Err(e) = &result {
+            if self.misses.len() == MISSES_KEPT {
+                self.misses.remove(0);
+            }
+            self.misses.push((attempt, e.clone()));
+        }
         let r = result?;
         self.last_start = if guess.is_some() { WarmStart::Used } else { WarmStart::Cold };
         self.set_warm_start(&r.active_set);

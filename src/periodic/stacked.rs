@@ -12,14 +12,14 @@ impl PeriodicProblem {
         let nh = k / 2 + 1;
         let mut q = vec![0.0; k * m];
         let mut spec = vec![num_complex::Complex64::ZERO; nh];
-        let angles = crate::model::GridAngles::new(k);
+        let gaps = self.gap_samples(k);
         for (a, ca) in self.model().contacts.iter().enumerate() {
             let s = self.pairing_of(ca).offset();
             for (p, v) in spec.iter_mut().enumerate() {
                 *v = asm.bxlin_hat[p * m + a];
             }
             let bx = fft.inverse(&spec);
-            let gap = ca.gap_samples(&angles, self.period_multiple());
+            let gap = &gaps[a];
             for j in 0..k {
                 let jj = (j + s) % k;
                 q[j * m + a] = gap[jj] - bx[jj];

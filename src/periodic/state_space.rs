@@ -159,13 +159,19 @@ pub fn step_map(problem: &PeriodicProblem) -> Result<StepMapLcp, NoStepMap> {
     let galerkin = disc.scheme == Scheme::Galerkin;
     let mut c = vec![0.0; k * d];
     let mut fbar = vec![0.0; n];
+    // W row by row (the products below read rows), and no product at an unloaded instant (c_j
+    // stays 0): the real blade's casing is its only excitation (issue 23).
+    let w_rows: Vec<f64> = (0..n * n).map(|e| w[(e / n, e % n)]).collect();
     for j in 0..k {
         for (dof, f) in fbar.iter_mut().enumerate() {
             let at = |jj: usize| forces[jj * n + dof];
             *f = if galerkin { (at((j + 1) % k) + 4.0 * at(j) + at((j + k - 1) % k)) / 6.0 } else { at(j) };
         }
+        if fbar.iter().all(|&f| f == 0.0) {
+            continue;
+        }
         for r in 0..n {
-            let v: f64 = (0..n).map(|l| w[(r, l)] * fbar[l]).sum();
+            let v: f64 = w_rows[r * n..(r + 1) * n].iter().zip(&fbar).map(|(w, f)| w * f).sum();
             for b in 0..p {
                 c[j * d + b * n + r] = v;
             }
@@ -178,7 +184,7 @@ pub fn step_map(problem: &PeriodicProblem) -> Result<StepMapLcp, NoStepMap> {
     let mut r = vec![0.0; k * m];
     // The contacts' forces enter through Ẽᵀ (rubbing: Ẽ ≠ B̃, S non-symmetric), their gaps through B̃.
     let wb = dense_product(&w, &cond.force_rows.transpose().to_owned());
-    let angles = crate::model::GridAngles::new(k);
+    let gaps = problem.gap_samples(k);
     for (ci, contact) in model.contacts.iter().enumerate() {
         // Implicit (s = L) reads x_(j+L), y's first block; explicit (s = L − 1) reads
         // x_(j+L−1) = x_(j+L) − ∇x_(j+L), known before the step (Γ's blocks are equal: HΓ = 0).
@@ -196,7 +202,7 @@ pub fn step_map(problem: &PeriodicProblem) -> Result<StepMapLcp, NoStepMap> {
         if let Compliance::Compliant { stiffness } = contact.compliance {
             flexibility[ci * m + ci] += 1.0 / stiffness;
         }
-        let gap = contact.gap_samples(&angles, problem.period_multiple());
+        let gap = &gaps[ci];
         for j in 0..k {
             let at = (j + offsets[ci]) % k;
             r[j * m + ci] = gap[at] + gap_shift[at * m + ci];

@@ -31,20 +31,78 @@ pub fn product(a: &Mat<f64>, b: &Mat<f64>) -> Mat<f64> {
         faer::linalg::matmul::matmul(c.as_mut(), faer::Accum::Replace, a.as_ref(), b.as_ref(), 1.0, faer::Par::Seq);
         return c;
     }
-    // Column slices (no per-element bounds checks) let the compiler vectorise the axpy; the
-    // operations and their order are those of the indexed loop, so the result is bit-identical.
-    for j in 0..m {
-        let cj = c.col_as_slice_mut(j);
-        for l in 0..inner {
-            let blj = b[(l, j)];
-            if blj != 0.0 {
-                for (ci, &ail) in cj.iter_mut().zip(a.col_as_slice(l)) {
-                    *ci += ail * blj;
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx512f") {
+        // SAFETY: the CPU has AVX-512F (checked on the line above).
+        unsafe { blocked_avx512(a, b, &mut c) };
+        return c;
+    } else if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2 (checked on the line above).
+        unsafe { blocked_avx2(a, b, &mut c) };
+        return c;
+    }
+    blocked(a, b, &mut c);
+    c
+}
+
+/// [`blocked`] compiled for AVX-512 (the build targets baseline x86-64: SSE2 alone).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn blocked_avx512(a: &Mat<f64>, b: &Mat<f64>, c: &mut Mat<f64>) {
+    blocked(a, b, c);
+}
+
+/// [`blocked`] compiled for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn blocked_avx2(a: &Mat<f64>, b: &Mat<f64>, c: &mut Mat<f64>) {
+    blocked(a, b, c);
+}
+
+/// Rows and columns of c held in registers by [`blocked`] (8 × 4 measured fastest at d + 1 = 41:
+/// 2.0× the plain axpy loop under AVX2, 2.8× under AVX-512).
+const BLOCK_ROWS: usize = 8;
+const BLOCK_COLS: usize = 4;
+
+/// c = a·b by blocks of c kept in registers, each entry summed over l in order from 0, as the
+/// plain loop c_ij += a_il·b_lj does: the same operations in the same order, so the result is
+/// bit-identical whatever the instruction set (Rust never fuses a·b + c). Why: the Jacobians'
+/// (d+1)² products were a sixth of the real blade's 1e-3 sweep (issue 23), and the axpy loop
+/// reloads and stores a column of c per term.
+#[inline(always)]
+fn blocked(a: &Mat<f64>, b: &Mat<f64>, c: &mut Mat<f64>) {
+    let (n, inner, m) = (a.nrows(), a.ncols(), b.ncols());
+    let (rows, cols) = (n / BLOCK_ROWS * BLOCK_ROWS, m / BLOCK_COLS * BLOCK_COLS);
+    let entry = |i: usize, j: usize| (0..inner).fold(0.0, |s, l| s + a[(i, l)] * b[(l, j)]);
+    let a_columns: Vec<&[f64]> = (0..inner).map(|l| a.col_as_slice(l)).collect();
+    for j in (0..cols).step_by(BLOCK_COLS) {
+        let columns: [&[f64]; BLOCK_COLS] = std::array::from_fn(|cc| b.col_as_slice(j + cc));
+        for i in (0..rows).step_by(BLOCK_ROWS) {
+            let mut acc = [[0.0f64; BLOCK_ROWS]; BLOCK_COLS];
+            for (l, a_column) in a_columns.iter().enumerate() {
+                let ail: &[f64; BLOCK_ROWS] = a_column[i..i + BLOCK_ROWS].try_into().expect("a block of rows");
+                for (cc, acc) in acc.iter_mut().enumerate() {
+                    let blj = columns[cc][l];
+                    for x in 0..BLOCK_ROWS {
+                        acc[x] += ail[x] * blj;
+                    }
                 }
+            }
+            for (cc, acc) in acc.iter().enumerate() {
+                c.col_as_slice_mut(j + cc)[i..i + BLOCK_ROWS].copy_from_slice(acc);
+            }
+        }
+        for jj in j..j + BLOCK_COLS {
+            for i in rows..n {
+                c[(i, jj)] = entry(i, jj);
             }
         }
     }
-    c
+    for j in cols..m {
+        for i in 0..n {
+            c[(i, j)] = entry(i, j);
+        }
+    }
 }
 
 /// Powers of the contact-free step, augmented: diag(Φ, 1)^(2^i), i = 0..=log₂ k.
@@ -235,16 +293,41 @@ mod tests {
     use super::*;
     use crate::lcp::structured::StepMapData;
 
+    /// Uniform draws in [−½, ½) from a linear congruential generator seeded with `seed`.
+    fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        }
+    }
+
+    /// The blocked product (register blocks, AVX2/AVX-512 where the CPU has them) equals the
+    /// textbook triple loop bit for bit, on sizes with and without remainder rows and columns.
+    #[test]
+    fn the_blocked_product_equals_the_triple_loop_bit_for_bit() {
+        let mut draw = uniform(5);
+        for (n, inner, m) in [(41, 41, 41), (1, 1, 1), (8, 3, 4), (13, 7, 9), (95, 40, 17)] {
+            let a = Mat::from_fn(n, inner, |_, _| draw());
+            let b = Mat::from_fn(inner, m, |_, _| draw());
+            let c = product(&a, &b);
+            for i in 0..n {
+                for j in 0..m {
+                    let mut sum = 0.0;
+                    for l in 0..inner {
+                        sum += a[(i, l)] * b[(l, j)];
+                    }
+                    assert_eq!(c[(i, j)].to_bits(), sum.to_bits(), "({n}×{inner})·({inner}×{m}) at ({i}, {j})");
+                }
+            }
+        }
+    }
+
     /// The runs' product (squaring, cached powers of Φ, faer's gemm at d = 120 > GEMM_MIN) equals
     /// the step-by-step product to round-off, on sets with runs of every length and an empty run
     /// at both ends.
     #[test]
     fn the_runs_product_equals_the_step_by_step_product() {
-        let mut seed = 11u64;
-        let mut draw = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut draw = uniform(11);
         for (d, m, k) in [(7, 3, 300), (40, 6, 1000), (120, 5, 1000)] {
             // Φ near the identity (a damped step) with a carry on its diagonal, as the schemes'.
             let phi: Vec<f64> = (0..d * d).map(|e| if e / d == e % d { -0.002 } else { 0.02 / d as f64 } * (1.0 + draw())).collect();

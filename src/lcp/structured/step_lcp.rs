@@ -159,8 +159,17 @@ pub(super) fn step_lcp(s: &[f64], m: usize, r: &[f64], guess: u64, z: &mut [f64]
         if !solve_active(s, m, r, mask, z) {
             return None;
         }
+        // z is zero off the set: its non-zero entries, in order, are summed as a scan of all m
+        // would (most steps have none, and the scan was m² tests per step).
+        let (members, p) = members(mask, m);
+        let mut nonzero = [0usize; MAX_PAIRS];
+        let mut n = 0;
+        for &j in members[..p].iter().filter(|&&j| z[j] != 0.0) {
+            nonzero[n] = j;
+            n += 1;
+        }
         for i in 0..m {
-            w[i] = r[i] + (0..m).filter(|&j| z[j] != 0.0).map(|j| s[i * m + j] * z[j]).sum::<f64>();
+            w[i] = r[i] + nonzero[..n].iter().map(|&j| s[i * m + j] * z[j]).sum::<f64>();
         }
         match (0..m).find(|&i| if mask >> i & 1 == 1 { z[i] < -tol } else { w[i] < -tol }) {
             None => {
