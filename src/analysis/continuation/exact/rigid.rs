@@ -372,6 +372,12 @@ impl Walk<'_> {
             // between them 2.5e-6 of the period when the corrector stalls, and no zero ahead).
             (Switch::Impact { stick: false }, Switch::Impact { stick: true }) => {
                 list.remove(e);
+                // The merged orbit held by a negative landing force: the merge is that force's
+                // zero ahead (the coarse blade at 2316.83 rad/s: 2316.95), not where its
+                // micro-flight becomes visible (2322.33, the force still −4.1e-4 there).
+                if let Some(n) = self.held_merge(here, &list, if e + 1 < ne { e } else { 0 }, what) {
+                    return Some(n);
+                }
                 // The flight vanishes where the merged orbit's force at its landing touches zero:
                 // ahead by the flight over its rate of shrinking (the coarse blade at 2226.26 rad/s,
                 // ρ = 30: a flight of 6.5e-7 of the period, the zero 0.03–0.3 rad/s ahead).
@@ -384,10 +390,6 @@ impl Walk<'_> {
                 reach.retain(|f| *f > 0.0 && *f <= 1e-2);
                 reach.sort_by(f64::total_cmp);
                 if let Some(n) = reach.into_iter().find_map(|f| self.fade((lambda, lambda + sense * f * rho), here, list.clone(), what, "the impact")) {
-                    return Some(n);
-                }
-                // The sticking impact, after the pure one removed.
-                if let Some(n) = self.held_merge(here, &list, if e + 1 < ne { e } else { 0 }, what) {
                     return Some(n);
                 }
                 let sig = Signature { events: list.iter().map(|l| l.1).collect(), always: here.orbit.always_closed().to_vec() };
@@ -535,9 +537,9 @@ fn touch_point(fam: &mut Family, guess: &[f64], la: f64, lb: f64) -> Option<Node
     if let Some(e) = landing::lifted(&bad) {
         // The zero lies on the admissible side of the visible lift-off: bracketed a short way on.
         let on = lok + away * 1e-4 * rho;
-        if let Some((n, _)) = landing::landing_zero(fam, &bad.w, e, (lbad, on), away) {
-            return Some(n);
-        }
+        // Without a zero there, the held orbit is admissible by the lift-off tolerance alone
+        // (its landing force far from zero): not the change sought.
+        return landing::landing_zero(fam, &bad.w, e, (lbad, on), away).map(|z| z.0);
     }
     let prev: Vec<f64> = e_l.iter().map(|x| x * away).collect();
     fam.node(ok.w, &prev)

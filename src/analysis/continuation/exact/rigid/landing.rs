@@ -102,7 +102,7 @@ impl Walk<'_> {
             .filter(|n| n.orbit.landing_force(k).is_some_and(|h| h < 0.0))
             .and_then(|n| landing_zero(&self.fam, &n.w, k, (lambda, lambda + sense * 1e-4 * rho), sense))
             .map(|z| z.0)
-            .filter(|z| margin(z) >= -TOL);
+            .filter(|z| margin(z) >= -TOL && (z.lambda(rho) - lambda) * sense >= -BRACKET * rho);
         match zero {
             Some(z) => {
                 let detail = format!(
