@@ -341,6 +341,14 @@ pub fn craig_bampton(
     })
 }
 
+/// A sparse matrix as it is (no copy of a real blade's 4 million entries), a dense one converted.
+fn sparse_view(a: &Matrix) -> std::borrow::Cow<'_, SparseColMat<usize, f64>> {
+    match a {
+        Matrix::Sparse(s) => std::borrow::Cow::Borrowed(s),
+        Matrix::Dense(_) => std::borrow::Cow::Owned(to_sparse(a)),
+    }
+}
+
 /// Converts the engine's matrix to sparse (dense input is scanned for non-zeros).
 pub fn to_sparse(a: &Matrix) -> SparseColMat<usize, f64> {
     match a {
@@ -368,8 +376,7 @@ pub fn reduce_structure(
     opts: &CraigBamptonOptions,
     damping: Option<&Damping>,
 ) -> Result<ReducedModel, ReductionError> {
-    let k = to_sparse(&s.stiffness);
-    let m = to_sparse(&s.mass);
+    let (k, m) = (sparse_view(&s.stiffness), sparse_view(&s.mass));
     let mut red = match method {
         Method::CraigBampton => craig_bampton(&k, &m, boundary, opts)?,
         Method::MasslessBoundary => super::massless::massless_boundary(&k, &m, boundary, opts)?,

@@ -197,6 +197,15 @@ pub fn lanczos(
         y
     };
 
+    // Thread CPU of the solves, the orthonormalisation and the Ritz steps (profile only).
+    let (mut cpu_solve, mut cpu_orth, mut cpu_ritz, mut steps) = (0.0, 0.0, 0.0, 0usize);
+    let lap = |acc: &mut f64, since: &mut Option<f64>| {
+        let now = crate::fe::profile_cpu();
+        if let (Some(a), Some(b)) = (now, *since) {
+            *acc += a - b;
+        }
+        *since = now;
+    };
     let mut seed = opts.seed;
     // Start block: K⁻¹M applied to random vectors (purges the null space of M).
     let mut w = solve(sparse_times_dense(m, random_block(n, p, seed).as_ref()));
@@ -214,7 +223,10 @@ pub fn lanczos(
     loop {
         // Extend the basis with v.
         let pb = v.ncols();
+        let mut since = crate::fe::profile_cpu();
         let mut w = solve(mv.clone());
+        lap(&mut cpu_solve, &mut since);
+        steps += 1;
         q.push(v);
         mq.push(mv);
         let new_dim = dim + pb;
@@ -244,6 +256,7 @@ pub fn lanczos(
         dim = new_dim;
         last_block_len = pb;
         let (vn, mvn, r) = if dim < n { m_orthonormalise(m, &q, &mq, &mut w, 1e-10) } else { (Mat::zeros(n, 0), Mat::zeros(n, 0), Mat::zeros(0, pb)) };
+        lap(&mut cpu_orth, &mut since);
         last_r = r;
         v = vn;
         mv = mvn;
@@ -272,8 +285,17 @@ pub fn lanczos(
                     break;
                 }
             }
+            lap(&mut cpu_ritz, &mut since);
             if converged >= count || dim >= n {
-                return check(k, m, finish(k, m, &q, &theta, &s, count, dim));
+                let modes = finish(k, m, &q, &theta, &s, count, dim);
+                if let Some(end) = crate::fe::profile_cpu() {
+                    let done = since.unwrap_or(end);
+                    eprintln!(
+                        "set-up profile: lanczos {steps} blocks to dimension {dim}: thread CPU solves {cpu_solve:.3} s, orthonormalisation {cpu_orth:.3} s, Ritz {cpu_ritz:.3} s, modes and residuals {:.3} s",
+                        end - done
+                    );
+                }
+                return check(k, m, modes);
             }
             if exhausted {
                 return Err(EigenError::NotConverged { converged, requested: count, dim });
@@ -358,17 +380,18 @@ fn finish(k: &SparseColMat<usize, f64>, m: &SparseColMat<usize, f64>, q: &[Mat<f
 
 /// Mass-normalises and signs each column; returns the relative residuals.
 fn normalise_and_check(k: &SparseColMat<usize, f64>, m: &SparseColMat<usize, f64>, mut shapes: Mat<f64>, omega: &[f64]) -> (Mat<f64>, Vec<f64>) {
-    let mphi = sparse_times_dense(m, shapes.as_ref());
+    let mut mphi = sparse_times_dense(m, shapes.as_ref());
     for j in 0..shapes.ncols() {
         let nm: f64 = (0..shapes.nrows()).map(|i| shapes[(i, j)] * mphi[(i, j)]).sum::<f64>().sqrt();
         let big = (0..shapes.nrows()).max_by(|&a, &b| shapes[(a, j)].abs().total_cmp(&shapes[(b, j)].abs())).unwrap_or(0);
         let sign = if shapes[(big, j)] < 0.0 { -1.0 } else { 1.0 };
+        // M φ scales with φ: one product with M, not two (the residual's round-off only).
         for i in 0..shapes.nrows() {
             shapes[(i, j)] *= sign / nm;
+            mphi[(i, j)] *= sign / nm;
         }
     }
     let kphi = sparse_times_dense(k, shapes.as_ref());
-    let mphi = sparse_times_dense(m, shapes.as_ref());
     let residual = (0..shapes.ncols())
         .map(|j| {
             let w2 = omega[j] * omega[j];

@@ -38,6 +38,7 @@ pub fn massless_boundary(
         return Err(ReductionError::TooManyModes { requested: eta, internal: n - nb });
     }
     let mut timings = Timings::default();
+    let cpu0 = crate::fe::profile_cpu();
     let llt = eigen::cholesky(k).map_err(|e| ReductionError::Stiffness(e.to_string()))?;
     timings.factor = t0.elapsed().as_secs_f64();
 
@@ -99,6 +100,9 @@ pub fn massless_boundary(
     let mass = Mat::from_fn(nr, nr, |i, j| if i == j && i >= nb { 1.0 } else { 0.0 });
     timings.projection = t3.elapsed().as_secs_f64();
     timings.total = t0.elapsed().as_secs_f64();
+    if let (Some(a), Some(b)) = (cpu0, crate::fe::profile_cpu()) {
+        eprintln!("set-up profile: massless-boundary reduction {:.3} s thread CPU ({timings:?}, wall)", b - a);
+    }
     Ok(ReducedModel {
         method: Method::MasslessBoundary,
         n_full: n,

@@ -39,9 +39,9 @@ pub(super) fn reduce(
         (None, None, Some(c)) => Damping::Matrix(crate::reduction::to_sparse(c)),
         (None, None, None) => Damping::None,
     };
-    let undamped = Structure { mass: full.structure.mass.clone(), stiffness: full.structure.stiffness.clone(), damping: None };
     let opts = CraigBamptonOptions { modes: spec.modes.unwrap_or(DEFAULT_MODES), ..Default::default() };
-    let red = crate::reduction::reduce_structure(&undamped, method, &boundary, &opts, Some(&damping)).map_err(|e| match e {
+    // The damping given overrides the structure's matrix (no copy of M and K to drop it).
+    let red = crate::reduction::reduce_structure(full.structure, method, &boundary, &opts, Some(&damping)).map_err(|e| match e {
         ReductionError::TooManyModes { requested, internal } => BuildError::field(
             "reduction.modes",
             format!("is {requested}, but only {internal} internal DOFs remain besides the {} boundary DOFs", boundary.len()),
