@@ -552,13 +552,25 @@ impl Walk<'_> {
             let value = |n: &Node| if side(n, kind) == s { 1.0 } else { -1.0 } * test_value(n, kind).abs();
             let same = |n: &Node| side(n, kind) == s;
             let test = if kind == EventKind::NeimarkSacker { Test::Side(&same) } else { Test::Value(&value) };
-            let node = locate(&self.fam, a, b, test, false).map_or_else(|| b.clone(), |(_, hi)| hi);
+            let located = locate(&self.fam, a, b, test, false);
+            let missed = located.is_none();
+            let node = located.map_or_else(|| b.clone(), |(_, hi)| hi);
             // det(I + M) also changes sign when a multiplier passes through ∞ (an impact's
             // velocity fading at a grazing, Nordmark 1991): no multiplier at −1, no doubling.
-            if kind == EventKind::PeriodDoubling && !node.mu.iter().any(|m| (m + 1.0).norm() < 1e-3) {
+            // Unlocated (a trial's corrector failed), a real multiplier crossing −1 between the
+            // two points is the doubling (the real blade's at 2283.42 rad/s was dropped so).
+            let doubling = if missed { floquet::crosses_minus_one(&a.mu, &b.mu) } else { node.mu.iter().any(|m| (m + 1.0).norm() < 1e-3) };
+            if kind == EventKind::PeriodDoubling && !doubling {
                 continue;
             }
-            let detail = detail_of(kind, &node);
+            let mut detail = detail_of(kind, &node);
+            if missed {
+                detail += &format!(
+                    "; not located: between λ = {} and {} (a trial's corrector failed), given at the latter",
+                    a.lambda(self.fam.rho),
+                    b.lambda(self.fam.rho)
+                );
+            }
             found.push((kind, node, detail));
         }
         let sec: Vec<f64> = b.w.iter().zip(&a.w).map(|(x, y)| x - y).collect();
