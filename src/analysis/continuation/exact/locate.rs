@@ -8,6 +8,7 @@
 //! real blade (k = 1024, 52 events) 52 s CPU per bisection to [`BRACKET`], about 37 halvings.
 use super::family::{Family, Node};
 use super::{BRACKET, NEWTON_NOISE, dot, profile};
+use crate::analysis::continuation::{EventKind, floquet};
 
 /// What tells the two sides of an event apart.
 pub(super) enum Test<'a> {
@@ -83,4 +84,28 @@ fn locate_on(fam: &Family, a: &Node, b: &Node, test: &Test, touches: bool) -> Op
         }
     }
     Some((lo, hi))
+}
+
+/// The side of a point for an event's test function.
+pub(super) fn side(n: &Node, kind: EventKind) -> i64 {
+    match kind {
+        EventKind::Fold => i64::from(n.tangent[n.tangent.len() - 1] > 0.0),
+        EventKind::PeriodDoubling => i64::from(floquet::doubling_sign(&n.mu)),
+        EventKind::NeimarkSacker => floquet::complex_outside(&n.mu) as i64,
+        EventKind::Grazing => 0,
+    }
+}
+
+/// A fold's and a period doubling's test function, whose sign is [`side`]'s: the tangent's λ
+/// component, det(I + M) (Seydel 2010, §7.4). The others: 1.
+pub(super) fn test_value(n: &Node, kind: EventKind) -> f64 {
+    match kind {
+        EventKind::Fold => n.tangent[n.tangent.len() - 1],
+        EventKind::PeriodDoubling => floquet::doubling_test(&n.mu),
+        _ => 1.0,
+    }
+}
+
+pub(super) fn detail_of(kind: EventKind, node: &Node) -> String {
+    floquet::event_detail(kind, &node.mu)
 }

@@ -27,7 +27,7 @@ use crate::analysis::polish::{self, EventKind as Switch, PolishedOrbit};
 use crate::error::Error;
 use crate::periodic::{PeriodicProblem, PeriodicSolver};
 use family::{Family, Node, Signature};
-use locate::{Test, locate};
+use locate::{Test, detail_of, locate, side, test_value};
 
 /// A phase shorter than this (fraction of the period) and shrinking has vanished: a grazing.
 const VANISH: f64 = 1e-6;
@@ -582,28 +582,4 @@ impl Walk<'_> {
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
-}
-
-/// The side of a point for an event's test function.
-fn side(n: &Node, kind: EventKind) -> i64 {
-    match kind {
-        EventKind::Fold => i64::from(n.tangent[n.tangent.len() - 1] > 0.0),
-        EventKind::PeriodDoubling => i64::from(floquet::doubling_sign(&n.mu)),
-        EventKind::NeimarkSacker => floquet::complex_outside(&n.mu) as i64,
-        EventKind::Grazing => 0,
-    }
-}
-
-/// A fold's and a period doubling's test function, whose sign is [`side`]'s: the tangent's λ
-/// component, det(I + M) (Seydel 2010, §7.4). The others: 1.
-fn test_value(n: &Node, kind: EventKind) -> f64 {
-    match kind {
-        EventKind::Fold => n.tangent[n.tangent.len() - 1],
-        EventKind::PeriodDoubling => floquet::doubling_test(&n.mu),
-        _ => 1.0,
-    }
-}
-
-fn detail_of(kind: EventKind, node: &Node) -> String {
-    super::floquet::event_detail(kind, &node.mu)
 }
