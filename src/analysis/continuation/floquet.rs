@@ -82,8 +82,6 @@ pub fn complex_outside(mu: &[Complex64]) -> usize {
     mu.iter().filter(|m| m.im.abs() > 1e-9 * m.norm() && m.norm() > 1.0).count()
 }
 
-/// What an event's multipliers say in its detail: the pair of a Neimark–Sacker, the multiplier
-/// nearest −1 of a period doubling; nothing for the other kinds.
 /// A real multiplier within 0.1 of −1 on each side of it, one in `a` and one in `b` (a period
 /// doubling between two points, where det(I + M)'s sign change could not be located).
 pub fn crosses_minus_one(a: &[Complex64], b: &[Complex64]) -> bool {
@@ -91,6 +89,8 @@ pub fn crosses_minus_one(a: &[Complex64], b: &[Complex64]) -> bool {
     (near(a, true) && near(b, false)) || (near(a, false) && near(b, true))
 }
 
+/// What an event's multipliers say in its detail: the pair of a Neimark–Sacker, the multiplier
+/// nearest −1 of a period doubling; nothing for the other kinds.
 pub fn event_detail(kind: super::EventKind, mu: &[Complex64]) -> String {
     match kind {
         super::EventKind::NeimarkSacker => {
