@@ -126,7 +126,14 @@ pub(super) fn solve_active(s: &[f64], m: usize, r: &[f64], mask: u64, z: &mut [f
     if p == 0 {
         return true;
     }
-    let mut a = vec![0.0; p * p];
+    // On the stack up to 8 active pairs (every step of a march solves this).
+    let (mut stack, mut heap) = ([0.0; 64], Vec::new());
+    let a: &mut [f64] = if p <= 8 {
+        &mut stack[..p * p]
+    } else {
+        heap.resize(p * p, 0.0);
+        &mut heap
+    };
     let mut b = [0.0; MAX_PAIRS];
     for (i, &ai) in act.iter().enumerate() {
         b[i] = -r[ai];
@@ -134,7 +141,7 @@ pub(super) fn solve_active(s: &[f64], m: usize, r: &[f64], mask: u64, z: &mut [f
             a[i * p + j] = s[ai * m + aj];
         }
     }
-    if eliminate(&mut a, &mut b[..p], p) == 0.0 {
+    if eliminate(a, &mut b[..p], p) == 0.0 {
         return false;
     }
     for (i, &ai) in act.iter().enumerate() {
