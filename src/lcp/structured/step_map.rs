@@ -254,7 +254,7 @@ pub(super) fn march(sm: &StepMapLcp, s0: &[f64], shift: f64, contacts: Contacts<
             matmul(MatMut::from_column_major_slice_mut(&mut y, d, 1), Accum::Add, sm.phi.as_ref(), x, 1.0, Par::Seq);
         } else {
             rows_dot(&sm.phi_rows, &s, &mut y);
-            y.iter_mut().zip(&sm.c[step * d..(step + 1) * d]).for_each(|(v, &c)| *v = c + *v);
+            y.iter_mut().zip(&sm.c[step * d..(step + 1) * d]).for_each(|(v, &c)| *v += c);
         }
         for &(i, l) in &sm.carry {
             y[i] += s[l];
@@ -265,7 +265,7 @@ pub(super) fn march(sm: &StepMapLcp, s0: &[f64], shift: f64, contacts: Contacts<
             matmul(MatMut::from_column_major_slice_mut(&mut r, m, 1), Accum::Add, h_rows, x, 1.0, Par::Seq);
         } else {
             rows_dot(&sm.h, &y, &mut r);
-            r.iter_mut().zip(&sm.r[step * m..(step + 1) * m]).for_each(|(v, &rj)| *v = rj + shift + *v);
+            r.iter_mut().zip(&sm.r[step * m..(step + 1) * m]).for_each(|(v, &rj)| *v += rj + shift);
         }
         let mask = match contacts {
             Contacts::Free => {
