@@ -379,7 +379,7 @@ impl PeriodicProblem {
         let t_lcp = Instant::now();
         // A cold solve of a stiff model with rigid impacts starts from a coarse bds1 pilot's sets.
         let pilot = warm_start.is_none().then(|| super::pilot::warm_start(self)).flatten();
-        let sol = super::rubbing::solve_lcp(self, fft, &a, &q, warm_start.or(pilot.as_ref().map(|p| p.0.as_slice())))?;
+        let (sol, walked) = super::rubbing::solve_lcp(self, fft, &a, &q, warm_start.or(pilot.as_ref().map(|p| p.0.as_slice())))?;
         let t_lcp = t_lcp.elapsed().as_secs_f64();
         super::rubbing::check_gross_slip(self, asm, fft, &sol.z)?;
 
@@ -392,6 +392,9 @@ impl PeriodicProblem {
             // The caller gave no warm start: say where the sets came from, not "warm start used".
             response.lcp.warm_start_used = false;
             response.lcp.path = format!("{} (started from a bds1 pilot's active sets at k = {k})", response.lcp.path);
+        }
+        if let Some(note) = walked {
+            response.lcp.path = format!("{} ({note})", response.lcp.path);
         }
         response.timing_s.total = t_start.elapsed().as_secs_f64();
         Ok(response)
