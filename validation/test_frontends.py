@@ -158,9 +158,14 @@ def _refused_everywhere(cli, scene, path, fmu, k, phrase):
     assert not missing, f"{scene}: {missing} refuse without the reason {phrase!r}: {refusals}"
 
 
-def _same_as_the_sweep(cli, scene, path, raw, folder):
-    """The CLI's peak amplitude of SWEPT[scene]'s DOF equals the last point of a sweep warm from below."""
+def _same_as_the_sweep(cli, scene, folder):
+    """At the scene's own frequency, the CLI's peak amplitude of SWEPT[scene]'s DOF equals the last
+    point of a sweep warm from below. Not at the whole-nanosecond frequency: 0.18 rad/s below
+    2300 the walk crosses the fold by marching and lands on another orbit (README "Friction")."""
     dof, start, points = SWEPT[scene]
+    os.makedirs(folder, exist_ok=True)
+    path = _scene_copy(scene, folder, None)
+    raw = _cli(cli, path, os.path.join(folder, "own.json"))
     with open(path, "rb") as fh:
         omega = tomllib.load(fh)["excitation"]["frequency"]
     out = os.path.join(folder, "sweep.csv")
@@ -201,7 +206,7 @@ def test_every_front_end_gives_the_cli_displacements(cli, workdir, scene):
     raw = _cli(cli, path, os.path.join(folder, "cli.json"))
     walls["CLI"] = time.perf_counter() - t0
     if scene in SWEPT:
-        _same_as_the_sweep(cli, scene, path, raw, folder)
+        _same_as_the_sweep(cli, scene, os.path.join(folder, "own"))
     assert raw["steps"] == k, f"{scene}: k = {raw['steps']} at the whole-nanosecond frequency, {k} at the scene's"
     period = raw["period"]
     want = {key: np.asarray(x) for key, x in raw["displacement"].items()}

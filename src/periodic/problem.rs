@@ -452,7 +452,11 @@ impl PeriodicProblem {
         // auto's dense fallback after shooting only when its projected cost is affordable.
         let refused = (method == LcpMethod::Auto && step_map.is_some()).then(|| dense_fallback_allowed(q.len()).err()).flatten();
         let method = if refused.is_some() { LcpMethod::Shooting } else { method };
-        let reach = crate::lcp::ShootingReach { warm_only: self.solver.shooting_warm_only, homotopy: self.solver.shooting_homotopy };
+        let reach = crate::lcp::ShootingReach {
+            warm_only: self.solver.shooting_warm_only,
+            homotopy: self.solver.shooting_homotopy,
+            settle: self.solver.shooting_settle,
+        };
         let (sol, _state) = solve_periodic_lcp_with(a, q, step_map.as_ref(), method, self.solver.tolerance, warm_start, reach);
         match refused {
             _ if sol.outcome == LcpOutcome::Solved => Ok(sol),
