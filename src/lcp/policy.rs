@@ -190,8 +190,14 @@ pub fn solve_periodic_lcp_with(
             // bounds each try.
             let defaults = ShootingSettings::default();
             let max_work = if method == LcpMethod::Auto && dense_ok { defaults.max_work.max(0.5 * (q.len() as f64).powi(3)) } else { defaults.max_work };
-            let (sol, state) =
-                shooting(a, q, sm, tolerance, warm_start, &ShootingSettings { max_work, warm_only: reach.warm_only, homotopy: reach.homotopy, ..defaults });
+            let (sol, state) = shooting(
+                a,
+                q,
+                sm,
+                tolerance,
+                warm_start,
+                &ShootingSettings { max_work, warm_only: reach.warm_only, homotopy: reach.homotopy, settle: reach.settle, ..defaults },
+            );
             if sol.outcome == LcpOutcome::Solved || method == LcpMethod::Shooting || !dense_ok {
                 return (sol, state);
             }

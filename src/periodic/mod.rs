@@ -95,11 +95,14 @@ pub struct SolverSettings {
     /// Shooting may follow the offset homotopy when Newton misses (default on; off for a
     /// guarded sweep's cold try inside a run of failed points).
     pub shooting_homotopy: bool,
+    /// Periods marched from a warm start before shooting's Newton (0: none; a lone rubbing
+    /// solve's jump past a fold, `rubbing/walk.rs`).
+    pub shooting_settle: usize,
 }
 
 impl Default for SolverSettings {
     fn default() -> Self {
-        SolverSettings { method: LcpMethod::Auto, tolerance: 1e-9, parallel: true, shooting_warm_only: false, shooting_homotopy: true }
+        SolverSettings { method: LcpMethod::Auto, tolerance: 1e-9, parallel: true, shooting_warm_only: false, shooting_homotopy: true, shooting_settle: 0 }
     }
 }
 

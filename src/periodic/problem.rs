@@ -379,7 +379,7 @@ impl PeriodicProblem {
         let t_lcp = Instant::now();
         // A cold solve of a stiff model with rigid impacts starts from a coarse bds1 pilot's sets.
         let pilot = warm_start.is_none().then(|| super::pilot::warm_start(self)).flatten();
-        let sol = super::rubbing::solve_lcp(self, fft, &a, &q, warm_start.or(pilot.as_ref().map(|p| p.0.as_slice())))?;
+        let (sol, walked) = super::rubbing::solve_lcp(self, fft, &a, &q, warm_start.or(pilot.as_ref().map(|p| p.0.as_slice())))?;
         let t_lcp = t_lcp.elapsed().as_secs_f64();
         super::rubbing::check_gross_slip(self, asm, fft, &sol.z)?;
 
@@ -392,6 +392,9 @@ impl PeriodicProblem {
             // The caller gave no warm start: say where the sets came from, not "warm start used".
             response.lcp.warm_start_used = false;
             response.lcp.path = format!("{} (started from a bds1 pilot's active sets at k = {k})", response.lcp.path);
+        }
+        if let Some(note) = walked {
+            response.lcp.path = format!("{} ({note})", response.lcp.path);
         }
         response.timing_s.total = t_start.elapsed().as_secs_f64();
         Ok(response)
@@ -449,7 +452,11 @@ impl PeriodicProblem {
         // auto's dense fallback after shooting only when its projected cost is affordable.
         let refused = (method == LcpMethod::Auto && step_map.is_some()).then(|| dense_fallback_allowed(q.len()).err()).flatten();
         let method = if refused.is_some() { LcpMethod::Shooting } else { method };
-        let reach = crate::lcp::ShootingReach { warm_only: self.solver.shooting_warm_only, homotopy: self.solver.shooting_homotopy };
+        let reach = crate::lcp::ShootingReach {
+            warm_only: self.solver.shooting_warm_only,
+            homotopy: self.solver.shooting_homotopy,
+            settle: self.solver.shooting_settle,
+        };
         let (sol, _state) = solve_periodic_lcp_with(a, q, step_map.as_ref(), method, self.solver.tolerance, warm_start, reach);
         match refused {
             _ if sol.outcome == LcpOutcome::Solved => Ok(sol),

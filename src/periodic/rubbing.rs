@@ -9,6 +9,8 @@ use crate::model::{Compliance, Contact, Model};
 use num_complex::Complex64 as C;
 use std::borrow::Cow;
 
+mod walk;
+
 /// The tangential row of a rubbing contact after the fold: its response to each contact's
 /// force (with the friction it carries) and its linear part, per harmonic.
 #[derive(Clone, Debug)]
@@ -103,27 +105,49 @@ const HOMOTOPY_MIN_STEP: f64 = 1.0 / 256.0;
 /// affordable dense fallback follows (`shooting` alone, or `auto` on an LCP whose dense Lemke is
 /// refused by its projected cost), the μ-homotopy ([`friction_homotopy`]) gives shooting a warm
 /// start. Why: near the real blade's μ = 0.15 resonance cold shooting's offset homotopy follows a
-/// path that folds and ends at a kink (README "Friction"), where μ = 0 solves at once.
-pub(super) fn solve_lcp(problem: &PeriodicProblem, fft: &PeriodFft, a: &BlockCirculant, q: &[f64], warm: Option<&[usize]>) -> Result<LcpSolution, SolveError> {
+/// path that folds and ends at a kink (README "Friction"), where μ = 0 solves at once. Where that
+/// misses too, a lone solve (`auto`; a sweep's tries are `shooting`) walks up in ω from below
+/// ([`walk::walk_up`]). Returns the solution and, after the walk, a note for `lcp.path`.
+pub(super) fn solve_lcp(
+    problem: &PeriodicProblem,
+    fft: &PeriodFft,
+    a: &BlockCirculant,
+    q: &[f64],
+    warm: Option<&[usize]>,
+) -> Result<(LcpSolution, Option<String>), SolveError> {
     let settings = problem.solver_settings();
     let rubbing = problem.model().rubbing.iter().any(|r| r.coefficient > 0.0);
     // A warm-only try (a guarded sweep's quick one, and the homotopy's own steps) stays one try;
     // an affordable dense Lemke is the surer fallback.
     let dense_next = settings.method == LcpMethod::Auto && crate::lcp::dense_fallback_allowed(q.len()).is_ok();
     if !rubbing || settings.shooting_warm_only || dense_next || !matches!(settings.method, LcpMethod::Auto | LcpMethod::Shooting) {
-        return problem.solve_lcp(a, q, warm);
+        return problem.solve_lcp(a, q, warm).map(|sol| (sol, None));
     }
     let missed = match problem.solve_lcp(a, q, warm) {
-        Ok(sol) => return Ok(sol),
+        Ok(sol) => return Ok((sol, None)),
         Err(e) => e,
     };
-    progress(&format!("shooting missed ({missed}); μ-homotopy from μ = 0 next"));
-    let homotopy = friction_homotopy(problem, fft).and_then(|set| {
+    // Shooting at full μ from a homotopy's or the walk's final active sets (Newton from them).
+    let from_set = |set: Vec<usize>| {
         let mut p = problem.clone();
         p.set_solver_settings(SolverSettings { method: LcpMethod::Shooting, ..settings.clone() })?;
         p.solve_lcp(a, q, Some(&set))
-    });
-    homotopy.map_err(|e| annotate(missed, &format!("the μ-homotopy from μ = 0 missed too ({e})")))
+    };
+    progress(&format!("shooting missed ({missed}); μ-homotopy from μ = 0 next"));
+    let why = match friction_homotopy(problem, fft).and_then(&from_set) {
+        Ok(sol) => return Ok((sol, None)),
+        Err(e) => format!("the μ-homotopy from μ = 0 missed too ({e})"),
+    };
+    if settings.method != LcpMethod::Auto {
+        return Err(annotate(missed, &why));
+    }
+    progress(&format!("{why}; a frequency walk from below next"));
+    match walk::walk_up(problem) {
+        Ok((set, note)) => {
+            from_set(set).map(|sol| (sol, Some(note))).map_err(|e| annotate(missed, &format!("{why}; shooting from the frequency walk's orbit missed ({e})")))
+        }
+        Err(walked) => Err(annotate(missed, &format!("{why}; {walked}"))),
+    }
 }
 
 /// The μ-homotopy: solves the model without friction (the symmetric LCP, one answer), then

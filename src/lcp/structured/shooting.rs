@@ -48,6 +48,10 @@ pub struct ShootingSettings {
     /// contact-free orbit misses. Off: a guarded sweep's cold try inside a run of failed points
     /// (issue 23: there it met 70–100 kinks and missed, 2–5 s each).
     pub homotopy: bool,
+    /// With a warm start, first march this many periods from its orbit (the period map iterated:
+    /// time marching), then Newton from where they end: the jump onto the attractor past a fold
+    /// that Newton from the warm orbit alone misses (a lone rubbing solve's frequency walk).
+    pub settle: usize,
 }
 
 /// What a shooting solve may try beyond Newton from its warm start ([`ShootingSettings`]'s
@@ -56,11 +60,12 @@ pub struct ShootingSettings {
 pub struct ShootingReach {
     pub warm_only: bool,
     pub homotopy: bool,
+    pub settle: usize,
 }
 
 impl ShootingReach {
     /// Everything: warm Newton, the contact-free start, the offset homotopy.
-    pub const FULL: ShootingReach = ShootingReach { warm_only: false, homotopy: true };
+    pub const FULL: ShootingReach = ShootingReach { warm_only: false, homotopy: true, settle: 0 };
 }
 
 impl Default for ShootingSettings {
@@ -74,6 +79,7 @@ impl Default for ShootingSettings {
             work_iterations: 40.0,
             warm_only: false,
             homotopy: true,
+            settle: 0,
         }
     }
 }
@@ -312,6 +318,13 @@ fn shoot(nt: &mut Newton<'_>, warm: Option<&[u64]>) -> ShootingSolution {
         work: nt.work,
         work_per_iteration: nt.march_work + nt.jacobian_work,
     };
+    // 0. Past a fold: time marching from the warm sets' orbit, then Newton.
+    if settings.settle > 0
+        && let Some(sets) = warm.filter(|w| w.len() == k)
+        && let Some(it) = settle_then_newton(nt, sets)
+    {
+        return done(nt, it, 0, "warm");
+    }
     // 1. Newton from the warm sets' orbit, then from the contact-free orbit (formed only when
     // the warm start fails: its Jacobian costs as much as a Newton iteration).
     if let Some(sets) = warm.filter(|w| w.len() == k)
@@ -522,6 +535,19 @@ fn fixed_point(nt: &mut Newton<'_>, contacts: Contacts<'_>) -> Option<(Vec<f64>,
     nt.work += nt.march_work;
     let m = march(nt.sm, &s, 0.0, contacts)?;
     Some((s, m))
+}
+
+/// `settle` periods marched from the orbit the warm sets give (each step's LCP solved: time
+/// marching, which follows the transient onto an attractor), then Newton from their end.
+fn settle_then_newton(nt: &mut Newton<'_>, sets: &[u64]) -> Option<Iterate> {
+    let mut s = fixed_state(nt, Contacts::Frozen(sets))?;
+    let mut masks = sets.to_vec();
+    for _ in 0..nt.settings.settle {
+        nt.marches += 1;
+        let m = march(nt.sm, &s, 0.0, Contacts::Solve(&masks))?;
+        (s, masks) = (m.end, m.masks);
+    }
+    nt.solve(s, 0.0, &masks, nt.settings.max_iterations).ok()
 }
 
 /// [`fixed_point`]'s state alone (a warm start's Newton marches from it with the sets solved).
