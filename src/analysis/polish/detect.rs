@@ -13,6 +13,7 @@ use super::phase::Phase;
 use super::{PolishFailure, PolishedOrbit, verify};
 use crate::model::Model;
 use nalgebra::{DMatrix, DVector};
+use std::sync::Arc;
 
 // The switch search on a phase's grid without a flow per step.
 mod grid;
@@ -29,6 +30,17 @@ const MAX_ITERATIONS: usize = 10;
 
 thread_local! {
     static PROFILE: bool = std::env::var_os("PERIODIC_CONTACT_PROFILE").is_some();
+    static TALLY: std::cell::RefCell<[f64; 8]> = const { std::cell::RefCell::new([0.0; 8]) };
+}
+
+/// TEMP profiling: adds the CPU since `since` to tally `k`.
+pub(super) fn tally(k: usize, since: Option<f64>) {
+    if let (Some(a), Some(b)) = (since, super::thread_cpu()) {
+        TALLY.with(|t| t.borrow_mut()[k] += b - a);
+    }
+}
+pub(super) fn cpu_now() -> Option<f64> {
+    if PROFILE.with(|p| *p) { super::thread_cpu() } else { None }
 }
 
 /// Phases by closed set at one ω: `prev`'s re-tuned where it has the set (only the particular
@@ -43,6 +55,8 @@ struct Flows<'a> {
     phases: Vec<Phase>,
     /// Each phase's switch-search grid.
     grids: Vec<Grid>,
+    /// Each contact's gap harmonics (the grids' periodic parts).
+    gaps: Vec<super::phase::Harmonics>,
     /// CPU spent building phases [s], under `PERIODIC_CONTACT_PROFILE`.
     building: f64,
 }
@@ -53,7 +67,8 @@ impl Flows<'_> {
             return Ok(k);
         }
         let clock = PROFILE.with(|on| on.then(super::thread_cpu).flatten());
-        let old = self.prev.phases.iter().find(|o| self.retune && o.is_for(&[], closed)).or_else(|| self.bank.find(self.model, closed));
+        let banked = self.bank.find(self.model, closed);
+        let old = self.prev.phases.iter().find(|o| self.retune && o.is_for(&[], closed)).or(banked.map(|(p, _)| p));
         let p = match old {
             Some(o) => o.retuned(self.model),
             None => Phase::new(self.model, &[], closed).map(|mut p| {
@@ -68,7 +83,13 @@ impl Flows<'_> {
             self.building += b - a;
         }
         let h = 1.0 / (STEPS_PER_RADIAN * p.speed_hint().max(self.model.frequency));
-        self.grids.push(Grid::new(self.model, &p, h));
+        let c = cpu_now();
+        let fixed = match banked {
+            Some((_, f)) if f.h == h => Arc::clone(f),
+            _ => Arc::new(grid::Fixed::new(self.model, &p, h)),
+        };
+        self.grids.push(Grid::new(self.model, &p, fixed, &self.gaps));
+        tally(0, c);
         self.phases.push(p);
         Ok(self.phases.len() - 1)
     }
@@ -115,10 +136,12 @@ pub fn follow_detected_with(model: &Model, prev: &PolishedOrbit, start: &[f64], 
     if model.contacts.iter().any(|c| c.is_rigid()) || !model.frictions.is_empty() || !model.rubbing.is_empty() {
         return Err(PolishFailure("switch-detecting shooting: only for compliant contacts".into()));
     }
-    let mut flows = Flows { model, prev, bank, retune: same_system(model, &prev.model), phases: Vec::new(), grids: Vec::new(), building: 0.0 };
+    let gaps = (0..model.contacts.len()).map(|i| super::phase::gap_harmonics(model, i)).collect();
+    let mut flows = Flows { model, prev, bank, retune: same_system(model, &prev.model), phases: Vec::new(), grids: Vec::new(), gaps, building: 0.0 };
     let out = newton(&mut flows, start);
     let phases = std::mem::take(&mut flows.phases);
-    bank.keep(model, phases);
+    let kept = phases.into_iter().zip(flows.grids.iter().map(|g| Arc::clone(&g.fixed))).collect();
+    bank.keep(model, kept);
     out
 }
 
@@ -145,14 +168,20 @@ fn newton(flows: &mut Flows, start: &[f64]) -> Result<PolishedOrbit, PolishFailu
         }
         // d y(T) / d y(0) = L_last (Π e^{A τ}) R: every phase shares the free basis (no stuck
         // contact), so R L_j = I between phases (phase.rs's `transition`).
+        let c = cpu_now();
         let m = flows.phases[shot.last_phase].transition(&shot.product(&flows.phases));
         let jac = m - DMatrix::identity(n2, n2);
         let du = jac.lu().solve(&(-&r)).ok_or_else(|| fail("the monodromy has a multiplier 1"))?;
+        tally(1, c);
         let before = r.component_mul(&w).amax();
         let mut lambda = 1.0;
         let (next, next_shot, rn) = loop {
             let cand = &y + &du * lambda;
-            if let Ok(s) = shoot(&carrier, flows, &cand) {
+            let c = cpu_now();
+            let shot_try = shoot(&carrier, flows, &cand);
+            tally(2, c);
+            TALLY.with(|t| t.borrow_mut()[7] += 1.0);
+            if let Ok(s) = shot_try {
                 let rc = &s.end - &cand;
                 let merit = rc.component_mul(&w).amax();
                 if merit < before || merit < floor {
@@ -174,7 +203,8 @@ fn newton(flows: &mut Flows, start: &[f64]) -> Result<PolishedOrbit, PolishFailu
         }
     };
     let residual = r.component_mul(&w).amax();
-    super::profile(&format!("switch detection: {iterations} iterations, {} phases built in {:.3} s CPU", flows.phases.len(), flows.building), clock);
+    let t = TALLY.with(|t| *t.borrow());
+    super::profile(&format!("switch detection: {iterations} iterations, {} phases built in {:.3} s CPU; TALLY grids {:.3} jac {:.3} shots {:.3} earliest {:.3} flowto {:.3} steps {:.3} nshots {}", flows.phases.len(), flows.building, t[0], t[1], t[2], t[3], t[4], t[5], t[7]), clock);
     let orbit = assemble(model, prev, flows, shot, (iterations, residual, correction))?;
     super::profile("the orbit on the detected signature", clock);
     verify::check(&orbit)?;
