@@ -159,7 +159,15 @@ fn newton(flows: &mut Flows, start: &[f64]) -> Result<PolishedOrbit, PolishFailu
     let mut shot = shoot(&carrier, flows, &y)?;
     let mut r = &shot.end - &y;
     let mut iterations = 0;
+    // The last Jacobian's factors: a correction below round-off by this chord ends Newton without
+    // a new Jacobian and a confirming shot (the chord's step is the exact one's to O(‖Δy‖) relative).
+    let mut chord: Option<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>> = None;
     let correction = loop {
+        if let Some(du) = chord.as_ref().and_then(|lu| lu.solve(&(-&r))) {
+            if du.component_mul(&w).amax() < 1e-12 * size {
+                break du.rows(0, model.n()).amax();
+            }
+        }
         if iterations == MAX_ITERATIONS {
             // Near a grazing the flow's derivative is not Lipschitz and Newton may stall short
             // of round-off: the polish's Newton on the detected signature, its times as seeds.
@@ -171,7 +179,9 @@ fn newton(flows: &mut Flows, start: &[f64]) -> Result<PolishedOrbit, PolishFailu
         let c = cpu_now();
         let m = flows.phases[shot.last_phase].transition(&shot.product(&flows.phases));
         let jac = m - DMatrix::identity(n2, n2);
-        let du = jac.lu().solve(&(-&r)).ok_or_else(|| fail("the monodromy has a multiplier 1"))?;
+        let lu = jac.lu();
+        let du = lu.solve(&(-&r)).ok_or_else(|| fail("the monodromy has a multiplier 1"))?;
+        chord = Some(lu);
         tally(1, c);
         let before = r.component_mul(&w).amax();
         let mut lambda = 1.0;
