@@ -26,6 +26,9 @@ pub(super) struct Fixed {
     /// B_i P̂_p from the particular solution's coordinates).
     on_massive: DMatrix<f64>,
     on_massless: DMatrix<f64>,
+    /// The modes a real signal needs, with their weights: one of each conjugate pair of Â's
+    /// eigenvalues (weight 2: Re(m e^{λτ}) + Re(m̄ e^{λ̄τ}) = 2 Re(m e^{λτ})) and the real ones (1).
+    modes: Vec<(usize, f64)>,
 }
 
 impl Fixed {
@@ -36,14 +39,30 @@ impl Fixed {
         let along = |basis: &DMatrix<f64>| DMatrix::from_fn(m, basis.ncols(), |i, k| model.contacts[i].along(|d| basis[(d, k)]));
         let rows = along(lift);
         let modal_rows = ph.rows_on_modes(&rows);
-        Fixed { h, step: ph.grid_step(h), rows, modal_rows, on_massive: along(ph.massive_basis()), on_massless: along(ph.massless_basis()) }
+        let lambda = ph.modal_coordinates(&DVector::zeros(2 * lift.ncols())).map_or_else(Vec::new, |(l, _)| l.to_vec());
+        let mut paired = vec![false; lambda.len()];
+        let mut modes = Vec::with_capacity(lambda.len());
+        for j in 0..lambda.len() {
+            if paired[j] {
+                continue;
+            }
+            let twin = (lambda[j].im != 0.0).then(|| (j + 1..lambda.len()).find(|&k| !paired[k] && lambda[k] == lambda[j].conj())).flatten();
+            if let Some(k) = twin {
+                paired[k] = true;
+            }
+            modes.push((j, if twin.is_some() { 2.0 } else { 1.0 }));
+        }
+        let (on_massive, on_massless) = (along(ph.massive_basis()), along(ph.massless_basis()));
+        Fixed { h, step: ph.grid_step(h), rows, modal_rows, on_massive, on_massless, modes }
     }
 }
 
 /// One phase's grid at one ω: its [`Fixed`] part and the clearances' periodic parts.
 pub(super) struct Grid {
     pub fixed: Arc<Fixed>,
-    /// The harmonics' rates pω and e^{ipωh}.
+    /// ω, the harmonics' orders p (ascending), rates pω and e^{ipωh}.
+    omega: f64,
+    orders: Vec<u32>,
     rates: Vec<f64>,
     turn: Vec<C>,
     /// Contact i's clearance's periodic part at each harmonic (rows: contacts): gap_i − B_i P̂_p.
@@ -70,7 +89,7 @@ impl Grid {
         }
         let rates: Vec<f64> = orders.iter().map(|&p| p as f64 * w).collect();
         let turn = rates.iter().map(|r| C::from_polar(1.0, r * fixed.h)).collect();
-        Grid { fixed, rates, turn, periodic }
+        Grid { fixed, omega: w, orders, rates, turn, periodic }
     }
 
     /// Each contact's clearance at `t` from the deviation `z` (2n_a) and e^{ipωt} (`phasors`).
@@ -84,9 +103,18 @@ impl Grid {
     }
 
     /// Contact `i`'s clearance at `s` in closed form from the deviation's modes at `t0`
-    /// ([`Phase::modal_coordinates`]: `lambda`, and `modal` = B_i L V_x c, its row on them).
+    /// ([`Phase::modal_coordinates`]: `lambda`, and `modal` = B_i L V_x c, its row on them, the
+    /// modes of [`Fixed`]'s `modes` only, weighted). e^{ipωs} as powers of e^{iωs} (one sine and
+    /// cosine per call, p·ε relative).
     fn clearance_at(&self, i: usize, s: f64, t0: f64, lambda: &[C], modal: &[C]) -> f64 {
-        let periodic: f64 = self.rates.iter().enumerate().map(|(p, r)| (self.periodic[(i, p)] * C::from_polar(1.0, r * s)).re).sum();
+        let base = C::from_polar(1.0, self.omega * s);
+        let (mut power, mut order) = (C::new(1.0, 0.0), 0);
+        let mut periodic = 0.0;
+        for (col, &p) in self.orders.iter().enumerate() {
+            power *= base.powu(p - order);
+            order = p;
+            periodic += (self.periodic[(i, col)] * power).re;
+        }
         let transient: f64 = lambda.iter().zip(modal).map(|(l, m)| (m * (l * (s - t0)).exp()).re).sum();
         periodic - transient
     }
@@ -166,8 +194,10 @@ fn earliest(
     for &i in &negative {
         let ts = match &modes {
             Some(((lambda, c), rows)) => {
-                let modal: Vec<C> = c.iter().enumerate().map(|(j, c)| rows[(i, j)] * c).collect();
-                let g = |s: f64| sign[i] * grid.clearance_at(i, s, t0, lambda, &modal);
+                let kept = &grid.fixed.modes;
+                let lambda: Vec<C> = kept.iter().map(|&(j, _)| lambda[j]).collect();
+                let modal: Vec<C> = kept.iter().map(|&(j, weight)| rows[(i, j)] * c[j] * weight).collect();
+                let g = |s: f64| sign[i] * grid.clearance_at(i, s, t0, &lambda, &modal);
                 illinois(&g, t0, t1, c1[i])
             }
             // No eigendecomposition: the state flowed per trial time.
