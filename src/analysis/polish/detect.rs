@@ -30,17 +30,6 @@ const MAX_ITERATIONS: usize = 10;
 
 thread_local! {
     static PROFILE: bool = std::env::var_os("PERIODIC_CONTACT_PROFILE").is_some();
-    static TALLY: std::cell::RefCell<[f64; 8]> = const { std::cell::RefCell::new([0.0; 8]) };
-}
-
-/// TEMP profiling: adds the CPU since `since` to tally `k`.
-pub(super) fn tally(k: usize, since: Option<f64>) {
-    if let (Some(a), Some(b)) = (since, super::thread_cpu()) {
-        TALLY.with(|t| t.borrow_mut()[k] += b - a);
-    }
-}
-pub(super) fn cpu_now() -> Option<f64> {
-    if PROFILE.with(|p| *p) { super::thread_cpu() } else { None }
 }
 
 /// Phases by closed set at one ω: `prev`'s re-tuned where it has the set (only the particular
@@ -83,13 +72,11 @@ impl Flows<'_> {
             self.building += b - a;
         }
         let h = 1.0 / (STEPS_PER_RADIAN * p.speed_hint().max(self.model.frequency));
-        let c = cpu_now();
         let fixed = match banked {
             Some((_, f)) if f.h == h => Arc::clone(f),
             _ => Arc::new(grid::Fixed::new(self.model, &p, h)),
         };
         self.grids.push(Grid::new(self.model, &p, fixed, &self.gaps));
-        tally(0, c);
         self.phases.push(p);
         Ok(self.phases.len() - 1)
     }
@@ -163,10 +150,8 @@ fn newton(flows: &mut Flows, start: &[f64]) -> Result<PolishedOrbit, PolishFailu
     // a new Jacobian and a confirming shot (the chord's step is the exact one's to O(‖Δy‖) relative).
     let mut chord: Option<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>> = None;
     let correction = loop {
-        if let Some(du) = chord.as_ref().and_then(|lu| lu.solve(&(-&r))) {
-            if du.component_mul(&w).amax() < 1e-12 * size {
-                break du.rows(0, model.n()).amax();
-            }
+        if let Some(du) = chord.as_ref().and_then(|lu| lu.solve(&(-&r))).filter(|du| du.component_mul(&w).amax() < 1e-12 * size) {
+            break du.rows(0, model.n()).amax();
         }
         if iterations == MAX_ITERATIONS {
             // Near a grazing the flow's derivative is not Lipschitz and Newton may stall short
@@ -176,22 +161,16 @@ fn newton(flows: &mut Flows, start: &[f64]) -> Result<PolishedOrbit, PolishFailu
         }
         // d y(T) / d y(0) = L_last (Π e^{A τ}) R: every phase shares the free basis (no stuck
         // contact), so R L_j = I between phases (phase.rs's `transition`).
-        let c = cpu_now();
         let m = flows.phases[shot.last_phase].transition(&shot.product(&flows.phases));
         let jac = m - DMatrix::identity(n2, n2);
         let lu = jac.lu();
         let du = lu.solve(&(-&r)).ok_or_else(|| fail("the monodromy has a multiplier 1"))?;
         chord = Some(lu);
-        tally(1, c);
         let before = r.component_mul(&w).amax();
         let mut lambda = 1.0;
         let (next, next_shot, rn) = loop {
             let cand = &y + &du * lambda;
-            let c = cpu_now();
-            let shot_try = shoot(&carrier, flows, &cand);
-            tally(2, c);
-            TALLY.with(|t| t.borrow_mut()[7] += 1.0);
-            if let Ok(s) = shot_try {
+            if let Ok(s) = shoot(&carrier, flows, &cand) {
                 let rc = &s.end - &cand;
                 let merit = rc.component_mul(&w).amax();
                 if merit < before || merit < floor {
@@ -213,8 +192,7 @@ fn newton(flows: &mut Flows, start: &[f64]) -> Result<PolishedOrbit, PolishFailu
         }
     };
     let residual = r.component_mul(&w).amax();
-    let t = TALLY.with(|t| *t.borrow());
-    super::profile(&format!("switch detection: {iterations} iterations, {} phases built in {:.3} s CPU; TALLY grids {:.3} jac {:.3} shots {:.3} earliest {:.3} flowto {:.3} steps {:.3} nshots {}", flows.phases.len(), flows.building, t[0], t[1], t[2], t[3], t[4], t[5], t[7]), clock);
+    super::profile(&format!("switch detection: {iterations} iterations, {} phases built in {:.3} s CPU", flows.phases.len(), flows.building), clock);
     let orbit = assemble(model, prev, flows, shot, (iterations, residual, correction))?;
     super::profile("the orbit on the detected signature", clock);
     verify::check(&orbit)?;

@@ -153,11 +153,6 @@ pub(super) fn first_switch(
         let c1 = grid.clearances(&z, &phasors).component_mul(&DVector::from_column_slice(&sign));
         if c1.iter().any(|v| *v < 0.0) {
             // `next` holds the deviation at t0 (swapped out).
-            let c = super::cpu_now();
-            let out = earliest(model, ph, grid, (a, ya), (t0, t1), &next, &c1, &sign);
-            super::tally(3, c);
-            return out;
-            #[allow(unreachable_code)]
             return earliest(model, ph, grid, (a, ya), (t0, t1), &next, &c1, &sign);
         }
         j += 1;
@@ -208,10 +203,7 @@ fn earliest(
         }
     }
     let (i, ts) = first?;
-    let c = super::cpu_now();
-    let out = ph.flow(a, ya, ts);
-    super::tally(4, c);
-    Some((i, ts, out))
+    Some((i, ts, ph.flow(a, ya, ts)))
 }
 
 /// Where `g` (≥ 0 at `a`, `gb` < 0 at `b`) changes sign: the Illinois method (regula falsi with
