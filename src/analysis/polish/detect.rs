@@ -13,6 +13,7 @@ use super::phase::Phase;
 use super::{PolishFailure, PolishedOrbit, verify};
 use crate::model::Model;
 use nalgebra::{DMatrix, DVector};
+use std::sync::Arc;
 
 // The switch search on a phase's grid without a flow per step.
 mod grid;
@@ -43,6 +44,8 @@ struct Flows<'a> {
     phases: Vec<Phase>,
     /// Each phase's switch-search grid.
     grids: Vec<Grid>,
+    /// Each contact's gap harmonics (the grids' periodic parts).
+    gaps: Vec<super::phase::Harmonics>,
     /// CPU spent building phases [s], under `PERIODIC_CONTACT_PROFILE`.
     building: f64,
 }
@@ -53,7 +56,8 @@ impl Flows<'_> {
             return Ok(k);
         }
         let clock = PROFILE.with(|on| on.then(super::thread_cpu).flatten());
-        let old = self.prev.phases.iter().find(|o| self.retune && o.is_for(&[], closed)).or_else(|| self.bank.find(self.model, closed));
+        let banked = self.bank.find(self.model, closed);
+        let old = self.prev.phases.iter().find(|o| self.retune && o.is_for(&[], closed)).or(banked.map(|(p, _)| p));
         let p = match old {
             Some(o) => o.retuned(self.model),
             None => Phase::new(self.model, &[], closed).map(|mut p| {
@@ -68,7 +72,11 @@ impl Flows<'_> {
             self.building += b - a;
         }
         let h = 1.0 / (STEPS_PER_RADIAN * p.speed_hint().max(self.model.frequency));
-        self.grids.push(Grid::new(self.model, &p, h));
+        let fixed = match banked {
+            Some((_, f)) if f.h == h => Arc::clone(f),
+            _ => Arc::new(grid::Fixed::new(self.model, &p, h)),
+        };
+        self.grids.push(Grid::new(self.model, &p, fixed, &self.gaps));
         self.phases.push(p);
         Ok(self.phases.len() - 1)
     }
@@ -115,10 +123,12 @@ pub fn follow_detected_with(model: &Model, prev: &PolishedOrbit, start: &[f64], 
     if model.contacts.iter().any(|c| c.is_rigid()) || !model.frictions.is_empty() || !model.rubbing.is_empty() {
         return Err(PolishFailure("switch-detecting shooting: only for compliant contacts".into()));
     }
-    let mut flows = Flows { model, prev, bank, retune: same_system(model, &prev.model), phases: Vec::new(), grids: Vec::new(), building: 0.0 };
+    let gaps = (0..model.contacts.len()).map(|i| super::phase::gap_harmonics(model, i)).collect();
+    let mut flows = Flows { model, prev, bank, retune: same_system(model, &prev.model), phases: Vec::new(), grids: Vec::new(), gaps, building: 0.0 };
     let out = newton(&mut flows, start);
     let phases = std::mem::take(&mut flows.phases);
-    bank.keep(model, phases);
+    let kept = phases.into_iter().zip(flows.grids.iter().map(|g| Arc::clone(&g.fixed))).collect();
+    bank.keep(model, kept);
     out
 }
 
@@ -136,7 +146,13 @@ fn newton(flows: &mut Flows, start: &[f64]) -> Result<PolishedOrbit, PolishFailu
     let mut shot = shoot(&carrier, flows, &y)?;
     let mut r = &shot.end - &y;
     let mut iterations = 0;
+    // The last Jacobian's factors: a correction below round-off by this chord ends Newton without
+    // a new Jacobian and a confirming shot (the chord's step is the exact one's to O(‖Δy‖) relative).
+    let mut chord: Option<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>> = None;
     let correction = loop {
+        if let Some(du) = chord.as_ref().and_then(|lu| lu.solve(&(-&r))).filter(|du| du.component_mul(&w).amax() < 1e-12 * size) {
+            break du.rows(0, model.n()).amax();
+        }
         if iterations == MAX_ITERATIONS {
             // Near a grazing the flow's derivative is not Lipschitz and Newton may stall short
             // of round-off: the polish's Newton on the detected signature, its times as seeds.
@@ -147,7 +163,9 @@ fn newton(flows: &mut Flows, start: &[f64]) -> Result<PolishedOrbit, PolishFailu
         // contact), so R L_j = I between phases (phase.rs's `transition`).
         let m = flows.phases[shot.last_phase].transition(&shot.product(&flows.phases));
         let jac = m - DMatrix::identity(n2, n2);
-        let du = jac.lu().solve(&(-&r)).ok_or_else(|| fail("the monodromy has a multiplier 1"))?;
+        let lu = jac.lu();
+        let du = lu.solve(&(-&r)).ok_or_else(|| fail("the monodromy has a multiplier 1"))?;
+        chord = Some(lu);
         let before = r.component_mul(&w).amax();
         let mut lambda = 1.0;
         let (next, next_shot, rn) = loop {

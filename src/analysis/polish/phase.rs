@@ -187,6 +187,8 @@ impl Phase {
             m_aa: sub(&m_ff),
             c_aa: sub(&c_ff),
             k_cond,
+            free_rows: tuning::unit_rows(&free),
+            slave_rows: tuning::unit_rows(&slave),
         });
         let mut phase = Phase {
             n,

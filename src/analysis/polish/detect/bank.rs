@@ -3,7 +3,9 @@
 //! (its particular solution only) instead of made again with its eigendecomposition (on the
 //! compliant real blade 1199 phases were made anew over 200 points, of 297 sets).
 use super::super::phase::Phase;
+use super::grid::Fixed;
 use crate::model::Model;
+use std::sync::Arc;
 
 /// The most sets kept (~0.25 MB each on the 69-DOF blade); the least recently used goes first.
 const CAPACITY: usize = 512;
@@ -12,34 +14,36 @@ const CAPACITY: usize = 512;
 #[derive(Default)]
 pub struct PhaseBank {
     model: Option<Model>,
-    /// (last use, closed set, phase).
-    phases: Vec<(u64, Vec<usize>, Phase)>,
+    /// (last use, closed set, phase, its switch-search grid's ω-independent part).
+    phases: Vec<(u64, Vec<usize>, Phase, Arc<Fixed>)>,
     clock: u64,
 }
 
 impl PhaseBank {
-    /// The phase of the closed set `closed` kept for `model`'s system, at the ω it was made.
-    pub(super) fn find(&self, model: &Model, closed: &[usize]) -> Option<&Phase> {
+    /// The phase of the closed set `closed` kept for `model`'s system, at the ω it was made, and
+    /// its grid's ω-independent part.
+    pub(super) fn find(&self, model: &Model, closed: &[usize]) -> Option<(&Phase, &Arc<Fixed>)> {
         let same = self.model.as_ref().is_some_and(|m| super::same_system(model, m));
-        same.then(|| self.phases.iter().find(|(_, set, _)| set == closed).map(|(_, _, p)| p)).flatten()
+        same.then(|| self.phases.iter().find(|(_, set, _, _)| set == closed).map(|(_, _, p, f)| (p, f))).flatten()
     }
 
-    /// Keeps `phases` (of `model`), replacing those of the same sets; a new system empties the bank.
-    pub(super) fn keep(&mut self, model: &Model, phases: Vec<Phase>) {
+    /// Keeps `phases` (of `model`, with their grids' ω-independent parts), replacing those of the
+    /// same sets; a new system empties the bank.
+    pub(super) fn keep(&mut self, model: &Model, phases: Vec<(Phase, Arc<Fixed>)>) {
         if !self.model.as_ref().is_some_and(|m| super::same_system(model, m)) {
             self.model = Some(model.clone());
             self.phases.clear();
         }
         self.clock += 1;
-        for p in phases {
+        for (p, f) in phases {
             let set: Vec<usize> = (0..model.contacts.len()).filter(|&i| p.closed(i)).collect();
-            match self.phases.iter_mut().find(|(_, s, _)| *s == set) {
-                Some(slot) => *slot = (self.clock, set, p),
-                None => self.phases.push((self.clock, set, p)),
+            match self.phases.iter_mut().find(|(_, s, _, _)| *s == set) {
+                Some(slot) => *slot = (self.clock, set, p, f),
+                None => self.phases.push((self.clock, set, p, f)),
             }
         }
         while self.phases.len() > CAPACITY {
-            let oldest = self.phases.iter().enumerate().min_by_key(|(_, (t, _, _))| *t).map(|(k, _)| k).expect("over capacity");
+            let oldest = self.phases.iter().enumerate().min_by_key(|(_, (t, _, _, _))| *t).map(|(k, _)| k).expect("over capacity");
             self.phases.swap_remove(oldest);
         }
     }

@@ -11,50 +11,91 @@ use super::super::phase::{self, Phase};
 use crate::model::Model;
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64 as C;
+use std::sync::Arc;
 
-/// One phase's grid (made once per phase and ω).
-pub(super) struct Grid {
+/// What a phase's grid keeps at every ω (made once per contact set and shared by its re-tunings
+/// through the [`super::PhaseBank`]): the step, e^{Ah}, and the contacts' rows.
+pub(super) struct Fixed {
     /// The step [s] and e^{Ah} on [x_a; v_a].
     pub h: f64,
     step: DMatrix<f64>,
-    /// The harmonics' rates pω and e^{ipωh}.
+    /// B_i L (rows: contacts, columns: the massive coordinates x_a), and on Â's modes (B_i L V_x).
+    rows: DMatrix<f64>,
+    modal_rows: Option<DMatrix<C>>,
+    /// B_i N_a and B_i N_b: the contacts' rows on the massive and massless coordinates (for
+    /// B_i P̂_p from the particular solution's coordinates).
+    on_massive: DMatrix<f64>,
+    on_massless: DMatrix<f64>,
+    /// The modes a real signal needs, with their weights: one of each conjugate pair of Â's
+    /// eigenvalues (weight 2: Re(m e^{λτ}) + Re(m̄ e^{λ̄τ}) = 2 Re(m e^{λτ})) and the real ones (1).
+    modes: Vec<(usize, f64)>,
+}
+
+impl Fixed {
+    /// The ω-independent part of `ph`'s grid with step `h`.
+    pub fn new(model: &Model, ph: &Phase, h: f64) -> Fixed {
+        let m = model.contacts.len();
+        let lift = ph.lifted();
+        let along = |basis: &DMatrix<f64>| DMatrix::from_fn(m, basis.ncols(), |i, k| model.contacts[i].along(|d| basis[(d, k)]));
+        let rows = along(lift);
+        let modal_rows = ph.rows_on_modes(&rows);
+        let lambda = ph.modal_coordinates(&DVector::zeros(2 * lift.ncols())).map_or_else(Vec::new, |(l, _)| l.to_vec());
+        let mut paired = vec![false; lambda.len()];
+        let mut modes = Vec::with_capacity(lambda.len());
+        for j in 0..lambda.len() {
+            if paired[j] {
+                continue;
+            }
+            let twin = (lambda[j].im != 0.0).then(|| (j + 1..lambda.len()).find(|&k| !paired[k] && lambda[k] == lambda[j].conj())).flatten();
+            if let Some(k) = twin {
+                paired[k] = true;
+            }
+            modes.push((j, if twin.is_some() { 2.0 } else { 1.0 }));
+        }
+        let (on_massive, on_massless) = (along(ph.massive_basis()), along(ph.massless_basis()));
+        Fixed { h, step: ph.grid_step(h), rows, modal_rows, on_massive, on_massless, modes }
+    }
+}
+
+/// One phase's grid at one ω: its [`Fixed`] part and the clearances' periodic parts.
+pub(super) struct Grid {
+    pub fixed: Arc<Fixed>,
+    /// ω, the harmonics' orders p (ascending), rates pω and e^{ipωh}.
+    omega: f64,
+    orders: Vec<u32>,
     rates: Vec<f64>,
     turn: Vec<C>,
     /// Contact i's clearance's periodic part at each harmonic (rows: contacts): gap_i − B_i P̂_p.
     periodic: DMatrix<C>,
-    /// B_i L (rows: contacts, columns: the massive coordinates x_a), and on Â's modes (B_i L V_x).
-    rows: DMatrix<f64>,
-    modal_rows: Option<DMatrix<C>>,
 }
 
 impl Grid {
-    /// The grid of `ph` with step `h`.
-    pub fn new(model: &Model, ph: &Phase, h: f64) -> Grid {
-        let (m, w) = (model.contacts.len(), model.frequency);
-        let lift = ph.lifted();
-        let na = lift.ncols();
-        // Each contact's gap and B_i P̂_p per harmonic, on the union of their orders.
-        let gaps: Vec<phase::Harmonics> = (0..m).map(|i| phase::gap_harmonics(model, i)).collect();
-        let along: Vec<Vec<(u32, C)>> = model.contacts.iter().map(|c| ph.particular_along(&c.row)).collect();
-        let mut orders: Vec<u32> = along.iter().flat_map(|a| a.iter().map(|(p, _)| *p)).chain(gaps.iter().flat_map(|g| g.iter().map(|(p, _)| *p))).collect();
+    /// The grid of `ph` at `model`'s ω on `fixed` (made for `ph`'s contact set), `gaps` each
+    /// contact's gap harmonics.
+    pub fn new(model: &Model, ph: &Phase, fixed: Arc<Fixed>, gaps: &[phase::Harmonics]) -> Grid {
+        let w = model.frequency;
+        let along = ph.particular_on(&fixed.on_massive, &fixed.on_massless);
+        let mut orders: Vec<u32> = along.iter().map(|(p, _)| *p).chain(gaps.iter().flat_map(|g| g.iter().map(|(p, _)| *p))).collect();
         orders.sort_unstable();
         orders.dedup();
-        let periodic = DMatrix::from_fn(m, orders.len(), |i, col| {
-            let p = orders[col];
-            let gap = gaps[i].iter().find(|(q, _)| *q == p).map_or(C::new(0.0, 0.0), |(_, g)| g[0]);
-            gap - along[i].iter().find(|(q, _)| *q == p).map_or(C::new(0.0, 0.0), |(_, x)| *x)
-        });
-        let rows = DMatrix::from_fn(m, na, |i, k| model.contacts[i].along(|d| lift[(d, k)]));
+        let zero = C::new(0.0, 0.0);
+        let mut periodic = DMatrix::from_element(gaps.len(), orders.len(), zero);
+        for (col, p) in orders.iter().enumerate() {
+            let part = along.iter().find(|(q, _)| q == p).map(|(_, x)| x);
+            for (i, g) in gaps.iter().enumerate() {
+                let gap = g.iter().find(|(q, _)| q == p).map_or(zero, |(_, g)| g[0]);
+                periodic[(i, col)] = gap - part.map_or(zero, |x| x[i]);
+            }
+        }
         let rates: Vec<f64> = orders.iter().map(|&p| p as f64 * w).collect();
-        let turn = rates.iter().map(|r| C::from_polar(1.0, r * h)).collect();
-        let modal_rows = ph.rows_on_modes(&rows);
-        Grid { h, step: ph.grid_step(h), rates, turn, periodic, rows, modal_rows }
+        let turn = rates.iter().map(|r| C::from_polar(1.0, r * fixed.h)).collect();
+        Grid { fixed, omega: w, orders, rates, turn, periodic }
     }
 
     /// Each contact's clearance at `t` from the deviation `z` (2n_a) and e^{ipωt} (`phasors`).
     fn clearances(&self, z: &DVector<f64>, phasors: &[C]) -> DVector<f64> {
-        let na = self.rows.ncols();
-        let mut c = -(&self.rows * z.rows(0, na));
+        let rows = &self.fixed.rows;
+        let mut c = -(rows * z.rows(0, rows.ncols()));
         for (i, v) in c.iter_mut().enumerate() {
             *v += phasors.iter().enumerate().map(|(p, u)| (self.periodic[(i, p)] * u).re).sum::<f64>();
         }
@@ -62,9 +103,18 @@ impl Grid {
     }
 
     /// Contact `i`'s clearance at `s` in closed form from the deviation's modes at `t0`
-    /// ([`Phase::modal_coordinates`]: `lambda`, and `modal` = B_i L V_x c, its row on them).
+    /// ([`Phase::modal_coordinates`]: `lambda`, and `modal` = B_i L V_x c, its row on them, the
+    /// modes of [`Fixed`]'s `modes` only, weighted). e^{ipωs} as powers of e^{iωs} (one sine and
+    /// cosine per call, p·ε relative).
     fn clearance_at(&self, i: usize, s: f64, t0: f64, lambda: &[C], modal: &[C]) -> f64 {
-        let periodic: f64 = self.rates.iter().enumerate().map(|(p, r)| (self.periodic[(i, p)] * C::from_polar(1.0, r * s)).re).sum();
+        let base = C::from_polar(1.0, self.omega * s);
+        let (mut power, mut order) = (C::new(1.0, 0.0), 0);
+        let mut periodic = 0.0;
+        for (col, &p) in self.orders.iter().enumerate() {
+            power *= base.powu(p - order);
+            order = p;
+            periodic += (self.periodic[(i, col)] * power).re;
+        }
         let transient: f64 = lambda.iter().zip(modal).map(|(l, m)| (m * (l * (s - t0)).exp()).re).sum();
         periodic - transient
     }
@@ -89,15 +139,15 @@ pub(super) fn first_switch(
     let mut next = DVector::zeros(z.len());
     let mut j = 0usize;
     loop {
-        let t0 = a + grid.h * j as f64;
-        let t1 = a + grid.h * (j + 1) as f64;
+        let t0 = a + grid.fixed.h * j as f64;
+        let t1 = a + grid.fixed.h * (j + 1) as f64;
         if t1 >= end {
             // The last, shorter interval on the flowed state (as the search before did).
             let y1 = ph.flow(a, ya, end);
             let c1 = DVector::from_fn(m, |i, _| sign[i] * clearance(model, i, &y1, end));
             return earliest(model, ph, grid, (a, ya), (t0, end), &z, &c1, &sign);
         }
-        next.gemv(1.0, &grid.step, &z, 0.0);
+        next.gemv(1.0, &grid.fixed.step, &z, 0.0);
         std::mem::swap(&mut z, &mut next);
         phasors.iter_mut().zip(&grid.turn).for_each(|(u, r)| *u *= r);
         let c1 = grid.clearances(&z, &phasors).component_mul(&DVector::from_column_slice(&sign));
@@ -134,13 +184,15 @@ fn earliest(
         return None;
     }
     // The deviation's modal coordinates at t0, and each crossing contact's row on them.
-    let modes = ph.modal_coordinates(z0).zip(grid.modal_rows.as_ref());
+    let modes = ph.modal_coordinates(z0).zip(grid.fixed.modal_rows.as_ref());
     let mut first: Option<(usize, f64)> = None;
     for &i in &negative {
         let ts = match &modes {
             Some(((lambda, c), rows)) => {
-                let modal: Vec<C> = c.iter().enumerate().map(|(j, c)| rows[(i, j)] * c).collect();
-                let g = |s: f64| sign[i] * grid.clearance_at(i, s, t0, lambda, &modal);
+                let kept = &grid.fixed.modes;
+                let lambda: Vec<C> = kept.iter().map(|&(j, _)| lambda[j]).collect();
+                let modal: Vec<C> = kept.iter().map(|&(j, weight)| rows[(i, j)] * c[j] * weight).collect();
+                let g = |s: f64| sign[i] * grid.clearance_at(i, s, t0, &lambda, &modal);
                 illinois(&g, t0, t1, c1[i])
             }
             // No eigendecomposition: the state flowed per trial time.

@@ -10,6 +10,11 @@ impl Phase {
         &self.free
     }
 
+    /// N_b (n × n_b, orthonormal columns): the massless free coordinates, condensed.
+    pub fn massless_basis(&self) -> &DMatrix<f64> {
+        &self.slave
+    }
+
     /// L = N_a + N_b S (n × n_a): every DOF's displacement (velocity) from the massive
     /// coordinates' deviation from the particular solution (the stuck DOFs' rows zero, the
     /// massless DOFs' condensed, src/formulation.md §4.1); N_aᵀ L = I.

@@ -110,6 +110,27 @@ impl Phase {
             .collect()
     }
 
+    /// B P̂_p for the rows B on the particular solution's displacement, per harmonic, given as
+    /// B N_a (`on_massive`) and B N_b (`on_massless`): B N_a X̂_a + B N_b X̂_b. Only for a phase
+    /// without stuck contacts (no prescribed motion), as the switch search's.
+    pub fn particular_on(&self, on_massive: &DMatrix<f64>, on_massless: &DMatrix<f64>) -> Vec<(u32, DVector<C>)> {
+        debug_assert!(self.stuck.is_empty());
+        let nf = self.free.ncols();
+        let times = |a: &DMatrix<f64>, x: &nalgebra::DVectorView<C>| {
+            let (re, im) = (a * x.map(|z| z.re), a * x.map(|z| z.im));
+            DVector::from_fn(a.nrows(), |i, _| C::new(re[i], im[i]))
+        };
+        let mut out: Vec<(u32, DVector<C>)> = self.part.iter().map(|(p, y)| (*p, times(on_massive, &y.rows(0, nf)))).collect();
+        for (p, xb) in &self.slave_part {
+            let v = times(on_massless, &xb.rows(0, xb.len()));
+            match out.iter_mut().find(|(q, _)| q == p) {
+                Some((_, x)) => *x += v,
+                None => out.push((*p, v)),
+            }
+        }
+        out
+    }
+
     /// The stuck contacts' forces along the particular solution `part` ([`Self::particular`]),
     /// per harmonic: B_S (f_p − (−(pω)² M + ipω C + K) X̂_p) (its acceleration is (ipω)² X̂_p,
     /// the equations of motion holding exactly on it).

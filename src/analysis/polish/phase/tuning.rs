@@ -16,6 +16,32 @@ pub(super) struct Tuning {
     pub m_aa: DMatrix<f64>,
     pub c_aa: DMatrix<f64>,
     pub k_cond: DMatrix<f64>,
+    /// The DOF of each column of N_a (N_b) where every column is a unit vector e_d (no stuck
+    /// contact over several DOFs): Nᵀ r is then a gather of r, not a product.
+    pub free_rows: Option<Vec<usize>>,
+    pub slave_rows: Option<Vec<usize>>,
+}
+
+/// The DOF d of each column of `basis` when every column is a unit vector e_d.
+pub(super) fn unit_rows(basis: &DMatrix<f64>) -> Option<Vec<usize>> {
+    basis
+        .column_iter()
+        .map(|c| {
+            let mut nonzero = c.iter().enumerate().filter(|(_, v)| **v != 0.0);
+            match (nonzero.next(), nonzero.next()) {
+                (Some((d, v)), None) if *v == 1.0 => Some(d),
+                _ => None,
+            }
+        })
+        .collect()
+}
+
+/// Nᵀ x for the basis `basis` (its unit columns' DOFs `rows`, when known) and complex x.
+fn projected(basis: &DMatrix<f64>, rows: Option<&[usize]>, x: &DVector<C>) -> DVector<C> {
+    match rows {
+        Some(rows) => DVector::from_iterator(rows.len(), rows.iter().map(|&d| x[d])),
+        None => tr_times(basis, x),
+    }
 }
 
 /// The full model's forcing with the closed springs' obstacle terms (k_c B_iᵀ gap_i(t) each) and
@@ -76,7 +102,7 @@ impl Phase {
             }
             let yb = match &t.k_bb {
                 Some(lu) => {
-                    let gb = tr_times(&self.slave, &r);
+                    let gb = projected(&self.slave, t.slave_rows.as_deref(), &r);
                     let (re, im) = (lu.solve(&gb.map(|z| z.re))?, lu.solve(&gb.map(|z| z.im))?);
                     DVector::from_fn(nb, |i, _| C::new(re[i], im[i]))
                 }
@@ -85,7 +111,7 @@ impl Phase {
             let xa = if nf == 0 {
                 DVector::zeros(0)
             } else {
-                let ga = tr_times(&self.free, &r) - times(&t.k_ab, &yb);
+                let ga = projected(&self.free, t.free_rows.as_deref(), &r) - times(&t.k_ab, &yb);
                 let op = DMatrix::from_fn(nf, nf, |i, j| C::new(t.k_cond[(i, j)] - w * w * t.m_aa[(i, j)], w * t.c_aa[(i, j)]));
                 op.lu().solve(&ga)?
             };
