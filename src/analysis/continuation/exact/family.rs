@@ -65,6 +65,9 @@ pub(super) struct Family {
     /// contact set). With the first orbit's only, every orbit past the coarse blade's first
     /// grazing decomposed its new phases again: a quarter of the walk's time.
     modes: std::cell::RefCell<Vec<(SignatureKey, PolishedOrbit)>>,
+    /// The flight (its phase) whose re-impact time alone kept the last corrector from
+    /// converging ([`Self::unresolved_flight`]).
+    unresolved: std::cell::Cell<Option<usize>>,
 }
 
 /// A signature's events (contact, kind) and its contacts closed all period long.
@@ -121,6 +124,7 @@ impl Family {
             last_jacobian: Default::default(),
             chord: Default::default(),
             modes: Default::default(),
+            unresolved: Default::default(),
         }
     }
 
@@ -317,10 +321,29 @@ impl Family {
         self.newton(pred, normal, target, None)
     }
 
+    /// The flight (its phase, from a pure impact to a re-impact of one contact with mass) whose
+    /// re-impact time alone kept the last corrector from converging: its last correction the
+    /// largest and every other one below [`ATTAINABLE`]. Over a flight Δ the clearance is
+    /// O(jΔ³), so a short one's re-impact time is set by round-off (the coarse rigid blade at
+    /// 2338.39 rad/s: contact 2's flight 1.8e-6 of the period, its time wandering by 1e-7 to
+    /// 8e-6 each iteration while the state had converged).
+    pub fn unresolved_flight(&self) -> Option<usize> {
+        self.unresolved.get()
+    }
+
+    /// The flight whose re-impact time is the only unconverged component of the correction `dw`.
+    fn unresolved_in(&self, dw: &DVector<f64>) -> Option<usize> {
+        let worst = dw.iamax();
+        let rest = dw.iter().enumerate().filter(|(i, _)| *i != worst).fold(0.0f64, |m, (_, v)| m.max(v.abs()));
+        let (_, _, p, _) = self.reimpacts().into_iter().find(|r| r.1 == worst)?;
+        (rest < ATTAINABLE).then_some(p - self.n2)
+    }
+
     fn newton(&self, pred: &[f64], normal: &[f64], target: f64, mut chord: Option<DMatrix<f64>>) -> Option<Vec<f64>> {
         let d = self.dim();
         let mut w = pred.to_vec();
         let mut last = f64::INFINITY;
+        self.unresolved.set(None);
         for _ in 0..MAX_ITERATIONS {
             let here = self.orbit(w[d - 1] * self.rho)?;
             let f = self.residual_with(&here, &w)?;
@@ -338,6 +361,7 @@ impl Family {
             }
             rhs[d - 1] = target - normal.iter().zip(&w).map(|(n, x)| n * x).sum::<f64>();
             let dw = a.lu().solve(&rhs)?;
+            self.unresolved.set(self.unresolved_in(&dw));
             w.iter_mut().zip(dw.iter()).for_each(|(x, s)| *x += s);
             let step = dw.amax();
             if !step.is_finite() || step > 1.0 {
@@ -349,6 +373,7 @@ impl Family {
                     // The Jacobian of the last iterate, ‖Δw‖ away: the tangent's.
                     self.last_jacobian.replace(Some((w.clone(), jac)));
                 }
+                self.unresolved.set(None);
                 return Some(w);
             }
             if !fresh && step > CHORD_CONTRACTION * last && step >= ATTAINABLE {

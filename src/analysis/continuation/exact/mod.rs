@@ -31,6 +31,12 @@ use locate::{Test, detail_of, locate, side, test_value};
 
 /// A phase shorter than this (fraction of the period) and shrinking has vanished: a grazing.
 const VANISH: f64 = 1e-6;
+/// Below this step (scaled unknowns) a corrector that fails on a flight's re-impact time alone
+/// ([`Family::unresolved_flight`]) means the flight is below resolution: merged there, not
+/// crawled at (the coarse rigid blade at 2338.39 rad/s: every other step of 1e-6 failed so,
+/// hundreds of points in 0.01 rad/s; the walk at 2246 rad/s, its contact 0's flight 5e-6 of
+/// the period but resolved, steps of 2e-2).
+const UNRESOLVED_STEP: f64 = 1e-4;
 /// The phase of a pair of events just inserted at a grazing (fraction of the period).
 const NEW_PAIR: f64 = 1e-5;
 /// Bisection stops when the bracket is this short (scaled unknowns).
@@ -277,6 +283,20 @@ impl Walk<'_> {
                 None => {
                     self.fam.sig = old;
                     ds = step / 2.0;
+                    let unresolved = self.fam.unresolved_flight().filter(|_| step < UNRESOLVED_STEP);
+                    let merged = unresolved.and_then(|e| {
+                        let what = format!("contact {}: its free phase below resolution (its re-impact's time unresolved)", self.fam.sig.events[e].contact);
+                        self.merge(&here, e, &what)
+                    });
+                    if let Some(n) = merged {
+                        if self.ends_here(&n, dir) {
+                            return done(self, "a fold at a grazing".into(), false, false);
+                        }
+                        self.report(on_point);
+                        here = n;
+                        ds = settings.initial_step;
+                        continue;
+                    }
                     if ds < settings.min_step {
                         // Rigid events merging (a flight between two impacts, an impact fading): the branch past them.
                         if let Some(n) = self.rigid_stall(&here, to) {

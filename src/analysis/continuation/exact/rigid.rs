@@ -338,7 +338,7 @@ impl Walk<'_> {
 
     /// The branch past `here` without its phase `e` (between two events of one rigid contact,
     /// about to vanish), on the exact orbit; `None` for other phases or where that fails.
-    fn merge(&mut self, here: &Node, e: usize, what: &str) -> Option<Node> {
+    pub(super) fn merge(&mut self, here: &Node, e: usize, what: &str) -> Option<Node> {
         let ne = self.fam.ne();
         let (ev, next) = (self.fam.sig.events[e], self.fam.sig.events[(e + 1) % ne]);
         let wl = here.w[here.w.len() - 1];
