@@ -23,6 +23,8 @@ use crate::periodic::{PeriodicProblem, PeriodicSolver};
 use crate::time::Discretization;
 
 mod landing;
+mod trace;
+use trace::trace;
 
 /// Margins above −this are admissible (the relative tolerance of the polish's own checks).
 const TOL: f64 = 1e-9;
@@ -385,21 +387,7 @@ impl Walk<'_> {
             }
             (Switch::Release, Switch::Impact { stick: true }) => {
                 let removed = signature::remove(&self.fam, &here.orbit, e, wl);
-                trace(format_args!("merge: flight {e} of contact {} removed: {}", ev.contact, removed.is_some()));
-                let t0 = list[e].0;
-                for (k, (at, x)) in list.iter().enumerate().filter(|(_, l)| ((l.0 - t0 + 0.5).rem_euclid(1.0) - 0.5).abs() < 2e-3) {
-                    let force = here.orbit.landing_force(k);
-                    trace(format_args!("merge: event {k} at {at:.12} of the period: contact {} {:?}; landing force {force:?}", x.contact, x.kind));
-                }
-                if let Some(m) = here.orbit.rigid_margin() {
-                    trace(format_args!(
-                        "merge: the old orbit's margin: contact {} {} {:e} at {:.12}",
-                        m.contact,
-                        m.what,
-                        m.value,
-                        m.time / here.orbit.period()
-                    ));
-                }
+                trace::merge(here, &list, (e, ne), ev.contact, removed.is_some());
                 removed?
             }
             // A pure impact and the sticking impact after it merge: located on the orbit without
@@ -499,13 +487,6 @@ impl Walk<'_> {
             }
         }
         None
-    }
-}
-
-/// A line of the un-merge's trace on stderr when `PC_TRACE_UNMERGE` is set.
-fn trace(line: std::fmt::Arguments) {
-    if std::env::var_os("PC_TRACE_UNMERGE").is_some() {
-        eprintln!("{line}");
     }
 }
 
