@@ -493,3 +493,21 @@ fn period_multiple_grid_and_limits() {
     let e = periodic_contact::scene::Scene::parse(&bad, "nlvib03").unwrap().to_problem("nlvib03").unwrap_err().to_string();
     assert!(e.contains("discretization.period_multiple") && e.contains("-1"), "{e}");
 }
+
+/// A monodromy with a non-finite entry has no multipliers (NaN, the exact walk then rejects the
+/// point) instead of nalgebra's unbounded Schur loop (the real blade's walk hung at 2293.30
+/// rad/s); a finite one keeps its closed-form eigenvalues: r·e^{±iφ} of a scaled rotation and
+/// the diagonal's −1.5.
+#[test]
+fn multipliers_of_a_bad_monodromy_are_nan() {
+    let (r, phi) = (0.9_f64, 0.7_f64);
+    let m = nalgebra::DMatrix::from_row_slice(3, 3, &[r * phi.cos(), -r * phi.sin(), 0.0, r * phi.sin(), r * phi.cos(), 0.0, 0.0, 0.0, -1.5]);
+    let mu = continuation::multipliers(&m);
+    assert!((mu[0].re + 1.5).abs() < 1e-14 && mu[0].im.abs() < 1e-14, "{mu:?}");
+    for z in &mu[1..] {
+        assert!((z.norm() - r).abs() < 1e-14 && (z.arg().abs() - phi).abs() < 1e-14, "{mu:?}");
+    }
+    let mut bad = m.clone();
+    bad[(0, 1)] = f64::NAN;
+    assert!(continuation::multipliers(&bad).iter().all(|z| z.re.is_nan()));
+}

@@ -7,12 +7,22 @@
 //!   multiplier through −1 changes its sign; Kuznetsov, "Elements of Applied Bifurcation
 //!   Theory", §10.2);
 //! - Neimark–Sacker: the number of non-real multipliers outside the unit circle.
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, Schur};
 use num_complex::Complex64;
 
+/// QR sweeps at most for the monodromy's Schur form (LAPACK's hseqr allows 30 per eigenvalue).
+const SCHUR_SWEEPS: usize = 10_000;
+
 /// The multipliers of a monodromy matrix, largest modulus first.
+/// NaN where the Schur iteration does not converge in [`SCHUR_SWEEPS`] (nalgebra's own loop has
+/// no bound: the real blade's exact walk hung at 2293.30 rad/s in it).
 pub fn multipliers(monodromy: &DMatrix<f64>) -> Vec<Complex64> {
-    let mut mu: Vec<Complex64> = balanced(monodromy).complex_eigenvalues().iter().map(|c| Complex64::new(c.re, c.im)).collect();
+    let n = monodromy.nrows();
+    let schur = monodromy.iter().all(|x| x.is_finite()).then(|| Schur::try_new(balanced(monodromy), f64::EPSILON, SCHUR_SWEEPS)).flatten();
+    let Some(schur) = schur else {
+        return vec![Complex64::new(f64::NAN, f64::NAN); n];
+    };
+    let mut mu: Vec<Complex64> = schur.complex_eigenvalues().iter().map(|c| Complex64::new(c.re, c.im)).collect();
     mu.sort_by(|a, b| b.norm().total_cmp(&a.norm()));
     mu
 }

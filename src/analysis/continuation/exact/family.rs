@@ -431,6 +431,10 @@ impl Family {
         let defect = self.residual_with(&orbit, &w)?.amax() * self.ys;
         let orbit = orbit.at(&y, &times, defect).ok()?;
         let mu = floquet::multipliers(orbit.monodromy());
+        // No multipliers (the Schur iteration did not converge): no point, the step is shortened.
+        if mu.iter().any(|m| !m.is_finite()) {
+            return None;
+        }
         let touches = if touches { orbit.touches() } else { Vec::new() };
         Some(Node { w, tangent, orbit, mu, touches, amplitude: Vec::new() })
     }

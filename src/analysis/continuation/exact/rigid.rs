@@ -23,6 +23,8 @@ use crate::periodic::{PeriodicProblem, PeriodicSolver};
 use crate::time::Discretization;
 
 mod landing;
+mod trace;
+use trace::trace;
 
 /// Margins above −this are admissible (the relative tolerance of the polish's own checks).
 const TOL: f64 = 1e-9;
@@ -296,7 +298,20 @@ impl Walk<'_> {
         let d = self.fam.dim();
         let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
         let sense = at.tangent[at.tangent.len() - 1].signum();
-        let found = self.fam.correct(&guess, &e_l, lambda / rho).and_then(|w| {
+        let corrected = self.fam.correct(&guess, &e_l, lambda / rho);
+        trace(format_args!(
+            "restart at λ {lambda:.10}: {before} -> {} events, corrected at λ fixed: {}, margin there {:?}",
+            self.fam.ne(),
+            corrected.is_some(),
+            corrected.as_ref().and_then(|w| self.fam.node_with(w.clone(), &e_l, false)).and_then(|n| n.orbit.rigid_margin().map(|m| (
+                m.contact,
+                m.what,
+                m.value,
+                m.event,
+                m.time / n.orbit.period()
+            )))
+        ));
+        let found = corrected.and_then(|w| {
             [sense, -sense].into_iter().find_map(|s| {
                 let prev: Vec<f64> = e_l.iter().map(|x| x * s).collect();
                 let n = self.fam.node(w.clone(), &prev)?;
@@ -305,6 +320,11 @@ impl Walk<'_> {
                     let pred: Vec<f64> = n.w.iter().zip(&n.tangent).map(|(w, t)| w + step * t).collect();
                     let target: f64 = n.tangent.iter().zip(&pred).map(|(t, p)| t * p).sum();
                     let trial = self.fam.correct(&pred, &n.tangent, target).and_then(|w| self.fam.node_with(w, &n.tangent, false));
+                    trace(format_args!(
+                        "restart: sense {s}, trial {step:e}: λ {:?}, margin {:?}",
+                        trial.as_ref().map(|t| t.lambda(rho)),
+                        trial.as_ref().and_then(|t| t.orbit.rigid_margin().map(|m| (m.contact, m.what, m.value, m.event)))
+                    ));
                     trial.is_some_and(|t| margin(&t) >= -TOL)
                 });
                 admissible.then_some(n)
@@ -365,7 +385,11 @@ impl Walk<'_> {
                 let sig = Signature { events: list.iter().map(|l| l.1).collect(), always: here.orbit.always_closed().to_vec() };
                 (sig, signature::guess(&self.fam, &here.orbit, &list, wl))
             }
-            (Switch::Release, Switch::Impact { stick: true }) => signature::remove(&self.fam, &here.orbit, e, wl)?,
+            (Switch::Release, Switch::Impact { stick: true }) => {
+                let removed = signature::remove(&self.fam, &here.orbit, e, wl);
+                trace::merge(here, &list, (e, ne), ev.contact, removed.is_some());
+                removed?
+            }
             // A pure impact and the sticking impact after it merge: located on the orbit without
             // the pure impact, where the force at its landing touches zero, a short way ahead;
             // else that orbit's branch from here (the coarse blade at 2215.5 rad/s: the flight
@@ -434,13 +458,22 @@ impl Walk<'_> {
             if (l - to) * (to - lambda).signum() > 0.0 && (to - lambda) * sense > 0.0 {
                 l = to;
             }
-            let Some(orbit) = grid_orbit(self.problem, self.fam.param, l) else { continue };
+            let Some(orbit) = grid_orbit(self.problem, self.fam.param, l) else {
+                trace(format_args!("reseed: no grid orbit polished at λ {l}"));
+                continue;
+            };
             let sig = Signature { events: orbit.events().to_vec(), always: orbit.always_closed().to_vec() };
             let old = std::mem::replace(&mut self.fam.sig, sig);
             let d = self.fam.dim();
             let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
             let prev: Vec<f64> = e_l.iter().map(|x| x * sense).collect();
             let node = self.fam.correct(&self.fam.pack(&orbit, l), &e_l, l / rho).and_then(|w| self.fam.node(w, &prev));
+            trace(format_args!(
+                "reseed at λ {l}: {} events, corrected {}, margin {:?}",
+                self.fam.ne(),
+                node.is_some(),
+                node.as_ref().and_then(|n| n.orbit.rigid_margin().map(|m| (m.contact, m.what, m.value)))
+            ));
             match node {
                 Some(n) if margin(&n) >= -TOL => {
                     let detail = format!(
@@ -454,13 +487,6 @@ impl Walk<'_> {
             }
         }
         None
-    }
-}
-
-/// A line of the un-merge's trace on stderr when `PC_TRACE_UNMERGE` is set.
-fn trace(line: std::fmt::Arguments) {
-    if std::env::var_os("PC_TRACE_UNMERGE").is_some() {
-        eprintln!("{line}");
     }
 }
 

@@ -1,0 +1,29 @@
+//! The rigid changes' trace on stderr (`PC_TRACE_UNMERGE` set): why a restart or a merge fails.
+use super::super::family::Node;
+use crate::analysis::polish::Event;
+
+/// A line of the trace on stderr when `PC_TRACE_UNMERGE` is set.
+pub(super) fn trace(line: std::fmt::Arguments) {
+    if std::env::var_os("PC_TRACE_UNMERGE").is_some() {
+        eprintln!("{line}");
+    }
+}
+
+/// A flight `e` of `contact` (release → sticking landing) about to be merged at `here`: the orbit's
+/// events within 2e-3 of the period of it (`list`, fractions of the period), the family's θ of
+/// the pair (`ne` events in the family's signature), and the old orbit's margin.
+pub(super) fn merge(here: &Node, list: &[(f64, Event)], (e, ne): (usize, usize), contact: usize, removed: bool) {
+    if std::env::var_os("PC_TRACE_UNMERGE").is_none() {
+        return;
+    }
+    let n2 = here.w.len() - 1 - ne;
+    let theta = (here.w[n2 + e], here.w[n2 + (e + 1) % ne]);
+    eprintln!("merge: flight {e} of contact {contact} removed: {removed}; the family's θ of the pair {theta:?} ({ne} events; the orbit {})", list.len());
+    let t0 = list[e].0;
+    for (k, (at, x)) in list.iter().enumerate().filter(|(_, l)| ((l.0 - t0 + 0.5).rem_euclid(1.0) - 0.5).abs() < 2e-3) {
+        eprintln!("merge: orbit event {k} at {at:.12} of the period: contact {} {:?}", x.contact, x.kind);
+    }
+    if let Some(m) = here.orbit.rigid_margin() {
+        eprintln!("merge: the old orbit's margin: contact {} {} {:e} at {:.12}", m.contact, m.what, m.value, m.time / here.orbit.period());
+    }
+}
