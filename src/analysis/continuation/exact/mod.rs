@@ -1,20 +1,18 @@
 //! Continuation of the exact orbit (issue 24): branches that do not depend on the grid.
 //!
-//! The grid LCP and the polish give the first orbit and its event signature; from there the
-//! branch is continued on the exact hybrid orbit ([`family`]: state and event times, exact
-//! flows between events, pseudo-arclength in the parameter; Keller 1977). Stability: the
-//! multipliers of the exact monodromy (the phases' exponentials, identity saltation at compliant
-//! switches). Events between two points are located by bisection on the arc to 1e-12 of the
-//! scaled unknowns: fold (the tangent's parameter component), period doubling (det(I + M)),
-//! Neimark–Sacker (complex multipliers outside the unit circle), grazing (the signature changes).
-//! A grazing is met from either side: a contact's clearance touching zero between its events
-//! (located where the touch's sign flips; a pair of events is inserted there and the new branch
-//! starts with its phase 1e-5 of the period long), or a phase between two events of one contact
-//! shrinking below 1e-6 of the period (steps land on it by quarters; the pair is removed and the
-//! branch goes on in the same direction of the parameter). Rigid contacts (plastic impacts,
-//! sticking arcs, releases; the monodromy is the relocated one-period map, rank-deficient at an
-//! impact): their signature changes are located on the exact orbit and the branch goes on from
-//! there, from the grid LCP only where that fails ([`rigid`]).
+//! The grid LCP and the polish give the first orbit and its event signature; from there the branch is continued
+//! on the exact hybrid orbit ([`family`]: state and event times, exact flows between events, pseudo-arclength in
+//! the parameter; Keller 1977). Stability: the multipliers of the exact monodromy (the phases' exponentials,
+//! identity saltation at compliant switches). Events between two points are located by bisection on the arc to
+//! 1e-12 of the scaled unknowns: fold (the tangent's parameter component), period doubling (det(I + M)),
+//! Neimark–Sacker (complex multipliers outside the unit circle), grazing (the signature changes). A grazing is
+//! met from either side: a contact's clearance touching zero between its events (located where the touch's sign
+//! flips; a pair of events is inserted there and the new branch starts with its phase 1e-5 of the period long),
+//! or a phase between two events of one contact shrinking below 1e-6 of the period (steps land on it by quarters;
+//! the pair is removed and the branch goes on in the same direction of the parameter). Rigid contacts (plastic
+//! impacts, sticking arcs, releases; the monodromy is the relocated one-period map, rank-deficient at an impact):
+//! their signature changes are located on the exact orbit and the branch goes on from there, from the grid LCP
+//! only where that fails ([`rigid`]).
 mod family;
 mod locate;
 mod metric;
@@ -31,11 +29,8 @@ use locate::{Test, detail_of, locate, side, test_value};
 
 /// A phase shorter than this (fraction of the period) and shrinking has vanished: a grazing.
 const VANISH: f64 = 1e-6;
-/// Below this step (scaled unknowns) a corrector that fails on a flight's re-impact time alone
-/// ([`Family::unresolved_flight`]) means the flight is below resolution: merged there, not
-/// crawled at (the coarse rigid blade at 2338.39 rad/s: every other step of 1e-6 failed so,
-/// hundreds of points in 0.01 rad/s; the walk at 2246 rad/s, its contact 0's flight 5e-6 of
-/// the period but resolved, steps of 2e-2).
+/// Below this step a corrector failing on a flight's re-impact time alone ([`Family::unresolved_flight`]):
+/// the flight is below resolution, merged, not crawled at (coarse rigid blade, 2338.39 rad/s; README).
 const UNRESOLVED_STEP: f64 = 1e-4;
 /// The phase of a pair of events just inserted at a grazing (fraction of the period).
 const NEW_PAIR: f64 = 1e-5;
@@ -283,10 +278,9 @@ impl Walk<'_> {
                 None => {
                     self.fam.sig = old;
                     ds = step / 2.0;
-                    let unresolved = self.fam.unresolved_flight().filter(|_| step < UNRESOLVED_STEP);
-                    let merged = unresolved.and_then(|e| {
-                        let what = format!("contact {}: its free phase below resolution (its re-impact's time unresolved)", self.fam.sig.events[e].contact);
-                        self.merge(&here, e, &what)
+                    let merged = self.fam.unresolved_flight().filter(|_| step < UNRESOLVED_STEP).and_then(|e| {
+                        let c = self.fam.sig.events[e].contact;
+                        self.merge(&here, e, &format!("contact {c}: its free phase below resolution (its re-impact's time unresolved)"))
                     });
                     if let Some(n) = merged {
                         if self.ends_here(&n, dir) {
