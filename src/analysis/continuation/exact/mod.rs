@@ -282,7 +282,12 @@ impl Walk<'_> {
                         let c = self.fam.sig.events[e].contact;
                         self.merge(&here, e, &format!("contact {c}: its free phase below resolution (its re-impact's time unresolved)"))
                     });
-                    if let Some(n) = merged {
+                    // Rigid events merging (a flight between two impacts, an impact fading): the branch past them.
+                    let restarted = match merged {
+                        None if ds < settings.min_step => self.rigid_stall(&here, to),
+                        m => m,
+                    };
+                    if let Some(n) = restarted {
                         if self.ends_here(&n, dir) {
                             return done(self, "a fold at a grazing".into(), false, false);
                         }
@@ -292,16 +297,6 @@ impl Walk<'_> {
                         continue;
                     }
                     if ds < settings.min_step {
-                        // Rigid events merging (a flight between two impacts, an impact fading): the branch past them.
-                        if let Some(n) = self.rigid_stall(&here, to) {
-                            if self.ends_here(&n, dir) {
-                                return done(self, "a fold at a grazing".into(), false, false);
-                            }
-                            self.report(on_point);
-                            here = n;
-                            ds = settings.initial_step;
-                            continue;
-                        }
                         let stop = format!("no exact orbit at {} = {} with the smallest step", self.name(), here.lambda(rho));
                         return done(self, stop, false, false);
                     }
