@@ -510,4 +510,6 @@ fn multipliers_of_a_bad_monodromy_are_nan() {
     let mut bad = m.clone();
     bad[(0, 1)] = f64::NAN;
     assert!(continuation::multipliers(&bad).iter().all(|z| z.re.is_nan()));
+    // Unknown multipliers are not a stable orbit: the largest is NaN, not f64::max's 0.
+    assert!(continuation::largest_multiplier(&continuation::multipliers(&bad)).is_nan());
 }

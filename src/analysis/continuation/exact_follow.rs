@@ -38,11 +38,12 @@ fn knob(a: &Tuning, b: &Tuning) -> Result<(Parameter, f64, f64, Tuning), &'stati
     }
 }
 
-/// The stability of an exact orbit: the multipliers of its exact monodromy.
-pub(super) fn exact_stability(orbit: &PolishedOrbit) -> Stability {
+/// The stability of an exact orbit: the multipliers of its exact monodromy; none where its Schur
+/// form did not converge (no NaN reported as a stability).
+pub(super) fn exact_stability(orbit: &PolishedOrbit) -> Option<Stability> {
     let multipliers = floquet::multipliers(orbit.monodromy());
     let largest = floquet::largest(&multipliers);
-    Stability { stable: largest <= 1.0, largest, multipliers }
+    largest.is_finite().then_some(Stability { stable: largest <= 1.0, largest, multipliers })
 }
 
 /// The active set (the LCP's z indices, step-major) of the grid response `r`'s contact phases:
@@ -144,7 +145,7 @@ fn on_branch(session: &mut PeriodicSolver, c: &Current<'_>, end: PolishedOrbit) 
         session.set_warm_start(&exact.active_set);
         response = exact;
     }
-    let stability = Some(exact_stability(&end));
+    let stability = exact_stability(&end);
     Ok(Resolved { response, jump: None, not_followed: None, orbit: Some(end), stability, exact: None })
 }
 
@@ -176,7 +177,7 @@ fn jump(session: &mut PeriodicSolver, c: &Current<'_>, param: Parameter, at: f64
         session.set_warm_start(&exact.active_set);
         (response, orbit) = (exact, Some(o));
     }
-    let stability = orbit.as_ref().map(exact_stability);
+    let stability = orbit.as_ref().and_then(exact_stability);
     let mut fold = c.tuning;
     match param {
         Parameter::Frequency | Parameter::Speed { .. } => fold.frequency = at,

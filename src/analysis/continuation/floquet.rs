@@ -72,8 +72,9 @@ fn balanced(m: &DMatrix<f64>) -> DMatrix<f64> {
 }
 
 /// Largest modulus (0 for an empty state).
+/// NaN when a multiplier is (an unconverged Schur form): `f64::max` would drop it and read 0, stable.
 pub fn largest(mu: &[Complex64]) -> f64 {
-    mu.iter().fold(0.0, |a, m| a.max(m.norm()))
+    mu.iter().fold(0.0, |a: f64, m| if m.norm().is_nan() { f64::NAN } else { a.max(m.norm()) })
 }
 
 /// Sign of det(I + M) = Π(1 + μ): flips where a real multiplier crosses −1.

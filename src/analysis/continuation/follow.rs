@@ -199,6 +199,9 @@ pub fn stability(problem: &PeriodicProblem, set: &[usize]) -> Result<Stability, 
     let monodromy = fam.smoothed_monodromy(&solved, blocks, fam.smoothing).unwrap_or_else(|| solved.monodromy.clone());
     let multipliers = floquet::multipliers(&monodromy);
     let largest = floquet::largest(&multipliers);
+    if !largest.is_finite() {
+        return Err("the monodromy's Schur form did not converge (its multipliers are unknown): no stability is reported".into());
+    }
     Ok(Stability { stable: largest <= 1.0, largest, multipliers })
 }
 

@@ -25,7 +25,7 @@ mod parameter;
 mod switch;
 
 pub use events::EventKind;
-pub use floquet::multipliers;
+pub use floquet::{largest as largest_multiplier, multipliers};
 pub use follow::{Current, Followed, Jump, Resolved, Stability, amplitude, follow, resolve, stability};
 pub use parameter::Parameter;
 pub use switch::{run_switching, switch_at};
