@@ -408,40 +408,31 @@ fn assemble_modal(
     let phio = Mat::<f64>::from_fn(nd, n, |r, i| along_row(&rows[r].1, |d| phi[(d, i)]));
     let (xre, xim) = (&phio * &ure, &phio * &uim);
     let (bre, bim) = (&bphi * &ure, &bphi * &uim);
-    let mut asm = Assembly {
+    // Ĝ_p[a][b] = Σ_i (BΦ)[a,i] (BΦ)[b,i] D_p[i] and Ẑ_p⁻¹Bᵀ[r][b] = Σ_i Φ_out[r,i] (BΦ)[b,i] D_p[i]:
+    // one product each, rows the pairs' mode products, so that column p is harmonic p's block in
+    // storage order (one sequential write; 2m products and m strided passes before, issue 23).
+    let pairs = Mat::<f64>::from_fn(m * m, n, |ab, i| bphi[(ab / m, i)] * bphi[(ab % m, i)]);
+    let (gre, gim) = (&pairs * &dre, &pairs * &dim);
+    let outs = Mat::<f64>::from_fn(nd * m, n, |rb, i| phio[(rb / m, i)] * bphi[(rb % m, i)]);
+    let (hre, him) = (&outs * &dre, &outs * &dim);
+    let by_harmonic = |re: &Mat<f64>, im: &Mat<f64>| -> Vec<C> {
+        let mut v = Vec::with_capacity(re.nrows() * nh);
+        for p in 0..nh {
+            v.extend(re.col_as_slice(p).iter().zip(im.col_as_slice(p)).map(|(&a, &b)| C::new(a, b)));
+        }
+        v
+    };
+    let asm = Assembly {
         k,
         m,
         dofs: rows.iter().map(|r| r.0).collect(),
         symbols,
-        g_hat: vec![C::ZERO; nh * m * m],
-        xlin_hat: vec![C::ZERO; nh * nd],
-        bxlin_hat: vec![C::ZERO; nh * m],
-        h_hat: vec![C::ZERO; nh * nd * m],
+        g_hat: by_harmonic(&gre, &gim),
+        xlin_hat: by_harmonic(&xre, &xim),
+        bxlin_hat: by_harmonic(&bre, &bim),
+        h_hat: by_harmonic(&hre, &him),
         tangential: Vec::new(),
     };
-    for p in 0..nh {
-        for r in 0..nd {
-            asm.xlin_hat[p * nd + r] = C::new(xre[(r, p)], xim[(r, p)]);
-        }
-        for a in 0..m {
-            asm.bxlin_hat[p * m + a] = C::new(bre[(a, p)], bim[(a, p)]);
-        }
-    }
-    for b in 0..m {
-        // v_b = D ∘ (BΦ)[b, :]ᵀ, then Φ_out v_b and BΦ v_b.
-        let vre = Mat::<f64>::from_fn(n, nh, |i, p| dre[(i, p)] * bphi[(b, i)]);
-        let vim = Mat::<f64>::from_fn(n, nh, |i, p| dim[(i, p)] * bphi[(b, i)]);
-        let (hre, him) = (&phio * &vre, &phio * &vim);
-        let (gre, gim) = (&bphi * &vre, &bphi * &vim);
-        for p in 0..nh {
-            for r in 0..nd {
-                asm.h_hat[(p * nd + r) * m + b] = C::new(hre[(r, p)], him[(r, p)]);
-            }
-            for a in 0..m {
-                asm.g_hat[(p * m + a) * m + b] = C::new(gre[(a, p)], gim[(a, p)]);
-            }
-        }
-    }
     let finite = asm.g_hat.iter().chain(&asm.xlin_hat).chain(&asm.h_hat).all(|v| v.re.is_finite() && v.im.is_finite());
     if !finite {
         return Err(SolveError::SingularOperator { harmonic: 0, frequency: 0.0 });
