@@ -302,7 +302,20 @@ const SUBSTEP_HALVINGS: u32 = 4;
 /// is bounded by shooting's work budget. Returns the answer and the sub-steps solved before it.
 /// `cold`: how to end ([`ColdTry`]; `No`: a miss after the sub-steps is the failure).
 fn solve_guarded(solver: &mut PeriodicSolver, last: Option<f64>, f: f64, cold: ColdTry) -> (Result<Response, SolveError>, usize) {
-    let at = |solver: &mut PeriodicSolver, w: f64, warm: bool| solver.update_frequency(w).and_then(|()| solver.solve_by_shooting(warm));
+    let profile = std::env::var_os("PERIODIC_CONTACT_PROFILE").is_some();
+    let at = |solver: &mut PeriodicSolver, w: f64, warm: bool| {
+        let t = Instant::now();
+        let r = solver.update_frequency(w).and_then(|()| solver.solve_by_shooting(warm));
+        if profile {
+            let how = if r.is_ok() { "solved" } else { "missed" };
+            eprintln!(
+                "sweep profile: ω = {f} rad/s, try at {w} rad/s (k = {}, warm {warm}) {how} in {:.3} s",
+                solver.problem().discretization().steps,
+                t.elapsed().as_secs_f64()
+            );
+        }
+        r
+    };
     let had_warm = solver.warm_start().is_some();
     let first = match at(solver, f, true) {
         Ok(r) => return (Ok(r), 0),
