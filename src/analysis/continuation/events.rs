@@ -64,7 +64,8 @@ pub(super) fn between(fam: &mut Family, a: &Node, b: &Node, contacts: usize) -> 
         if a.side(kind, c) == b.side(kind, c) {
             continue;
         }
-        let node = locate(fam, a, b, kind, c).unwrap_or_else(|| b.clone());
+        // A located node with unknown multipliers (unconverged Schur form) gives way to b, whose are known.
+        let node = locate(fam, a, b, kind, c).filter(|n| !floquet::largest(&n.mu).is_nan()).unwrap_or_else(|| b.clone());
         let detail = match kind {
             EventKind::Grazing => format!("contact {c}: active steps {} -> {}", active_steps(a, c), active_steps(b, c)),
             EventKind::NeimarkSacker | EventKind::PeriodDoubling => floquet::event_detail(kind, &node.mu),

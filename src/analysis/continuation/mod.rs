@@ -409,6 +409,18 @@ impl Walk<'_> {
                 continue;
             };
             let mut next = Node::new(fam, next, t_next);
+            // Unknown multipliers (an unconverged Schur form) would read as no event and print NaN:
+            // the point is refused like an unconverged corrector (the exact walk does the same).
+            if floquet::largest(&next.mu).is_nan() {
+                ds /= 2.0;
+                if ds < settings.min_step {
+                    break format!(
+                        "the monodromy's Schur form does not converge at {name} = {} (multipliers unknown) with the smallest step",
+                        next.solved.parameter(rho)
+                    );
+                }
+                continue;
+            }
             let lambda = next.solved.parameter(rho);
             // Past an end of the range: the last point at that end exactly, interpolated.
             let end = [(to, (lambda - to) * dir > 0.0), (from, (lambda - from) * dir < 0.0)].into_iter().find(|e| e.1).map(|e| e.0);
@@ -504,6 +516,11 @@ fn point(fam: &Family, solver: &mut PeriodicSolver, node: &Node, event: Option<E
     got.sort_unstable();
     let amplitude = amplitudes(solver.problem(), &r);
     let max_multiplier = floquet::largest(&node.mu);
+    if max_multiplier.is_nan() {
+        return Err(Error::solve(format!(
+            "the orbit at {lambda} has no stability: its monodromy's Schur form did not converge (multipliers unknown); remedy: another k or a smaller step"
+        )));
+    }
     Ok(BranchPoint {
         parameter: lambda,
         amplitude,
