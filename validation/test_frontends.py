@@ -214,7 +214,9 @@ def test_every_front_end_gives_the_cli_displacements(cli, workdir, scene):
     got = {}
     if "C API" in front_ends:
         t0 = time.perf_counter()
-        got["C API"] = engine.capi_displacements(cli, path, list(want), k)
+        # Without the error estimate, as the CLI's --no-estimate: the estimate's second solve at k/2
+        # of the rubbing real blade misses shooting and runs dense Lemke for minutes (README).
+        got["C API"] = engine.capi_displacements(cli, path, list(want), k, estimate=False)
         walls["C API"] = time.perf_counter() - t0
     fmu = os.path.join(folder, f"{name}.fmu")
     t0 = time.perf_counter()

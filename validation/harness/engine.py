@@ -162,9 +162,11 @@ def build_fmu(cli: str, scene_text: str, workdir: str, name: str) -> str:
     return fmu
 
 
-def capi_displacements(cli: str, scene: str, keys, k: int) -> dict[str, np.ndarray]:
+def capi_displacements(cli: str, scene: str, keys, k: int, estimate: bool = True) -> dict[str, np.ndarray]:
     """The C API (libperiodic_contact.so beside the CLI) through ctypes, as a Python user calls it:
-    pc_problem_from_scene_file, pc_problem_solve, pc_result_displacement of each key at the k instants."""
+    pc_problem_from_scene_file, pc_problem_solve, pc_result_displacement of each key at the k instants.
+    estimate=False: pc_problem_set_error_estimate(p, 0), as the CLI's --no-estimate (the C API's
+    default estimates by a second solve at k/2, which is not the CLI's solve)."""
     c = ctypes
     lib = c.CDLL(os.path.join(os.path.dirname(cli), "libperiodic_contact.so"))
     lib.pc_last_error.restype = c.c_char_p
@@ -181,6 +183,8 @@ def capi_displacements(cli: str, scene: str, keys, k: int) -> dict[str, np.ndarr
     if not p:
         raise EngineError(f"pc_problem_from_scene_file({scene}): {lib.pc_last_error().decode()}")
     try:
+        if not estimate and lib.pc_problem_set_error_estimate(c.c_void_p(p), 0) != 0:
+            raise EngineError(f"pc_problem_set_error_estimate({scene}): {lib.pc_last_error().decode()}")
         r = lib.pc_problem_solve(p)
         if not r:
             raise EngineError(f"pc_problem_solve({scene}): {lib.pc_last_error().decode()}")
