@@ -463,6 +463,11 @@ impl Walk<'_> {
                 trace(format_args!("reseed: no grid orbit polished at λ {l}"));
                 continue;
             };
+            // A grazing changes one contact's phases; more (11 -> 0 events at 2397.64) is another branch.
+            if signature::contacts_changed(orbit.events(), &self.fam.sig.events) > 1 {
+                trace(format_args!("reseed at λ {l}: the grid orbit changes several contacts' phases (another branch): refused"));
+                continue;
+            }
             let sig = Signature { events: orbit.events().to_vec(), always: orbit.always_closed().to_vec() };
             let old = std::mem::replace(&mut self.fam.sig, sig);
             let d = self.fam.dim();
