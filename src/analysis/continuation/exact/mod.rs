@@ -13,9 +13,11 @@
 //! impacts, sticking arcs, releases; the monodromy is the relocated one-period map, rank-deficient at an impact):
 //! their signature changes are located on the exact orbit and the branch goes on from there, from the grid LCP
 //! only where that fails ([`rigid`]).
+mod approach;
 mod family;
 mod locate;
 mod metric;
+mod pairs;
 mod profile;
 mod rigid;
 mod signature;
@@ -253,6 +255,15 @@ impl Walk<'_> {
                     }
                 }
             }
+            // A short rigid flight vanishing within the step: merged at its located end, not approached.
+            if let Some(next) = self.early_merge(&here, &shrinking, ds) {
+                if self.ends_here(&next, dir) {
+                    return done(self, "a fold at a grazing".into(), false, false);
+                }
+                self.report(on_point);
+                (here, ds) = (next, settings.initial_step);
+                continue;
+            }
             // Land on a vanishing phase by quarters.
             let mut step = ds;
             for &(_, len, rate) in &shrinking {
@@ -463,91 +474,6 @@ impl Walk<'_> {
         }
         moved.w = w;
         (sectioned, Some(moved))
-    }
-
-    /// The grazing at `here` where phase `e` has vanished: the point recorded, the pair of
-    /// events removed, and the first point of the branch without it, oriented in the parameter
-    /// as the branch came.
-    fn remove_pair(&mut self, here: &Node, e: usize) -> Option<Node> {
-        let rho = self.fam.rho;
-        let ev = self.fam.sig.events[e];
-        let before = self.fam.ne();
-        let (sig, guess) = signature::remove(&self.fam, &here.orbit, e, here.w[here.w.len() - 1])?;
-        let detail = format!(
-            "contact {}: events per period {before} -> {} (its {} phase vanishes)",
-            ev.contact,
-            sig.events.len(),
-            if ev.kind == Switch::On { "closed" } else { "open" }
-        );
-        self.push(here, Some(EventKind::Grazing), detail);
-        self.fam.sig = sig;
-        let d = self.fam.dim();
-        let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
-        let w = self.fam.correct(&guess, &e_l, here.lambda(rho) / rho)?;
-        let sign = here.tangent[here.tangent.len() - 1].signum();
-        let prev: Vec<f64> = e_l.iter().map(|x| x * if sign == 0.0 { 1.0 } else { sign }).collect();
-        self.fam.node(w, &prev)
-    }
-
-    /// The grazing at `lo`, the last point after `here` where no contact's clearance has crossed
-    /// zero between its events (located on the arc): recorded with the events between, the
-    /// pair of events inserted around the touch, and the first point of the branch with its phase
-    /// [`NEW_PAIR`] long.
-    fn insert_pair(&mut self, here: &Node, lo: &Node) -> Option<Node> {
-        for (kind, node, detail) in self.events_between(here, lo) {
-            self.push(&node, Some(kind), detail);
-        }
-        let touch = *lo.worst_touch()?;
-        let before = self.fam.ne();
-        let wl = lo.w[lo.w.len() - 1];
-        let kinds = if touch.closed { (Switch::Off, Switch::On) } else { (Switch::On, Switch::Off) };
-        let (sig, guess, pair) = signature::insert(&self.fam, &lo.orbit, &touch, kinds, NEW_PAIR, wl);
-        let detail = format!(
-            "contact {}: events per period {before} -> {} ({} phase begins)",
-            touch.contact,
-            sig.events.len(),
-            if touch.closed { "an open" } else { "a closed" }
-        );
-        self.push(lo, Some(EventKind::Grazing), detail);
-        let first = self.open_phase(sig, &guess, pair)?;
-        self.multipliers_across(lo, &first);
-        Some(first)
-    }
-
-    /// The first point of the branch of signature `sig` whose phase between its events `ia` and
-    /// `ib` (one contact's) begins at a grazing: corrected from `guess` with that phase
-    /// [`NEW_PAIR`] and twice that long, its tangent along the secant (the phase growing). The
-    /// family keeps its old signature when the corrector fails.
-    fn open_phase(&mut self, sig: Signature, guess: &[f64], (ia, ib): (usize, usize)) -> Option<Node> {
-        let old = std::mem::replace(&mut self.fam.sig, sig);
-        let d = self.fam.dim();
-        let n2 = d - 1 - self.fam.ne();
-        let mut normal = vec![0.0; d];
-        normal[n2 + ib] = 1.0;
-        normal[n2 + ia] = -1.0;
-        let wrap = if ib < ia { 1.0 } else { 0.0 };
-        let first = self.fam.correct(guess, &normal, NEW_PAIR - wrap).and_then(|w1| {
-            let mut g2 = w1.clone();
-            g2[n2 + ia] -= 0.5 * NEW_PAIR;
-            g2[n2 + ib] += 0.5 * NEW_PAIR;
-            let w2 = self.fam.correct(&g2, &normal, 2.0 * NEW_PAIR - wrap)?;
-            let sec: Vec<f64> = w2.iter().zip(&w1).map(|(a, b)| a - b).collect();
-            self.fam.node(w1, &sec)
-        });
-        if first.is_none() {
-            self.fam.sig = old;
-        }
-        first
-    }
-
-    /// Multiplier events across a grazing, from `lo` (the old signature) to `first` (the new
-    /// one): both orbits are the same there.
-    fn multipliers_across(&mut self, lo: &Node, first: &Node) {
-        for kind in [EventKind::PeriodDoubling, EventKind::NeimarkSacker] {
-            if side(lo, kind) != side(first, kind) {
-                self.push(first, Some(kind), detail_of(kind, first));
-            }
-        }
     }
 
     /// The events between two points of one signature, each located by bisection, in order.

@@ -135,7 +135,8 @@ impl Walk<'_> {
                 // The held orbit went on while its micro-flight was below resolution: the change
                 // is where the landing force crosses zero, back towards `here` (or just behind).
                 let back = if (here.lambda(rho) - l0).abs() > 1e-9 * rho { here.lambda(rho) } else { l0 - sense * 1e-4 * rho };
-                let zero = landing::landing_zero(&self.fam, &lo.w, e, (l0, back), sense).map(|z| z.0);
+                // Not ahead of `lo`: the secant may run on to the next zero (2351.59 → 2354.03 rad/s, README).
+                let zero = landing::landing_zero(&self.fam, &lo.w, e, (l0, back), sense).map(|z| z.0).filter(|z| (z.lambda(rho) - l0) * sense <= BRACKET * rho);
                 if let Some(n) = self.unmerge(&lo, zero.as_ref(), e, sense, &what) {
                     return Some(n);
                 }
@@ -462,6 +463,11 @@ impl Walk<'_> {
                 trace(format_args!("reseed: no grid orbit polished at λ {l}"));
                 continue;
             };
+            // A grazing changes one contact's phases; more (11 -> 0 events at 2397.64) is another branch.
+            if signature::contacts_changed(orbit.events(), &self.fam.sig.events) > 1 {
+                trace(format_args!("reseed at λ {l}: the grid orbit changes several contacts' phases (another branch): refused"));
+                continue;
+            }
             let sig = Signature { events: orbit.events().to_vec(), always: orbit.always_closed().to_vec() };
             let old = std::mem::replace(&mut self.fam.sig, sig);
             let d = self.fam.dim();
@@ -491,7 +497,7 @@ impl Walk<'_> {
 }
 
 /// The orbit's events with their times as fractions of the period.
-fn timed(orbit: &polish::PolishedOrbit) -> Vec<(f64, Event)> {
+pub(super) fn timed(orbit: &polish::PolishedOrbit) -> Vec<(f64, Event)> {
     let t = orbit.period();
     orbit.events().iter().zip(orbit.times()).map(|(e, &s)| (s / t, *e)).collect()
 }

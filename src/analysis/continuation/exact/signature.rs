@@ -199,3 +199,10 @@ pub(super) fn reversed(fam: &Family, w: &[f64]) -> bool {
 pub(super) fn collapsed(fam: &Family, pred: &[f64], w: &[f64]) -> bool {
     (0..fam.ne()).any(|e| pair_phase(fam, w, e).zip(pair_phase(fam, pred, e)).is_some_and(|(len, was)| len < super::VANISH && len < 0.1 * was))
 }
+
+/// How many contacts have a different number of events in `a` and `b`.
+pub(super) fn contacts_changed(a: &[Event], b: &[Event]) -> usize {
+    let count = |events: &[Event], c: usize| events.iter().filter(|e| e.contact == c).count();
+    let contacts = a.iter().chain(b).map(|e| e.contact + 1).max().unwrap_or(0);
+    (0..contacts).filter(|&c| count(a, c) != count(b, c)).count()
+}
