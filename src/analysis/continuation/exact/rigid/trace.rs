@@ -27,3 +27,19 @@ pub(super) fn merge(here: &Node, list: &[(f64, Event)], (e, ne): (usize, usize),
         eprintln!("merge: the old orbit's margin: contact {} {} {:e} at {:.12}", m.contact, m.what, m.value, m.time / here.orbit.period());
     }
 }
+
+/// The corrector stalled at `here` (`rigid_stall`): λ, the tangent's λ-component and every
+/// phase between two events of one contact (`pairs`: event, contact, length and rate of
+/// shrinking along the tangent, fractions of the period).
+pub(super) fn stall(here: &Node, rho: f64, pairs: &[(usize, usize, f64, f64)]) {
+    if std::env::var_os("PC_TRACE_UNMERGE").is_none() {
+        return;
+    }
+    let t = &here.tangent;
+    eprintln!("stall: rigid_stall at λ {:.10}, the tangent's λ-component {:e}, {} pair phases", here.lambda(rho), t[t.len() - 1], pairs.len());
+    let mut sorted = pairs.to_vec();
+    sorted.sort_by(|a, b| a.2.total_cmp(&b.2));
+    for (e, c, len, rate) in sorted {
+        eprintln!("stall: phase {e} of contact {c}: {len:e} of the period, shrinking at {rate:e} per unit of arclength");
+    }
+}
