@@ -3,6 +3,7 @@ use super::super::family::Node;
 use super::super::{VANISH, Walk};
 use super::trace::{self, trace};
 use super::{TOL, margin};
+use crate::analysis::polish;
 
 /// The longest phase (fraction of the period) merged at a stall: 100 × [`VANISH`]. The merges
 /// seen at a stall were flights of 6.5e-7 … 2.5e-6 of the period (coarse blade, 2215.5 and
@@ -45,6 +46,18 @@ impl Walk<'_> {
             && let Some(n) = self.past_zero_margin(here, to)
         {
             return Some(n);
+        }
+        // A sticking landing whose force is at zero (the k = 4096 blade at 2278.9746626: contact
+        // 1's, the old signature not correctable past it): the flight after it, started at λ fixed.
+        if m.value.abs() <= TOL
+            && m.what == polish::STUCK
+            && let Some(e) = super::landing(here, m.contact, m.time)
+        {
+            let sense = here.tangent[here.tangent.len() - 1].signum();
+            trace(format_args!("stall: contact {}'s landing (event {e}) at zero force: unmerged", m.contact));
+            if let Some(n) = self.unmerge(here, None, e, sense, &what) {
+                return Some(n);
+            }
         }
         self.reseed(here, &what, to)
     }

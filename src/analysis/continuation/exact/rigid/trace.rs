@@ -42,4 +42,14 @@ pub(super) fn stall(here: &Node, rho: f64, pairs: &[(usize, usize, f64, f64)]) {
     for (e, c, len, rate) in sorted {
         eprintln!("stall: phase {e} of contact {c}: {len:e} of the period, shrinking at {rate:e} per unit of arclength");
     }
+    // The events within 2e-3 of the period of the smallest margin: is it at a landing?
+    if let Some(m) = here.orbit.rigid_margin() {
+        let (p, at) = (here.orbit.period(), m.time / here.orbit.period());
+        eprintln!("stall: the smallest margin: contact {} {} {:e} at {at:.9} (event {:?})", m.contact, m.what, m.value, m.event);
+        for (k, (x, s)) in here.orbit.events().iter().zip(here.orbit.times()).enumerate() {
+            if ((s / p - at + 0.5).rem_euclid(1.0) - 0.5).abs() < 2e-3 {
+                eprintln!("stall: event {k} at {:.9}: contact {} {:?}", s / p, x.contact, x.kind);
+            }
+        }
+    }
 }
