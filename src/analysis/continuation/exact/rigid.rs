@@ -23,6 +23,7 @@ use crate::periodic::{PeriodicProblem, PeriodicSolver};
 use crate::time::Discretization;
 
 mod landing;
+mod stall;
 mod trace;
 use trace::trace;
 
@@ -423,27 +424,6 @@ impl Walk<'_> {
             _ => return None,
         };
         self.restart(here, sig, guess, what)
-    }
-
-    /// The corrector stalls at `here` with the smallest step on an orbit with rigid contacts:
-    /// events merging (a flight between two impacts shrinking as the second impact fades, a pure
-    /// impact starting to stick), where the old signature's Jacobian turns singular. `None`
-    /// without rigid contacts.
-    pub(super) fn rigid_stall(&mut self, here: &Node, to: f64) -> Option<Node> {
-        let m = here.orbit.rigid_margin()?;
-        let what = format!("the events merge (the corrector stalls; the smallest margin: contact {}'s {}, {:.1e})", m.contact, m.what, m.value);
-        // The shortest phase between two events of one contact: the one merging.
-        let (ne, n2) = (self.fam.ne(), here.w.len() - 1 - self.fam.ne());
-        let length = |e: usize| here.w[n2 + (e + 1) % ne] - here.w[n2 + e] + if e + 1 == ne { 1.0 } else { 0.0 };
-        let shortest = (0..ne)
-            .filter(|&e| ne >= 2 && self.fam.sig.events[e].contact == self.fam.sig.events[(e + 1) % ne].contact)
-            .min_by(|&a, &b| length(a).total_cmp(&length(b)));
-        if let Some(e) = shortest
-            && let Some(n) = self.merge(here, e, &what)
-        {
-            return Some(n);
-        }
-        self.reseed(here, &what, to)
     }
 
     /// Records the grazing at `at` and starts the branch past it from the grid LCP's orbit,

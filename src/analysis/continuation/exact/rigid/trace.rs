@@ -27,3 +27,29 @@ pub(super) fn merge(here: &Node, list: &[(f64, Event)], (e, ne): (usize, usize),
         eprintln!("merge: the old orbit's margin: contact {} {} {:e} at {:.12}", m.contact, m.what, m.value, m.time / here.orbit.period());
     }
 }
+
+/// The corrector stalled at `here` (`rigid_stall`): λ, the tangent's λ-component and every
+/// phase between two events of one contact (`pairs`: event, contact, length and rate of
+/// shrinking along the tangent, fractions of the period).
+pub(super) fn stall(here: &Node, rho: f64, pairs: &[(usize, usize, f64, f64)]) {
+    if std::env::var_os("PC_TRACE_UNMERGE").is_none() {
+        return;
+    }
+    let t = &here.tangent;
+    eprintln!("stall: rigid_stall at λ {:.10}, the tangent's λ-component {:e}, {} pair phases", here.lambda(rho), t[t.len() - 1], pairs.len());
+    let mut sorted = pairs.to_vec();
+    sorted.sort_by(|a, b| a.2.total_cmp(&b.2));
+    for (e, c, len, rate) in sorted {
+        eprintln!("stall: phase {e} of contact {c}: {len:e} of the period, shrinking at {rate:e} per unit of arclength");
+    }
+    // The events within 2e-3 of the period of the smallest margin: is it at a landing?
+    if let Some(m) = here.orbit.rigid_margin() {
+        let (p, at) = (here.orbit.period(), m.time / here.orbit.period());
+        eprintln!("stall: the smallest margin: contact {} {} {:e} at {at:.9} (event {:?})", m.contact, m.what, m.value, m.event);
+        for (k, (x, s)) in here.orbit.events().iter().zip(here.orbit.times()).enumerate() {
+            if ((s / p - at + 0.5).rem_euclid(1.0) - 0.5).abs() < 2e-3 {
+                eprintln!("stall: event {k} at {:.9}: contact {} {:?}", s / p, x.contact, x.kind);
+            }
+        }
+    }
+}
