@@ -11,11 +11,10 @@
 //! Every mode returned is mass-normalised (φᵀ M φ = 1) and signed so that its largest-magnitude
 //! entry is positive.
 use crate::fe::sparse::sparse_times_dense;
-use faer::linalg::matmul::matmul;
 use faer::linalg::solvers::Solve;
 use faer::sparse::SparseColMat;
 use faer::sparse::linalg::solvers::Llt;
-use faer::{Accum, Mat, MatRef, Par, Side};
+use faer::{Mat, MatRef, Side};
 
 /// Why modes could not be computed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -120,65 +119,55 @@ fn random_block(n: usize, p: usize, seed: u64) -> Mat<f64> {
     })
 }
 
-/// Removes from `w` its M-projection on the basis `q` (n × dim, M-orthonormal columns; `mq` = M q),
-/// twice (classical Gram–Schmidt as one product with the whole basis, not block by block), then
-/// M-orthonormalises its columns among themselves (modified Gram–Schmidt, twice). Returns the
-/// orthonormal block V, its M-image MV, and the triangular factor R with W = V R (rows = kept
-/// columns). Columns whose norm falls below `drop_tol` times their norm after the basis
-/// projection are dropped (deflation). One sparse product with M per call. `first` = (MQ)ᵀ W when
-/// the caller has it already (the Lanczos step's column of T): the first pass reuses it.
-fn m_orthonormalise(
-    m: &SparseColMat<usize, f64>,
-    q: MatRef<'_, f64>,
-    mq: MatRef<'_, f64>,
-    w: &mut Mat<f64>,
-    drop_tol: f64,
-    first: Option<Mat<f64>>,
-) -> (Mat<f64>, Mat<f64>, Mat<f64>) {
+/// Removes from `w` its M-projection on the basis blocks `q` (whose M-images are `mq`), twice,
+/// then M-orthonormalises its columns among themselves (modified Gram–Schmidt, twice). Returns
+/// the orthonormal block V, its M-image MV, and the triangular factor R with W = V R (rows =
+/// kept columns). Columns whose norm falls below `drop_tol` times their norm after the block
+/// projection are dropped (deflation). Two sparse products with M per call.
+fn m_orthonormalise(m: &SparseColMat<usize, f64>, q: &[Mat<f64>], mq: &[Mat<f64>], w: &mut Mat<f64>, drop_tol: f64) -> (Mat<f64>, Mat<f64>, Mat<f64>) {
     let p = w.ncols();
     let n = w.nrows();
-    if q.ncols() > 0 {
-        let mut c = first.unwrap_or_else(|| mq.transpose() * &*w);
-        matmul(w.as_mut(), Accum::Add, q, c.as_ref(), -1.0, Par::Seq);
-        matmul(c.as_mut(), Accum::Replace, mq.transpose(), w.as_ref(), 1.0, Par::Seq);
-        matmul(w.as_mut(), Accum::Add, q, c.as_ref(), -1.0, Par::Seq);
+    for _pass in 0..2 {
+        for (qb, mqb) in q.iter().zip(mq) {
+            let c = mqb.transpose() * &*w;
+            *w -= qb * &c;
+        }
     }
-    let mut mw = sparse_times_dense(m, w.as_ref());
+    let mw = sparse_times_dense(m, w.as_ref());
     let mut r = Mat::<f64>::zeros(p, p);
-    let mut kept = 0usize;
-    // Kept columns are moved to the front of w and mw (column `kept` is the next free slot).
+    let mut kept: Vec<usize> = Vec::new();
+    let mut vcols: Vec<Vec<f64>> = Vec::new();
+    let mut mvcols: Vec<Vec<f64>> = Vec::new();
     for j in 0..p {
-        let norm0 = col_dot(w.as_ref(), j, mw.as_ref(), j).max(0.0).sqrt();
+        let mut v: Vec<f64> = (0..n).map(|i| w[(i, j)]).collect();
+        let mut mv: Vec<f64> = (0..n).map(|i| mw[(i, j)]).collect();
+        let norm0 = dot(&v, &mv).max(0.0).sqrt();
         for _pass in 0..2 {
-            for idx in 0..kept {
-                let c = col_dot(mw.as_ref(), idx, w.as_ref(), j);
+            for (idx, (u, mu)) in vcols.iter().zip(&mvcols).enumerate() {
+                let c = dot(mu, &v);
                 for i in 0..n {
-                    w[(i, j)] -= c * w[(i, idx)];
-                    mw[(i, j)] -= c * mw[(i, idx)];
+                    v[i] -= c * u[i];
+                    mv[i] -= c * mu[i];
                 }
                 r[(idx, j)] += c;
             }
         }
-        let norm = col_dot(w.as_ref(), j, mw.as_ref(), j).max(0.0).sqrt();
+        let norm = dot(&v, &mv).max(0.0).sqrt();
         if !(norm > drop_tol * norm0) || !norm.is_finite() {
             continue;
         }
-        r[(kept, j)] = norm;
-        for i in 0..n {
-            w[(i, kept)] = w[(i, j)] / norm;
-            mw[(i, kept)] = mw[(i, j)] / norm;
-        }
-        kept += 1;
+        r[(vcols.len(), j)] = norm;
+        v.iter_mut().for_each(|x| *x /= norm);
+        mv.iter_mut().for_each(|x| *x /= norm);
+        kept.push(j);
+        vcols.push(v);
+        mvcols.push(mv);
     }
-    let v = w.as_ref().subcols(0, kept).to_owned();
-    let mv = mw.as_ref().subcols(0, kept).to_owned();
-    let r = r.as_ref().subrows(0, kept).to_owned();
+    let k = vcols.len();
+    let v = Mat::from_fn(n, k, |i, j| vcols[j][i]);
+    let mv = Mat::from_fn(n, k, |i, j| mvcols[j][i]);
+    let r = Mat::from_fn(k, p, |i, j| r[(i, j)]);
     (v, mv, r)
-}
-
-/// Column `i` of `a` dotted with column `j` of `b`.
-fn col_dot(a: MatRef<'_, f64>, i: usize, b: MatRef<'_, f64>, j: usize) -> f64 {
-    dot(a.col(i).try_as_col_major().expect("contiguous").as_slice(), b.col(j).try_as_col_major().expect("contiguous").as_slice())
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
@@ -220,15 +209,12 @@ pub fn lanczos(
     let mut seed = opts.seed;
     // Start block: K⁻¹M applied to random vectors (purges the null space of M).
     let mut w = solve(sparse_times_dense(m, random_block(n, p, seed).as_ref()));
-    let empty = Mat::<f64>::zeros(n, 0);
-    let (mut v, mut mv, _) = m_orthonormalise(m, empty.as_ref(), empty.as_ref(), &mut w, 1e-12, None);
+    let (mut v, mut mv, _) = m_orthonormalise(m, &[], &[], &mut w, 1e-12);
     if v.ncols() == 0 {
         return Err(EigenError::MassNotDefinite("K⁻¹M annihilates every start vector".into()));
     }
-    // The Krylov basis Q and its M-image, contiguous (one product with the whole basis per step).
-    let mut q = Mat::<f64>::zeros(n, 0);
-    let mut mq = Mat::<f64>::zeros(n, 0);
-    let (mut q_cap, mut mq_cap) = (0usize, 0usize);
+    let mut q: Vec<Mat<f64>> = Vec::new();
+    let mut mq: Vec<Mat<f64>> = Vec::new();
     let mut t = Mat::<f64>::zeros(0, 0);
     let mut dim = 0usize;
     let mut last_r: Mat<f64>;
@@ -241,18 +227,22 @@ pub fn lanczos(
         let mut w = solve(mv.clone());
         lap(&mut cpu_solve, &mut since);
         steps += 1;
+        q.push(v);
+        mq.push(mv);
         let new_dim = dim + pb;
-        append_columns(&mut q, &v, &mut q_cap);
-        append_columns(&mut mq, &mv, &mut mq_cap);
         let mut t2 = Mat::<f64>::zeros(new_dim, new_dim);
         t2.as_mut().submatrix_mut(0, 0, dim, dim).copy_from(&t);
         // Column block of T: Q_allᵀ M (K⁻¹M Q_b) = (MQ_all)ᵀ W.
-        let c = mq.transpose() * &w;
-        for i in 0..new_dim {
-            for j in 0..pb {
-                t2[(i, dim + j)] = c[(i, j)];
-                t2[(dim + j, i)] = c[(i, j)];
+        let mut row = 0;
+        for mqb in &mq {
+            let c = mqb.transpose() * &w;
+            for i in 0..c.nrows() {
+                for j in 0..pb {
+                    t2[(row + i, dim + j)] = c[(i, j)];
+                    t2[(dim + j, row + i)] = c[(i, j)];
+                }
             }
+            row += mqb.ncols();
         }
         // Symmetrise the new diagonal block.
         for i in 0..pb {
@@ -265,11 +255,7 @@ pub fn lanczos(
         t = t2;
         dim = new_dim;
         last_block_len = pb;
-        let (vn, mvn, r) = if dim < n {
-            m_orthonormalise(m, q.as_ref(), mq.as_ref(), &mut w, 1e-10, Some(c))
-        } else {
-            (Mat::zeros(n, 0), Mat::zeros(n, 0), Mat::zeros(0, pb))
-        };
+        let (vn, mvn, r) = if dim < n { m_orthonormalise(m, &q, &mq, &mut w, 1e-10) } else { (Mat::zeros(n, 0), Mat::zeros(n, 0), Mat::zeros(0, pb)) };
         lap(&mut cpu_orth, &mut since);
         last_r = r;
         v = vn;
@@ -301,7 +287,7 @@ pub fn lanczos(
             }
             lap(&mut cpu_ritz, &mut since);
             if converged >= count || dim >= n {
-                let modes = finish(k, m, q.as_ref(), &theta, &s, count, dim);
+                let modes = finish(k, m, &q, &theta, &s, count, dim);
                 if let Some(end) = crate::fe::profile_cpu() {
                     let done = since.unwrap_or(end);
                     eprintln!(
@@ -319,26 +305,15 @@ pub fn lanczos(
             // Invariant subspace: continue with fresh random directions.
             seed = seed.wrapping_add(1);
             let mut w = solve(sparse_times_dense(m, random_block(n, p, seed).as_ref()));
-            let (vn, mvn, _) = m_orthonormalise(m, q.as_ref(), mq.as_ref(), &mut w, 1e-10, None);
+            let (vn, mvn, _) = m_orthonormalise(m, &q, &mq, &mut w, 1e-10);
             if vn.ncols() == 0 {
                 let (theta, s) = ritz(&t)?;
-                return check(k, m, finish(k, m, q.as_ref(), &theta, &s, count.min(dim), dim));
+                return check(k, m, finish(k, m, &q, &theta, &s, count.min(dim), dim));
             }
             v = vn;
             mv = mvn;
         }
     }
-}
-
-/// Appends the columns of `b` to `a` (capacity doubled when full: no copy of the basis per step).
-fn append_columns(a: &mut Mat<f64>, b: &Mat<f64>, capacity: &mut usize) {
-    let (n, old) = (a.nrows(), a.ncols());
-    let new = old + b.ncols();
-    if new > *capacity {
-        *capacity = (2 * *capacity).max(new).max(16);
-        a.reserve(n, *capacity);
-    }
-    a.resize_with(n, new, |i, j| b[(i, j - old)]);
 }
 
 /// Refuses a singular K (ω² negligible against the stiffness/mass scale: the Cholesky factor of
@@ -387,10 +362,17 @@ pub fn symmetric_eigen(a: MatRef<'_, f64>) -> Result<(Vec<f64>, Mat<f64>), Eigen
     Ok((vals, e.U().to_owned()))
 }
 
-fn finish(k: &SparseColMat<usize, f64>, m: &SparseColMat<usize, f64>, q: MatRef<'_, f64>, theta: &[f64], s: &Mat<f64>, count: usize, dim: usize) -> Modes {
+fn finish(k: &SparseColMat<usize, f64>, m: &SparseColMat<usize, f64>, q: &[Mat<f64>], theta: &[f64], s: &Mat<f64>, count: usize, dim: usize) -> Modes {
+    let n = k.nrows();
     // Ritz coefficients of the wanted modes (largest θ first).
     let sel = Mat::from_fn(dim, count, |i, j| s[(i, dim - 1 - j)]);
-    let shapes = q * &sel;
+    let mut shapes = Mat::<f64>::zeros(n, count);
+    let mut row = 0;
+    for qb in q {
+        let b = qb.ncols();
+        shapes += qb * sel.as_ref().subrows(row, b);
+        row += b;
+    }
     let omega: Vec<f64> = (0..count).map(|j| (1.0 / theta[dim - 1 - j]).sqrt()).collect();
     let (shapes, residual) = normalise_and_check(k, m, shapes, &omega);
     Modes { omega, shapes, residual, krylov_dim: dim }
