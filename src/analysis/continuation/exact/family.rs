@@ -102,6 +102,11 @@ impl Node {
     }
 }
 
+/// The unit vector along λ, the last of `d` unknowns (the normal of a corrector at λ fixed).
+pub(super) fn lambda_axis(d: usize) -> Vec<f64> {
+    (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect()
+}
+
 impl Family {
     pub fn new(base: &Model, param: Parameter, rho: f64, ys: f64, sig: Signature) -> Family {
         let weight = state_weights(base);

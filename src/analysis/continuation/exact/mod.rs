@@ -26,7 +26,7 @@ use super::{BranchPoint, ContinuationSettings, EventKind, Parameter, Source, flo
 use crate::analysis::polish::{self, EventKind as Switch, PolishedOrbit};
 use crate::error::Error;
 use crate::periodic::{PeriodicProblem, PeriodicSolver};
-use family::{Family, Node, Signature};
+use family::{Family, Node, Signature, lambda_axis};
 use locate::{Test, detail_of, locate, side, test_value};
 
 /// A phase shorter than this (fraction of the period) and shrinking has vanished: a grazing.
@@ -113,7 +113,7 @@ fn begin<'a>(problem: &'a PeriodicProblem, param: Parameter, from: f64, to: f64,
     let mut fam = Family::new(problem.model(), param, rho, 1.0, sig);
     fam.ys = fam.scale_of(orbit.initial_state());
     let d = fam.dim();
-    let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
+    let e_l = lambda_axis(d);
     let w0 = fam
         .correct(&fam.pack(orbit, from), &e_l, from / rho)
         .ok_or_else(|| Error::solve(format!("the polished orbit at {} = {from} did not close as a function of the parameter", param.name())))?;
@@ -324,7 +324,7 @@ impl Walk<'_> {
                 let f = (bound - l0) / (lambda - l0);
                 let pred: Vec<f64> = w0.iter().zip(&next.w).map(|(a, b)| a + f * (b - a)).collect();
                 let d = self.fam.dim();
-                let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
+                let e_l = lambda_axis(d);
                 self.fam.correct(&pred, &e_l, bound / rho).and_then(|w| self.fam.node_with(w, &self.fam.metric.lower(&next.tangent), false)).unwrap_or(next)
             } else {
                 next

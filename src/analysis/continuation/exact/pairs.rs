@@ -1,6 +1,6 @@
 //! A pair of events of one contact removed where the phase between them has vanished, or
 //! inserted at a grazing; the multiplier events across such a change.
-use super::family::{Node, Signature};
+use super::family::{Node, Signature, lambda_axis};
 use super::locate::{detail_of, side};
 use super::{EventKind, NEW_PAIR, Switch, Walk, signature};
 
@@ -22,7 +22,7 @@ impl Walk<'_> {
         self.push(here, Some(EventKind::Grazing), detail);
         self.fam.sig = sig;
         let d = self.fam.dim();
-        let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
+        let e_l = lambda_axis(d);
         let w = self.fam.correct(&guess, &e_l, here.lambda(rho) / rho)?;
         let sign = here.tangent[here.tangent.len() - 1].signum();
         let prev: Vec<f64> = e_l.iter().map(|x| x * if sign == 0.0 { 1.0 } else { sign }).collect();

@@ -15,7 +15,7 @@
 //! stretch between is not traced, and the grazing's detail says so.
 //!
 //! [`PolishedOrbit::rigid_margin`]: crate::analysis::polish::PolishedOrbit::rigid_margin
-use super::family::{Family, Node, Signature};
+use super::family::{Family, Node, Signature, lambda_axis};
 use super::locate::{Test, locate};
 use super::{BRACKET, EventKind, NEW_PAIR, Walk, signature};
 use crate::analysis::polish::{self, Event, EventKind as Switch, Touch};
@@ -185,7 +185,7 @@ impl Walk<'_> {
     /// λ's order among the points of the held orbit walked past it, or at `lo` without it.
     fn unmerge(&mut self, lo: &Node, zero: Option<&Node>, e: usize, sense: f64, what: &str) -> Option<Node> {
         let (rho, d) = (self.fam.rho, self.fam.dim());
-        let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
+        let e_l = lambda_axis(d);
         let before = self.fam.ne();
         for f in UNMERGE {
             let l = lo.lambda(rho) + sense * f * rho;
@@ -298,7 +298,7 @@ impl Walk<'_> {
         let before = self.fam.ne();
         let old = std::mem::replace(&mut self.fam.sig, sig);
         let d = self.fam.dim();
-        let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
+        let e_l = lambda_axis(d);
         let sense = at.tangent[at.tangent.len() - 1].signum();
         let corrected = self.fam.correct(&guess, &e_l, lambda / rho);
         trace(format_args!(
@@ -451,7 +451,7 @@ impl Walk<'_> {
             let sig = Signature { events: orbit.events().to_vec(), always: orbit.always_closed().to_vec() };
             let old = std::mem::replace(&mut self.fam.sig, sig);
             let d = self.fam.dim();
-            let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
+            let e_l = lambda_axis(d);
             let prev: Vec<f64> = e_l.iter().map(|x| x * sense).collect();
             let node = self.fam.correct(&self.fam.pack(&orbit, l), &e_l, l / rho).and_then(|w| self.fam.node(w, &prev));
             trace(format_args!(
@@ -514,7 +514,7 @@ fn grid_orbit(problem: &PeriodicProblem, param: super::Parameter, lambda: f64) -
 /// ([`landing::landing_zero`]). `None` without a sign change or where the corrector fails.
 fn touch_point(fam: &mut Family, guess: &[f64], la: f64, lb: f64) -> Option<Node> {
     let (rho, d) = (fam.rho, fam.dim());
-    let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
+    let e_l = lambda_axis(d);
     // The orbit at λ from the unknowns `from`: (node, admissible).
     let at = |fam: &mut Family, from: &[f64], lambda: f64| -> Option<(Node, bool)> {
         let mut g = from.to_vec();

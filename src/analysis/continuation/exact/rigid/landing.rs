@@ -4,7 +4,7 @@
 //! clearance scale (polish's `lift_off`), so a bisection on the margin's sign finds where the
 //! flight becomes visible (the impact oscillator: 8.1e-6 before the closed form's change), not
 //! the change of topology.
-use super::super::family::{Family, Node, Signature};
+use super::super::family::{Family, Node, Signature, lambda_axis};
 use super::super::{BRACKET, EventKind, Walk, signature};
 use super::{TOL, margin};
 use crate::analysis::polish;
@@ -36,7 +36,7 @@ pub(in super::super) fn lifted(n: &Node) -> Option<usize> {
 /// landing holds). `None` where the corrector fails or no zero is found.
 pub(in super::super) fn landing_zero(fam: &Family, from: &[f64], e: usize, (la, lb): (f64, f64), sense: f64) -> Option<(Node, f64)> {
     let (rho, d) = (fam.rho, fam.dim());
-    let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
+    let e_l = lambda_axis(d);
     let at = |w0: &[f64], lambda: f64| -> Option<(Vec<f64>, f64)> {
         let mut g = w0.to_vec();
         g[d - 1] = lambda / rho;
@@ -96,7 +96,7 @@ impl Walk<'_> {
         let before = self.fam.ne();
         let old = std::mem::replace(&mut self.fam.sig, sig);
         let d = self.fam.dim();
-        let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
+        let e_l = lambda_axis(d);
         let held = self.fam.correct(&guess, &e_l, lambda / rho).and_then(|w| self.fam.node_with(w, &e_l, false));
         let zero = held
             .filter(|n| n.orbit.landing_force(k).is_some_and(|h| h < 0.0))

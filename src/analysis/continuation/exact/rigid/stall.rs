@@ -1,5 +1,5 @@
 //! The corrector's stall with the smallest step on an orbit with rigid contacts.
-use super::super::family::Node;
+use super::super::family::{Node, lambda_axis};
 use super::super::{VANISH, Walk};
 use super::trace::{self, trace};
 use super::{TOL, margin};
@@ -66,7 +66,7 @@ impl Walk<'_> {
     /// corrected at λ fixed; where its margin is negative, the change located between them.
     fn past_zero_margin(&mut self, here: &Node, to: f64) -> Option<Node> {
         let (rho, d) = (self.fam.rho, self.fam.dim());
-        let e_l: Vec<f64> = (0..d).map(|i| if i + 1 == d { 1.0 } else { 0.0 }).collect();
+        let e_l = lambda_axis(d);
         let sense = here.tangent[d - 1].signum();
         for f in AHEAD {
             let l = here.lambda(rho) + sense * f * rho;
