@@ -130,7 +130,8 @@ fn m_orthonormalise(m: &SparseColMat<usize, f64>, q: &[Mat<f64>], mq: &[Mat<f64>
     for _pass in 0..2 {
         for (qb, mqb) in q.iter().zip(mq) {
             let c = mqb.transpose() * &w;
-            w -= qb * &c;
+            // W −= Q_b C accumulated into W: no n × p temporary per block (memory-bound pass).
+            faer::linalg::matmul::matmul(w.as_mut(), faer::Accum::Add, qb.as_ref(), c.as_ref(), -1.0, faer::get_global_parallelism());
         }
     }
     let mut mw = sparse_times_dense(m, w.as_ref());
