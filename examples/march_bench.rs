@@ -18,7 +18,8 @@
 //! Times: process CPU (user + system, /proc/self/stat) and wall.
 //!
 //! `cargo run --release --example march_bench -- SCENE OMEGA REF_K OURS_TOLS MARCH_N MARCH_TOL`
-//! (lists comma-separated; MARCH_N entries `sN` mean N × the stable steps, rounded up to 256).
+//! (lists comma-separated; MARCH_N entries `sN` mean N × the stable steps, rounded up to 256;
+//! MARCH_N = `none` skips the march).
 //! The scene must have `scheme = "auto"`. Driver: validation/march_bench.sh.
 use periodic_contact::analysis::{polish, scheme_auto};
 use periodic_contact::marching::{MarchSettings, march, stable_omega_max};
@@ -62,7 +63,12 @@ fn gcd(a: usize, b: usize) -> usize {
     if b == 0 { a } else { gcd(b, a % b) }
 }
 
+#[path = "../src/bin/periodic-contact/malloc.rs"]
+mod malloc;
+
 fn main() {
+    // Before any allocation of the set-up: the CLI's allocator settings, so the timings are the CLI's.
+    malloc::keep_freed_memory();
     let a: Vec<String> = std::env::args().collect();
     if a.len() < 7 {
         eprintln!("usage: march_bench SCENE OMEGA REF_K OURS_TOLS MARCH_N MARCH_TOL");
@@ -144,6 +150,10 @@ fn main() {
         }
     }
 
+    // MARCH_N = none: the set-up, the reference and ours only (the march's recorded figures stand).
+    if a[5] == "none" {
+        return;
+    }
     let model = base.model();
     let wmax = stable_omega_max(model).unwrap();
     let period = 2.0 * std::f64::consts::PI / omega;

@@ -38,7 +38,12 @@ fn read_dump(path: &str) -> Vec<Vec<f64>> {
         .collect()
 }
 
+#[path = "../src/bin/periodic-contact/malloc.rs"]
+mod malloc;
+
 fn main() {
+    // Before any allocation of the set-up: the CLI's allocator settings, so the timings are the CLI's.
+    malloc::keep_freed_memory();
     let a: Vec<String> = std::env::args().collect();
     if a.len() == 4 && a[1] == "--compare" {
         for (name, (x, y)) in NAMES.iter().zip(read_dump(&a[2]).iter().zip(&read_dump(&a[3]))) {

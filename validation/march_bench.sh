@@ -5,7 +5,8 @@
 # the table; its output (reference, every run's error and CPU) goes to out/march-bench/*.txt.
 # Needs examples/real-blade/job/ (bash examples/real_blade.sh writes it) and `cargo build --release
 # --example march_bench`. About 5–30 min per case on 2 loaded cores.
-#   CASES="rigid-massless-2300 ..." to run a subset; OURS_TOLS / MARCH_TOL to change the ladders.
+#   CASES="rigid-massless-2300 ..." to run a subset; OURS_TOLS / MARCH_TOL to change the ladders;
+#   MARCH_N=none to run only the set-up, the reference and ours.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=out/march-bench

@@ -124,26 +124,29 @@ fn random_block(n: usize, p: usize, seed: u64) -> Mat<f64> {
 /// the orthonormal block V, its M-image MV, and the triangular factor R with W = V R (rows =
 /// kept columns). Columns whose norm falls below `drop_tol` times their norm after the block
 /// projection are dropped (deflation). Two sparse products with M per call.
-fn m_orthonormalise(m: &SparseColMat<usize, f64>, q: &[Mat<f64>], mq: &[Mat<f64>], w: &mut Mat<f64>, drop_tol: f64) -> (Mat<f64>, Mat<f64>, Mat<f64>) {
+fn m_orthonormalise(m: &SparseColMat<usize, f64>, q: &[Mat<f64>], mq: &[Mat<f64>], mut w: Mat<f64>, drop_tol: f64) -> (Mat<f64>, Mat<f64>, Mat<f64>) {
     let p = w.ncols();
     let n = w.nrows();
     for _pass in 0..2 {
         for (qb, mqb) in q.iter().zip(mq) {
-            let c = mqb.transpose() * &*w;
-            *w -= qb * &c;
+            let c = mqb.transpose() * &w;
+            // W −= Q_b C accumulated into W: no n × p temporary per block (memory-bound pass).
+            faer::linalg::matmul::matmul(w.as_mut(), faer::Accum::Add, qb.as_ref(), c.as_ref(), -1.0, faer::get_global_parallelism());
         }
     }
-    let mw = sparse_times_dense(m, w.as_ref());
+    let mut mw = sparse_times_dense(m, w.as_ref());
     let mut r = Mat::<f64>::zeros(p, p);
+    // Columns are orthonormalised in place in w and mw (no copy per column: the blocks are n × p,
+    // megabytes each); `kept` lists the columns already done.
     let mut kept: Vec<usize> = Vec::new();
-    let mut vcols: Vec<Vec<f64>> = Vec::new();
-    let mut mvcols: Vec<Vec<f64>> = Vec::new();
+    let (mut v, mut mv) = (vec![0.0; n], vec![0.0; n]);
     for j in 0..p {
-        let mut v: Vec<f64> = (0..n).map(|i| w[(i, j)]).collect();
-        let mut mv: Vec<f64> = (0..n).map(|i| mw[(i, j)]).collect();
+        v.copy_from_slice(w.col_as_slice(j));
+        mv.copy_from_slice(mw.col_as_slice(j));
         let norm0 = dot(&v, &mv).max(0.0).sqrt();
         for _pass in 0..2 {
-            for (idx, (u, mu)) in vcols.iter().zip(&mvcols).enumerate() {
+            for (idx, &kj) in kept.iter().enumerate() {
+                let (u, mu) = (w.col_as_slice(kj), mw.col_as_slice(kj));
                 let c = dot(mu, &v);
                 for i in 0..n {
                     v[i] -= c * u[i];
@@ -156,17 +159,22 @@ fn m_orthonormalise(m: &SparseColMat<usize, f64>, q: &[Mat<f64>], mq: &[Mat<f64>
         if !(norm > drop_tol * norm0) || !norm.is_finite() {
             continue;
         }
-        r[(vcols.len(), j)] = norm;
-        v.iter_mut().for_each(|x| *x /= norm);
-        mv.iter_mut().for_each(|x| *x /= norm);
+        r[(kept.len(), j)] = norm;
+        for (x, y) in w.col_as_slice_mut(j).iter_mut().zip(&v) {
+            *x = y / norm;
+        }
+        for (x, y) in mw.col_as_slice_mut(j).iter_mut().zip(&mv) {
+            *x = y / norm;
+        }
         kept.push(j);
-        vcols.push(v);
-        mvcols.push(mv);
     }
-    let k = vcols.len();
-    let v = Mat::from_fn(n, k, |i, j| vcols[j][i]);
-    let mv = Mat::from_fn(n, k, |i, j| mvcols[j][i]);
+    let k = kept.len();
     let r = Mat::from_fn(k, p, |i, j| r[(i, j)]);
+    if k == p {
+        return (w, mw, r);
+    }
+    let v = Mat::from_fn(n, k, |i, j| w[(i, kept[j])]);
+    let mv = Mat::from_fn(n, k, |i, j| mw[(i, kept[j])]);
     (v, mv, r)
 }
 
@@ -208,8 +216,8 @@ pub fn lanczos(
     };
     let mut seed = opts.seed;
     // Start block: K⁻¹M applied to random vectors (purges the null space of M).
-    let mut w = solve(sparse_times_dense(m, random_block(n, p, seed).as_ref()));
-    let (mut v, mut mv, _) = m_orthonormalise(m, &[], &[], &mut w, 1e-12);
+    let w = solve(sparse_times_dense(m, random_block(n, p, seed).as_ref()));
+    let (mut v, mut mv, _) = m_orthonormalise(m, &[], &[], w, 1e-12);
     if v.ncols() == 0 {
         return Err(EigenError::MassNotDefinite("K⁻¹M annihilates every start vector".into()));
     }
@@ -224,7 +232,7 @@ pub fn lanczos(
         // Extend the basis with v.
         let pb = v.ncols();
         let mut since = crate::fe::profile_cpu();
-        let mut w = solve(mv.clone());
+        let w = solve(mv.clone());
         lap(&mut cpu_solve, &mut since);
         steps += 1;
         q.push(v);
@@ -255,7 +263,7 @@ pub fn lanczos(
         t = t2;
         dim = new_dim;
         last_block_len = pb;
-        let (vn, mvn, r) = if dim < n { m_orthonormalise(m, &q, &mq, &mut w, 1e-10) } else { (Mat::zeros(n, 0), Mat::zeros(n, 0), Mat::zeros(0, pb)) };
+        let (vn, mvn, r) = if dim < n { m_orthonormalise(m, &q, &mq, w, 1e-10) } else { (Mat::zeros(n, 0), Mat::zeros(n, 0), Mat::zeros(0, pb)) };
         lap(&mut cpu_orth, &mut since);
         last_r = r;
         v = vn;
@@ -304,8 +312,8 @@ pub fn lanczos(
         if v.ncols() == 0 {
             // Invariant subspace: continue with fresh random directions.
             seed = seed.wrapping_add(1);
-            let mut w = solve(sparse_times_dense(m, random_block(n, p, seed).as_ref()));
-            let (vn, mvn, _) = m_orthonormalise(m, &q, &mq, &mut w, 1e-10);
+            let w = solve(sparse_times_dense(m, random_block(n, p, seed).as_ref()));
+            let (vn, mvn, _) = m_orthonormalise(m, &q, &mq, w, 1e-10);
             if vn.ncols() == 0 {
                 let (theta, s) = ritz(&t)?;
                 return check(k, m, finish(k, m, &q, &theta, &s, count.min(dim), dim));

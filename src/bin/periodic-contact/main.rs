@@ -11,6 +11,7 @@ mod cmd_solve;
 mod cmd_study;
 mod cmd_sweep;
 mod defaults;
+mod malloc;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -172,6 +173,7 @@ impl Failure {
 }
 
 fn main() -> ExitCode {
+    malloc::keep_freed_memory();
     let cli = Cli::parse();
     let result = match cli.command {
         None => cmd_solve::run_default(),
