@@ -3,16 +3,26 @@
 //! a matrix, twenty-five years later", SIAM Rev. 45, 2003, method 14), so a Newton iteration, a
 //! sampled phase and an admissibility check no longer pay a Padé exponential (scaling and
 //! squaring: ~20 products of the 2n_a × 2n_a matrix) per span, and a state costs O(n_a²).
-//! Method 14's error grows with the condition number κ(V): e^{Âτ}'s rounding is about ε κ(V)
-//! relative (ibid., §6), so a V with κ₁(V) > [`MAX_CONDITION`] (a defective or nearly defective
-//! Â: repeated poles, a critically damped mode) is refused and the phase keeps the Padé path.
+//! Method 14's error grows with the condition number of the basis the state is resolved in, so V⁻¹
+//! is not V's inverse computed as such: each conjugate pair's eigenvector v = p + iq is turned so
+//! that p ⟂ q, and the real basis X of the unit vectors p/‖p‖, q/‖q‖ (and the real eigenvectors)
+//! is inverted instead; V⁻¹'s rows follow from X⁻¹'s in closed form (see [`EigenFlow::new`]).
+//! A balanced phase's pair is [φ; ±iωφ/s] (phase.rs): for a mode much slower than the balancing
+//! rate s (a Craig–Bampton model: s ≈ 8.4e6 rad/s against ω₁ ≈ 2.3e3 rad/s) the two are ω/s from
+//! parallel and κ₁(V) ≈ 1e6 (the Padé path for every flow: the polish's 150–230 s), while p and q
+//! ([φ; 0] and [0; φ] undamped) are orthogonal and κ₁(X) is the mode shapes' own. e^{Âτ}'s
+//! rounding is then about ε κ₁(X) relative (Moler & Van Loan, §6, for the real block-diagonal
+//! form X diag(e^{B_j τ}) X⁻¹), so an X with κ₁(X) > [`MAX_CONDITION`] (a defective or nearly
+//! defective Â: repeated poles, a critically damped mode) is refused and the phase keeps the Padé path.
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64 as C;
 
-/// The largest κ₁(V) = ‖V‖₁ ‖V⁻¹‖₁ taken: ε κ ≈ 2e-13 keeps the exponential's rounding below the
-/// 1e-12 the polish's Newton converges to (the unit columns faer returns make κ within √(2n_a)
-/// of its smallest over column scalings, van der Sluis 1969).
-pub(super) const MAX_CONDITION: f64 = 1e3;
+/// The largest κ₁(X) = ‖X‖₁ ‖X⁻¹‖₁ taken: ε κ ≈ 2e-12 keeps the exponential's rounding two decades
+/// below the 1e-10 (of the state's scale) at which the polish's Newton takes its residual for
+/// round-off (orbit.rs). The 1-norm of X's unit columns counts up to √(2n_a) each over the 2-norm
+/// (van der Sluis 1969: within √(2n_a) of the smallest κ over column scalings); the Craig–Bampton
+/// blade's 34 phases have κ₁(X) = 7.0e2–1.8e3 (κ₁(V) = 4e5–1.3e6).
+pub(super) const MAX_CONDITION: f64 = 1e4;
 
 /// Â = V Λ V⁻¹ with V and V⁻¹ split in real and imaginary parts (two real products per use).
 #[derive(Clone, Debug)]
@@ -22,14 +32,24 @@ pub(super) struct EigenFlow {
     v_im: DMatrix<f64>,
     inv_re: DMatrix<f64>,
     inv_im: DMatrix<f64>,
-    /// κ₁(V), printed by the tests (the decomposition's accuracy scales with it).
+    /// κ₁(X) of the real basis (module doc), printed by the tests (the accuracy scales with it).
     #[cfg_attr(not(test), allow(dead_code))]
     pub condition: f64,
 }
 
+/// How far from exact conjugates (relative to |λ|) a pair of eigenvalues may be, and how far from
+/// real (relative to its norm) a real eigenvalue's turned eigenvector: faer's real Schur form
+/// gives both exactly; anything else is refused.
+const PAIRING: f64 = 1e-10;
+
 impl EigenFlow {
-    /// The decomposition of `a`; `None` when faer's eigensolver fails, V is singular, or
-    /// κ₁(V) > [`MAX_CONDITION`].
+    /// The decomposition of `a`; `None` when faer's eigensolver fails, the eigenvalues do not
+    /// come in conjugate pairs, X is singular, or κ₁(X) > [`MAX_CONDITION`].
+    ///
+    /// With v = p + iq turned so that pᵀq = 0 (by e^{−i arg(vᵀv)/2}), p̂ = p/‖p‖, q̂ = q/‖q‖ and
+    /// ρ = ‖q‖/‖p‖, the eigenvector is p̂ + iρq̂ (that column of V, its conjugate the twin's), and a
+    /// real y = c_p p̂ + c_q q̂ + … (c = X⁻¹y) has γ = (c_p − i c_q/ρ)/2 on it and γ̄ on the twin:
+    /// V⁻¹'s rows are (X⁻¹_p − i X⁻¹_q/ρ)/2 and their conjugates, and a real eigenvector's row is X⁻¹'s.
     pub fn new(a: &DMatrix<f64>) -> Option<Self> {
         let n = a.nrows();
         if n == 0 || !a.iter().all(|x| x.is_finite()) {
@@ -37,20 +57,86 @@ impl EigenFlow {
         }
         let eig = faer::Mat::from_fn(n, n, |i, j| a[(i, j)]).eigen().ok()?;
         let (u, s) = (eig.U(), eig.S().column_vector());
-        let v = DMatrix::from_fn(n, n, |i, j| u[(i, j)]);
-        let lambda: Vec<C> = (0..n).map(|i| s[i]).collect();
-        let inv = v.clone().try_inverse()?;
-        let norm1 = |m: &DMatrix<C>| m.column_iter().map(|c| c.iter().map(|z| z.norm()).sum::<f64>()).fold(0.0, f64::max);
-        let condition = norm1(&v) * norm1(&inv);
-        // Also refuse a decomposition whose residual ‖ÂV − VΛ‖₁ is not at round-off of ‖Â‖₁‖V‖₁.
-        let vl = DMatrix::from_fn(n, n, |i, j| v[(i, j)] * lambda[j]);
-        let av = a.map(|x| C::new(x, 0.0)) * &v;
-        let norm_a = a.column_iter().map(|c| c.iter().map(|x| x.abs()).sum::<f64>()).fold(0.0, f64::max);
-        let residual = norm1(&(av - vl));
-        if !(condition <= MAX_CONDITION) || !(residual <= 1e-12 * norm_a.max(f64::MIN_POSITIVE) * norm1(&v)) {
+        let mut lambda: Vec<C> = (0..n).map(|i| s[i]).collect();
+        let column = |j: usize| DVector::from_fn(n, |i, _| u[(i, j)]);
+        // Each mode: (its index, its twin's) for a pair, (index, index) for a real eigenvalue.
+        let mut twin = vec![usize::MAX; n];
+        for j in 0..n {
+            if twin[j] != usize::MAX || lambda[j].im < 0.0 {
+                continue;
+            }
+            if lambda[j].im == 0.0 {
+                twin[j] = j;
+                continue;
+            }
+            let k = (0..n)
+                .filter(|&k| twin[k] == usize::MAX && lambda[k].im < 0.0)
+                .min_by(|&a, &b| (lambda[a] - lambda[j].conj()).norm().total_cmp(&(lambda[b] - lambda[j].conj()).norm()))?;
+            if (lambda[k] - lambda[j].conj()).norm() > PAIRING * lambda[j].norm() {
+                return None;
+            }
+            lambda[k] = lambda[j].conj();
+            (twin[j], twin[k]) = (k, j);
+        }
+        if twin.contains(&usize::MAX) {
             return None;
         }
-        Some(EigenFlow { lambda, v_re: v.map(|z| z.re), v_im: v.map(|z| z.im), inv_re: inv.map(|z| z.re), inv_im: inv.map(|z| z.im), condition })
+        // The real basis X (unit columns: p̂ at j, q̂ at the twin; a real eigenvector at j) and ρ.
+        let mut x = DMatrix::zeros(n, n);
+        let mut rho = vec![0.0; n];
+        for j in (0..n).filter(|&j| lambda[j].im >= 0.0) {
+            let v = column(j);
+            if twin[j] == j {
+                let big = v.iter().copied().max_by(|a, b| a.norm().total_cmp(&b.norm()))?;
+                let r = v.map(|z| (z * big.conj() / big.norm()).re);
+                let im = v.map(|z| (z * big.conj() / big.norm()).im);
+                if !(im.norm() <= PAIRING * r.norm()) {
+                    return None;
+                }
+                x.set_column(j, &(&r / r.norm()));
+                continue;
+            }
+            let turn = C::from_polar(1.0, -0.5 * v.iter().map(|z| z * z).sum::<C>().arg());
+            let (p, q) = (v.map(|z| (z * turn).re), v.map(|z| (z * turn).im));
+            let (np, nq) = (p.norm(), q.norm());
+            if !(np > 0.0 && nq > 0.0) {
+                return None;
+            }
+            x.set_column(j, &(&p / np));
+            x.set_column(twin[j], &(&q / nq));
+            rho[j] = nq / np;
+        }
+        let x_inv = x.clone().try_inverse()?;
+        let norm1 = |m: &DMatrix<f64>| m.column_iter().map(|c| c.iter().map(|v| v.abs()).sum::<f64>()).fold(0.0, f64::max);
+        let condition = norm1(&x) * norm1(&x_inv);
+        if !(condition <= MAX_CONDITION) {
+            return None;
+        }
+        let (mut v_re, mut v_im) = (x.clone(), DMatrix::zeros(n, n));
+        let (mut inv_re, mut inv_im) = (x_inv.clone(), DMatrix::zeros(n, n));
+        for j in (0..n).filter(|&j| lambda[j].im > 0.0) {
+            let k = twin[j];
+            let (p, q) = (x.column(j).into_owned(), x.column(k).into_owned());
+            let (rp, rq) = (x_inv.row(j).into_owned(), x_inv.row(k).into_owned());
+            // v_j = p̂ + iρq̂, v_k = p̂ − iρq̂; rows (X⁻¹_p ∓ i X⁻¹_q/ρ)/2.
+            v_re.set_column(k, &p);
+            v_im.set_column(j, &(&q * rho[j]));
+            v_im.set_column(k, &(&q * -rho[j]));
+            inv_re.set_row(j, &(&rp * 0.5));
+            inv_re.set_row(k, &(&rp * 0.5));
+            inv_im.set_row(j, &(&rq * (-0.5 / rho[j])));
+            inv_im.set_row(k, &(&rq * (0.5 / rho[j])));
+        }
+        // Refuse a decomposition whose residual ‖ÂV − VΛ‖₁ is not at round-off of ‖Â‖₁‖V‖₁.
+        let v = v_re.zip_map(&v_im, C::new);
+        let vl = DMatrix::from_fn(n, n, |i, j| v[(i, j)] * lambda[j]);
+        let av = a.map(|x| C::new(x, 0.0)) * &v;
+        let norm_c = |m: &DMatrix<C>| m.column_iter().map(|c| c.iter().map(|z| z.norm()).sum::<f64>()).fold(0.0, f64::max);
+        let residual = norm_c(&(av - vl));
+        if !(residual <= 1e-12 * norm1(a).max(f64::MIN_POSITIVE) * norm_c(&v)) {
+            return None;
+        }
+        Some(EigenFlow { lambda, v_re, v_im, inv_re, inv_im, condition })
     }
 
     /// e^{Âτ} = Re(V e^{Λτ} V⁻¹) = Re(V e^{Λτ}) Re V⁻¹ − Im(V e^{Λτ}) Im V⁻¹.
@@ -165,6 +251,32 @@ mod tests {
             let u = DVector::from_fn(a.nrows(), |i, _| (i as f64).sin());
             let d = (f.apply(tau, &u) - &pade * &u).amax() / (&pade * &u).amax();
             assert!(d < 1e-12, "apply at τ = {tau:e}: {d:e}");
+        }
+    }
+
+    #[test]
+    fn eigen_exponential_matches_pade_when_the_balancing_rate_dwarfs_the_slow_modes() {
+        // A Craig–Bampton-like spread: one spring ~1e6× stiffer makes s ≈ 6e3× the slowest mode's
+        // ω, so V's pairs [φ; ±iωφ/s] are nearly parallel (κ₁(V) ≫ MAX_CONDITION) while the
+        // real basis X stays well conditioned (module doc): the decomposition must be taken.
+        let n = 20;
+        let mut a = chain(n);
+        let s = a[(0, n)];
+        // Rebalanced to s_new ≥ the stiff mode's rate √(k_stiff/m₀).
+        let (k_stiff, s_new) = (1e11, 1e11f64.sqrt() * 2.0);
+        a.view_mut((n, 0), (n, n)).scale_mut(s / s_new);
+        a.view_mut((0, n), (n, n)).scale_mut(s_new / s);
+        // A stiff spring to ground on the first mass: −M⁻¹K stays M⁻¹ times a symmetric matrix.
+        a[(n, 0)] -= k_stiff / s_new;
+        let f = EigenFlow::new(&a).expect("a stiff chain's real basis is well conditioned");
+        let slowest = f.eigenvalues().iter().map(|l| l.norm()).fold(f64::INFINITY, f64::min);
+        println!("stiff chain: s/ω_min = {:.1e}, κ₁(X) = {:.2e}", s_new / slowest, f.condition);
+        assert!(s_new / slowest > 1e3, "the case must have the CB spread");
+        for tau in [0.1, 1.0, 10.0, 100.0].map(|r| r / slowest) {
+            let (e, pade) = (f.exp(tau), (&a * tau).exp());
+            let err = relative(&e, &pade);
+            println!("stiff chain, ω_min τ = {:.1}: relative difference to Padé {err:.2e}", slowest * tau);
+            assert!(err < 1e-9, "exp at τ = {tau:e}: {err:e}");
         }
     }
 
