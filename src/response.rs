@@ -187,7 +187,7 @@ pub struct Accuracy {
     /// Why there is no estimate when the neighbour grid's solve was not had (its cause and the
     /// remedy); absent when estimated, or when no estimate applies (`method` says why).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub missing: Option<EstimateMissing>,
+    pub missing: Option<Box<EstimateMissing>>,
 }
 
 /// Why the error estimate's neighbour grid was not solved: the point's own answer stands,

@@ -163,29 +163,13 @@ fn an_impact_before_a_sticking_arc_is_estimated_at_first_order() {
     assert!((1.0..=10.0).contains(&(est / truth)), "estimate {est:e} vs true {truth:e}");
 }
 
-/// The compliant stop under fourier collocation at k = 64 (no step map: the neighbour at k/2 is
-/// dense Lemke alone, projected N³/1e10 s), as a scene for the C API.
-const FOURIER_STOP: &str = r#"
-[structure]
-mass = [[1.0]]
-stiffness = [[1.0]]
-[damping]
-matrix = [[0.05]]
-[excitation]
-frequency = 1.3
-[[force]]
-dof = 0
-amplitude = 1.0
-[[contact]]
-dof = 0
-gap = 1.0
-stiffness = 10.0
-[discretization]
-scheme = "fourier"
-steps = 64
-[output]
-displacement = [0]
-"#;
+/// The compliant stop (`fmu/scenes/compliant-stop.toml`) under fourier collocation at k = 64 (no
+/// step map: the neighbour at k/2 is dense Lemke alone, projected N³/1e10 s), for the C API.
+fn fourier_stop() -> String {
+    let shipped = include_str!("../fmu/scenes/compliant-stop.toml");
+    assert!(shipped.contains("scheme = \"cds\"\nsteps = 512"), "the shipped scene changed");
+    shipped.replace("scheme = \"cds\"\nsteps = 512", "scheme = \"fourier\"\nsteps = 64")
+}
 
 /// Issue 23: an estimate whose neighbour would pass its CPU budget (here 0 s: even the
 /// microseconds of dense Lemke at N = 32 do) gives no estimate, typed (`missing`, cause
@@ -214,7 +198,7 @@ fn an_estimate_past_its_budget_is_typed_and_leaves_the_answer_as_without_it() {
     check("compliant fourier k = 64", e, truth, &a.method);
 
     // The C API: estimate on with a zero budget, against estimate off.
-    let text = CString::new(FOURIER_STOP).unwrap();
+    let text = CString::new(fourier_stop()).unwrap();
     let solve = |estimate: i32, budget: f64| unsafe {
         let p = pc_problem_from_scene_text(text.as_ptr());
         assert!(!p.is_null());

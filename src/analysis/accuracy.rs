@@ -158,7 +158,7 @@ pub fn estimate_within(problem: &PeriodicProblem, r: &Response, budget: f64) -> 
 /// No estimate, because a neighbour solve missed: "none: no estimate: …, remedy: …".
 fn without(missing: EstimateMissing) -> Accuracy {
     let method = format!("none: no estimate: {} ({}), remedy: {}", missing.detail, cause_name(missing.cause), missing.remedy);
-    Accuracy { method, missing: Some(missing), ..Accuracy::default() }
+    Accuracy { method, missing: Some(Box::new(missing)), ..Accuracy::default() }
 }
 
 fn cause_name(c: MissingCause) -> &'static str {

@@ -36,7 +36,10 @@ pub use tuning::Tuning;
 use crate::error::{Error, ErrorKind};
 /// The step map's type, for analyses that march it (continuation, stability).
 pub use crate::lcp::StepMapLcp;
-pub use crate::lcp::{AUTO_LEMKE_MAX, DENSE_MAX, LEMKE_AFTER_SHOOTING_MAX, LcpMethod, solve_circulant_lcp};
+pub use crate::lcp::{
+    AUTO_LEMKE_MAX, DENSE_MAX, DENSE_MEMORY_MAX, LEMKE_AFTER_SHOOTING_MAX, LEMKE_FLOPS_PER_S, LcpMethod, dense_lemke_seconds, dense_memory, progress,
+    solve_circulant_lcp,
+};
 use crate::lcp::{LcpOutcome, LcpSolution};
 use crate::model::ModelError;
 

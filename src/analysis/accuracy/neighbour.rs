@@ -5,8 +5,10 @@
 //! is a typed miss ([`EstimateMissing`]) and the point keeps its own certified answer. Why: on the
 //! rubbing real blade (issue 23) the neighbours missed shooting and `auto`'s dense fallback ran
 //! minutes each on the non-symmetric LCP (254 s CPU for one estimate, against 8 s for the solve).
-use crate::lcp::{DENSE_MEMORY_MAX, LEMKE_FLOPS_PER_S, LcpMethod, dense_lemke_seconds, dense_memory, progress};
-use crate::periodic::{PeriodFft, PeriodicProblem, PeriodicSolver, SolveError, SolverSettings};
+use crate::periodic::{
+    DENSE_MEMORY_MAX, LEMKE_FLOPS_PER_S, LcpMethod, PeriodFft, PeriodicProblem, PeriodicSolver, SolveError, SolverSettings, dense_lemke_seconds, dense_memory,
+    progress,
+};
 use crate::response::{EstimateMissing, MissingCause, Response};
 use crate::time::Scheme;
 use std::time::Instant;
