@@ -121,6 +121,9 @@ const char *pc_problem_contact_pairing(const pc_problem *p, size_t i);
 /* on = 1 (default, or the scene's [discretization] error_estimate): every solve also
  * estimates its error by a second solve at k/2 (Richardson); 0: skip it, for speed. */
 int pc_problem_set_error_estimate(pc_problem *p, int on);
+/* CPU seconds the estimate's neighbour solves may take together (default 30, >= 0); past it the
+ * result has no estimate: pc_result_accuracy gives *estimated = 0 and the method says why. */
+int pc_problem_set_error_estimate_budget(pc_problem *p, double seconds);
 /* on = 1 (or the scene's [discretization] polish = true): every solve is refined by the
  * event-fitted polish (exact flows between the events read from the LCP, Newton on the event
  * times and states): the samples become the exact orbit's, with its events and an exact

@@ -11,7 +11,7 @@
 //! one result may run concurrently (the JSON is cached in a `OnceLock`); a problem must not be
 //! mutated while another thread solves it. Readers of contacts, pairing, warm start and
 //! solver path: `inspect`.
-use crate::analysis::accuracy;
+use crate::analysis::accuracy::{self, neighbour::ESTIMATE_BUDGET_CPU_S as BUDGET};
 use crate::model::{Compliance, Contact, Force, Harmonic, Matrix, Model, Structure};
 use crate::periodic::Tuning;
 use crate::periodic::{OutputSelection, PeriodicProblem, PeriodicSolver, SolveError, SolverSettings};
@@ -20,7 +20,7 @@ use crate::scene::Scene;
 use crate::time::{Discretization, Pairing, Scheme};
 mod branch;
 pub use branch::{pc_problem_set_stability, pc_result_jump, pc_result_stability};
-mod estimate;
+pub mod estimate;
 mod friction;
 pub use friction::*;
 mod inspect;
@@ -118,6 +118,8 @@ pub struct PcProblem {
     tuning: Tuning,
     /// Estimate the error of every result (`[discretization] error_estimate`, default true).
     estimate: bool,
+    /// CPU seconds for the estimate's neighbour solves (`pc_problem_set_error_estimate_budget`).
+    budget: f64,
     /// Refine every result by the event-fitted polish (`[discretization] polish`, default false).
     polish: bool,
     /// Built at the first solve.
@@ -145,7 +147,7 @@ pub struct PcResult {
 
 impl PcProblem {
     fn new(base: PeriodicProblem) -> Box<Self> {
-        Box::new(PcProblem { tuning: Tuning::of(&base), base, estimate: true, polish: false, session: None, branch: Default::default() })
+        Box::new(PcProblem { tuning: Tuning::of(&base), base, estimate: true, budget: BUDGET, polish: false, session: None, branch: Default::default() })
     }
     /// Rebuilds the base problem after an edit, keeping the old one if the edit is invalid.
     fn edit(&mut self, f: impl FnOnce(&mut Model, &mut OutputSelection)) -> Result<(), (c_int, String)> {
@@ -396,7 +398,7 @@ pub unsafe extern "C" fn pc_problem_solve(p: *mut PcProblem) -> *mut PcResult {
         let (mut response, branch) = branch::solve(p)?;
         let session = p.session.as_ref().expect("made by branch::solve");
         response.accuracy = if p.estimate {
-            accuracy::estimate(session.problem(), &response)
+            accuracy::estimate_within(session.problem(), &response, p.budget)
         } else {
             Accuracy { method: "none: not requested (pc_problem_set_error_estimate)".into(), ..Accuracy::default() }
         };

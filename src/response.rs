@@ -184,6 +184,33 @@ pub struct Accuracy {
     pub relative_own: Option<f64>,
     /// How it was obtained, e.g. "richardson: k/2 = 256, order 2 (cds, forward, rigid contact with sticking)".
     pub method: String,
+    /// Why there is no estimate when the neighbour grid's solve was not had (its cause and the
+    /// remedy); absent when estimated, or when no estimate applies (`method` says why).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub missing: Option<Box<EstimateMissing>>,
+}
+
+/// Why the error estimate's neighbour grid was not solved: the point's own answer stands,
+/// certified, without an estimate.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct EstimateMissing {
+    /// What stopped it.
+    pub cause: MissingCause,
+    /// The neighbour grid ("k/2 = 512") and what was tried, with figures.
+    pub detail: String,
+    /// What the user can do.
+    pub remedy: String,
+}
+
+/// What stopped an error estimate's neighbour solve.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MissingCause {
+    /// Shooting missed and the dense fallback would pass the estimate's CPU budget (projected,
+    /// or its pivot cap ran out).
+    Budget,
+    /// Every try missed within the budget (or the neighbour's LCP has no dense fallback).
+    Missed,
 }
 
 /// One event of a polished orbit.

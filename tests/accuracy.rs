@@ -162,3 +162,63 @@ fn an_impact_before_a_sticking_arc_is_estimated_at_first_order() {
     assert!(a.method.contains("separate impact"), "{}", a.method);
     assert!((1.0..=10.0).contains(&(est / truth)), "estimate {est:e} vs true {truth:e}");
 }
+
+/// The compliant stop (`fmu/scenes/compliant-stop.toml`) under fourier collocation at k = 64 (no
+/// step map: the neighbour at k/2 is dense Lemke alone, projected N³/1e10 s), for the C API.
+fn fourier_stop() -> String {
+    let shipped = include_str!("../fmu/scenes/compliant-stop.toml");
+    assert!(shipped.contains("scheme = \"cds\"\nsteps = 512"), "the shipped scene changed");
+    shipped.replace("scheme = \"cds\"\nsteps = 512", "scheme = \"fourier\"\nsteps = 64")
+}
+
+/// Issue 23: an estimate whose neighbour would pass its CPU budget (here 0 s: even the
+/// microseconds of dense Lemke at N = 32 do) gives no estimate, typed (`missing`, cause
+/// `budget`, "none: no estimate: …, remedy: …"), never a number; the point's own answer is the
+/// one solved without the estimate (the C API, estimate on with the budget 0 against off), and
+/// with the default budget the same point is estimated within 10× of the exact error.
+#[test]
+fn an_estimate_past_its_budget_is_typed_and_leaves_the_answer_as_without_it() {
+    use periodic_contact::capi::estimate::*;
+    use periodic_contact::capi::*;
+    use periodic_contact::response::MissingCause;
+    use std::ffi::{CStr, CString};
+    let osc = Oscillator::new(1.0, 0.05, 1.0, 1.0, 1.3);
+    let p = problem(&osc, Oscillator::stop(1.0, Compliance::Compliant { stiffness: 10.0 }), Scheme::Fourier, 64);
+    let r = p.solve().unwrap();
+    let none = accuracy::estimate_within(&p, &r, 0.0);
+    let missing = none.missing.as_ref().unwrap_or_else(|| panic!("estimated within a zero budget: {}", none.method));
+    assert_eq!(missing.cause, MissingCause::Budget, "{missing:?}");
+    assert!(none.estimate.is_none() && none.relative.is_none(), "{none:?}");
+    assert!(none.method.starts_with("none: no estimate: the neighbour at k/2 = 32") && none.method.contains("remedy: "), "{}", none.method);
+    // The control: the default budget estimates this point, near the exact error.
+    let exact = CompliantStopOrbit::solve(&osc, 10.0, 1.0, None).unwrap();
+    let truth = r.time.iter().zip(&r.displacement["0"]).map(|(&t, &x)| (x - exact.eval(t).0).abs()).fold(0.0, f64::max);
+    let a = accuracy::estimate(&p, &r);
+    let e = a.estimate.unwrap_or_else(|| panic!("no estimate with the default budget: {}", a.method));
+    check("compliant fourier k = 64", e, truth, &a.method);
+
+    // The C API: estimate on with a zero budget, against estimate off.
+    let text = CString::new(fourier_stop()).unwrap();
+    let solve = |estimate: i32, budget: f64| unsafe {
+        let p = pc_problem_from_scene_text(text.as_ptr());
+        assert!(!p.is_null());
+        assert_eq!(pc_problem_set_error_estimate(p, estimate), 0);
+        assert_eq!(pc_problem_set_error_estimate_budget(p, budget), 0);
+        let r = pc_problem_solve(p);
+        assert!(!r.is_null(), "{}", CStr::from_ptr(pc_last_error()).to_string_lossy());
+        let mut x = vec![0.0; 64];
+        assert_eq!(pc_result_displacement(r, 0, x.as_mut_ptr(), 64), 0);
+        let (mut estimated, mut value, mut relative, mut method) = (-1, f64::NAN, f64::NAN, std::ptr::null());
+        assert_eq!(pc_result_accuracy(r, &mut estimated, &mut value, &mut relative, &mut method), 0);
+        let method = CStr::from_ptr(method).to_string_lossy().into_owned();
+        pc_result_free(r);
+        pc_problem_set_error_estimate_budget(p, f64::NAN).ne(&0).then_some(()).expect("a NaN budget is refused");
+        pc_problem_free(p);
+        (x, estimated, value, relative, method)
+    };
+    let (x_on, estimated, value, relative, method) = solve(1, 0.0);
+    let (x_off, ..) = solve(0, 30.0);
+    assert_eq!(x_on, x_off, "the answer with the estimate past its budget is the one without it");
+    assert_eq!((estimated, value, relative), (0, 0.0, 0.0), "no estimate, and no NaN: {method}");
+    assert!(method.starts_with("none: no estimate:") && method.contains("budget"), "{method}");
+}

@@ -331,7 +331,7 @@ struct CApi {
     result_free: unsafe extern "C" fn(P),
 }
 
-const C_API_FUNCTIONS: [&str; 60] = [
+const C_API_FUNCTIONS: [&str; 61] = [
     "pc_problem_friction_count",
     "pc_problem_set_normal_force_scale",
     "pc_result_friction_count",
@@ -351,6 +351,7 @@ const C_API_FUNCTIONS: [&str; 60] = [
     "pc_result_stability",
     "pc_result_jump",
     "pc_problem_set_error_estimate",
+    "pc_problem_set_error_estimate_budget",
     "pc_result_accuracy",
     "pc_problem_dof_count",
     "pc_problem_contact_count",

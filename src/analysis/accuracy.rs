@@ -11,8 +11,11 @@
 //! under cds at k = 1024), the second solve is at 2k instead: dearer (twice the unknowns), but
 //! the only one that is honest there.
 use crate::model::Compliance;
+use crate::periodic::carried_active_set;
 use crate::periodic::{PeriodicProblem, PeriodicSolver, SolveError};
-use crate::response::{Accuracy, Response};
+use crate::response::{Accuracy, EstimateMissing, MissingCause, Response};
+
+pub mod neighbour;
 use crate::time::{Discretization, Pairing, Scheme};
 
 /// Fewest forced instants in a row that count as a sticking arc (a pure impact loads one or two
@@ -117,21 +120,52 @@ pub fn solve_warm(active: &[usize], rows: usize, instants: usize, grid: &Periodi
 /// k/4 for the observed order ([`estimate_from`]); when k/2 breaks the scheme's stability limit
 /// (ω_max·h ≥ limit: cds, galerkin on stiff models) by a second solve at 2k instead, and `method`
 /// says so. The estimate is `None`, with the reason in `method`, when k is odd or too small, the
-/// scheme does not converge for this contact, or the second solve is refused or fails; a
-/// refused or failed third solve leaves the two-grid estimate.
+/// scheme does not converge for this contact, or the second solve is refused or missed; a
+/// refused or missed third solve leaves the two-grid estimate. The neighbour solves are bounded
+/// by [`neighbour::ESTIMATE_BUDGET_CPU_S`] ([`estimate_within`]).
 pub fn estimate(problem: &PeriodicProblem, r: &Response) -> Accuracy {
+    estimate_within(problem, r, neighbour::ESTIMATE_BUDGET_CPU_S)
+}
+
+/// [`estimate`] with the neighbour solves bounded by `budget` CPU seconds together
+/// ([`neighbour::solve`]): a second grid not solved within it gives no estimate, with
+/// [`Accuracy::missing`] saying why and the remedy; `r` is untouched.
+pub fn estimate_within(problem: &PeriodicProblem, r: &Response, budget: f64) -> Accuracy {
+    let budget = neighbour::Budget::new(budget);
     let instants = problem.instants();
-    let solve = |grid: &PeriodicProblem| solve_warm(&r.active_set, r.lcp.size / instants.max(1), instants, grid);
+    let rows = r.lcp.size / instants.max(1);
+    let solve = |grid: &PeriodicProblem, note: &str| neighbour::solve(grid, &carried_active_set(&r.active_set, rows, instants, grid.instants()), &budget, note);
     let (second, note) = match second_grid(problem, r) {
         Ok(g) => g,
         Err(a) => return a,
     };
-    let rs = match solve(&second) {
+    let rs = match solve(&second, &note) {
         Ok(rs) => rs,
-        Err(e) => return unestimated(format!("the second solve at {note} failed: {}", short(&e))),
+        Err(missing) => return without(missing),
     };
-    let third = (second.discretization().steps < problem.discretization().steps).then(|| third_grid(&second)).flatten().and_then(|g| solve(&g).ok());
-    estimate_from(problem, r, &rs, third.as_ref(), &note)
+    let third = (second.discretization().steps < problem.discretization().steps).then(|| third_grid(&second)).flatten();
+    let third = third.map(|g| {
+        let k = g.discretization().steps;
+        solve(&g, &format!("k/4 = {k}"))
+    });
+    let mut a = estimate_from(problem, r, &rs, third.as_ref().and_then(|t| t.as_ref().ok()), &note);
+    if let Some(Err(m)) = third {
+        a.method = format!("{} (no observed order: {}, {})", a.method, cause_name(m.cause), m.detail);
+    }
+    a
+}
+
+/// No estimate, because a neighbour solve missed: "none: no estimate: …, remedy: …".
+fn without(missing: EstimateMissing) -> Accuracy {
+    let method = format!("none: no estimate: {} ({}), remedy: {}", missing.detail, cause_name(missing.cause), missing.remedy);
+    Accuracy { method, missing: Some(Box::new(missing)), ..Accuracy::default() }
+}
+
+fn cause_name(c: MissingCause) -> &'static str {
+    match c {
+        MissingCause::Budget => "over the estimate's CPU budget",
+        MissingCause::Missed => "missed",
+    }
 }
 
 /// [`estimate`] with the second solve made by `solve_second` (given the problem at k/2 or 2k):
@@ -149,7 +183,7 @@ pub fn estimate_with(problem: &PeriodicProblem, r: &Response, solve_second: &mut
 }
 
 fn unestimated(why: String) -> Accuracy {
-    Accuracy { estimate: None, relative: None, relative_own: None, method: format!("none: {why}") }
+    Accuracy { method: format!("none: {why}"), ..Accuracy::default() }
 }
 
 /// The problem of the estimate's second grid (k/2, or 2k when k/2 breaks the scheme's stability
@@ -292,6 +326,7 @@ fn differences_estimate(
         relative: (big > 0.0).then(|| estimate / big),
         relative_own: (big > 0.0).then_some(own),
         method: format!("richardson: {note}, order {p}{observed} ({scheme}, {why})"),
+        missing: None,
     }
 }
 

@@ -19,6 +19,24 @@ pub unsafe extern "C" fn pc_problem_set_error_estimate(p: *mut PcProblem, on: c_
     })
 }
 
+/// The CPU seconds the error estimate's neighbour solves may take together (default 30, ≥ 0).
+/// Past it a result has no estimate (`pc_result_accuracy`: `*estimated` = 0, `*method` "none:
+/// no estimate: …, remedy: …"); its own answer is the one without the estimate.
+///
+/// # Safety
+/// `p` is NULL or a live problem handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pc_problem_set_error_estimate_budget(p: *mut PcProblem, seconds: f64) -> c_int {
+    guarded(|| {
+        let p = unsafe { problem(p) }?;
+        if !(seconds.is_finite() && seconds >= 0.0) {
+            return Err(arg(format!("seconds is {seconds}, must be finite and ≥ 0")));
+        }
+        p.budget = seconds;
+        Ok(())
+    })
+}
+
 /// The result's error estimate (the JSON's `accuracy`): `*estimated` = 1 and `*estimate` [length]
 /// and `*relative` (of the peak-to-peak amplitude; 0 when that is 0) when there is one, else
 /// `*estimated` = 0 and both 0; `*method` says how or why not (owned by the result). Any output

@@ -121,11 +121,13 @@ pub fn solve_periodic_lcp(
     tolerance: f64,
     warm_start: Option<&[usize]>,
 ) -> (LcpSolution, Option<Vec<f64>>) {
-    solve_periodic_lcp_with(a, q, step_map, method, tolerance, warm_start, ShootingReach::FULL)
+    solve_periodic_lcp_with(a, q, step_map, method, tolerance, warm_start, ShootingReach::FULL, None)
 }
 
 /// [`solve_periodic_lcp`]; `reach`: what shooting may try beyond Newton from the warm start
-/// ([`ShootingReach`]: a guarded sweep's quick tries).
+/// ([`ShootingReach`]: a guarded sweep's quick tries); `dense_pivots`: a cap on dense Lemke's
+/// pivots ([`LemkeSettings::max_pivots`]: an error estimate's bounded fallback).
+#[allow(clippy::too_many_arguments)]
 pub fn solve_periodic_lcp_with(
     a: &BlockCirculant,
     q: &[f64],
@@ -134,13 +136,15 @@ pub fn solve_periodic_lcp_with(
     tolerance: f64,
     warm_start: Option<&[usize]>,
     reach: ShootingReach,
+    dense_pivots: Option<usize>,
 ) -> (LcpSolution, Option<Vec<f64>>) {
     if q.is_empty() {
         return (LcpSolution { outcome: LcpOutcome::Solved, z: vec![], w: vec![], info: Default::default() }, None);
     }
     let step = |method, sol: &LcpSolution| LcpStep { method, size: q.len(), pivots: sol.info.pivots, outcome: sol.outcome, time_s: sol.info.time_s };
     let lemke = || {
-        let settings = LemkeSettings { certify_tol: tolerance, warm_start: warm_start.map(<[usize]>::to_vec), ..LemkeSettings::default() };
+        let settings =
+            LemkeSettings { certify_tol: tolerance, warm_start: warm_start.map(<[usize]>::to_vec), max_pivots: dense_pivots, ..LemkeSettings::default() };
         let mut sol = Lemke::new(settings).solve(a, q);
         // Lemke accepts a guess that certifies as it is, or discards it and runs cold.
         sol.info.warm = match (warm_start, sol.info.warm_start_used) {

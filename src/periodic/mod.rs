@@ -36,7 +36,10 @@ pub use tuning::Tuning;
 use crate::error::{Error, ErrorKind};
 /// The step map's type, for analyses that march it (continuation, stability).
 pub use crate::lcp::StepMapLcp;
-pub use crate::lcp::{AUTO_LEMKE_MAX, DENSE_MAX, LEMKE_AFTER_SHOOTING_MAX, LcpMethod, solve_circulant_lcp};
+pub use crate::lcp::{
+    AUTO_LEMKE_MAX, DENSE_MAX, DENSE_MEMORY_MAX, LEMKE_AFTER_SHOOTING_MAX, LEMKE_FLOPS_PER_S, LcpMethod, dense_lemke_seconds, dense_memory, progress,
+    solve_circulant_lcp,
+};
 use crate::lcp::{LcpOutcome, LcpSolution};
 use crate::model::ModelError;
 
@@ -98,11 +101,23 @@ pub struct SolverSettings {
     /// Periods marched from a warm start before shooting's Newton (0: none; a lone rubbing
     /// solve's jump past a fold, `rubbing/walk.rs`).
     pub shooting_settle: usize,
+    /// The most pivots dense Lemke may take (`None`: its own limit, 20·N + 100). Why: an error
+    /// estimate's neighbour solve bounds its dense fallback by its CPU budget
+    /// (`analysis::accuracy`).
+    pub dense_pivots: Option<usize>,
 }
 
 impl Default for SolverSettings {
     fn default() -> Self {
-        SolverSettings { method: LcpMethod::Auto, tolerance: 1e-9, parallel: true, shooting_warm_only: false, shooting_homotopy: true, shooting_settle: 0 }
+        SolverSettings {
+            method: LcpMethod::Auto,
+            tolerance: 1e-9,
+            parallel: true,
+            shooting_warm_only: false,
+            shooting_homotopy: true,
+            shooting_settle: 0,
+            dense_pivots: None,
+        }
     }
 }
 

@@ -457,7 +457,7 @@ impl PeriodicProblem {
             homotopy: self.solver.shooting_homotopy,
             settle: self.solver.shooting_settle,
         };
-        let (sol, _state) = solve_periodic_lcp_with(a, q, step_map.as_ref(), method, self.solver.tolerance, warm_start, reach);
+        let (sol, _state) = solve_periodic_lcp_with(a, q, step_map.as_ref(), method, self.solver.tolerance, warm_start, reach, self.solver.dense_pivots);
         match refused {
             _ if sol.outcome == LcpOutcome::Solved => Ok(sol),
             Some(cost) => Err(SolveError::Limit(format!(

@@ -21,6 +21,8 @@ fn solve(problem: &PeriodicProblem) -> Result<Response, Failure> {
 #[derive(Clone, Copy, Debug)]
 pub struct Refine {
     pub estimate: bool,
+    /// CPU seconds for the estimate's neighbour solves.
+    pub estimate_budget: f64,
     pub polish: bool,
 }
 
@@ -67,7 +69,7 @@ fn load(scene: &Path, overrides: Overrides, flags: Refine) -> Result<Loaded, Fai
     }
     let friction_dofs = s.friction.iter().map(|f| f.dof.unwrap_or(usize::MAX)).collect();
     let built = s.build_in(&scene.display().to_string(), &dir).map_err(|e| Failure::input(e.to_string()))?;
-    let refine = Refine { estimate: flags.estimate && built.error_estimate, polish: flags.polish || built.polish };
+    let refine = Refine { estimate: flags.estimate && built.error_estimate, polish: flags.polish || built.polish, ..flags };
     let auto = built.accuracy_target.zip(built.scheme_choice);
     Ok(Loaded { problem: built.problem, refine, labels: built.labels, friction_dofs, auto })
 }
@@ -77,7 +79,7 @@ fn refine(problem: &PeriodicProblem, r: &mut Response, refine: Refine) {
     if r.scheme_choice.is_some() {
         // `scheme = "auto"` estimated every k it solved.
     } else if refine.estimate {
-        r.accuracy = accuracy::estimate(problem, r);
+        r.accuracy = accuracy::estimate_within(problem, r, refine.estimate_budget);
     } else {
         r.accuracy.method = "none: not requested (--no-estimate or error_estimate = \"none\")".to_string();
     }

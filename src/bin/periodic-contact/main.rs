@@ -43,6 +43,10 @@ enum Command {
         /// `[discretization] error_estimate` says).
         #[arg(long)]
         no_estimate: bool,
+        /// CPU seconds the error estimate's neighbour solves may take together; past it the
+        /// result has no estimate and says why (`accuracy.missing`), its own answer unchanged.
+        #[arg(long, value_name = "SECONDS", default_value_t = periodic_contact::analysis::accuracy::neighbour::ESTIMATE_BUDGET_CPU_S)]
+        estimate_budget: f64,
         /// Refine the orbit by the event-fitted polish (also `[discretization] polish = true`).
         #[arg(long)]
         polish: bool,
@@ -177,10 +181,10 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         None => cmd_solve::run_default(),
-        Some(Command::Solve { scene, output, frequency, export_lcp, no_estimate, polish, period_multiple, hysteresis }) => {
+        Some(Command::Solve { scene, output, frequency, export_lcp, no_estimate, estimate_budget, polish, period_multiple, hysteresis }) => {
             let overrides = cmd_solve::Overrides { frequency, period_multiple };
             let files = cmd_solve::Files { output: &output, export_lcp: export_lcp.as_deref(), hysteresis: hysteresis.as_deref() };
-            cmd_solve::run(&scene, files, overrides, cmd_solve::Refine { estimate: !no_estimate, polish })
+            cmd_solve::run(&scene, files, overrides, cmd_solve::Refine { estimate: !no_estimate, estimate_budget, polish })
         }
         Some(Command::Modes { scene, count }) => cmd_modes::run(&scene, count),
         Some(Command::Deck { scene, output }) => cmd_deck::run(&scene, &output),

@@ -58,11 +58,15 @@ pub struct LemkeSettings {
     pub certify_tol: f64,
     /// Optional warm start: indices expected to have z > 0.
     pub warm_start: Option<Vec<usize>>,
+    /// A cap on the pivots below `max_pivots_per_dim · n + 100` (`None`: that limit alone). Why:
+    /// an error estimate's dense fallback is bounded by its CPU budget (on the non-symmetric
+    /// rubbing LCP, Lemke ran minutes towards its 20·N limit at N = 4352).
+    pub max_pivots: Option<usize>,
 }
 
 impl Default for LemkeSettings {
     fn default() -> Self {
-        LemkeSettings { pivot_tol: 1e-12, max_pivots_per_dim: 20, refinement_steps: 3, certify_tol: 1e-9, warm_start: None }
+        LemkeSettings { pivot_tol: 1e-12, max_pivots_per_dim: 20, refinement_steps: 3, certify_tol: 1e-9, warm_start: None, max_pivots: None }
     }
 }
 
@@ -137,7 +141,7 @@ impl Lemke {
         let sq = qmax; // > 0 here since some q_i < 0
         let qhat: Vec<f64> = q.iter().map(|v| v / sq).collect();
         let mut rev = Revised::new(a, qhat, sa);
-        let limit = s.max_pivots_per_dim.saturating_mul(n).saturating_add(100);
+        let limit = s.max_pivots_per_dim.saturating_mul(n).saturating_add(100).min(s.max_pivots.unwrap_or(usize::MAX));
         let (end, pivots) = rev.run(s.pivot_tol, limit);
         let tableau_z = rev.current_z(sq / sa);
         let alpha = rev.basic_z();
