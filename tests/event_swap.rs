@@ -216,3 +216,63 @@ fn multiplier_distance(a: &[num_complex::Complex64], b: &[num_complex::Complex64
     };
     one_way(a, b).max(one_way(b, a))
 }
+
+/// Mass B's gap in [`inside_model`]: B is in contact all over the walk (one held arc a period;
+/// at 1.0 its point hits twice), A grazes at GRAZE_GAP.
+const B_GAP: f64 = 1.8;
+
+/// Two uncoupled masses with massless contact points (as [`model`], both of spring K1[0]): A's
+/// stop GRAZE_GAP away, B's B_GAP, B's forcing leading A's by `lead` of the period.
+fn inside_model(omega: f64, lead: f64) -> Model {
+    let mut m = model(omega);
+    let mut k: Vec<Vec<f64>> = (0..4).map(|i| (0..4).map(|j| m.structure.stiffness.get(i, j)).collect()).collect();
+    k[2][2] = K1[0] + K2;
+    m.structure.stiffness = Matrix::from_rows(&k);
+    m.contacts[0].gap = GRAZE_GAP;
+    m.contacts[1].gap = B_GAP;
+    m.forces[1].term.phase = 2.0 * std::f64::consts::PI * lead;
+    m
+}
+
+/// A's held arc vanishing with B's closing inside it (the real blade at 2278.97466 rad/s:
+/// contact 13's arc with contact 15's landing in it, which the walk did not see, the events not
+/// being adjacent, and stalled on). B's forcing is phased so that its closing falls at A's
+/// grazing instant at ω_g (closed forms: the linear orbit's peak at ψ/ω, ψ = atan2(cω, k1 − ω²);
+/// B's entry time), so that A's arc, √(ω − ω_g) wide, keeps B's closing (moving linearly in ω)
+/// inside it down to ω_g. The walk from 0.75 to 0.6 must record that grazing at the closed form's
+/// ω_g (the linear amplitude equal to the gap), and B's own further down at its gap's, every point
+/// exact (measured: 1.2e-12 and 4.6e-13 from the closed forms, 61 points, 0.5 s).
+#[test]
+fn a_massless_held_arc_vanishing_with_another_contacts_closing_inside_it() {
+    // (k1 − u)² + c²u − (F/g)² = 0, the root below resonance: where the linear amplitude is the gap g.
+    let graze_at = |g: f64| {
+        let (b, c0) = (C * C - 2.0 * K1[0], K1[0] * K1[0] - (F / g).powi(2));
+        ((-b - (b * b - 4.0 * c0).sqrt()) / 2.0).sqrt()
+    };
+    let graze = graze_at(GRAZE_GAP);
+    let psi = (C * graze).atan2(K1[0] - graze * graze);
+    let ob = CompliantStopOrbit::solve(&Oscillator::new(1.0, C, K1[0], F, graze), K2, B_GAP, None).unwrap();
+    let lead = (ob.entry_time().unwrap() / ob.period() - psi / (2.0 * std::f64::consts::PI)).rem_euclid(1.0);
+    let (from, to) = (0.75, 0.6);
+    let outputs = OutputSelection { displacement: vec![0, 2], velocity: vec![], acceleration: vec![], contacts: true };
+    let disc = Discretization { scheme: Scheme::Cds, steps: 256, pairing: None };
+    let p = PeriodicProblem::new(inside_model(from, lead), disc, outputs, SolverSettings::default()).unwrap();
+    let start = std::time::Instant::now();
+    let br = continuation::run(&p, Parameter::Frequency, from, to, &ContinuationSettings::default(), &|_| {}).unwrap();
+    eprintln!("lead {lead:.6}: {} points in {:.2} s: {}", br.points.len(), start.elapsed().as_secs_f64(), br.stop);
+    for e in br.events() {
+        eprintln!("event at ω = {:.12}: {:?} {}", e.parameter, e.event, e.detail);
+    }
+    assert!(br.reached(), "{}", br.stop);
+    assert!(br.points.iter().all(|q| q.source == Source::Exact), "{}", br.stop);
+    // A's arc vanishing (B's closing inside it), then B's own at its gap's ω_g further down.
+    let grazings: Vec<(f64, bool)> =
+        br.events().filter(|e| e.event == Some(EventKind::Grazing)).map(|e| (e.parameter, e.detail.starts_with("contact 0"))).collect();
+    assert_eq!(grazings.len(), 2, "two grazings: {grazings:?}");
+    for (at, a) in grazings {
+        let want = if a { graze } else { graze_at(B_GAP) };
+        eprintln!("grazing of {} at {at:.12} (closed form {want:.12})", if a { "A" } else { "B" });
+        assert!((at - want).abs() < 1e-8, "grazing at {at} instead of {want}");
+    }
+    assert!(br.events().all(|e| !e.detail.contains("not traced")), "the branch past the grazing is the exact orbit's");
+}

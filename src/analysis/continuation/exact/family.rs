@@ -167,6 +167,10 @@ impl Family {
         m
     }
 
+    /// The scene's model (at its own λ).
+    pub fn base(&self) -> &Model {
+        &self.base
+    }
     pub fn ne(&self) -> usize {
         self.sig.events.len()
     }

@@ -239,7 +239,8 @@ impl Walk<'_> {
             let shrinking = signature::shrinking(&self.fam, &here.w, &along);
             if let Some(&(e, len, rate)) = shrinking.iter().find(|s| s.1 < VANISH) {
                 let (ev, ne) = (self.fam.sig.events[e], self.fam.ne());
-                let which = format!("contact {}: {:?} → {:?}, {len:.1e} of the period", ev.contact, ev.kind, self.fam.sig.events[(e + 1) % ne].kind);
+                let end = signature::partner(self.fam.base(), &self.fam.sig.events, e).unwrap_or((e + 1) % ne);
+                let which = format!("contact {}: {:?} → {:?}, {len:.1e} of the period", ev.contact, ev.kind, self.fam.sig.events[end].kind);
                 let _ = rate;
                 let next = if self.rigid_event(e) { self.rigid_vanish(&here, e, to) } else { self.remove_pair(&here, e) };
                 match next {

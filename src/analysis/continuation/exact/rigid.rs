@@ -22,6 +22,8 @@ use crate::analysis::polish::{self, Event, EventKind as Switch, Touch};
 use crate::periodic::{PeriodicProblem, PeriodicSolver};
 use crate::time::Discretization;
 
+mod diagnose;
+mod held;
 mod landing;
 mod stall;
 mod trace;
@@ -362,7 +364,7 @@ impl Walk<'_> {
     /// about to vanish), on the exact orbit; `None` for other phases or where that fails.
     pub(super) fn merge(&mut self, here: &Node, e: usize, what: &str) -> Option<Node> {
         let ne = self.fam.ne();
-        let (ev, next) = (self.fam.sig.events[e], self.fam.sig.events[(e + 1) % ne]);
+        let (ev, next) = (self.fam.sig.events[e], self.fam.sig.events[signature::partner(self.fam.base(), &self.fam.sig.events, e)?]);
         let wl = here.w[here.w.len() - 1];
         let mut list = timed(&here.orbit);
         let (rho, lambda) = (self.fam.rho, here.lambda(self.fam.rho));
@@ -373,7 +375,7 @@ impl Walk<'_> {
             // arc is where it would be negative, √ long in λ), so the point flies free past it:
             // closing and release removed, the orbit the same there (the inverse of
             // `rigid_crossing`'s massless arm). A pure impact has no meaning without mass.
-            (Switch::Impact { stick: true }, Switch::Release) if massless => signature::remove(&self.fam, &here.orbit, e, wl)?,
+            (Switch::Impact { stick: true }, Switch::Release) if massless => return self.merge_held_arc(here, e, what),
             // Located on the orbit with a pure impact, where the force that would hold its contact
             // touches zero, a short way ahead; else that orbit's branch from here.
             (Switch::Impact { stick: true }, Switch::Release) => {

@@ -34,17 +34,13 @@ pub(super) fn insert(
     (sig, guess(fam, orbit, &list, wl), (ia, ib))
 }
 
-/// The signature of `orbit` without the events `phase` and `phase + 1` (cyclic) of one contact,
+/// The signature of `orbit` without the event `phase` and its [`partner`] (one contact's),
 /// whose phase between them shrinks to nothing; the new unknowns' guess at λ/ρ `wl`. `None`
-/// when the two events are not one contact's.
+/// without a partner.
 pub(super) fn remove(fam: &Family, orbit: &PolishedOrbit, phase: usize, wl: f64) -> Option<(Signature, Vec<f64>)> {
     let t = orbit.period();
-    let ne = orbit.events().len();
-    let (a, b) = (phase, (phase + 1) % ne);
-    let (ea, eb) = (orbit.events()[a], orbit.events()[b]);
-    if ea.contact != eb.contact || a == b {
-        return None;
-    }
+    let (a, b) = (phase, partner(fam.base(), orbit.events(), phase)?);
+    let ea = orbit.events()[a];
     let list: Vec<(f64, Event)> =
         orbit.events().iter().zip(orbit.times()).enumerate().filter(|(i, _)| *i != a && *i != b).map(|(_, (e, &s))| (s / t, *e)).collect();
     let mut always = orbit.always_closed().to_vec();
@@ -157,14 +153,36 @@ pub(super) fn toggled(fam: &Family, model: &Model, here: &[f64], pred: &[f64]) -
     any.then_some(out)
 }
 
-/// The length (fraction of the period) of phase `e` of the unknowns `w` when it lies between two
-/// events of one contact (the pair a grazing adds or removes), else `None`.
-fn pair_phase(fam: &Family, w: &[f64], e: usize) -> Option<f64> {
-    let events = &fam.sig.events;
+/// The event that ends contact `events[e].contact`'s phase begun by event `e`: the next event
+/// when it is that contact's; for a rigid contact on a massless DOF, its next event whatever
+/// lies between (other contacts' events inside its phase: the real blade at 2278.9746626 rad/s,
+/// contact 13's held arc vanishing with contact 15's landing in it, which the adjacent test
+/// missed and the corrector stalled on). `None` otherwise.
+pub(super) fn partner(model: &Model, events: &[Event], e: usize) -> Option<usize> {
     let ne = events.len();
-    let n2 = w.len() - 1 - ne;
+    let c = events.get(e)?.contact;
     let b = (e + 1) % ne;
-    (ne >= 2 && events[e].contact == events[b].contact).then(|| w[n2 + b] - w[n2 + e] + if b == 0 { 1.0 } else { 0.0 })
+    if ne < 2 || b == e {
+        return None;
+    }
+    if events[b].contact == c {
+        return Some(b);
+    }
+    let contact = &model.contacts[c];
+    if !(contact.is_rigid() && model.contact_is_massless(contact)) {
+        return None;
+    }
+    (1..ne).map(|k| (e + k) % ne).find(|&f| events[f].contact == c)
+}
+
+/// The phase begun by event `e` of the unknowns `w` when it lies between two events of one
+/// contact (the pair a grazing adds or removes, [`partner`]): (its end's event, its length as a
+/// fraction of the period), else `None`.
+fn pair_phase(fam: &Family, w: &[f64], e: usize) -> Option<(usize, f64)> {
+    let ne = fam.ne();
+    let n2 = w.len() - 1 - ne;
+    let b = partner(fam.base(), &fam.sig.events, e)?;
+    Some((b, w[n2 + b] - w[n2 + e] + if b <= e { 1.0 } else { 0.0 }))
 }
 
 /// Phases between two events of one contact that shrink along the tangent `along` at the
@@ -174,8 +192,8 @@ pub(super) fn shrinking(fam: &Family, w: &[f64], along: &[f64]) -> Vec<(usize, f
     let n2 = w.len() - 1 - ne;
     (0..ne)
         .filter_map(|e| {
-            let len = pair_phase(fam, w, e)?;
-            let rate = along[n2 + e] - along[n2 + (e + 1) % ne];
+            let (b, len) = pair_phase(fam, w, e)?;
+            let rate = along[n2 + e] - along[n2 + b];
             (rate > 0.0).then_some((e, len, rate))
         })
         .collect()
@@ -186,7 +204,7 @@ pub(super) fn shrinking(fam: &Family, w: &[f64], along: &[f64]) -> Vec<(usize, f
 /// (a massless point's held arc is √ long in λ there, so that continuation turns back in λ:
 /// the real blade's false fold at 2298.19 rad/s), which is no orbit.
 pub(super) fn reversed(fam: &Family, w: &[f64]) -> bool {
-    (0..fam.ne()).any(|e| pair_phase(fam, w, e).is_some_and(|len| len <= 0.0))
+    (0..fam.ne()).any(|e| pair_phase(fam, w, e).is_some_and(|(_, len)| len <= 0.0))
 }
 
 /// Whether a phase between two events of one contact collapsed in the corrector: below
@@ -197,7 +215,7 @@ pub(super) fn reversed(fam: &Family, w: &[f64]) -> bool {
 /// 126: the closed phase 1e-2 → 1e-16 of the period in one step, the walk then stopped on the
 /// penetrating orbit), where the steps that land on a vanishing phase by quarters reach it.
 pub(super) fn collapsed(fam: &Family, pred: &[f64], w: &[f64]) -> bool {
-    (0..fam.ne()).any(|e| pair_phase(fam, w, e).zip(pair_phase(fam, pred, e)).is_some_and(|(len, was)| len < super::VANISH && len < 0.1 * was))
+    (0..fam.ne()).any(|e| pair_phase(fam, w, e).zip(pair_phase(fam, pred, e)).is_some_and(|((_, len), (_, was))| len < super::VANISH && len < 0.1 * was))
 }
 
 /// How many contacts have a different number of events in `a` and `b`.

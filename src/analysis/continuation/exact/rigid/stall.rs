@@ -1,6 +1,6 @@
 //! The corrector's stall with the smallest step on an orbit with rigid contacts.
 use super::super::family::{Node, lambda_axis};
-use super::super::{VANISH, Walk};
+use super::super::{VANISH, Walk, signature};
 use super::trace::{self, trace};
 use super::{TOL, margin};
 use crate::analysis::polish;
@@ -22,13 +22,16 @@ impl Walk<'_> {
     /// it). `None` without rigid contacts.
     pub(in super::super) fn rigid_stall(&mut self, here: &Node, to: f64) -> Option<Node> {
         let m = here.orbit.rigid_margin()?;
+        self.diagnose_stall(here);
         let what = format!("the events merge (the corrector stalls; the smallest margin: contact {}'s {}, {:.1e})", m.contact, m.what, m.value);
         // The shortest phase between two events of one contact: the one merging.
         let (ne, n2) = (self.fam.ne(), here.w.len() - 1 - self.fam.ne());
-        let length = |e: usize| here.w[n2 + (e + 1) % ne] - here.w[n2 + e] + if e + 1 == ne { 1.0 } else { 0.0 };
         let pairs: Vec<_> = (0..ne)
-            .filter(|&e| ne >= 2 && self.fam.sig.events[e].contact == self.fam.sig.events[(e + 1) % ne].contact)
-            .map(|e| (e, self.fam.sig.events[e].contact, length(e), here.tangent[n2 + e] - here.tangent[n2 + (e + 1) % ne]))
+            .filter_map(|e| Some((e, signature::partner(self.fam.base(), &self.fam.sig.events, e)?)))
+            .map(|(e, b)| {
+                let length = here.w[n2 + b] - here.w[n2 + e] + if b <= e { 1.0 } else { 0.0 };
+                (e, self.fam.sig.events[e].contact, length, here.tangent[n2 + e] - here.tangent[n2 + b])
+            })
             .collect();
         trace::stall(here, self.fam.rho, &pairs);
         let shortest = pairs.iter().min_by(|a, b| a.2.total_cmp(&b.2));

@@ -1,5 +1,6 @@
 //! The rigid changes' trace on stderr (`PC_TRACE_UNMERGE` set): why a restart or a merge fails.
-use super::super::family::Node;
+use super::super::family::{Family, Node};
+use super::super::signature;
 use crate::analysis::polish::Event;
 
 /// A line of the trace on stderr when `PC_TRACE_UNMERGE` is set.
@@ -51,5 +52,32 @@ pub(super) fn stall(here: &Node, rho: f64, pairs: &[(usize, usize, f64, f64)]) {
                 eprintln!("stall: event {k} at {:.9}: contact {} {:?}", s / p, x.contact, x.kind);
             }
         }
+    }
+}
+
+/// A massless contact's held arc from event `e` about to be removed at `here`: its end (the
+/// [`signature::partner`]), its length and rate, the other contacts' events inside it (θ).
+pub(super) fn held_arc(here: &Node, fam: &Family, e: usize) {
+    if std::env::var_os("PC_TRACE_UNMERGE").is_none() {
+        return;
+    }
+    let ne = fam.ne();
+    let n2 = here.w.len() - 1 - ne;
+    let Some(b) = signature::partner(fam.base(), &fam.sig.events, e) else { return };
+    let len = here.w[n2 + b] - here.w[n2 + e] + if b <= e { 1.0 } else { 0.0 };
+    let rate = here.tangent[n2 + e] - here.tangent[n2 + b];
+    let t = &here.tangent;
+    eprintln!(
+        "held arc: contact {} events {e} → {b} at θ {:.13} → {:.13}: {len:e} of the period, shrinking at {rate:e} per unit of arclength (λ-component {:e}) at λ {:.10}",
+        fam.sig.events[e].contact,
+        here.w[n2 + e],
+        here.w[n2 + b],
+        t[t.len() - 1],
+        here.lambda(fam.rho)
+    );
+    let mut k = (e + 1) % ne;
+    while k != b {
+        eprintln!("held arc:   inside: event {k} contact {} {:?} at θ {:.13}", fam.sig.events[k].contact, fam.sig.events[k].kind, here.w[n2 + k]);
+        k = (k + 1) % ne;
     }
 }
