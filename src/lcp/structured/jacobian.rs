@@ -105,24 +105,27 @@ fn blocked(a: &Mat<f64>, b: &Mat<f64>, c: &mut Mat<f64>) {
     }
 }
 
-/// Powers of the contact-free step, augmented: diag(Φ, 1)^(2^i), i = 0..=log₂ k.
-pub(super) struct PhiPowers(Vec<Mat<f64>>);
+/// Powers of the contact-free step, augmented: diag(Φ, 1)^(2^i), i = 0..=log₂ k; with H·Φ (m×d,
+/// row-major), which every step matrix reads ([`step_matrix`]).
+pub(super) struct PhiPowers(Vec<Mat<f64>>, Vec<f64>);
 
 impl PhiPowers {
     pub(super) fn new(sm: &StepMapLcp) -> Self {
-        let d = sm.d;
+        let (d, m) = (sm.d, sm.m);
         let mut first = Mat::zeros(d + 1, d + 1);
         first.as_mut().submatrix_mut(0, 0, d, d).copy_from(sm.phi.as_ref());
         for &(i, j) in &sm.carry {
             first[(i, j)] += 1.0;
         }
         first[(d, d)] = 1.0;
+        // Row a of H times Φ, summed over i in order as each step matrix summed it.
+        let h_phi = (0..m * d).map(|e| (0..d).map(|i| sm.h[e / d * d + i] * first[(i, e % d)]).sum()).collect();
         let mut p = vec![first];
         while 1usize << p.len() <= sm.k {
             let last = p.last().expect("one power");
             p.push(product(last, last));
         }
-        PhiPowers(p)
+        PhiPowers(p, h_phi)
     }
 }
 
@@ -170,16 +173,22 @@ pub(super) fn step_matrix(sm: &StepMapLcp, powers: &PhiPowers, mask: u64) -> Mat
     let mut rhs = vec![0.0; p];
     for col in 0..=d {
         for (r, &a) in act.iter().enumerate() {
-            rhs[r] = if col == d { 1.0 } else { (0..d).map(|i| sm.h[a * d + i] * phi[(i, col)]).sum() };
+            rhs[r] = if col == d { 1.0 } else { powers.1[a * d + col] };
         }
         for (r, v) in lu.solve(&rhs).into_iter().enumerate() {
             y[(r, col)] = v;
         }
     }
+    // Γ_a Y's rows repeat as Γ's do (`StepMapLcp::rows`): the distinct ones, then subtracted.
+    let n = sm.rows;
     let mut t = phi.clone();
+    let mut term = vec![0.0; n];
     for col in 0..=d {
+        for (i, v) in term.iter_mut().enumerate() {
+            *v = act.iter().enumerate().map(|(r, &a)| sm.gamma[i * m + a] * y[(r, col)]).sum::<f64>();
+        }
         for i in 0..d {
-            t[(i, col)] -= act.iter().enumerate().map(|(r, &a)| sm.gamma[i * m + a] * y[(r, col)]).sum::<f64>();
+            t[(i, col)] -= term[i % n];
         }
     }
     t

@@ -10,7 +10,8 @@
 //! is brought to 0 by steps, each solved by Newton from a secant prediction of the previous.
 //! Nothing here is certified on the stacked LCP: the caller does that and falls back.
 use super::jacobian::{PhiPowers, RunsJacobian};
-use super::step_map::{Contacts, DenseLu, March, StepMapLcp, march};
+use super::step_lcp::ActiveBlocks;
+use super::step_map::{Contacts, DenseLu, March, StepMapLcp, march_with};
 use faer::Mat;
 
 /// A defect Newton cannot lower on an unchanged piece is accepted up to this (relative): the
@@ -131,6 +132,8 @@ struct Newton<'a> {
     powers: PhiPowers,
     /// What the next Jacobian can reuse of the last ones (the same step map throughout).
     runs: RunsJacobian,
+    /// The step LCPs' factored blocks, shared by every march of the solve.
+    blocks: ActiveBlocks,
     settings: &'a ShootingSettings,
     scale: f64,
     iterations: usize,
@@ -167,7 +170,7 @@ impl<'a> Newton<'a> {
         self.marches += 1;
         self.work += self.march_work;
         let clock = std::time::Instant::now();
-        let m = march(self.sm, s, shift, Contacts::Solve(guess));
+        let m = march_with(&mut self.blocks, self.sm, s, shift, Contacts::Solve(guess));
         self.march_s += clock.elapsed().as_secs_f64();
         let m = m?;
         self.changes += m.changes;
@@ -260,6 +263,7 @@ pub fn solve_shooting(sm: &StepMapLcp, warm: Option<&[u64]>, settings: &Shooting
         sm,
         powers: PhiPowers::new(sm),
         runs: RunsJacobian::default(),
+        blocks: ActiveBlocks::default(),
         settings,
         scale: scale.max(f64::MIN_POSITIVE),
         iterations: 0,
@@ -533,7 +537,7 @@ fn fixed_point(nt: &mut Newton<'_>, contacts: Contacts<'_>) -> Option<(Vec<f64>,
     let s = fixed_state(nt, contacts)?;
     nt.marches += 1;
     nt.work += nt.march_work;
-    let m = march(nt.sm, &s, 0.0, contacts)?;
+    let m = march_with(&mut nt.blocks, nt.sm, &s, 0.0, contacts)?;
     Some((s, m))
 }
 
@@ -544,7 +548,7 @@ fn settle_then_newton(nt: &mut Newton<'_>, sets: &[u64]) -> Option<Iterate> {
     let mut masks = sets.to_vec();
     for _ in 0..nt.settings.settle {
         nt.marches += 1;
-        let m = march(nt.sm, &s, 0.0, Contacts::Solve(&masks))?;
+        let m = march_with(&mut nt.blocks, nt.sm, &s, 0.0, Contacts::Solve(&masks))?;
         (s, masks) = (m.end, m.masks);
     }
     nt.solve(s, 0.0, &masks, nt.settings.max_iterations).ok()
@@ -556,7 +560,7 @@ fn fixed_state(nt: &mut Newton<'_>, contacts: Contacts<'_>) -> Option<Vec<f64>> 
     let zero = vec![0.0; d];
     nt.marches += 1;
     nt.work += nt.march_work;
-    let m0 = march(nt.sm, &zero, 0.0, contacts)?;
+    let m0 = march_with(&mut nt.blocks, nt.sm, &zero, 0.0, contacts)?;
     nt.ensure_jacobian(&m0.masks);
     let a = Mat::from_fn(d, d, |i, j| if i == j { 1.0 } else { 0.0 } - nt.jac[(i, j)]);
     let s = DenseLu::new(&a).solve(&m0.end);

@@ -88,9 +88,75 @@ fn check_symmetric_part(s: &[f64], m: usize, group: &[usize], scale: f64) -> Res
 /// Gaussian elimination with partial pivoting of the n×n `a` (row-major), applied to `b` too and
 /// finished by back substitution (b becomes a⁻¹b); returns det(a), 0 when a pivot is exactly 0.
 pub(super) fn eliminate(a: &mut [f64], b: &mut [f64], n: usize) -> f64 {
+    let (mut multipliers, mut pivots) = (vec![0.0; n * n], vec![0usize; n]);
+    let det = factor(a, &mut multipliers, &mut pivots, n);
+    if det != 0.0 {
+        replay(a, &multipliers, &pivots, b);
+    }
+    det
+}
+
+/// The elimination of one principal block S_aa: its upper triangle, multipliers and row
+/// exchanges ([`factor`]), and its determinant.
+#[derive(Clone, Debug)]
+struct Factored {
+    mask: u64,
+    upper: Vec<f64>,
+    multipliers: Vec<f64>,
+    pivots: [usize; MAX_PAIRS],
+    det: f64,
+}
+
+/// Blocks S_aa factored on one step map (S is fixed there), by set: a step replays its block's
+/// elimination on its right-hand side instead of eliminating again (the same operations on b in
+/// the same order: the same bits). Consecutive steps mostly share their set, and a period's sets
+/// recur over a solve's marches. Why: the elimination was 8 % of the real blade's 1e-3 sweep
+/// (issue 23).
+#[derive(Clone, Debug, Default)]
+pub(super) struct ActiveBlocks {
+    blocks: Vec<Factored>,
+    by_mask: std::collections::HashMap<u64, usize>,
+    /// The block the last step used.
+    last: usize,
+}
+
+/// Sets an [`ActiveBlocks`] keeps at most (a long homotopy meets thousands).
+const BLOCKS_KEPT: usize = 4096;
+
+impl ActiveBlocks {
+    /// The factored block of `mask` (non-empty), made and kept if not there.
+    fn block(&mut self, s: &[f64], m: usize, mask: u64) -> &Factored {
+        if self.blocks.get(self.last).is_some_and(|f| f.mask == mask) {
+            return &self.blocks[self.last];
+        }
+        if let Some(&i) = self.by_mask.get(&mask) {
+            self.last = i;
+            return &self.blocks[i];
+        }
+        if self.blocks.len() == BLOCKS_KEPT {
+            self.blocks.clear();
+            self.by_mask.clear();
+        }
+        let (members, p) = members(mask, m);
+        let act = &members[..p];
+        let mut a: Vec<f64> = act.iter().flat_map(|&ai| act.iter().map(move |&aj| s[ai * m + aj])).collect();
+        let mut multipliers = vec![0.0; p * p];
+        let mut pivots = [0usize; MAX_PAIRS];
+        let det = factor(&mut a, &mut multipliers, &mut pivots, p);
+        self.last = self.blocks.len();
+        self.by_mask.insert(mask, self.last);
+        self.blocks.push(Factored { mask, upper: a, multipliers, pivots, det });
+        &self.blocks[self.last]
+    }
+}
+
+/// Gaussian elimination with partial pivoting of the n×n row-major `a`, recording each column's
+/// pivot row and each row's multiplier (`multipliers[i·n + col]`); returns det(a), 0 when a pivot is exactly 0.
+fn factor(a: &mut [f64], multipliers: &mut [f64], pivots: &mut [usize], n: usize) -> f64 {
     let mut det = 1.0;
     for col in 0..n {
         let piv = (col..n).max_by(|&i, &j| a[i * n + col].abs().total_cmp(&a[j * n + col].abs())).unwrap_or(col);
+        pivots[col] = piv;
         if !(a[piv * n + col].abs() > 0.0) {
             return 0.0;
         }
@@ -98,52 +164,56 @@ pub(super) fn eliminate(a: &mut [f64], b: &mut [f64], n: usize) -> f64 {
             for j in 0..n {
                 a.swap(piv * n + j, col * n + j);
             }
-            b.swap(piv, col);
             det = -det;
         }
         det *= a[col * n + col];
         for i in col + 1..n {
             let f = a[i * n + col] / a[col * n + col];
+            multipliers[i * n + col] = f;
             for j in col..n {
                 a[i * n + j] -= f * a[col * n + j];
             }
-            b[i] -= f * b[col];
         }
-    }
-    for i in (0..n).rev() {
-        let t: f64 = (i + 1..n).map(|j| a[i * n + j] * b[j]).sum();
-        b[i] = (b[i] - t) / a[i * n + i];
     }
     det
 }
 
-/// Solves S_aa z_a = −r_a for the active set `mask` into `z` (zero off the set); false when the
-/// principal block is singular to working precision.
-pub(super) fn solve_active(s: &[f64], m: usize, r: &[f64], mask: u64, z: &mut [f64]) -> bool {
+/// Gaussian elimination's operations on `b` (n = b.len()) from a [`factor`]ed block (its upper
+/// triangle, multipliers and pivot rows), then back substitution: b becomes a⁻¹b.
+fn replay(upper: &[f64], multipliers: &[f64], pivots: &[usize], b: &mut [f64]) {
+    let n = b.len();
+    for col in 0..n {
+        if pivots[col] != col {
+            b.swap(pivots[col], col);
+        }
+        for i in col + 1..n {
+            b[i] -= multipliers[i * n + col] * b[col];
+        }
+    }
+    for i in (0..n).rev() {
+        let t: f64 = (i + 1..n).map(|j| upper[i * n + j] * b[j]).sum();
+        b[i] = (b[i] - t) / upper[i * n + i];
+    }
+}
+
+/// Solves S_aa z_a = −r_a for the active set `mask` into `z` (zero off the set), from the step
+/// map's factored blocks; false when the principal block is singular to working precision.
+pub(super) fn solve_active(blocks: &mut ActiveBlocks, s: &[f64], m: usize, r: &[f64], mask: u64, z: &mut [f64]) -> bool {
     z.iter_mut().for_each(|v| *v = 0.0);
     let (members, p) = members(mask, m);
     let act = &members[..p];
     if p == 0 {
         return true;
     }
-    // On the stack up to 8 active pairs (every step of a march solves this).
-    let (mut stack, mut heap) = ([0.0; 64], Vec::new());
-    let a: &mut [f64] = if p <= 8 {
-        &mut stack[..p * p]
-    } else {
-        heap.resize(p * p, 0.0);
-        &mut heap
-    };
+    let block = blocks.block(s, m, mask);
+    if block.det == 0.0 {
+        return false;
+    }
     let mut b = [0.0; MAX_PAIRS];
     for (i, &ai) in act.iter().enumerate() {
         b[i] = -r[ai];
-        for (j, &aj) in act.iter().enumerate() {
-            a[i * p + j] = s[ai * m + aj];
-        }
     }
-    if eliminate(a, &mut b[..p], p) == 0.0 {
-        return false;
-    }
+    replay(&block.upper, &block.multipliers, &block.pivots[..p], &mut b[..p]);
     for (i, &ai) in act.iter().enumerate() {
         z[ai] = b[i];
     }
@@ -156,14 +226,15 @@ pub(super) fn solve_active(s: &[f64], m: usize, r: &[f64], mask: u64, z: &mut [f
 /// work per step is O(|a|³) per set change, not the 2^m of an enumeration. Returns the active set,
 /// z and the number of set changes; `None` when a block is singular or the changes pass a bound
 /// far above any seen (a P-matrix lost to round-off).
-pub(super) fn step_lcp(s: &[f64], m: usize, r: &[f64], guess: u64, z: &mut [f64], w: &mut [f64]) -> Option<(u64, usize)> {
+/// `blocks`: the step map's factored blocks ([`ActiveBlocks`]).
+pub(super) fn step_lcp(blocks: &mut ActiveBlocks, s: &[f64], m: usize, r: &[f64], guess: u64, z: &mut [f64], w: &mut [f64]) -> Option<(u64, usize)> {
     // Round-off of a zero: a sign within this of zero counts as zero.
     let tol = 1e-14 * r.iter().fold(f64::MIN_POSITIVE, |a, v| a.max(v.abs()));
     let valid = if m == MAX_PAIRS { u64::MAX } else { (1u64 << m) - 1 };
     let mut mask = guess & valid;
     let most = 1usize << m.min(20);
     for changes in 0..=most {
-        if !solve_active(s, m, r, mask, z) {
+        if !solve_active(blocks, s, m, r, mask, z) {
             return None;
         }
         // z is zero off the set: its non-zero entries, in order, are summed as a scan of all m
@@ -217,13 +288,13 @@ mod tests {
         assert!(check_p_matrix(&s, m).is_ok());
         let r: Vec<f64> = (0..m).map(|_| draw()).collect();
         let (mut z, mut w) = (vec![0.0; m], vec![0.0; m]);
-        let (cold, _) = step_lcp(&s, m, &r, 0, &mut z, &mut w).unwrap();
+        let (cold, _) = step_lcp(&mut ActiveBlocks::default(), &s, m, &r, 0, &mut z, &mut w).unwrap();
         for i in 0..m {
             let wi = r[i] + (0..m).map(|j| s[i * m + j] * z[j]).sum::<f64>();
             assert!(z[i] >= 0.0 && wi >= -1e-12 && (z[i] * wi).abs() <= 1e-12, "pair {i}: z = {}, w = {wi}", z[i]);
         }
         let z_cold = z.clone();
-        let (warm, _) = step_lcp(&s, m, &r, !cold & ((1 << m) - 1), &mut z, &mut w).unwrap();
+        let (warm, _) = step_lcp(&mut ActiveBlocks::default(), &s, m, &r, !cold & ((1 << m) - 1), &mut z, &mut w).unwrap();
         assert_eq!(warm, cold);
         assert!(z.iter().zip(&z_cold).all(|(a, b)| (a - b).abs() <= 1e-12));
         // A non-symmetric coupled group of 13 pairs whose symmetric part is indefinite is refused.

@@ -14,7 +14,7 @@
 //! which costs O(k·(d² + d·m + |a|³)) to evaluate (|a| the pairs active at a step). Each step's LCP has a unique answer when S is a
 //! P-matrix ([`StepMapLcp::new`] checks it), so P is well defined and continuous.
 use super::jacobian::{GEMM_MIN, PhiPowers, period_jacobian};
-use super::step_lcp::{MAX_PAIRS, check_p_matrix, members, solve_active, step_lcp};
+use super::step_lcp::{ActiveBlocks, MAX_PAIRS, check_p_matrix, members, solve_active, step_lcp};
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatMut, MatRef, Par};
 
@@ -55,6 +55,9 @@ pub struct StepMapLcp {
     pub(super) phi: Mat<f64>,
     /// The same, row-major: the march's products read rows.
     phi_rows: Vec<f64>,
+    /// Row i of Φ, of every c_j and of Γ is row i mod `rows` ([`repeated_rows`]): the march
+    /// forms the first `rows` of Φs + c_j and Γz and copies them.
+    pub(super) rows: usize,
     /// The unit entries of Φ, (row, column).
     pub(super) carry: Vec<(usize, usize)>,
     /// c_j, k×d.
@@ -111,9 +114,10 @@ impl StepMapLcp {
             }
         }
         check_p_matrix(&s, m)?;
+        let rows = repeated_rows(d, m, &phi, &c, &gamma);
         let phi_rows = phi;
         let phi = Mat::from_fn(d, d, |i, j| phi_rows[i * d + j]);
-        Ok(StepMapLcp { k, d, m, phi, phi_rows, carry, c, h, gamma, s, r })
+        Ok(StepMapLcp { k, d, m, phi, phi_rows, rows, carry, c, h, gamma, s, r })
     }
 
     /// One march over the period from `s0` with every step's LCP solved (its active set tried
@@ -156,6 +160,23 @@ impl StepMapLcp {
     pub fn step_matrix(&self) -> &[f64] {
         &self.s
     }
+}
+
+/// The least n dividing d such that row i of Φ (d×d), of every c_j (k×d) and of Γ (d×m) equals
+/// row i mod n bit for bit; d when there is none. Why: a scheme's state of differences
+/// (x, ∇x, …) advances every block by the same δ (src/periodic/state_space.rs), so its rows repeat
+/// and half of the march's Φs (the real blade's d = 40) was computed twice.
+fn repeated_rows(d: usize, m: usize, phi: &[f64], c: &[f64], gamma: &[f64]) -> usize {
+    let same = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
+    let repeats = |n: usize| {
+        (n..d).all(|i| {
+            let o = i % n;
+            same(&phi[i * d..(i + 1) * d], &phi[o * d..(o + 1) * d])
+                && same(&gamma[i * m..(i + 1) * m], &gamma[o * m..(o + 1) * m])
+                && c.chunks_exact(d).all(|cj| cj[i].to_bits() == cj[o].to_bits())
+        })
+    };
+    (1..d).find(|&n| d % n == 0 && repeats(n)).unwrap_or(d)
 }
 
 /// What one march over the period gives.
@@ -234,6 +255,11 @@ impl DenseLu {
 
 /// Marches one period from `s0` with offset `shift` added to every r_j.
 pub(super) fn march(sm: &StepMapLcp, s0: &[f64], shift: f64, contacts: Contacts<'_>) -> Option<March> {
+    march_with(&mut ActiveBlocks::default(), sm, s0, shift, contacts)
+}
+
+/// [`march`] with the step map's factored blocks, kept across a solve's marches.
+pub(super) fn march_with(blocks: &mut ActiveBlocks, sm: &StepMapLcp, s0: &[f64], shift: f64, contacts: Contacts<'_>) -> Option<March> {
     let (k, d, m) = (sm.k, sm.d, sm.m);
     let mut s = s0.to_vec();
     let mut y = vec![0.0; d];
@@ -247,14 +273,20 @@ pub(super) fn march(sm: &StepMapLcp, s0: &[f64], shift: f64, contacts: Contacts<
     // plain loops (see `GEMM_MIN`).
     let gemv = d >= GEMM_MIN;
     let h_rows = MatRef::from_row_major_slice(&sm.h, m, d);
+    // The distinct rows of Φs + c_j and Γz (the others repeat them: `repeated_rows`).
+    let n = sm.rows;
+    let mut gz = vec![0.0; n];
     for step in 0..k {
         if gemv {
             y.copy_from_slice(&sm.c[step * d..(step + 1) * d]);
             let x = MatRef::from_column_major_slice(&s, d, 1);
             matmul(MatMut::from_column_major_slice_mut(&mut y, d, 1), Accum::Add, sm.phi.as_ref(), x, 1.0, Par::Seq);
         } else {
-            rows_dot(&sm.phi_rows, &s, &mut y);
-            y.iter_mut().zip(&sm.c[step * d..(step + 1) * d]).for_each(|(v, &c)| *v += c);
+            rows_dot(&sm.phi_rows[..n * d], &s, &mut y[..n]);
+            y[..n].iter_mut().zip(&sm.c[step * d..step * d + n]).for_each(|(v, &c)| *v += c);
+            for i in n..d {
+                y[i] = y[i - n];
+            }
         }
         for &(i, l) in &sm.carry {
             y[i] += s[l];
@@ -275,13 +307,13 @@ pub(super) fn march(sm: &StepMapLcp, s0: &[f64], shift: f64, contacts: Contacts<
             }
             Contacts::Solve(guess) => {
                 // The same step's set at the previous march, else the previous step's.
-                let (mask, changes) = step_lcp(&sm.s, m, &r, guess.get(step).copied().unwrap_or(previous), &mut zs, &mut ws)?;
+                let (mask, changes) = step_lcp(blocks, &sm.s, m, &r, guess.get(step).copied().unwrap_or(previous), &mut zs, &mut ws)?;
                 out.changes += changes;
                 mask
             }
             Contacts::Frozen(sets) => {
                 let mask = sets[step];
-                if !solve_active(&sm.s, m, &r, mask, &mut zs) {
+                if !solve_active(blocks, &sm.s, m, &r, mask, &mut zs) {
                     return None;
                 }
                 mask
@@ -293,8 +325,11 @@ pub(super) fn march(sm: &StepMapLcp, s0: &[f64], shift: f64, contacts: Contacts<
         s.copy_from_slice(&y);
         if mask != 0 {
             let (act, p) = members(mask, m);
-            for i in 0..d {
-                s[i] += act[..p].iter().map(|&a| sm.gamma[i * m + a] * zs[a]).sum::<f64>();
+            for (i, g) in gz.iter_mut().enumerate() {
+                *g = act[..p].iter().map(|&a| sm.gamma[i * m + a] * zs[a]).sum::<f64>();
+            }
+            for (i, v) in s.iter_mut().enumerate() {
+                *v += gz[i % n];
             }
         }
     }
