@@ -176,7 +176,7 @@ fn repeated_rows(d: usize, m: usize, phi: &[f64], c: &[f64], gamma: &[f64]) -> u
                 && c.chunks_exact(d).all(|cj| cj[i].to_bits() == cj[o].to_bits())
         })
     };
-    (1..d).find(|&n| d % n == 0 && repeats(n)).unwrap_or(d)
+    (1..d).find(|&n| d.is_multiple_of(n) && repeats(n)).unwrap_or(d)
 }
 
 /// What one march over the period gives.
