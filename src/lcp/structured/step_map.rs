@@ -284,8 +284,8 @@ pub(super) fn march_with(blocks: &mut ActiveBlocks, sm: &StepMapLcp, s0: &[f64],
         } else {
             rows_dot(&sm.phi_rows[..n * d], &s, &mut y[..n]);
             y[..n].iter_mut().zip(&sm.c[step * d..step * d + n]).for_each(|(v, &c)| *v += c);
-            for i in n..d {
-                y[i] = y[i - n];
+            for block in 1..d / n {
+                y.copy_within(0..n, block * n);
             }
         }
         for &(i, l) in &sm.carry {
@@ -453,6 +453,55 @@ mod tests {
             rows_dot_in_order(&a, &x, &mut in_order);
             assert_eq!(fast.iter().map(|v| v.to_bits()).collect::<Vec<_>>(), reference, "rows_dot, {rows}×{n}");
             assert_eq!(in_order.iter().map(|v| v.to_bits()).collect::<Vec<_>>(), reference, "in order, {rows}×{n}");
+        }
+    }
+
+    /// A state of differences (two blocks whose rows of Φ, c_j and Γ repeat, as the schemes'):
+    /// [`repeated_rows`] finds the block, and a march on its distinct rows gives the bits of the
+    /// march on every row (the same map with `rows` = d), in z, the sets and the end state.
+    #[test]
+    fn a_march_on_the_distinct_rows_equals_the_march_on_every_row_bit_for_bit() {
+        let (k, n, m) = (200, 5, 3);
+        let d = 2 * n;
+        let mut seed = 17u64;
+        let mut draw = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let block: Vec<f64> = (0..n * d).map(|_| 0.01 * draw()).collect();
+        let phi: Vec<f64> = (0..d * d).map(|e| block[(e / d % n) * d + e % d]).collect();
+        let c_rows: Vec<f64> = (0..k * n).map(|_| draw()).collect();
+        let c: Vec<f64> = (0..k * d).map(|e| c_rows[e / d * n + e % d % n]).collect();
+        let g: Vec<f64> = (0..n * m).map(|_| 0.1 * draw()).collect();
+        let gamma: Vec<f64> = (0..d * m).map(|e| g[(e / m % n) * m + e % m]).collect();
+        let data = StepMapData {
+            k,
+            d,
+            m,
+            phi,
+            carry: (0..2).flat_map(|b| (b..2).flat_map(move |i| (0..n).map(move |r| (b * n + r, i * n + r)))).collect(),
+            c,
+            h: (0..m * d).map(|_| draw()).collect(),
+            gamma,
+            flexibility: (0..m * m).map(|e| if e % (m + 1) == 0 { 2.0 } else { 0.0 }).collect(),
+            r: (0..k * m).map(|_| 0.3 * draw()).collect(),
+        };
+        let sm = StepMapLcp::new(data).unwrap();
+        assert_eq!(sm.rows, n);
+        let mut every = sm.clone();
+        every.rows = d;
+        let s0: Vec<f64> = (0..d).map(|_| draw()).collect();
+        let (a, b) = (march(&sm, &s0, 0.0, Contacts::Solve(&[])).unwrap(), march(&every, &s0, 0.0, Contacts::Solve(&[])).unwrap());
+        assert!(a.masks.iter().any(|&s| s != 0), "no pair is ever active");
+        assert_eq!(a.masks, b.masks);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&a.z), bits(&b.z));
+        assert_eq!(bits(&a.end), bits(&b.end));
+        // The step matrices of the Jacobian read the same rows: equal to every row's.
+        let powers = PhiPowers::new(&sm);
+        for mask in 1u64..(1 << m) {
+            let (x, y) = (super::super::jacobian::step_matrix(&sm, &powers, mask), super::super::jacobian::step_matrix(&every, &powers, mask));
+            assert!((0..=d).all(|i| (0..=d).all(|j| x[(i, j)].to_bits() == y[(i, j)].to_bits())), "set {mask:b}");
         }
     }
 }
