@@ -86,6 +86,7 @@ pub(super) struct Node {
     pub w: Vec<f64>,
     pub tangent: Vec<f64>,
     pub orbit: PolishedOrbit,
+    /// The Floquet multipliers (empty: not computed, [`Family::orbit_node`]).
     pub mu: Vec<Complex64>,
     pub touches: Vec<Touch>,
     /// The outputs' amplitudes when surveyed with the touches (empty: not yet).
@@ -427,18 +428,33 @@ impl Family {
         timed(Stage::Node, || self.solved(w, prev, touches))
     }
 
+    /// The orbit at the solution `w` and its touches (when `touches`), without the tangent (`prev`
+    /// stands for it) nor the multipliers: a bisection's trial point for a test of the orbit
+    /// alone. The tangent's Jacobian and the monodromy's Schur form were two thirds of a trial.
+    pub fn orbit_node(&self, w: Vec<f64>, prev: &[f64], touches: bool) -> Option<Node> {
+        timed(Stage::Node, || {
+            let orbit = self.exact_orbit(&w)?;
+            let touches = if touches { orbit.touches() } else { Vec::new() };
+            Some(Node { w, tangent: prev.to_vec(), orbit, mu: Vec::new(), touches, amplitude: Vec::new() })
+        })
+    }
+
+    /// The orbit at the solution `w` (its events' states and impulses), its defect recorded.
+    fn exact_orbit(&self, w: &[f64]) -> Option<PolishedOrbit> {
+        let orbit = self.orbit(w[w.len() - 1] * self.rho)?;
+        let (y, times) = self.unpack(w, orbit.period());
+        let defect = self.residual_with(&orbit, w)?.amax() * self.ys;
+        orbit.at(&y, &times, defect).ok()
+    }
+
     fn solved(&self, w: Vec<f64>, prev: &[f64], touches: bool) -> Option<Node> {
-        let lambda = w[w.len() - 1] * self.rho;
         let jac = match self.last_jacobian.take() {
             Some((at, j)) if at == w => j,
             _ => self.jacobian(&w)?,
         };
         let tangent = self.tangent(&jac, prev)?;
         self.chord.replace(Some(Chord { key: self.key(), jacobian: jac }));
-        let orbit = self.orbit(lambda)?;
-        let (y, times) = self.unpack(&w, orbit.period());
-        let defect = self.residual_with(&orbit, &w)?.amax() * self.ys;
-        let orbit = orbit.at(&y, &times, defect).ok()?;
+        let orbit = self.exact_orbit(&w)?;
         let mu = floquet::multipliers(orbit.monodromy());
         // No multipliers (the Schur iteration did not converge): no point, the step is shortened.
         if mu.iter().any(|m| !m.is_finite()) {

@@ -487,7 +487,7 @@ impl Walk<'_> {
             let s = side(a, kind);
             let value = |n: &Node| if side(n, kind) == s { 1.0 } else { -1.0 } * test_value(n, kind).abs();
             let same = |n: &Node| side(n, kind) == s;
-            let test = if kind == EventKind::NeimarkSacker { Test::Side(&same) } else { Test::Value(&value) };
+            let test = if kind == EventKind::NeimarkSacker { Test::Side(&same) } else { Test::Point(&value) };
             let located = locate(&self.fam, a, b, test, false);
             let missed = located.is_none();
             let node = located.map_or_else(|| b.clone(), |(_, hi)| hi);

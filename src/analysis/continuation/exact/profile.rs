@@ -22,9 +22,11 @@ pub(super) enum Stage {
     Bisect,
     /// One trial point of a bisection (a correction and a point).
     Trial,
+    /// An event's test function at a bisection's point (e.g. the rigid margin's sampled period).
+    Test,
 }
 
-const NAMES: [&str; 8] = [
+const NAMES: [&str; 9] = [
     "orbit built",
     "residual",
     "variational flow",
@@ -33,18 +35,19 @@ const NAMES: [&str; 8] = [
     "amplitudes",
     "bisections (inclusive)",
     "bisection trial points (inclusive)",
+    "bisection test functions",
 ];
 
 thread_local! {
-    static TOTALS: RefCell<Option<[(f64, usize); 8]>> = const { RefCell::new(None) };
+    static TOTALS: RefCell<Option<[(f64, usize); 9]>> = const { RefCell::new(None) };
 }
 
-fn enabled() -> bool {
+pub(super) fn enabled() -> bool {
     std::env::var_os("PERIODIC_CONTACT_PROFILE").is_some()
 }
 
 /// The thread's CPU time so far [s].
-fn cpu() -> f64 {
+pub(super) fn cpu() -> f64 {
     std::fs::read_to_string("/proc/thread-self/schedstat").ok().and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok()).unwrap_or(f64::NAN) * 1e-9
 }
 
@@ -58,7 +61,7 @@ pub(super) fn timed<T>(stage: Stage, f: impl FnOnce() -> T) -> T {
     let spent = cpu() - start;
     TOTALS.with(|t| {
         let mut t = t.borrow_mut();
-        let row = &mut t.get_or_insert([(0.0, 0); 8])[stage as usize];
+        let row = &mut t.get_or_insert([(0.0, 0); 9])[stage as usize];
         row.0 += spent;
         row.1 += 1;
     });
