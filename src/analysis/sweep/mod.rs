@@ -208,8 +208,6 @@ pub fn run(
                 // Guarded: the last solved frequency, kept past a failure with its active sets
                 // (the next point sub-steps from there instead of starting cold).
                 let mut last_solved: Option<f64> = None;
-                // Whether the last point missed every try (`solve_guarded_after`).
-                let mut missed = false;
                 // The k the last point ended at (a tolerance's refinement): the next point's guess.
                 let mut predicted: Option<usize> = None;
                 // A large LCP's sweep never waits for the dense fallback (see `solve_guarded`); its
@@ -224,7 +222,7 @@ pub fn run(
                         // after 70–100 kinks (2–5 s each), while the branch beyond (2473 rad/s)
                         // is reached by Newton from the contact-free orbit and the refill follows
                         // it back. The homotopy waits for the points the refill misses (`refill`).
-                        let (r, n) = solve_guarded_after(&mut solver, last_solved, f, ColdTry::WithoutHomotopy, missed);
+                        let (r, n) = solve_guarded(&mut solver, last_solved, f, ColdTry::WithoutHomotopy);
                         substeps = n;
                         r
                     } else {
@@ -252,7 +250,6 @@ pub fn run(
                         refine::refine(&mut point, solver.problem(), r, below, (&mut levels, &mut second), settings);
                     }
                     predicted = r.is_ok().then_some(point.steps);
-                    missed = guarded && r.is_err();
                     point.time_s = t.elapsed().as_secs_f64();
                     match r {
                         Ok(r) => {
@@ -305,14 +302,6 @@ const SUBSTEP_HALVINGS: u32 = 4;
 /// is bounded by shooting's work budget. Returns the answer and the sub-steps solved before it.
 /// `cold`: how to end ([`ColdTry`]; `No`: a miss after the sub-steps is the failure).
 fn solve_guarded(solver: &mut PeriodicSolver, last: Option<f64>, f: f64, cold: ColdTry) -> (Result<Response, SolveError>, usize) {
-    solve_guarded_after(solver, last, f, cold, false)
-}
-
-/// [`solve_guarded`]; `after_miss`: the point before missed every try, so the warm start is the
-/// tip of a branch that ended before that point, and the warm try at `f` itself (further from the
-/// tip) is skipped where a cold try follows: the sub-steps come first. Why: on the real blade's
-/// folds (issue 23) that try missed at all 7 such points, each a long Newton try.
-fn solve_guarded_after(solver: &mut PeriodicSolver, last: Option<f64>, f: f64, cold: ColdTry, after_miss: bool) -> (Result<Response, SolveError>, usize) {
     let profile = std::env::var_os("PERIODIC_CONTACT_PROFILE").is_some();
     let at = |solver: &mut PeriodicSolver, w: f64, warm: bool| {
         let t = Instant::now();
@@ -328,14 +317,9 @@ fn solve_guarded_after(solver: &mut PeriodicSolver, last: Option<f64>, f: f64, c
         r
     };
     let had_warm = solver.warm_start().is_some();
-    let skip = after_miss && had_warm && cold != ColdTry::No;
-    let first = if skip {
-        None
-    } else {
-        match at(solver, f, true) {
-            Ok(r) => return (Ok(r), 0),
-            Err(e) => Some(e),
-        }
+    let first = match at(solver, f, true) {
+        Ok(r) => return (Ok(r), 0),
+        Err(e) => e,
     };
     let mut substeps = 0;
     if let Some(f0) = last {
@@ -354,11 +338,10 @@ fn solve_guarded_after(solver: &mut PeriodicSolver, last: Option<f64>, f: f64, c
         }
     }
     // Cold shooting, unless the first try already was.
-    let last_try = match (cold, first) {
-        (ColdTry::Full, _) if had_warm => at(solver, f, false),
-        (ColdTry::WithoutHomotopy, _) if had_warm => solver.update_frequency(f).and_then(|()| solver.solve_by_shooting_with(false, false)),
-        (_, Some(first)) => Err(first),
-        (_, None) => unreachable!("the warm try is skipped only before a cold try"),
+    let last_try = match cold {
+        ColdTry::Full if had_warm => at(solver, f, false),
+        ColdTry::WithoutHomotopy if had_warm => solver.update_frequency(f).and_then(|()| solver.solve_by_shooting_with(false, false)),
+        _ => Err(first),
     };
     match last_try {
         Ok(r) => (Ok(r), substeps),
