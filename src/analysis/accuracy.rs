@@ -11,12 +11,11 @@
 //! under cds at k = 1024), the second solve is at 2k instead: dearer (twice the unknowns), but
 //! the only one that is honest there.
 use crate::model::Compliance;
-use crate::periodic::carried_active_set;
-use crate::periodic::{PeriodicProblem, PeriodicSolver, SolveError};
+use crate::periodic::{PeriodicProblem, PeriodicSolver, SolveError, carried_active_set};
 use crate::response::{Accuracy, EstimateMissing, MissingCause, Response};
+use crate::time::{Discretization, Pairing, Scheme};
 
 pub mod neighbour;
-use crate::time::{Discretization, Pairing, Scheme};
 
 /// Fewest forced instants in a row that count as a sticking arc (a pure impact loads one or two
 /// instants of a forward-paired scheme, its impulse spread over at most two steps).

@@ -137,15 +137,7 @@ impl Case {
     /// The problem at k instants, one thread, `auto` LCP method unless told.
     pub fn problem(self, scheme: Scheme, pairing: Option<Pairing>, k: usize, method: LcpMethod) -> Result<PeriodicProblem, Error> {
         let outputs = OutputSelection { displacement: self.dofs(), velocity: vec![], acceleration: vec![], contacts: self.has_contact() };
-        let solver = SolverSettings {
-            method,
-            tolerance: 1e-9,
-            parallel: false,
-            shooting_warm_only: false,
-            shooting_homotopy: true,
-            shooting_settle: 0,
-            dense_pivots: None,
-        };
+        let solver = SolverSettings { method, parallel: false, ..SolverSettings::default() };
         PeriodicProblem::new(self.model(), Discretization { scheme, steps: k, pairing }, outputs, solver).map_err(Error::from)
     }
 

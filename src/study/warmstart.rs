@@ -72,8 +72,7 @@ fn problem(omega: f64, k: usize, method: LcpMethod) -> Result<PeriodicProblem, E
     let osc = Oscillator { omega, ..RIGID_OSC };
     let model = osc.model(vec![Oscillator::stop(RIGID_GAP, Compliance::Rigid)]);
     let outputs = OutputSelection { displacement: vec![0], velocity: vec![], acceleration: vec![], contacts: true };
-    let solver =
-        SolverSettings { method, tolerance: 1e-9, parallel: false, shooting_warm_only: false, shooting_homotopy: true, shooting_settle: 0, dense_pivots: None };
+    let solver = SolverSettings { method, parallel: false, ..SolverSettings::default() };
     PeriodicProblem::new(model, Discretization { scheme: Scheme::Cds, steps: k, pairing: Some(Pairing::Forward) }, outputs, solver).map_err(Error::from)
 }
 

@@ -178,7 +178,7 @@ pub(super) fn partner(model: &Model, events: &[Event], e: usize) -> Option<usize
 /// The phase begun by event `e` of the unknowns `w` when it lies between two events of one
 /// contact (the pair a grazing adds or removes, [`partner`]): (its end's event, its length as a
 /// fraction of the period), else `None`.
-fn pair_phase(fam: &Family, w: &[f64], e: usize) -> Option<(usize, f64)> {
+pub(super) fn pair_phase(fam: &Family, w: &[f64], e: usize) -> Option<(usize, f64)> {
     let ne = fam.ne();
     let n2 = w.len() - 1 - ne;
     let b = partner(fam.base(), &fam.sig.events, e)?;

@@ -16,9 +16,8 @@ impl Walk<'_> {
     pub(super) fn merge_held_arc(&mut self, here: &Node, e: usize, what: &str) -> Option<Node> {
         trace::held_arc(here, &self.fam, e);
         let (ne, rho) = (self.fam.ne(), self.fam.rho);
-        let b = signature::partner(self.fam.base(), &self.fam.sig.events, e)?;
+        let (b, len) = signature::pair_phase(&self.fam, &here.w, e)?;
         let n2 = here.w.len() - 1 - ne;
-        let len = here.w[n2 + b] - here.w[n2 + e] + if b <= e { 1.0 } else { 0.0 };
         let rate = here.tangent[n2 + e] - here.tangent[n2 + b];
         let t_l = here.tangent[here.tangent.len() - 1];
         let (lambda, sense) = (here.lambda(rho), t_l.signum());

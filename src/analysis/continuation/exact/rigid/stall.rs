@@ -27,11 +27,8 @@ impl Walk<'_> {
         // The shortest phase between two events of one contact: the one merging.
         let (ne, n2) = (self.fam.ne(), here.w.len() - 1 - self.fam.ne());
         let pairs: Vec<_> = (0..ne)
-            .filter_map(|e| Some((e, signature::partner(self.fam.base(), &self.fam.sig.events, e)?)))
-            .map(|(e, b)| {
-                let length = here.w[n2 + b] - here.w[n2 + e] + if b <= e { 1.0 } else { 0.0 };
-                (e, self.fam.sig.events[e].contact, length, here.tangent[n2 + e] - here.tangent[n2 + b])
-            })
+            .filter_map(|e| signature::pair_phase(&self.fam, &here.w, e).map(|(b, length)| (e, b, length)))
+            .map(|(e, b, length)| (e, self.fam.sig.events[e].contact, length, here.tangent[n2 + e] - here.tangent[n2 + b]))
             .collect();
         trace::stall(here, self.fam.rho, &pairs);
         let shortest = pairs.iter().min_by(|a, b| a.2.total_cmp(&b.2));

@@ -63,8 +63,7 @@ pub(super) fn held_arc(here: &Node, fam: &Family, e: usize) {
     }
     let ne = fam.ne();
     let n2 = here.w.len() - 1 - ne;
-    let Some(b) = signature::partner(fam.base(), &fam.sig.events, e) else { return };
-    let len = here.w[n2 + b] - here.w[n2 + e] + if b <= e { 1.0 } else { 0.0 };
+    let Some((b, len)) = signature::pair_phase(fam, &here.w, e) else { return };
     let rate = here.tangent[n2 + e] - here.tangent[n2 + b];
     let t = &here.tangent;
     eprintln!(
