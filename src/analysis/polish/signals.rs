@@ -209,7 +209,8 @@ mod tests {
         let size = 2e-4;
         for (s, vs) in signals.iter().zip(Signal::values(&signals, &ts)) {
             let worst = ts.iter().zip(&vs).map(|(&t, v)| (v - s.value(t)).abs()).fold(0.0, f64::max);
-            assert!(worst <= 1e-13 * size, "worst difference {worst:e}");
+            // The reference's own round-off: the phase 3wt ≈ 2.6e3 rad carries ulp ≈ 4.5e-13.
+            assert!(worst <= 1e-12 * size, "worst difference {worst:e}");
         }
     }
 }
