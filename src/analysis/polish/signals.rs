@@ -9,6 +9,9 @@ use num_complex::Complex64 as C;
 
 /// Samples per phase before the bisection.
 const FIRST: usize = 16;
+/// Times between exact exponentials in [`Signal::values`]: the products' round-off grows ≈ 1e-16
+/// per step, so the values stay within ≈ 3e-15 of the signal's size.
+const ANCHOR: usize = 32;
 /// The deepest bisection: 2⁻⁶⁰ of a sampled interval is below round-off of the time.
 const DEPTH: u32 = 60;
 
@@ -69,8 +72,10 @@ impl Signal {
         self.jet(t).1
     }
 
-    /// The values of `signals` (one phase's: the same start and λ_j) at the times `ts`, the
-    /// exponentials e^{λ_j (t − a)} and e^{iwt} made once per time for all of them.
+    /// The values of `signals` (one phase's: the same start and λ_j) at the evenly spaced times
+    /// `ts`, the exponentials e^{λ_j (t − a)} and e^{iwt} made once per time for all of them: by
+    /// the step's factors e^{λ_j h}, e^{iwh} from an exact anchor every [`ANCHOR`] times (one
+    /// complex product each instead of an exp and a sincos: the rigid margin's time went to them).
     pub fn values(signals: &[Signal], ts: &[f64]) -> Vec<Vec<f64>> {
         let Some(first) = signals.first() else { return Vec::new() };
         let mut freqs: Vec<f64> = signals.iter().flat_map(|s| s.harmonics.iter().map(|h| h.0)).collect();
@@ -87,12 +92,21 @@ impl Signal {
                 c
             })
             .collect();
+        let h = if ts.len() > 1 { (ts[ts.len() - 1] - ts[0]) / (ts.len() - 1) as f64 } else { 0.0 };
+        let mode_step: Vec<C> = first.lambda.iter().map(|l| (l * h).exp()).collect();
+        let wave_step: Vec<C> = freqs.iter().map(|&w| C::from_polar(1.0, w * h)).collect();
+        let (mut modes, mut waves) = (vec![C::new(0.0, 0.0); first.lambda.len()], vec![C::new(0.0, 0.0); freqs.len()]);
         let mut out = vec![Vec::with_capacity(ts.len()); signals.len()];
-        for &t in ts {
-            let modes: Vec<C> = first.lambda.iter().map(|l| (l * (t - first.start)).exp()).collect();
-            let waves: Vec<C> = freqs.iter().map(|&w| C::from_polar(1.0, w * t)).collect();
+        let re = |a: &C, b: &C| a.re * b.re - a.im * b.im;
+        for (k, &t) in ts.iter().enumerate() {
+            if k % ANCHOR == 0 {
+                modes.iter_mut().zip(&first.lambda).for_each(|(e, l)| *e = (l * (t - first.start)).exp());
+                waves.iter_mut().zip(&freqs).for_each(|(e, &w)| *e = C::from_polar(1.0, w * t));
+            } else {
+                modes.iter_mut().zip(&mode_step).for_each(|(e, f)| *e *= f);
+                waves.iter_mut().zip(&wave_step).for_each(|(e, f)| *e *= f);
+            }
             for ((s, c), o) in signals.iter().zip(&coefficients).zip(&mut out) {
-                let re = |a: &C, b: &C| a.re * b.re - a.im * b.im;
                 o.push(s.modal.iter().zip(&modes).map(|(m, e)| re(m, e)).sum::<f64>() + c.iter().zip(&waves).map(|(h, e)| re(h, e)).sum::<f64>());
             }
         }
@@ -172,5 +186,31 @@ impl Signal {
             stack.push((mid, (t1, v1, d1), depth + 1, None));
         }
         best
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{C, Signal};
+
+    #[test]
+    fn values_by_stepped_exponentials_match_each_value_evaluated_alone() {
+        // A plastic impact's ringing (a stiff decaying pair, 6e5 rad/s) on a slow mode and three
+        // harmonics of 2300 rad/s, over one period in 6000 steps: the direct sums are the reference.
+        let w = 2300.0;
+        let lambda = vec![C::new(-900.0, 6.0e5), C::new(-900.0, -6.0e5), C::new(-3.0, 2.1e3), C::new(-3.0, -2.1e3), C::new(-40.0, 0.0)];
+        let modal = vec![C::new(1e-6, 2e-6), C::new(1e-6, -2e-6), C::new(3e-5, 1e-5), C::new(3e-5, -1e-5), C::new(-2e-5, 0.0)];
+        let harmonics = vec![(w, C::new(1e-4, -2e-5)), (2.0 * w, C::new(-3e-6, 4e-6)), (3.0 * w, C::new(5e-7, 1e-7))];
+        let start = 0.37;
+        let signals = vec![Signal::new(start, lambda.clone(), modal.clone(), harmonics.clone()), Signal::new(start, lambda, modal, harmonics[..1].to_vec())];
+        let (a, n) = (start + 1e-4, 6000);
+        let h = 2.0 * std::f64::consts::PI / w / n as f64;
+        let ts: Vec<f64> = (0..=n).map(|j| a + h * j as f64).collect();
+        let size = 2e-4;
+        for (s, vs) in signals.iter().zip(Signal::values(&signals, &ts)) {
+            let worst = ts.iter().zip(&vs).map(|(&t, v)| (v - s.value(t)).abs()).fold(0.0, f64::max);
+            // The reference's own round-off: the phase 3wt ≈ 2.6e3 rad carries ulp ≈ 4.5e-13.
+            assert!(worst <= 1e-12 * size, "worst difference {worst:e}");
+        }
     }
 }
