@@ -66,6 +66,8 @@ mod hard_cases;
 mod lcp;
 #[path = "linear.rs"]
 mod linear;
+#[path = "marching.rs"]
+mod marching;
 #[path = "massless_polish.rs"]
 mod massless_polish;
 #[path = "polish.rs"]

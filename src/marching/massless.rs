@@ -7,6 +7,9 @@
 //! K_bb b_{n+1} = f_b(t_{n+1}) − K_ba a_{n+1} − B_bᵀ λ_{n+1},   gap(t_{n+1}) − B_b b_{n+1} ≥ 0 ⟂ λ_{n+1} ≥ 0
 //! ```
 //!
+//! The first line in the summed form (see [`super`]): Δa_{n+1} = Δa_n − Ŵ_aa(K_aa a_n + K_ab b_n)
+//! − (Ŵ_aa C_aa/h) Δa_n + Ŵ_aa f_a, a_{n+1} = a_n + Δa_{n+1}, both sums compensated.
+//!
 //! The step LCP has G = B_b K_bb⁻¹ B_bᵀ (symmetric positive definite for independent rows), plus
 //! 1/k_c on the diagonal of a compliant contact (its spring in series, the same instant): the
 //! force is finite, as in the periodic LCP's step map. Stable for h < 2/ω_max with ω_max of the
@@ -76,8 +79,9 @@ pub(super) fn march_massless(model: &Model, settings: &MarchSettings, massless: 
     let sub = |m: &Mat<f64>, r: &[usize], c: &[usize]| Mat::<f64>::from_fn(r.len(), c.len(), |i, j| m[(r[i], c[j])]);
     let (maa, caa, kaa, kab) = (sub(&mm, &ia, &ia), sub(&cc, &ia, &ia), sub(&kk, &ia, &ia), sub(&kk, &ia, &ib));
     let w = Mat::<f64>::from_fn(na, na, |i, j| maa[(i, j)] / (h * h) + caa[(i, j)] / (2.0 * h)).partial_piv_lu().inverse();
-    let a1 = &w * Mat::<f64>::from_fn(na, na, |i, j| 2.0 * maa[(i, j)] / (h * h) - kaa[(i, j)]);
-    let a0 = &w * Mat::<f64>::from_fn(na, na, |i, j| -(maa[(i, j)] / (h * h) - caa[(i, j)] / (2.0 * h)));
+    // The increment's matrices −Ŵ_aa K_aa, −Ŵ_aa C_aa/h, −Ŵ_aa K_ab (no 2I − h²M⁻¹K is rounded).
+    let a1 = -(&w * &kaa);
+    let a0 = -(&w * &caa) * faer::Scale(1.0 / h);
     let ab = -(&w * &kab);
     let s = sub(&kk, &ib, &ib).partial_piv_lu().inverse();
     let sba = -(&s * sub(&kk, &ib, &ia));
@@ -131,29 +135,35 @@ pub(super) fn march_massless(model: &Model, settings: &MarchSettings, massless: 
     model.force_at(0.0, &mut fa);
     let r0 = Mat::<f64>::from_fn(na, 1, |i, _| fa[ia[i]] - (0..n).map(|d| cc[(ia[i], d)] * v0[d] + kk[(ia[i], d)] * x_cur[d]).sum::<f64>());
     let acc0 = maa.partial_piv_lu().solve(&r0);
-    let mut x_prev = x_cur.clone();
+    // Δ_0 = x_0 − x_{−1} = h v_0 − h²/2 a_0 on the massive DOFs (the massless ones start at rest).
+    let mut d_cur = vec![0.0; n];
     for (i, &a) in ia.iter().enumerate() {
-        x_prev[a] = x_cur[a] - h * v0[a] + 0.5 * h * h * acc0[(i, 0)];
+        d_cur[a] = h * v0[a] - 0.5 * h * h * acc0[(i, 0)];
     }
-    let mut x_next = vec![0.0; n];
+    let (mut x_next, mut d_next) = (x_cur.clone(), vec![0.0; n]);
+    let mut sum = super::Compensated::new(n);
     let mut rec = super::Recorder::new(n, m, ns, h);
     for p in 0..settings.max_periods {
         for j in 0..ns {
             let t = j as f64 * h;
             model.force_at(t, &mut fa);
             for (i, &a) in ia.iter().enumerate() {
-                let mut v: f64 = (0..na).map(|k| a1[(i, k)] * x_cur[ia[k]] + a0[(i, k)] * x_prev[ia[k]] + w[(i, k)] * fa[ia[k]]).sum();
+                let mut v: f64 = (0..na).map(|k| a1[(i, k)] * x_cur[ia[k]] + a0[(i, k)] * d_cur[ia[k]] + w[(i, k)] * fa[ia[k]]).sum();
                 v += (0..nb).map(|k| ab[(i, k)] * x_cur[ib[k]]).sum::<f64>();
-                x_next[a] = v;
+                d_next[a] = v;
             }
+            sum.step(&x_cur, &d_cur, &mut x_next, &mut d_next, ia.iter().copied());
             rec.contacts(j, model, t, &lam, &x_cur);
             condense((j + 1) as f64 * h, &mut x_next, &mut lam).map_err(|e| step_error(j, p + 1, e))?;
             if x_next.iter().any(|v| !v.is_finite()) {
                 return Err(MarchError::Diverged { step: j, period: p + 1 });
             }
-            rec.state(j, &x_prev, &x_cur, &x_next);
-            std::mem::swap(&mut x_prev, &mut x_cur);
+            for &b in &ib {
+                d_next[b] = x_next[b] - x_cur[b];
+            }
+            rec.state(j, &x_cur, &d_cur, &d_next);
             std::mem::swap(&mut x_cur, &mut x_next);
+            std::mem::swap(&mut d_cur, &mut d_next);
         }
         if rec.end_period(p, settings) {
             break;
