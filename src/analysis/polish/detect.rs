@@ -28,10 +28,6 @@ const STEPS_PER_RADIAN: f64 = 2.0;
 /// Newton iterations before the walk falls back to the signature-following polish.
 const MAX_ITERATIONS: usize = 10;
 
-thread_local! {
-    static PROFILE: bool = std::env::var_os("PERIODIC_CONTACT_PROFILE").is_some();
-}
-
 /// Phases by closed set at one ω: `prev`'s re-tuned where it has the set (only the particular
 /// solution depends on ω), else made and given `prev`'s eigendecomposition of the same matrix.
 struct Flows<'a> {
@@ -41,13 +37,16 @@ struct Flows<'a> {
     bank: &'a PhaseBank,
     /// Whether `model` is `prev`'s at another frequency (the same structure and contacts).
     retune: bool,
+    /// Whether `model` is the bank's system at another frequency.
+    same_as_bank: bool,
     phases: Vec<Phase>,
     /// Each phase's switch-search grid.
     grids: Vec<Grid>,
     /// Each contact's gap harmonics (the grids' periodic parts).
     gaps: Vec<super::phase::Harmonics>,
-    /// CPU spent building phases [s], under `PERIODIC_CONTACT_PROFILE`.
-    building: f64,
+    /// Phases made anew (not re-tuned), for the profile (a CPU tally per phase read /proc twice
+    /// per phase: ~0.2 s of the sweep's walk).
+    made: usize,
 }
 
 impl Flows<'_> {
@@ -55,12 +54,12 @@ impl Flows<'_> {
         if let Some(k) = self.phases.iter().position(|p| p.is_for(&[], closed)) {
             return Ok(k);
         }
-        let clock = PROFILE.with(|on| on.then(super::thread_cpu).flatten());
-        let banked = self.bank.find(self.model, closed);
+        let banked = self.bank.find(self.same_as_bank, closed);
         let old = self.prev.phases.iter().find(|o| self.retune && o.is_for(&[], closed)).or(banked.map(|(p, _)| p));
         let p = match old {
             Some(o) => o.retuned(self.model),
             None => Phase::new(self.model, &[], closed).map(|mut p| {
+                self.made += 1;
                 if let Some(o) = self.prev.phases.iter().find(|o| o.same_matrix(&p)) {
                     p.share_modes(o);
                 }
@@ -68,9 +67,6 @@ impl Flows<'_> {
             }),
         };
         let p = p.ok_or_else(|| PolishFailure("a phase's operator is singular at a forcing harmonic".into()))?;
-        if let (Some(a), Some(b)) = (clock, super::thread_cpu()) {
-            self.building += b - a;
-        }
         let h = 1.0 / (STEPS_PER_RADIAN * p.speed_hint().max(self.model.frequency));
         let fixed = match banked {
             Some((_, f)) if f.h == h => Arc::clone(f),
@@ -124,7 +120,10 @@ pub fn follow_detected_with(model: &Model, prev: &PolishedOrbit, start: &[f64], 
         return Err(PolishFailure("switch-detecting shooting: only for compliant contacts".into()));
     }
     let gaps = (0..model.contacts.len()).map(|i| super::phase::gap_harmonics(model, i)).collect();
-    let mut flows = Flows { model, prev, bank, retune: same_system(model, &prev.model), phases: Vec::new(), grids: Vec::new(), gaps, building: 0.0 };
+    let retune = same_system(model, &prev.model);
+    // The bank's system compared once per point (M, C, K: 3 n² comparisons), not per phase.
+    let same_as_bank = bank.is_for(model);
+    let mut flows = Flows { model, prev, bank, retune, same_as_bank, phases: Vec::new(), grids: Vec::new(), gaps, made: 0 };
     let out = newton(&mut flows, start);
     let phases = std::mem::take(&mut flows.phases);
     let kept = phases.into_iter().zip(flows.grids.iter().map(|g| Arc::clone(&g.fixed))).collect();
@@ -192,7 +191,7 @@ fn newton(flows: &mut Flows, start: &[f64]) -> Result<PolishedOrbit, PolishFailu
         }
     };
     let residual = r.component_mul(&w).amax();
-    super::profile(&format!("switch detection: {iterations} iterations, {} phases built in {:.3} s CPU", flows.phases.len(), flows.building), clock);
+    super::profile(&format!("switch detection: {iterations} iterations, {} phases, {} made anew", flows.phases.len(), flows.made), clock);
     let orbit = assemble(model, prev, flows, shot, (iterations, residual, correction))?;
     super::profile("the orbit on the detected signature", clock);
     verify::check(&orbit)?;

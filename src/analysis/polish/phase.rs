@@ -234,7 +234,12 @@ impl Phase {
     /// Shares `other`'s eigendecomposition and force gradient (made or to be made once for both):
     /// only for a phase of [`Self::same_matrix`] and the same M, C, K.
     pub fn share_modes(&mut self, other: &Phase) {
-        if self.same_matrix(other) && self.m == other.m && self.c == other.c && self.k == other.k {
+        // Already shared (a clone or re-tuning of `other`, or shared before): nothing to compare.
+        let shared = Arc::ptr_eq(&self.eigen, &other.eigen)
+            && Arc::ptr_eq(&self.force_gradient, &other.force_gradient)
+            && Arc::ptr_eq(&self.lift, &other.lift)
+            && Arc::ptr_eq(&self.grid_step, &other.grid_step);
+        if !shared && self.same_matrix(other) && self.m == other.m && self.c == other.c && self.k == other.k {
             self.eigen = Arc::clone(&other.eigen);
             self.force_gradient = Arc::clone(&other.force_gradient);
             self.lift = Arc::clone(&other.lift);
@@ -294,10 +299,23 @@ impl Phase {
             return y.clone();
         }
         let (n, nf) = (self.n, self.free.ncols());
+        if let Some(rows) = &self.tuning.free_rows {
+            // N_a's columns are unit vectors e_d: N_aᵀ y is a gather (the product's exact value).
+            return DVector::from_iterator(2 * nf, rows.iter().map(|&d| y[d]).chain(rows.iter().map(|&d| y[n + d])));
+        }
         let mut out = DVector::zeros(2 * nf);
-        out.rows_mut(0, nf).copy_from(&(self.free.transpose() * y.rows(0, n)));
-        out.rows_mut(nf, nf).copy_from(&(self.free.transpose() * y.rows(n, n)));
+        out.rows_mut(0, nf).copy_from(&self.free.tr_mul(&y.rows(0, n)));
+        out.rows_mut(nf, nf).copy_from(&self.free.tr_mul(&y.rows(n, n)));
         out
+    }
+
+    /// x + N u for the basis N (`basis`, its unit columns' DOFs `rows` when known): a scatter-add
+    /// where N's columns are unit vectors (the product's exact value), else the product.
+    fn add_in_basis(x: &mut DVector<f64>, basis: &DMatrix<f64>, rows: Option<&[usize]>, u: &nalgebra::DVectorView<f64>) {
+        match rows {
+            Some(rows) => rows.iter().zip(u.iter()).for_each(|(&d, v)| x[d] += v),
+            None => x.gemv(1.0, basis, u, 1.0),
+        }
     }
 
     /// The full state [x; v] at `t1`, from the full state `y0` at `t0` (stuck DOFs of `y0` are
@@ -387,14 +405,17 @@ impl Phase {
         }
         let (n, nf) = (self.n, self.free.ncols());
         let mut y = DVector::zeros(2 * n);
-        let mut x = eval(&self.presc, self.omega, t, 0, n) + &self.free * yf.rows(0, nf);
-        let mut v = eval(&self.presc, self.omega, t, 1, n) + &self.free * yf.rows(nf, nf);
+        let (free_rows, slave_rows) = (self.tuning.free_rows.as_deref(), self.tuning.slave_rows.as_deref());
+        let mut x = eval(&self.presc, self.omega, t, 0, n);
+        let mut v = eval(&self.presc, self.omega, t, 1, n);
+        Self::add_in_basis(&mut x, &self.free, free_rows, &yf.rows(0, nf));
+        Self::add_in_basis(&mut v, &self.free, free_rows, &yf.rows(nf, nf));
         if self.slave.ncols() > 0 {
             let (nb, pa) = (self.slave.ncols(), eval(&self.part, self.omega, t, 0, 2 * nf));
             let xb = eval(&self.slave_part, self.omega, t, 0, nb) + &self.slave_map * (yf.rows(0, nf) - pa.rows(0, nf));
             let vb = eval(&self.slave_part, self.omega, t, 1, nb) + &self.slave_map * (yf.rows(nf, nf) - pa.rows(nf, nf));
-            x += &self.slave * xb;
-            v += &self.slave * vb;
+            Self::add_in_basis(&mut x, &self.slave, slave_rows, &xb.rows(0, nb));
+            Self::add_in_basis(&mut v, &self.slave, slave_rows, &vb.rows(0, nb));
         }
         y.rows_mut(0, n).copy_from(&x);
         y.rows_mut(n, n).copy_from(&v);

@@ -20,17 +20,21 @@ pub struct PhaseBank {
 }
 
 impl PhaseBank {
-    /// The phase of the closed set `closed` kept for `model`'s system, at the ω it was made, and
-    /// its grid's ω-independent part.
-    pub(super) fn find(&self, model: &Model, closed: &[usize]) -> Option<(&Phase, &Arc<Fixed>)> {
-        let same = self.model.as_ref().is_some_and(|m| super::same_system(model, m));
+    /// The phase of the closed set `closed` kept, at the ω it was made, and its grid's
+    /// ω-independent part; `same` is [`Self::is_for`] of the model asked for (compared once per point).
+    pub(super) fn find(&self, same: bool, closed: &[usize]) -> Option<(&Phase, &Arc<Fixed>)> {
         same.then(|| self.phases.iter().find(|(_, set, _, _)| set == closed).map(|(_, _, p, f)| (p, f))).flatten()
+    }
+
+    /// Whether the bank holds phases of `model`'s system (`model` up to its frequency).
+    pub(super) fn is_for(&self, model: &Model) -> bool {
+        self.model.as_ref().is_some_and(|m| super::same_system(model, m))
     }
 
     /// Keeps `phases` (of `model`, with their grids' ω-independent parts), replacing those of the
     /// same sets; a new system empties the bank.
     pub(super) fn keep(&mut self, model: &Model, phases: Vec<(Phase, Arc<Fixed>)>) {
-        if !self.model.as_ref().is_some_and(|m| super::same_system(model, m)) {
+        if !self.is_for(model) {
             self.model = Some(model.clone());
             self.phases.clear();
         }

@@ -23,6 +23,9 @@ impl Transient {
     }
 }
 
+/// A DOF's column in a basis of unit columns (`Some(None)`: not in it), `None` where the basis is not.
+type Column = Option<Option<usize>>;
+
 impl Phase {
     /// The phase's transient from the full state `y` at `a` ([`Transient`]): Â's eigenvectors
     /// weighted by the modal coordinates of D⁻¹(N_aᵀ y − p(a)), scaled back by D (see
@@ -91,21 +94,32 @@ impl Phase {
         fn find(h: &Harmonics, p: u32) -> Option<&DVector<C>> {
             h.iter().find(|(q, _)| *q == p).map(|(_, v)| v)
         }
+        // Where N_a's (N_b's) columns are unit vectors e_d, the row's DOF d is the column k with
+        // rows[k] = d or none: the sum over k has that one term (its exact value).
+        let column = |rows: &Option<Vec<usize>>, d: usize| rows.as_ref().map(|r| r.iter().position(|&e| e == d));
+        let at_row: Vec<(usize, Column, Column)> =
+            row.iter().map(|&(d, _)| (d, column(&self.tuning.free_rows, d), column(&self.tuning.slave_rows, d))).collect();
         orders
             .into_iter()
             .map(|p| {
                 let (xa, xb, xp) = (find(&self.part, p), find(&self.slave_part, p), find(&self.presc, p));
-                let at = |d: usize| {
+                let at = |(d, ka, kb): (usize, Column, Column)| {
                     let mut v = xp.map_or(C::new(0.0, 0.0), |x| x[d]);
                     if let Some(xa) = xa {
-                        v += (0..nf).map(|k| xa[k] * self.free[(d, k)]).sum::<C>();
+                        v += match ka {
+                            Some(k) => k.map_or(C::new(0.0, 0.0), |k| xa[k]),
+                            None => (0..nf).map(|k| xa[k] * self.free[(d, k)]).sum::<C>(),
+                        };
                     }
                     if let Some(xb) = xb {
-                        v += (0..nb).map(|k| xb[k] * self.slave[(d, k)]).sum::<C>();
+                        v += match kb {
+                            Some(k) => k.map_or(C::new(0.0, 0.0), |k| xb[k]),
+                            None => (0..nb).map(|k| xb[k] * self.slave[(d, k)]).sum::<C>(),
+                        };
                     }
                     v
                 };
-                (p, row.iter().map(|&(d, c)| at(d) * c).sum())
+                (p, row.iter().zip(&at_row).map(|(&(_, c), &r)| at(r) * c).sum())
             })
             .collect()
     }
