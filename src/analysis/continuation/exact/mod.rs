@@ -166,6 +166,7 @@ impl Walk<'_> {
         let lambda = node.lambda(self.fam.rho);
         let amplitude = if node.amplitude.is_empty() { self.amplitudes(&node.orbit).1 } else { node.amplitude.clone() };
         let max_multiplier = floquet::largest(&node.mu);
+        rigid::trace_point(node, lambda);
         self.points.push(BranchPoint {
             parameter: lambda,
             amplitude,

@@ -49,16 +49,16 @@ impl Walk<'_> {
             if touch.closed { "an open" } else { "a closed" }
         );
         self.push(lo, Some(EventKind::Grazing), detail);
-        let first = self.open_phase(sig, &guess, pair)?;
+        let first = self.open_phase(sig, &guess, pair, NEW_PAIR)?;
         self.multipliers_across(lo, &first);
         Some(first)
     }
 
     /// The first point of the branch of signature `sig` whose phase between its events `ia` and
-    /// `ib` (one contact's) begins at a grazing: corrected from `guess` with that phase
-    /// [`NEW_PAIR`] and twice that long, its tangent along the secant (the phase growing). The
-    /// family keeps its old signature when the corrector fails.
-    pub(super) fn open_phase(&mut self, sig: Signature, guess: &[f64], (ia, ib): (usize, usize)) -> Option<Node> {
+    /// `ib` (one contact's) begins at a grazing: corrected from `guess` with that phase `len`
+    /// ([`NEW_PAIR`] or shorter) and twice that long, its tangent along the secant (the phase
+    /// growing). The family keeps its old signature when the corrector fails.
+    pub(super) fn open_phase(&mut self, sig: Signature, guess: &[f64], (ia, ib): (usize, usize), len: f64) -> Option<Node> {
         let old = std::mem::replace(&mut self.fam.sig, sig);
         let d = self.fam.dim();
         let n2 = d - 1 - self.fam.ne();
@@ -66,11 +66,13 @@ impl Walk<'_> {
         normal[n2 + ib] = 1.0;
         normal[n2 + ia] = -1.0;
         let wrap = if ib < ia { 1.0 } else { 0.0 };
-        let first = self.fam.correct(guess, &normal, NEW_PAIR - wrap).and_then(|w1| {
+        let mut g = guess.to_vec();
+        g[n2 + ib] = g[n2 + ia] + len - wrap;
+        let first = self.fam.correct(&g, &normal, len - wrap).and_then(|w1| {
             let mut g2 = w1.clone();
-            g2[n2 + ia] -= 0.5 * NEW_PAIR;
-            g2[n2 + ib] += 0.5 * NEW_PAIR;
-            let w2 = self.fam.correct(&g2, &normal, 2.0 * NEW_PAIR - wrap)?;
+            g2[n2 + ia] -= 0.5 * len;
+            g2[n2 + ib] += 0.5 * len;
+            let w2 = self.fam.correct(&g2, &normal, 2.0 * len - wrap)?;
             let sec: Vec<f64> = w2.iter().zip(&w1).map(|(a, b)| a - b).collect();
             self.fam.node(w1, &sec)
         });

@@ -15,7 +15,7 @@
 //! stretch between is not traced, and the grazing's detail says so.
 //!
 //! [`PolishedOrbit::rigid_margin`]: crate::analysis::polish::PolishedOrbit::rigid_margin
-use super::family::{Family, Node, Signature, lambda_axis};
+use super::family::{Node, Signature, lambda_axis};
 use super::locate::{Test, locate};
 use super::{BRACKET, EventKind, NEW_PAIR, Walk, signature};
 use crate::analysis::polish::{self, Event, EventKind as Switch, Touch};
@@ -26,7 +26,9 @@ mod diagnose;
 mod held;
 mod landing;
 mod stall;
+mod touch;
 mod trace;
+use touch::touch_point;
 use trace::trace;
 
 /// Margins above −this are admissible (the relative tolerance of the polish's own checks).
@@ -41,6 +43,10 @@ const RESEED: [f64; 6] = [1e-4, 1e-3, 3e-3, 1e-2, 3e-2, 0.1];
 /// arc a few instants long near the change), for models of at most [`REFINE_DOFS`] DOFs.
 const REFINE: usize = 4;
 const REFINE_DOFS: usize = 64;
+
+/// The length (fraction of the period) of a phase started at a grazing ([`Walk::open_phase`]),
+/// in turn until its first point is admissible.
+const START_PHASE: [f64; 3] = [NEW_PAIR, 0.1 * NEW_PAIR, 0.01 * NEW_PAIR];
 
 /// How far past a sticking arc's grazing start (fractions of ρ) the flight after its landing is
 /// first sought, in turn ([`Walk::unmerge`]).
@@ -62,6 +68,16 @@ pub(super) fn reimpact_factor(flight: f64) -> f64 {
 /// d/dΔ of [`reimpact_factor`].
 pub(super) fn reimpact_factor_rate(flight: f64) -> f64 {
     -2.0 * REIMPACT_REF * REIMPACT_REF / flight.powi(3)
+}
+
+/// A recorded point's rigid margin and events per period on the trace (`PC_TRACE_UNMERGE`):
+/// an inadmissible orbit walked on shows there.
+pub(super) fn trace_point(n: &Node, lambda: f64) {
+    trace(format_args!(
+        "point: λ {lambda:.10}: {} events, margin {:?}",
+        n.orbit.events().len(),
+        n.orbit.rigid_margin().map(|m| (m.contact, m.what, m.value, m.time / n.orbit.period()))
+    ));
 }
 
 /// The node's rigid margin; +∞ without rigid contacts.
@@ -256,7 +272,27 @@ impl Walk<'_> {
     /// begins at `at`, where it has zero length: its first point, the grazing recorded at `at`.
     fn start_phase(&mut self, at: &Node, sig: Signature, guess: &[f64], pair: (usize, usize), what: &str) -> Option<Node> {
         let before = self.fam.ne();
-        let first = self.open_phase(sig, guess, pair)?;
+        // The first point lies where the phase is `len` long, which may be far in λ (a flight
+        // growing slowly): the k = 1024 blade's contact 16 at 2287.578 rad/s, its 1e-5 flight
+        // 0.37 rad/s on, past contact 2's grazing (margin −2.5e-5), and the walk went on blind on
+        // that inadmissible branch to 2279.79. A shorter phase starts closer to the grazing.
+        let mut first = None;
+        for len in START_PHASE {
+            let old = self.fam.sig.clone();
+            let Some(n) = self.open_phase(sig.clone(), guess, pair, len) else { continue };
+            trace(format_args!(
+                "start phase {len:e}: first point λ {:.10} (the grazing at {:.10}), margin {:?}",
+                n.lambda(self.fam.rho),
+                at.lambda(self.fam.rho),
+                n.orbit.rigid_margin().map(|m| (m.contact, m.what, m.value, m.time / n.orbit.period()))
+            ));
+            if margin(&n) >= -TOL {
+                first = Some(n);
+                break;
+            }
+            self.fam.sig = old;
+        }
+        let first = first?;
         let detail = format!("{what}; events per period {before} -> {} (the new phase started on the exact orbit)", self.fam.ne());
         self.push(at, Some(EventKind::Grazing), detail);
         self.multipliers_across(at, &first);
@@ -506,77 +542,4 @@ fn grid_orbit(problem: &PeriodicProblem, param: super::Parameter, lambda: f64) -
     let disc = p.discretization();
     p.set_discretization(Discretization { steps: REFINE * disc.steps, ..disc }).ok()?;
     solve(&p)
-}
-
-/// The point between λ = `la` and `lb` where the orbit of the family's signature (corrected at λ
-/// fixed from `guess`'s unknowns) stops being admissible: bisection in λ on the sign of its
-/// rigid margin, to [`BRACKET`] of the range; the node on the admissible side, its tangent
-/// pointing away from the inadmissible one. Where the margin there is a landing's lift-off (its
-/// micro-flight just visible), the point is where that landing's force crosses zero
-/// ([`landing::landing_zero`]). `None` without a sign change or where the corrector fails.
-fn touch_point(fam: &mut Family, guess: &[f64], la: f64, lb: f64) -> Option<Node> {
-    let (rho, d) = (fam.rho, fam.dim());
-    let e_l = lambda_axis(d);
-    // The orbit at λ from the unknowns `from`: (node, admissible).
-    let at = |fam: &mut Family, from: &[f64], lambda: f64| -> Option<(Node, bool)> {
-        let mut g = from.to_vec();
-        g[d - 1] = lambda / rho;
-        let w = correct_far(fam, &g, &e_l, lambda / rho)?;
-        let n = fam.node_with(w, &e_l, false)?;
-        let ok = margin(&n) >= -TOL;
-        Some((n, ok))
-    };
-    let a = at(fam, guess, la)?;
-    let b = at(fam, &a.0.w, lb)?;
-    let (mut ok, mut bad, mut lok, mut lbad) = match (a.1, b.1) {
-        (true, false) => (a.0, b.0, la, lb),
-        (false, true) => (b.0, a.0, lb, la),
-        _ => return None,
-    };
-    while (lok - lbad).abs() > BRACKET * rho {
-        let mid = 0.5 * (lok + lbad);
-        match at(fam, &ok.w, mid)? {
-            (n, true) => (ok, lok) = (n, mid),
-            (n, false) => (bad, lbad) = (n, mid),
-        }
-    }
-    let away = (lok - lbad).signum();
-    trace(format_args!(
-        "touch point: {lok:.10} admissible, {lbad:.10} not: {:?}, lifted {:?}; landing forces {:?} / {:?}",
-        bad.orbit.rigid_margin().map(|m| (m.what, m.value, m.contact, m.time / bad.orbit.period(), m.event)),
-        landing::lifted(&bad),
-        (0..ok.orbit.events().len()).filter_map(|e| ok.orbit.landing_force(e).map(|h| (e, ok.orbit.times()[e] / ok.orbit.period(), h))).collect::<Vec<_>>(),
-        (0..bad.orbit.events().len()).filter_map(|e| bad.orbit.landing_force(e).map(|h| (e, h))).collect::<Vec<_>>()
-    ));
-    if let Some(e) = landing::lifted(&bad) {
-        // The zero lies on the admissible side of the visible lift-off: bracketed a short way on.
-        let on = lok + away * 1e-4 * rho;
-        // Without a zero there, the held orbit is admissible by the lift-off tolerance alone
-        // (its landing force far from zero): not the change sought.
-        return landing::landing_zero(fam, &bad.w, e, (lbad, on), away).map(|z| z.0);
-    }
-    let prev: Vec<f64> = e_l.iter().map(|x| x * away).collect();
-    fam.node(ok.w, &prev)
-}
-
-/// [`Family::correct`] from a guess whose state may lie further than the state scale from the
-/// solution (the orbit without an impact, guessed from the impacting one far from the grazing):
-/// where Newton's first steps exceed the scale, corrected on a 10× and 100× coarser state scale
-/// first, then on the family's own.
-fn correct_far(fam: &mut Family, guess: &[f64], normal: &[f64], target: f64) -> Option<Vec<f64>> {
-    if let Some(w) = fam.correct(guess, normal, target) {
-        return Some(w);
-    }
-    let (ys, states) = (fam.ys, fam.dim() - 1 - fam.ne());
-    for f in [10.0, 100.0] {
-        fam.ys = ys * f;
-        let g: Vec<f64> = guess.iter().enumerate().map(|(i, w)| if i < states { w / f } else { *w }).collect();
-        let coarse = fam.correct(&g, normal, target);
-        fam.ys = ys;
-        let fine = coarse.map(|w| w.iter().enumerate().map(|(i, w)| if i < states { w * f } else { *w }).collect::<Vec<f64>>());
-        if let Some(w) = fine.and_then(|w| fam.correct(&w, normal, target)) {
-            return Some(w);
-        }
-    }
-    None
 }

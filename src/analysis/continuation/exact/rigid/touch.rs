@@ -1,0 +1,77 @@
+//! The point where an orbit of a fixed signature stops being admissible, by bisection in λ.
+use super::super::BRACKET;
+use super::super::family::{Family, Node, lambda_axis};
+use super::{TOL, landing, margin, trace};
+
+/// The point between λ = `la` and `lb` where the orbit of the family's signature (corrected at λ
+/// fixed from `guess`'s unknowns) stops being admissible: bisection in λ on the sign of its
+/// rigid margin, to [`BRACKET`] of the range; the node on the admissible side, its tangent
+/// pointing away from the inadmissible one. Where the margin there is a landing's lift-off (its
+/// micro-flight just visible), the point is where that landing's force crosses zero
+/// ([`landing::landing_zero`]). `None` without a sign change or where the corrector fails.
+pub(super) fn touch_point(fam: &mut Family, guess: &[f64], la: f64, lb: f64) -> Option<Node> {
+    let (rho, d) = (fam.rho, fam.dim());
+    let e_l = lambda_axis(d);
+    // The orbit at λ from the unknowns `from`: (node, admissible).
+    let at = |fam: &mut Family, from: &[f64], lambda: f64| -> Option<(Node, bool)> {
+        let mut g = from.to_vec();
+        g[d - 1] = lambda / rho;
+        let w = correct_far(fam, &g, &e_l, lambda / rho)?;
+        let n = fam.node_with(w, &e_l, false)?;
+        let ok = margin(&n) >= -TOL;
+        Some((n, ok))
+    };
+    let a = at(fam, guess, la)?;
+    let b = at(fam, &a.0.w, lb)?;
+    let (mut ok, mut bad, mut lok, mut lbad) = match (a.1, b.1) {
+        (true, false) => (a.0, b.0, la, lb),
+        (false, true) => (b.0, a.0, lb, la),
+        _ => return None,
+    };
+    while (lok - lbad).abs() > BRACKET * rho {
+        let mid = 0.5 * (lok + lbad);
+        match at(fam, &ok.w, mid)? {
+            (n, true) => (ok, lok) = (n, mid),
+            (n, false) => (bad, lbad) = (n, mid),
+        }
+    }
+    let away = (lok - lbad).signum();
+    trace(format_args!(
+        "touch point: {lok:.10} admissible, {lbad:.10} not: {:?}, lifted {:?}; landing forces {:?} / {:?}",
+        bad.orbit.rigid_margin().map(|m| (m.what, m.value, m.contact, m.time / bad.orbit.period(), m.event)),
+        landing::lifted(&bad),
+        (0..ok.orbit.events().len()).filter_map(|e| ok.orbit.landing_force(e).map(|h| (e, ok.orbit.times()[e] / ok.orbit.period(), h))).collect::<Vec<_>>(),
+        (0..bad.orbit.events().len()).filter_map(|e| bad.orbit.landing_force(e).map(|h| (e, h))).collect::<Vec<_>>()
+    ));
+    if let Some(e) = landing::lifted(&bad) {
+        // The zero lies on the admissible side of the visible lift-off: bracketed a short way on.
+        let on = lok + away * 1e-4 * rho;
+        // Without a zero there, the held orbit is admissible by the lift-off tolerance alone
+        // (its landing force far from zero): not the change sought.
+        return landing::landing_zero(fam, &bad.w, e, (lbad, on), away).map(|z| z.0);
+    }
+    let prev: Vec<f64> = e_l.iter().map(|x| x * away).collect();
+    fam.node(ok.w, &prev)
+}
+
+/// [`Family::correct`] from a guess whose state may lie further than the state scale from the
+/// solution (the orbit without an impact, guessed from the impacting one far from the grazing):
+/// where Newton's first steps exceed the scale, corrected on a 10× and 100× coarser state scale
+/// first, then on the family's own.
+fn correct_far(fam: &mut Family, guess: &[f64], normal: &[f64], target: f64) -> Option<Vec<f64>> {
+    if let Some(w) = fam.correct(guess, normal, target) {
+        return Some(w);
+    }
+    let (ys, states) = (fam.ys, fam.dim() - 1 - fam.ne());
+    for f in [10.0, 100.0] {
+        fam.ys = ys * f;
+        let g: Vec<f64> = guess.iter().enumerate().map(|(i, w)| if i < states { w / f } else { *w }).collect();
+        let coarse = fam.correct(&g, normal, target);
+        fam.ys = ys;
+        let fine = coarse.map(|w| w.iter().enumerate().map(|(i, w)| if i < states { w * f } else { *w }).collect::<Vec<f64>>());
+        if let Some(w) = fine.and_then(|w| fam.correct(&w, normal, target)) {
+            return Some(w);
+        }
+    }
+    None
+}
