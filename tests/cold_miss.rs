@@ -15,7 +15,11 @@ fn point_on_a_stop() -> Model {
     let rows = |a: [[f64; 2]; 2]| Matrix::from_rows(&a.iter().map(|r| r.to_vec()).collect::<Vec<_>>());
     let (c, k2) = (0.01, 30.0);
     Model {
-        structure: Structure { mass: rows([[1.0, 0.0], [0.0, 0.0]]), stiffness: rows([[1.0 + k2, -k2], [-k2, k2]]), damping: Some(rows([[c, 0.0], [0.0, 0.0]])) },
+        structure: Structure {
+            mass: rows([[1.0, 0.0], [0.0, 0.0]]),
+            stiffness: rows([[1.0 + k2, -k2], [-k2, k2]]),
+            damping: Some(rows([[c, 0.0], [0.0, 0.0]])),
+        },
         forces: vec![Force { dof: 0, term: Harmonic { amplitude: 1.0, harmonic: 1, phase: 0.0 } }],
         contacts: vec![Contact::on_dof(1, 1.0, 3.0, Compliance::Compliant { stiffness: 30.0 })],
         frequency: 1.12,

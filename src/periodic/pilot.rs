@@ -53,11 +53,7 @@ pub(super) fn warm_start(problem: &PeriodicProblem) -> Option<(Vec<usize>, usize
 /// changes): the answer at δ = 0 is on another branch, and block pivoting (ray) and dense Lemke
 /// (1722 pivots, 2.5–4 s) followed. bds1 (A-stable, damped) on the same grid solves cold in
 /// 0.2 s, and Newton from its sets reaches the cds orbit (README "On a family, not one case").
-pub(super) fn solve_after_cold_miss(
-    problem: &PeriodicProblem,
-    a: &BlockCirculant,
-    q: &[f64],
-) -> Option<Result<(LcpSolution, Option<String>), SolveError>> {
+pub(super) fn solve_after_cold_miss(problem: &PeriodicProblem, a: &BlockCirculant, q: &[f64]) -> Option<Result<(LcpSolution, Option<String>), SolveError>> {
     let settings = problem.solver_settings();
     let model = problem.model();
     let disc = problem.discretization();
