@@ -10,8 +10,8 @@ use periodic_contact::periodic::{LcpMethod, OutputSelection, PeriodicProblem, So
 use periodic_contact::time::{Discretization, Scheme};
 
 /// The mass (DOF 0, m = 1, k1 = 1, c = 0.01) and the massless point (DOF 1) behind k2 = 30, a
-/// compliant stop k_c = 30 at gap 3 on the point, unit force at ω = 1.12 (tests/massless_polish.rs's model).
-fn point_on_a_stop() -> Model {
+/// compliant stop k_c = 30 at `gap` on the point, unit force at `omega` (tests/massless_polish.rs's model).
+fn point_on_a_stop(gap: f64, omega: f64) -> Model {
     let rows = |a: [[f64; 2]; 2]| Matrix::from_rows(&a.iter().map(|r| r.to_vec()).collect::<Vec<_>>());
     let (c, k2) = (0.01, 30.0);
     Model {
@@ -21,17 +21,21 @@ fn point_on_a_stop() -> Model {
             damping: Some(rows([[c, 0.0], [0.0, 0.0]])),
         },
         forces: vec![Force { dof: 0, term: Harmonic { amplitude: 1.0, harmonic: 1, phase: 0.0 } }],
-        contacts: vec![Contact::on_dof(1, 1.0, 3.0, Compliance::Compliant { stiffness: 30.0 })],
-        frequency: 1.12,
+        contacts: vec![Contact::on_dof(1, 1.0, gap, Compliance::Compliant { stiffness: 30.0 })],
+        frequency: omega,
         frictions: Vec::new(),
         rubbing: Vec::new(),
     }
 }
 
 fn with(method: LcpMethod) -> PeriodicProblem {
+    at(3.0, 1.12, method)
+}
+
+fn at(gap: f64, omega: f64, method: LcpMethod) -> PeriodicProblem {
     let outputs = OutputSelection { displacement: vec![0, 1], velocity: vec![], acceleration: vec![], contacts: true };
     let disc = Discretization { scheme: Scheme::Cds, steps: 128, pairing: None };
-    PeriodicProblem::new(point_on_a_stop(), disc, outputs, SolverSettings { method, ..SolverSettings::default() }).unwrap()
+    PeriodicProblem::new(point_on_a_stop(gap, omega), disc, outputs, SolverSettings { method, ..SolverSettings::default() }).unwrap()
 }
 
 #[test]
@@ -46,4 +50,18 @@ fn a_cold_shooting_miss_is_solved_from_a_bds1_pilot_and_agrees_with_lemke() {
     assert!(piloted.lcp.path.contains("bds1 pilot") && !piloted.lcp.path.contains("fallback"), "{}", piloted.lcp.path);
     assert!(max_abs(&piloted.contacts[0].force) > 0.0, "the stop is never reached");
     assert!(d <= 1e-10, "the piloted solve differs from lemke by {d:.3e}");
+}
+
+/// Where the pilot misses too (gap 1, ω = 1.39: bds1's cold shooting misses as cds's does, found
+/// by the same scan), `auto` falls back to dense Lemke as before the pilot: the path shows the
+/// missed shooting and the fallback, and the answer is certified.
+#[test]
+fn where_the_pilot_misses_too_auto_falls_back_to_lemke() {
+    assert!(at(1.0, 1.39, LcpMethod::Shooting).solve().is_err(), "cold shooting solved it");
+    let r = at(1.0, 1.39, LcpMethod::Auto).solve().unwrap();
+    eprintln!("{}", r.lcp.path);
+    let (first, fallback) = r.lcp.path.split_once("; fallback: ").expect("a fallback");
+    assert!(first.contains("shooting") && !first.ends_with("→ solved"), "{}", r.lcp.path);
+    assert!(fallback.starts_with("dense lexicographic Lemke") && fallback.contains("→ solved"), "{}", r.lcp.path);
+    assert!(r.lcp.residual <= 1e-9);
 }

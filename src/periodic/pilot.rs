@@ -65,8 +65,11 @@ pub(super) fn solve_after_cold_miss(problem: &PeriodicProblem, a: &BlockCirculan
     // Shooting alone first: what `auto` tries first, without its dense fallbacks.
     let mut shooting = problem.clone();
     shooting.set_solver_settings(SolverSettings { method: LcpMethod::Shooting, ..settings.clone() }).ok()?;
-    if let Ok(sol) = shooting.solve_lcp(a, q, None) {
-        return Some(Ok((sol, None)));
+    match shooting.solve_lcp(a, q, None) {
+        Ok(sol) => return Some(Ok((sol, None))),
+        // Not a miss (no step map, a refused size): `auto` as before, no pilot to pay for.
+        Err(e) if !matches!(e, SolveError::Lcp { .. }) => return Some(problem.solve_lcp(a, q, None).map(|sol| (sol, None))),
+        Err(_) => {}
     }
     crate::lcp::progress(&format!("cold shooting missed at k = {}; a bds1 pilot on the same grid next", disc.steps));
     let Some(sets) = bds1_active_set(problem, disc.steps) else {
