@@ -244,3 +244,28 @@ fn the_scene_keys_of_auto() {
         assert!(e.contains(key), "{extra}: {e}");
     }
 }
+
+/// `auto`'s own neighbour solves are bounded as the estimate's are (`accuracy::neighbour::solve`):
+/// fourier collocation has no step map, so a neighbour is dense Lemke only, and with a budget of
+/// 0 s CPU it is refused before it starts, the level's estimate typed missing (over the budget)
+/// instead of an unbounded dense solve; with the default budget the same levels are estimated.
+#[test]
+fn auto_neighbour_solves_are_bounded_by_the_estimate_budget() {
+    use periodic_contact::analysis::accuracy::neighbour::ESTIMATE_BUDGET_CPU_S;
+    use periodic_contact::response::MissingCause;
+    let osc = Oscillator::new(1.0, 0.1, 1.0, 1.0, 0.8);
+    let model = osc.model(vec![Oscillator::stop(1.0, Compliance::Compliant { stiffness: 10.0 })]);
+    let outputs = OutputSelection { displacement: vec![0], velocity: vec![], acceleration: vec![], contacts: true };
+    let target = AccuracyTarget { tolerance: 1e-12, max_steps: 128, ..Default::default() };
+    let solve = |budget: f64| {
+        let disc = Discretization { scheme: Scheme::Fourier, steps: 128, pairing: None };
+        let mut p = PeriodicProblem::new(model.clone(), disc, outputs.clone(), SolverSettings::default()).unwrap();
+        scheme_auto::solve_to_tolerance_within(&mut p, &target, "fourier, by hand", budget).unwrap()
+    };
+    let bounded = solve(0.0);
+    let missing = bounded.accuracy.missing.as_ref().unwrap_or_else(|| panic!("estimated within 0 s: {}", bounded.accuracy.method));
+    assert_eq!(missing.cause, MissingCause::Budget, "{}", missing.detail);
+    assert!(bounded.accuracy.estimate.is_none() && !bounded.scheme_choice.as_ref().unwrap().met);
+    let free = solve(ESTIMATE_BUDGET_CPU_S);
+    assert!(free.accuracy.missing.is_none() && free.accuracy.estimate.is_some(), "{}", free.accuracy.method);
+}

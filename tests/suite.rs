@@ -26,6 +26,8 @@ mod branch;
 mod capi;
 #[path = "cli.rs"]
 mod cli;
+#[path = "cold_miss.rs"]
+mod cold_miss;
 #[path = "continuation.rs"]
 mod continuation;
 #[path = "convergence.rs"]

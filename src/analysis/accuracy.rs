@@ -11,7 +11,7 @@
 //! under cds at k = 1024), the second solve is at 2k instead: dearer (twice the unknowns), but
 //! the only one that is honest there.
 use crate::model::Compliance;
-use crate::periodic::{PeriodicProblem, PeriodicSolver, SolveError, carried_active_set};
+use crate::periodic::{PeriodicProblem, carried_active_set};
 use crate::response::{Accuracy, EstimateMissing, MissingCause, Response};
 use crate::time::{Discretization, Pairing, Scheme};
 
@@ -105,16 +105,6 @@ fn runs(force: &[f64]) -> Vec<usize> {
     out
 }
 
-/// `grid` solved warm from an answer's active set (`rows` per instant, `instants` of them)
-/// carried to its instants. Why: Newton on the period map then starts on the right pieces, where
-/// a cold start's offset homotopy fails on stiff blades (the fine blade's 2k solve fell back to
-/// minutes of dense Lemke; `auto` on the rigid massless blade, 40 s per cold try).
-pub fn solve_warm(active: &[usize], rows: usize, instants: usize, grid: &PeriodicProblem) -> Result<Response, SolveError> {
-    let mut session = PeriodicSolver::new(grid.clone());
-    session.set_warm_start(&crate::periodic::carried_active_set(active, rows, instants, grid.instants()));
-    session.solve()
-}
-
 /// Estimates the error of `r` (solved from `problem`) by a second solve at k/2 and a third at
 /// k/4 for the observed order ([`estimate_from`]); when k/2 breaks the scheme's stability limit
 /// (ω_max·h ≥ limit: cds, galerkin on stiff models) by a second solve at 2k instead, and `method`
@@ -167,17 +157,22 @@ fn cause_name(c: MissingCause) -> &'static str {
     }
 }
 
-/// [`estimate`] with the second solve made by `solve_second` (given the problem at k/2 or 2k):
-/// a sweep passes a warm-started session of its own, so that the estimate of every point costs
-/// a warm solve instead of a cold one. Two grids only (no observed order).
-pub fn estimate_with(problem: &PeriodicProblem, r: &Response, solve_second: &mut dyn FnMut(&PeriodicProblem) -> Result<Response, SolveError>) -> Accuracy {
+/// [`estimate`] with the second solve made by `solve_second` (given the problem at k/2 or 2k and
+/// its note, "k/2 = 512"): `scheme = "auto"`'s refinement passes one that reuses its other
+/// levels' answers and solves the rest by [`neighbour::solve`] (bounded, a typed miss). Two grids
+/// only (no observed order).
+pub fn estimate_with(
+    problem: &PeriodicProblem,
+    r: &Response,
+    solve_second: &mut dyn FnMut(&PeriodicProblem, &str) -> Result<Response, EstimateMissing>,
+) -> Accuracy {
     let (second, note) = match second_grid(problem, r) {
         Ok(g) => g,
         Err(a) => return a,
     };
-    match solve_second(&second) {
+    match solve_second(&second, &note) {
         Ok(rs) => estimate_from(problem, r, &rs, None, &note),
-        Err(e) => unestimated(format!("the second solve at {note} failed: {}", short(&e))),
+        Err(missing) => without(missing),
     }
 }
 
@@ -327,11 +322,6 @@ fn differences_estimate(
         method: format!("richardson: {note}, order {p}{observed} ({scheme}, {why})"),
         missing: None,
     }
-}
-
-fn short(e: &SolveError) -> String {
-    let s = e.to_string();
-    s.split(':').next().unwrap_or(&s).to_string()
 }
 
 #[cfg(test)]

@@ -11,10 +11,10 @@
 //! The bound is the envelope of the Richardson estimates ([`envelope`]), trusted only when every
 //! contact phase is resolved ([`MIN_PHASE_STEPS`]) and the modes are resolved or the estimates
 //! fall at the scheme's order ([`modes_in_asymptotic_range`]).
-use super::accuracy;
+use super::accuracy::{self, neighbour};
 use crate::periodic::limits::AccuracyTarget;
-use crate::periodic::{PeriodicProblem, SolveError};
-use crate::response::{Response, SchemeChoice, SchemeTrial};
+use crate::periodic::{PeriodicProblem, SolveError, carried_active_set};
+use crate::response::{EstimateMissing, Response, SchemeChoice, SchemeTrial};
 use crate::time::Discretization;
 use std::time::Instant;
 
@@ -37,6 +37,14 @@ pub const MIN_PHASE_STEPS: usize = 32;
 /// decision, with the bound, in `scheme_choice`; `met` is false when the
 /// refinement stopped first (a warning says why). An error of the first solve is returned.
 pub fn solve_to_tolerance(problem: &mut PeriodicProblem, target: &AccuracyTarget, choice: &str) -> Result<Response, SolveError> {
+    solve_to_tolerance_within(problem, target, choice, neighbour::ESTIMATE_BUDGET_CPU_S)
+}
+
+/// [`solve_to_tolerance`] with each level's estimate bounded by `estimate_budget` CPU seconds
+/// ([`neighbour::solve`]: warm shooting, cold shooting, dense Lemke only within what is left); a
+/// neighbour past it or missed leaves that level without an estimate, typed in
+/// `accuracy.missing`, and the refinement goes on to the next k as after any missing estimate.
+pub fn solve_to_tolerance_within(problem: &mut PeriodicProblem, target: &AccuracyTarget, choice: &str, estimate_budget: f64) -> Result<Response, SolveError> {
     let mut tried: Vec<SchemeTrial> = Vec::new();
     // Results by k, for reuse as the neighbouring grid of the estimate.
     let mut solved: Vec<Response> = Vec::new();
@@ -64,13 +72,15 @@ pub fn solve_to_tolerance(problem: &mut PeriodicProblem, target: &AccuracyTarget
         };
         let (active, instants) = (r.active_set.clone(), problem.instants());
         let rows = r.lcp.size / instants.max(1);
-        let mut neighbour = |second: &PeriodicProblem| -> Result<Response, SolveError> {
+        let budget = neighbour::Budget::new(estimate_budget);
+        let mut neighbour = |second: &PeriodicProblem, note: &str| -> Result<Response, EstimateMissing> {
             match solved.iter().find(|r| r.steps == second.instants()) {
                 Some(r) => Ok(r.clone()),
                 None => {
                     // Warm from this k's active set, as `accuracy::estimate` does (cold, the rigid
-                    // massless blade missed in shooting at 2k = 1024: README "Against time marching").
-                    let rs = accuracy::solve_warm(&active, rows, instants, second)?;
+                    // massless blade missed in shooting at 2k = 1024: README "Against time
+                    // marching"), and bounded as it is (an unbounded dense fallback ran minutes).
+                    let rs = neighbour::solve(second, &carried_active_set(&active, rows, instants, second.instants()), &budget, note)?;
                     solved.push(rs.clone());
                     Ok(rs)
                 }

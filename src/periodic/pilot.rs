@@ -10,8 +10,8 @@
 //! unresolved modes) solves the coarse grid in 5 Newton iterations from the contact-free orbit,
 //! and its orbit is on the fine grid's pieces or next to them: Newton from its sets then
 //! converged in 6–9 iterations (README "Real-blade benchmark").
-use super::{PeriodFft, PeriodicProblem};
-use crate::lcp::LcpMethod;
+use super::{PeriodFft, PeriodicProblem, SolveError, SolverSettings};
+use crate::lcp::{BlockCirculant, LcpMethod, LcpSolution};
 use crate::time::{Discretization, Pairing, Scheme};
 
 /// Fewest instants for which a cold solve is piloted: below, cold shooting is cheap enough (the
@@ -41,6 +41,52 @@ pub(super) fn warm_start(problem: &PeriodicProblem) -> Option<(Vec<usize>, usize
     pilot.set_discretization(Discretization { scheme: Scheme::Bds1, steps, pairing: Some(Pairing::Same) }).ok()?;
     let r = pilot.solve_with(&PeriodFft::new(pilot.instants()), None).ok()?;
     Some((carried_active_set(&r.active_set, model.contacts.len(), pilot.instants(), problem.instants()), steps))
+}
+
+/// A cold `auto` solve whose shooting misses, re-tried from a bds1 pilot's active sets on the same
+/// grid before the dense fallbacks; `None` when it does not apply (a warm start, friction or
+/// rubbing, another method, or a bds1/fourier problem), and then the caller solves as before.
+///
+/// Why (issue 23, the compliant real blade at ω = 2535.5 rad/s, cds k = 256): the offset path
+/// from the contact-free orbit folds back at δ = 1.2e-6 m (10 % of the gap), climbs to 1.5e-4,
+/// folds again at 1.2e-6 and closes on the contact-free family after 52 steps (≈ 1500 set
+/// changes): the answer at δ = 0 is on another branch, and block pivoting (ray) and dense Lemke
+/// (1722 pivots, 2.5–4 s) followed. bds1 (A-stable, damped) on the same grid solves cold in
+/// 0.2 s, and Newton from its sets reaches the cds orbit (README "On a family, not one case").
+pub(super) fn solve_after_cold_miss(problem: &PeriodicProblem, a: &BlockCirculant, q: &[f64]) -> Option<Result<(LcpSolution, Option<String>), SolveError>> {
+    let settings = problem.solver_settings();
+    let model = problem.model();
+    let disc = problem.discretization();
+    let plain = model.frictions.is_empty() && model.rubbing.is_empty();
+    let full_reach = !settings.shooting_warm_only && settings.shooting_homotopy;
+    if !(plain && full_reach && settings.method == LcpMethod::Auto && matches!(disc.scheme, Scheme::Cds | Scheme::Galerkin | Scheme::Bds2) && !q.is_empty()) {
+        return None;
+    }
+    // Shooting alone first: what `auto` tries first, without its dense fallbacks.
+    let mut shooting = problem.clone();
+    shooting.set_solver_settings(SolverSettings { method: LcpMethod::Shooting, ..settings.clone() }).ok()?;
+    match shooting.solve_lcp(a, q, None) {
+        Ok(sol) => return Some(Ok((sol, None))),
+        // Not a miss (no step map, a refused size): `auto` as before, no pilot to pay for.
+        Err(e) if !matches!(e, SolveError::Lcp { .. }) => return Some(problem.solve_lcp(a, q, None).map(|sol| (sol, None))),
+        Err(_) => {}
+    }
+    crate::lcp::progress(&format!("cold shooting missed at k = {}; a bds1 pilot on the same grid next", disc.steps));
+    let Some(sets) = bds1_active_set(problem, disc.steps) else {
+        return Some(problem.solve_lcp(a, q, None).map(|sol| (sol, None)));
+    };
+    let note = format!("cold shooting missed; started from a bds1 pilot's active sets at k = {}", disc.steps);
+    Some(problem.solve_lcp(a, q, Some(&sets)).map(|sol| (sol, Some(note))))
+}
+
+/// The active set of a bds1 solve of `problem` at `steps` per period, carried to its instants.
+fn bds1_active_set(problem: &PeriodicProblem, steps: usize) -> Option<Vec<usize>> {
+    let mut pilot = problem.clone();
+    pilot.set_discretization(Discretization { scheme: Scheme::Bds1, steps, pairing: Some(Pairing::Same) }).ok()?;
+    // Shooting only: a pilot that misses hands over to the fine grid's own fallbacks.
+    pilot.set_solver_settings(SolverSettings { method: LcpMethod::Shooting, ..problem.solver_settings().clone() }).ok()?;
+    let r = pilot.solve_with(&PeriodFft::new(pilot.instants()), None).ok()?;
+    Some(carried_active_set(&r.active_set, problem.model().contacts.len(), pilot.instants(), problem.instants()))
 }
 
 /// An active set (indices j·m + c of instant j, row c of `rows`) of a grid of `from` instants,

@@ -379,7 +379,12 @@ impl PeriodicProblem {
         let t_lcp = Instant::now();
         // A cold solve of a stiff model with rigid impacts starts from a coarse bds1 pilot's sets.
         let pilot = warm_start.is_none().then(|| super::pilot::warm_start(self)).flatten();
-        let (sol, walked) = super::rubbing::solve_lcp(self, fft, &a, &q, warm_start.or(pilot.as_ref().map(|p| p.0.as_slice())))?;
+        // A cold solve whose shooting misses: a bds1 pilot's sets before the dense fallbacks.
+        let after_miss = (warm_start.is_none() && pilot.is_none()).then(|| super::pilot::solve_after_cold_miss(self, &a, &q)).flatten();
+        let (sol, walked) = match after_miss {
+            Some(solved) => solved?,
+            None => super::rubbing::solve_lcp(self, fft, &a, &q, warm_start.or(pilot.as_ref().map(|p| p.0.as_slice())))?,
+        };
         let t_lcp = t_lcp.elapsed().as_secs_f64();
         super::rubbing::check_gross_slip(self, asm, fft, &sol.z)?;
 
