@@ -139,7 +139,8 @@ pub fn run(scene: &Path, files: Files, overrides: Overrides, flags: Refine) -> R
     let mut r = match &auto {
         Some((target, choice)) => {
             eprintln!("{choice}");
-            scheme_auto::solve_to_tolerance(&mut problem, target, choice).map_err(|e| named(Failure::from(periodic_contact::Error::from(e))))?
+            scheme_auto::solve_to_tolerance_within(&mut problem, target, choice, flags.estimate_budget)
+                .map_err(|e| named(Failure::from(periodic_contact::Error::from(e))))?
         }
         None => solve(&problem).map_err(named)?,
     };

@@ -45,6 +45,7 @@ enum Command {
         no_estimate: bool,
         /// CPU seconds the error estimate's neighbour solves may take together; past it the
         /// result has no estimate and says why (`accuracy.missing`), its own answer unchanged.
+        /// With `scheme = "auto"` it bounds the estimate of every k the refinement solves.
         #[arg(long, value_name = "SECONDS", default_value_t = periodic_contact::analysis::accuracy::neighbour::ESTIMATE_BUDGET_CPU_S)]
         estimate_budget: f64,
         /// Refine the orbit by the event-fitted polish (also `[discretization] polish = true`).
