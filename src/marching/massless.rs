@@ -80,8 +80,8 @@ pub(super) fn march_massless(model: &Model, settings: &MarchSettings, massless: 
     let (maa, caa, kaa, kab) = (sub(&mm, &ia, &ia), sub(&cc, &ia, &ia), sub(&kk, &ia, &ia), sub(&kk, &ia, &ib));
     let w = Mat::<f64>::from_fn(na, na, |i, j| maa[(i, j)] / (h * h) + caa[(i, j)] / (2.0 * h)).partial_piv_lu().inverse();
     // The increment's matrices −Ŵ_aa K_aa, −Ŵ_aa C_aa/h, −Ŵ_aa K_ab (no 2I − h²M⁻¹K is rounded).
-    let a1 = -(&w * &kaa);
-    let a0 = -(&w * &caa) * faer::Scale(1.0 / h);
+    let q1 = -(&w * &kaa);
+    let q2 = -(&w * &caa) * faer::Scale(1.0 / h);
     let ab = -(&w * &kab);
     let s = sub(&kk, &ib, &ib).partial_piv_lu().inverse();
     let sba = -(&s * sub(&kk, &ib, &ia));
@@ -148,7 +148,7 @@ pub(super) fn march_massless(model: &Model, settings: &MarchSettings, massless: 
             let t = j as f64 * h;
             model.force_at(t, &mut fa);
             for (i, &a) in ia.iter().enumerate() {
-                let mut v: f64 = (0..na).map(|k| a1[(i, k)] * x_cur[ia[k]] + a0[(i, k)] * d_cur[ia[k]] + w[(i, k)] * fa[ia[k]]).sum();
+                let mut v: f64 = (0..na).map(|k| q1[(i, k)] * x_cur[ia[k]] + q2[(i, k)] * d_cur[ia[k]] + w[(i, k)] * fa[ia[k]]).sum();
                 v += (0..nb).map(|k| ab[(i, k)] * x_cur[ib[k]]).sum::<f64>();
                 d_next[a] = v;
             }

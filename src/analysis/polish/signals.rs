@@ -93,6 +93,7 @@ impl Signal {
             })
             .collect();
         let h = if ts.len() > 1 { (ts[ts.len() - 1] - ts[0]) / (ts.len() - 1) as f64 } else { 0.0 };
+        debug_assert!(ts.windows(2).all(|p| (p[1] - p[0] - h).abs() <= 1e-9 * h.abs()), "Signal::values: the times must be evenly spaced");
         let mode_step: Vec<C> = first.lambda.iter().map(|l| (l * h).exp()).collect();
         let wave_step: Vec<C> = freqs.iter().map(|&w| C::from_polar(1.0, w * h)).collect();
         let (mut modes, mut waves) = (vec![C::new(0.0, 0.0); first.lambda.len()], vec![C::new(0.0, 0.0); freqs.len()]);
