@@ -44,10 +44,13 @@ impl PeriodicProblem {
                 crate::model::Compliance::Rigid => 0.0,
             };
             for p in 0..=k / 2 {
-                let turn = 2.0 * std::f64::consts::PI * ((p * s) % k) as f64 / k as f64;
-                let shift = num_complex::Complex64::from_polar(1.0, turn);
                 let row = &mut spectrum[(p * m + a) * m..(p * m + a + 1) * m];
-                row.iter_mut().for_each(|v| *v = if s == 0 { *v } else { *v * shift });
+                // Unshifted rows skip the sin/cos (k/2 + 1 per contact, every solve).
+                if s != 0 {
+                    let turn = 2.0 * std::f64::consts::PI * ((p * s) % k) as f64 / k as f64;
+                    let shift = num_complex::Complex64::from_polar(1.0, turn);
+                    row.iter_mut().for_each(|v| *v *= shift);
+                }
                 row[a] += compliance;
                 if p == 0 || 2 * p == k {
                     row.iter_mut().for_each(|v| v.im = 0.0);
