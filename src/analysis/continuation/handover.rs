@@ -59,7 +59,7 @@ mod tests {
     /// error is kept; the stop's held orbit (amplitude capped at the gap g) against the free one is refused.
     #[test]
     fn handover_keeps_the_branch_and_refuses_another() {
-        let (k, m, f, w) = (1.0e4, 1.0, 50.0, 90.0);
+        let (k, m, f, w): (f64, f64, f64, f64) = (1.0e4, 1.0, 50.0, 90.0);
         let free = f / (k - m * w * w).abs();
         let exact = point(w, vec![free], Vec::new());
         assert!(left_branch(&exact, &point(w, vec![free * (1.0 + 1e-3)], vec![0]), "frequency").is_none());
