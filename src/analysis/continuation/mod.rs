@@ -19,6 +19,7 @@ mod exact_follow;
 mod floquet;
 mod follow;
 mod friction;
+mod handover;
 pub mod optimal_load;
 pub mod output;
 mod parameter;
@@ -185,6 +186,13 @@ pub fn run(problem: &PeriodicProblem, param: Parameter, from: f64, to: f64, sett
     let mut points = walked.points;
     match run_discrete(problem, param, at, to, settings, on_point) {
         Ok(rest) => {
+            if let (Some(last), Some(first)) = (points.last(), rest.points.first())
+                && let Some(why) = handover::left_branch(last, first, param.name())
+            {
+                eprintln!("continuation: {why}");
+                let stop = format!("{}; exact orbit up to {} = {at}, {why}", walked.stop, param.name());
+                return Ok(Branch { parameter: param, points, stop, marches: rest.marches, period_multiple: 1, label });
+            }
             points.extend(rest.points.into_iter().skip(1));
             let stop = format!("{}; exact orbit up to {} = {at} ({}), discrete walk from there", rest.stop, param.name(), walked.stop);
             Ok(Branch { parameter: param, points, stop, marches: rest.marches, period_multiple: 1, label })
