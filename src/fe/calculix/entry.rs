@@ -45,17 +45,7 @@ fn index(b: &[u8], i: &mut usize) -> Option<usize> {
 /// `[±]digits[.digits][(e|E)[±]digits]` with at most 19 significant-or-not digits in the
 /// mantissa and the fast path's conditions, or `None`.
 fn value(b: &[u8], i: &mut usize) -> Option<f64> {
-    let negative = match b.get(*i) {
-        Some(b'-') => {
-            *i += 1;
-            true
-        }
-        Some(b'+') => {
-            *i += 1;
-            false
-        }
-        _ => false,
-    };
+    let negative = sign(b, i);
     let (mut m, mut digits, mut frac) = (0u64, 0usize, 0i32);
     while *i < b.len() && b[*i].is_ascii_digit() {
         m = m.wrapping_mul(10).wrapping_add((b[*i] - b'0') as u64);
@@ -78,17 +68,7 @@ fn value(b: &[u8], i: &mut usize) -> Option<f64> {
     let mut e = 0i32;
     if matches!(b.get(*i), Some(b'e' | b'E')) {
         *i += 1;
-        let neg_e = match b.get(*i) {
-            Some(b'-') => {
-                *i += 1;
-                true
-            }
-            Some(b'+') => {
-                *i += 1;
-                false
-            }
-            _ => false,
-        };
+        let neg_e = sign(b, i);
         let start = *i;
         while *i < b.len() && b[*i].is_ascii_digit() && *i - start < 4 {
             e = 10 * e + (b[*i] - b'0') as i32;
@@ -112,6 +92,15 @@ fn value(b: &[u8], i: &mut usize) -> Option<f64> {
         m as f64 / POW10[(-e) as usize]
     };
     Some(if negative { -x } else { x })
+}
+
+/// An optional `+` or `-` at `i`, skipped; whether it was `-`.
+fn sign(b: &[u8], i: &mut usize) -> bool {
+    let s = b.get(*i).copied();
+    if matches!(s, Some(b'-' | b'+')) {
+        *i += 1;
+    }
+    s == Some(b'-')
 }
 
 #[cfg(test)]
