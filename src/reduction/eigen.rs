@@ -119,33 +119,20 @@ fn random_block(n: usize, p: usize, seed: u64) -> Mat<f64> {
     })
 }
 
-/// Removes from `w` its M-projection on the basis `q` (n × dim, contiguous; its M-image `mq`) by
-/// classical Gram–Schmidt twice, each pass two GEMMs (CGS2: Giraud, Langou & Rozložník 2005, "twice
-/// is enough"); `first`, if given, is the first pass's MQᵀW already computed (Lanczos's column block
-/// of T). Then M-orthonormalises its columns among themselves (modified Gram–Schmidt, twice). Returns
+/// Removes from `w` its M-projection on the basis blocks `q` (whose M-images are `mq`), twice,
+/// then M-orthonormalises its columns among themselves (modified Gram–Schmidt, twice). Returns
 /// the orthonormal block V, its M-image MV, and the triangular factor R with W = V R (rows =
 /// kept columns). Columns whose norm falls below `drop_tol` times their norm after the block
 /// projection are dropped (deflation). Two sparse products with M per call.
-fn m_orthonormalise(
-    m: &SparseColMat<usize, f64>,
-    q: MatRef<'_, f64>,
-    mq: MatRef<'_, f64>,
-    mut w: Mat<f64>,
-    first: Option<MatRef<'_, f64>>,
-    drop_tol: f64,
-) -> (Mat<f64>, Mat<f64>, Mat<f64>) {
+fn m_orthonormalise(m: &SparseColMat<usize, f64>, q: &[Mat<f64>], mq: &[Mat<f64>], mut w: Mat<f64>, drop_tol: f64) -> (Mat<f64>, Mat<f64>, Mat<f64>) {
     let p = w.ncols();
     let n = w.nrows();
-    for pass in 0..2 {
-        if q.ncols() == 0 {
-            break;
+    for _pass in 0..2 {
+        for (qb, mqb) in q.iter().zip(mq) {
+            let c = mqb.transpose() * &w;
+            // W −= Q_b C accumulated into W: no n × p temporary per block (memory-bound pass).
+            faer::linalg::matmul::matmul(w.as_mut(), faer::Accum::Add, qb.as_ref(), c.as_ref(), -1.0, faer::get_global_parallelism());
         }
-        let c = match first {
-            Some(c) if pass == 0 => c.to_owned(),
-            _ => mq.transpose() * &w,
-        };
-        // W −= Q C accumulated into W: one GEMM over the whole basis (memory-bound: reads Q once).
-        faer::linalg::matmul::matmul(w.as_mut(), faer::Accum::Add, q, c.as_ref(), -1.0, faer::get_global_parallelism());
     }
     let mut mw = sparse_times_dense(m, w.as_ref());
     let mut r = Mat::<f64>::zeros(p, p);
@@ -230,16 +217,12 @@ pub fn lanczos(
     let mut seed = opts.seed;
     // Start block: K⁻¹M applied to random vectors (purges the null space of M).
     let w = solve(sparse_times_dense(m, random_block(n, p, seed).as_ref()));
-    let none = Mat::<f64>::zeros(n, 0);
-    let (mut v, mut mv, _) = m_orthonormalise(m, none.as_ref(), none.as_ref(), w, None, 1e-12);
+    let (mut v, mut mv, _) = m_orthonormalise(m, &[], &[], w, 1e-12);
     if v.ncols() == 0 {
         return Err(EigenError::MassNotDefinite("K⁻¹M annihilates every start vector".into()));
     }
-    // The basis Q and its M-image MQ, contiguous (n × dim): each projection is one GEMM. Room for
-    // the usual final dimension up front (about 4 × count: 76–84 for 20 modes in blocks of 4).
-    let (mut q, mut mq) = (Mat::<f64>::zeros(n, 0), Mat::<f64>::zeros(n, 0));
-    q.reserve(n, (4 * count + 2 * p).min(max_dim));
-    mq.reserve(n, (4 * count + 2 * p).min(max_dim));
+    let mut q: Vec<Mat<f64>> = Vec::new();
+    let mut mq: Vec<Mat<f64>> = Vec::new();
     let mut t = Mat::<f64>::zeros(0, 0);
     let mut dim = 0usize;
     let mut last_r: Mat<f64>;
@@ -252,20 +235,22 @@ pub fn lanczos(
         let w = solve(mv.clone());
         lap(&mut cpu_solve, &mut since);
         steps += 1;
+        q.push(v);
+        mq.push(mv);
         let new_dim = dim + pb;
-        q.resize_with(n, new_dim, |_, _| 0.0);
-        mq.resize_with(n, new_dim, |_, _| 0.0);
-        q.as_mut().subcols_mut(dim, pb).copy_from(&v);
-        mq.as_mut().subcols_mut(dim, pb).copy_from(&mv);
         let mut t2 = Mat::<f64>::zeros(new_dim, new_dim);
         t2.as_mut().submatrix_mut(0, 0, dim, dim).copy_from(&t);
-        // Column block of T: Q_allᵀ M (K⁻¹M Q_b) = (MQ_all)ᵀ W, also the projection's first pass.
-        let c = mq.transpose() * &w;
-        for i in 0..new_dim {
-            for j in 0..pb {
-                t2[(i, dim + j)] = c[(i, j)];
-                t2[(dim + j, i)] = c[(i, j)];
+        // Column block of T: Q_allᵀ M (K⁻¹M Q_b) = (MQ_all)ᵀ W.
+        let mut row = 0;
+        for mqb in &mq {
+            let c = mqb.transpose() * &w;
+            for i in 0..c.nrows() {
+                for j in 0..pb {
+                    t2[(row + i, dim + j)] = c[(i, j)];
+                    t2[(dim + j, row + i)] = c[(i, j)];
+                }
             }
+            row += mqb.ncols();
         }
         // Symmetrise the new diagonal block.
         for i in 0..pb {
@@ -278,11 +263,7 @@ pub fn lanczos(
         t = t2;
         dim = new_dim;
         last_block_len = pb;
-        let (vn, mvn, r) = if dim < n {
-            m_orthonormalise(m, q.as_ref(), mq.as_ref(), w, Some(c.as_ref()), 1e-10)
-        } else {
-            (Mat::zeros(n, 0), Mat::zeros(n, 0), Mat::zeros(0, pb))
-        };
+        let (vn, mvn, r) = if dim < n { m_orthonormalise(m, &q, &mq, w, 1e-10) } else { (Mat::zeros(n, 0), Mat::zeros(n, 0), Mat::zeros(0, pb)) };
         lap(&mut cpu_orth, &mut since);
         last_r = r;
         v = vn;
@@ -314,7 +295,7 @@ pub fn lanczos(
             }
             lap(&mut cpu_ritz, &mut since);
             if converged >= count || dim >= n {
-                let modes = finish(k, m, q.as_ref(), &theta, &s, count, dim);
+                let modes = finish(k, m, &q, &theta, &s, count, dim);
                 if let Some(end) = crate::fe::profile_cpu() {
                     let done = since.unwrap_or(end);
                     eprintln!(
@@ -332,10 +313,10 @@ pub fn lanczos(
             // Invariant subspace: continue with fresh random directions.
             seed = seed.wrapping_add(1);
             let w = solve(sparse_times_dense(m, random_block(n, p, seed).as_ref()));
-            let (vn, mvn, _) = m_orthonormalise(m, q.as_ref(), mq.as_ref(), w, None, 1e-10);
+            let (vn, mvn, _) = m_orthonormalise(m, &q, &mq, w, 1e-10);
             if vn.ncols() == 0 {
                 let (theta, s) = ritz(&t)?;
-                return check(k, m, finish(k, m, q.as_ref(), &theta, &s, count.min(dim), dim));
+                return check(k, m, finish(k, m, &q, &theta, &s, count.min(dim), dim));
             }
             v = vn;
             mv = mvn;
@@ -389,10 +370,17 @@ pub fn symmetric_eigen(a: MatRef<'_, f64>) -> Result<(Vec<f64>, Mat<f64>), Eigen
     Ok((vals, e.U().to_owned()))
 }
 
-fn finish(k: &SparseColMat<usize, f64>, m: &SparseColMat<usize, f64>, q: MatRef<'_, f64>, theta: &[f64], s: &Mat<f64>, count: usize, dim: usize) -> Modes {
+fn finish(k: &SparseColMat<usize, f64>, m: &SparseColMat<usize, f64>, q: &[Mat<f64>], theta: &[f64], s: &Mat<f64>, count: usize, dim: usize) -> Modes {
+    let n = k.nrows();
     // Ritz coefficients of the wanted modes (largest θ first).
     let sel = Mat::from_fn(dim, count, |i, j| s[(i, dim - 1 - j)]);
-    let shapes = q * &sel;
+    let mut shapes = Mat::<f64>::zeros(n, count);
+    let mut row = 0;
+    for qb in q {
+        let b = qb.ncols();
+        shapes += qb * sel.as_ref().subrows(row, b);
+        row += b;
+    }
     let omega: Vec<f64> = (0..count).map(|j| (1.0 / theta[dim - 1 - j]).sqrt()).collect();
     let (shapes, residual) = normalise_and_check(k, m, shapes, &omega);
     Modes { omega, shapes, residual, krylov_dim: dim }
