@@ -8,7 +8,7 @@
 //! structure under a monotone friction law is incrementally stable (the energy of the difference
 //! of two motions never grows: Brogliato, Nonsmooth Mechanics, 3rd ed. 2016, §3.4), so each point
 //! is reported stable with an empty multiplier column.
-use super::{Branch, BranchPoint, ContinuationSettings, Parameter, Source, amplitudes};
+use super::{Branch, BranchPoint, ContinuationSettings, Parameter, amplitudes};
 use crate::error::Error;
 use crate::periodic::{PeriodicProblem, PeriodicSolver};
 
@@ -43,22 +43,7 @@ pub(super) fn walk(
         param.apply(&mut p, lambda)?;
         solver.update_problem(p);
         let r = solver.solve().map_err(|e| Error::from(e).context(format!("the friction orbit at {name} = {lambda}")))?;
-        Ok(BranchPoint {
-            parameter: lambda,
-            amplitude: amplitudes(solver.problem(), &r),
-            multipliers: Vec::new(),
-            max_multiplier: 0.0,
-            stable: true,
-            period_multiple: 1,
-            event: None,
-            detail: String::new(),
-            certified: true,
-            state: Vec::new(),
-            time: 0.0,
-            masks: Vec::new(),
-            tangent: Vec::new(),
-            source: Source::Discrete,
-        })
+        Ok(BranchPoint::discrete(lambda, amplitudes(solver.problem(), &r)))
     };
     let intervals = ((1.0 / settings.max_step).ceil() as usize).clamp(1, settings.max_points.max(2) - 1);
     let mut points = Vec::with_capacity(intervals + 1);

@@ -34,25 +34,9 @@ pub(super) fn left_branch(last: &BranchPoint, first: &BranchPoint, name: &str) -
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::analysis::continuation::Source;
 
     fn point(parameter: f64, amplitude: Vec<f64>, masks: Vec<u64>) -> BranchPoint {
-        BranchPoint {
-            parameter,
-            amplitude,
-            multipliers: Vec::new(),
-            max_multiplier: 0.0,
-            stable: true,
-            period_multiple: 1,
-            event: None,
-            detail: String::new(),
-            certified: true,
-            state: Vec::new(),
-            time: 0.0,
-            masks,
-            tangent: Vec::new(),
-            source: Source::Discrete,
-        }
+        BranchPoint { masks, ..BranchPoint::discrete(parameter, amplitude) }
     }
 
     /// A linear oscillator's amplitude F/|k − mω²| (closed form) against itself within the scheme's

@@ -111,6 +111,29 @@ pub struct BranchPoint {
     pub source: Source,
 }
 
+impl BranchPoint {
+    /// A discrete, certified, stable point with only its amplitudes (no multipliers, state or sets
+    /// yet): the friction walk's points, which add none of the rest.
+    pub(crate) fn discrete(parameter: f64, amplitude: Vec<f64>) -> Self {
+        BranchPoint {
+            parameter,
+            amplitude,
+            multipliers: Vec::new(),
+            max_multiplier: 0.0,
+            stable: true,
+            period_multiple: 1,
+            event: None,
+            detail: String::new(),
+            certified: true,
+            state: Vec::new(),
+            time: 0.0,
+            masks: Vec::new(),
+            tangent: Vec::new(),
+            source: Source::Discrete,
+        }
+    }
+}
+
 /// The progress callback of a walk: each point as it is added.
 pub type OnPoint<'a> = dyn Fn(&BranchPoint) + 'a;
 
