@@ -212,7 +212,6 @@ pub fn run(problem: &PeriodicProblem, param: Parameter, from: f64, to: f64, sett
             if let (Some(last), Some(first)) = (points.last(), rest.points.first())
                 && let Some(why) = handover::left_branch(last, first, param.name())
             {
-                eprintln!("continuation: {why}");
                 let stop = format!("{}; exact orbit up to {} = {at}, {why}", walked.stop, param.name());
                 return Ok(Branch { parameter: param, points, stop, marches: rest.marches, period_multiple: 1, label });
             }
