@@ -6,6 +6,7 @@
 use super::PolishFailure;
 use super::events::{Event, EventKind};
 use super::orbit::{PolishedOrbit, user_value};
+use super::phase::Phase;
 use crate::model::Model;
 use crate::periodic::OutputMap;
 use nalgebra::{DMatrix, DVector};
@@ -37,6 +38,28 @@ impl PolishedOrbit {
     /// period long on `model`, not solved: for [`Self::shooting_residual`] and [`Self::at`].
     pub fn unsolved(model: &Model, events: Vec<Event>, always: &[usize]) -> Result<Self, PolishFailure> {
         Self::new(model, events, always)
+    }
+
+    /// [`Self::unsolved`], each phase whose contact sets one of `bank`'s orbits holds re-tuned
+    /// from it ([`Phase::retuned`]: the loads and particular solution made at `model`'s ω, the
+    /// ω-independent rest shared, the same values as made anew) rather than made: the exact
+    /// walk's orbit at each λ made ~50 phases of dense n × n products, 70 % of its time on the
+    /// real blade. A bank orbit whose structure or contacts' rows and compliances differ from
+    /// `model`'s lends nothing.
+    pub fn unsolved_retuning(model: &Model, events: Vec<Event>, always: &[usize], bank: &[&PolishedOrbit]) -> Result<Self, PolishFailure> {
+        let same = |o: &PolishedOrbit| {
+            let (s, t) = (&model.structure, &o.model.structure);
+            s.mass == t.mass
+                && s.stiffness == t.stiffness
+                && s.damping == t.damping
+                && model.contacts.len() == o.model.contacts.len()
+                && model.contacts.iter().zip(&o.model.contacts).all(|(a, b)| a.row == b.row && a.compliance == b.compliance)
+        };
+        let bank: Vec<&PolishedOrbit> = bank.iter().copied().filter(|o| same(o)).collect();
+        Self::with_phases(model, events, always, |stuck, closed| match bank.iter().flat_map(|o| &o.phases).find(|p| p.is_for(stuck, closed)) {
+            Some(p) => p.retuned(model),
+            None => Phase::new(model, stuck, closed),
+        })
     }
 
     /// The shooting residual [y(τ_0 + T) − y0; event conditions] from the state `y0` just after

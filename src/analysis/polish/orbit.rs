@@ -93,20 +93,27 @@ impl PolishedOrbit {
 
     /// [`Self::new`], taking from `reuse` the phases whose contact sets it already holds.
     pub(super) fn reusing(model: &Model, evs: Vec<Event>, always: &[usize], reuse: &[Phase]) -> Result<Self, PolishFailure> {
+        Self::with_phases(model, evs, always, |stuck, closed| match reuse.iter().find(|p| p.is_for(stuck, closed)) {
+            Some(p) => Some(p.clone()),
+            None => Phase::new(model, stuck, closed),
+        })
+    }
+
+    /// [`Self::new`] with each phase (its stuck and closed contacts) made by `make`.
+    pub(super) fn with_phases(
+        model: &Model,
+        evs: Vec<Event>,
+        always: &[usize],
+        mut make: impl FnMut(&[usize], &[usize]) -> Option<Phase>,
+    ) -> Result<Self, PolishFailure> {
         let sets = events::phase_sets(model, &evs, always);
         let mut phases = Vec::new();
         let empty = vec![always.to_vec()];
         for set in if evs.is_empty() { &empty } else { &sets } {
             let stuck: Vec<usize> = set.iter().copied().filter(|&i| model.contacts[i].is_rigid()).collect();
             let closed: Vec<usize> = set.iter().copied().filter(|&i| !model.contacts[i].is_rigid()).collect();
-            if let Some(p) = reuse.iter().find(|p| p.is_for(&stuck, &closed)) {
-                phases.push(p.clone());
-                continue;
-            }
-            phases.push(
-                Phase::new(model, &stuck, &closed)
-                    .ok_or_else(|| PolishFailure("a phase's operator is singular at a forcing harmonic (undamped resonance)".into()))?,
-            );
+            phases
+                .push(make(&stuck, &closed).ok_or_else(|| PolishFailure("a phase's operator is singular at a forcing harmonic (undamped resonance)".into()))?);
         }
         // Stuck rows must stay orthonormal (phase.rs): contacts on disjoint DOFs.
         let mut dofs: Vec<usize> = model.contacts.iter().flat_map(|c| c.row.iter().map(|e| e.0)).collect();

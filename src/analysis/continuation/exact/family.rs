@@ -198,16 +198,16 @@ impl Family {
     }
 
     fn build(&self, lambda: f64) -> Option<PolishedOrbit> {
-        let mut orbit = PolishedOrbit::unsolved(&self.model_at(lambda), self.sig.events.clone(), &self.sig.always).ok()?;
         let key = self.signature_key();
         let mut modes = self.modes.borrow_mut();
-        if let Some((_, first)) = modes.iter().find(|(k, _)| *k == key) {
-            orbit.share_modes(first);
-            return Some(orbit);
+        // The signature's first orbit first: its phases in order, then those of any signature met before.
+        let mut bank: Vec<&PolishedOrbit> = modes.iter().filter(|(k, _)| *k == key).map(|(_, o)| o).collect();
+        let known = !bank.is_empty();
+        bank.extend(modes.iter().filter(|(k, _)| *k != key).map(|(_, o)| o));
+        let orbit = PolishedOrbit::unsolved_retuning(&self.model_at(lambda), self.sig.events.clone(), &self.sig.always, &bank).ok()?;
+        if !known {
+            modes.push((key, orbit.clone()));
         }
-        // A new signature: its phases of contact sets met before share those decompositions.
-        modes.iter().for_each(|(_, o)| orbit.share_modes(o));
-        modes.push((key, orbit.clone()));
         Some(orbit)
     }
 

@@ -73,6 +73,10 @@ pub(super) fn reimpact_factor_rate(flight: f64) -> f64 {
 /// A recorded point's rigid margin and events per period on the trace (`PC_TRACE_UNMERGE`):
 /// an inadmissible orbit walked on shows there.
 pub(super) fn trace_point(n: &Node, lambda: f64) {
+    // The margin samples the whole period (≈ 8 % of the real blade's walk): only when traced.
+    if !trace::tracing() {
+        return;
+    }
     trace(format_args!(
         "point: λ {lambda:.10}: {} events, margin {:?}",
         n.orbit.events().len(),

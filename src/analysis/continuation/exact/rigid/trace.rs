@@ -5,9 +5,14 @@ use crate::analysis::polish::Event;
 
 /// A line of the trace on stderr when `PC_TRACE_UNMERGE` is set.
 pub(super) fn trace(line: std::fmt::Arguments) {
-    if std::env::var_os("PC_TRACE_UNMERGE").is_some() {
+    if tracing() {
         eprintln!("{line}");
     }
+}
+
+/// Whether the trace is on: for a line whose arguments cost (format_args! evaluates them anyway).
+pub(super) fn tracing() -> bool {
+    std::env::var_os("PC_TRACE_UNMERGE").is_some()
 }
 
 /// A flight `e` of `contact` (release → sticking landing) about to be merged at `here`: the orbit's
