@@ -35,12 +35,8 @@ const MIN_SAMPLES: usize = 24;
 
 impl PolishedOrbit {
     /// The orbit of the event signature `events` (their seeds unused) and the contacts closed all
-    /// period long on `model`, not solved: for [`Self::shooting_residual`] and [`Self::at`].
-    pub fn unsolved(model: &Model, events: Vec<Event>, always: &[usize]) -> Result<Self, PolishFailure> {
-        Self::new(model, events, always)
-    }
-
-    /// [`Self::unsolved`], each phase whose contact sets one of `bank`'s orbits holds re-tuned
+    /// period long on `model`, not solved: for [`Self::shooting_residual`] and [`Self::at`]. Each
+    /// phase whose contact sets one of `bank`'s orbits holds is re-tuned
     /// from it ([`Phase::retuned`]: the loads and particular solution made at `model`'s ω, the
     /// ω-independent rest shared, the same values as made anew) rather than made: the exact
     /// walk's orbit at each λ made ~50 phases of dense n × n products, 70 % of its time on the
