@@ -10,7 +10,7 @@ the LCP, with its fallback) and `lcp FILE.dat` (the raw exported LCP, no step ma
 Environment (the defaults are CI's: about a minute for this file; the full run of the README is
 PC_PEERS_SIZES=1024,2048,4096 PC_PEERS_MULTI_SIZES=1024,2048,4096 PC_PEERS_RANDOM_SIZES=2048,
 about 20 min because Siconos needs minutes at N = 4096):
-  PC_PEERS_SIZES         N of the rigid stop (default "1024,2048"; .ci/run sets "1024,2048")
+  PC_PEERS_SIZES         N of the rigid stop (default "1024,2048"; .ci/run sets "1024")
   PC_PEERS_MULTI_SIZES   N of the chain (k = N/2) and of the compliant stop (default "1024";
                          Siconos: ~6 s and ~2.5 s at 1024, ~70 s and ~17 s at 2048)
   PC_PEERS_RANDOM_SIZES  N of one random member of each family (default "": none)
