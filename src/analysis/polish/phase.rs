@@ -23,7 +23,7 @@ pub(super) use particular::Transient;
 mod massive;
 // The particular solution at a frequency, and a phase re-tuned to another one.
 mod tuning;
-use tuning::{Tuning, loads};
+use tuning::{PrescTerms, Tuning, loads};
 
 /// Complex amplitudes of a harmonic signal: value(t) = Re Σ_p amp_p e^{i p ω t}.
 pub(super) type Harmonics = Vec<(u32, DVector<C>)>;
@@ -65,6 +65,9 @@ pub(super) struct Phase {
     slave_part: Harmonics,
     /// What the particular solution needs at any ω (tuning.rs), shared by the phase's clones.
     tuning: Arc<Tuning>,
+    /// K x_p, M x_p, C x_p of the prescribed motion's harmonics (tuning.rs), shared by the
+    /// phase's re-tunings while their prescribed motion is bitwise the same.
+    presc_terms: Arc<PrescTerms>,
     /// Â's eigendecomposition, made at the first flow and shared by the phase's clones (a
     /// reordered orbit's, a continuation step's); `None` inside where Â is refused
     /// ([`EigenFlow::new`]): the Padé and Taylor paths then.
@@ -211,6 +214,7 @@ impl Phase {
             slave_map,
             slave_part: Vec::new(),
             tuning,
+            presc_terms: Arc::default(),
             eigen: Arc::default(),
             force_gradient: Arc::default(),
             lift: Arc::default(),

@@ -6,6 +6,7 @@ use super::{Harmonics, Phase, add, force_harmonics, gap_harmonics};
 use crate::model::{Compliance, Model};
 use nalgebra::{DMatrix, DVector, Dyn, LU};
 use num_complex::Complex64 as C;
+use std::sync::Arc;
 
 /// What the particular solution needs at any ω: K_bb's LU (massless coordinates), K_ab, and the
 /// massive coordinates' M_aa, C_aa and condensed stiffness (phase.rs).
@@ -20,6 +21,28 @@ pub(super) struct Tuning {
     /// contact over several DOFs): Nᵀ r is then a gather of r, not a product.
     pub free_rows: Option<Vec<usize>>,
     pub slave_rows: Option<Vec<usize>>,
+}
+
+/// The products K x_p, M x_p, C x_p of each harmonic x_p of a phase's prescribed motion: with
+/// the same loads they do not depend on ω (a frequency walk), so re-tunings reuse them.
+#[derive(Clone, Debug, Default)]
+pub(super) struct PrescTerms {
+    presc: Harmonics,
+    kmc: Vec<[DVector<C>; 3]>,
+}
+
+impl PrescTerms {
+    fn new(phase: &Phase) -> PrescTerms {
+        let kmc = phase.presc.iter().map(|(_, xp)| [times(&phase.k, xp), times(&phase.m, xp), times(&phase.c, xp)]).collect();
+        PrescTerms { presc: phase.presc.clone(), kmc }
+    }
+
+    /// Whether these are the products of `presc`: bit for bit (−0.0 ≠ 0.0), so reuse cannot
+    /// change a result.
+    fn is_for(&self, presc: &Harmonics) -> bool {
+        let bits = |v: &DVector<C>| v.iter().flat_map(|z| [z.re.to_bits(), z.im.to_bits()]).collect::<Vec<_>>();
+        self.presc.len() == presc.len() && self.presc.iter().zip(presc).all(|((p, a), (q, b))| p == q && a.len() == b.len() && bits(a) == bits(b))
+    }
 }
 
 /// The DOF d of each column of `basis` when every column is a unit vector e_d.
@@ -89,6 +112,9 @@ impl Phase {
     /// is singular (an undamped resonance).
     pub(super) fn tune(&mut self) -> Option<()> {
         let (nf, nb) = (self.free.ncols(), self.slave.ncols());
+        if !self.presc_terms.is_for(&self.presc) {
+            self.presc_terms = Arc::new(PrescTerms::new(self));
+        }
         let t = &self.tuning;
         let mut ps: Vec<u32> = self.force.iter().chain(&self.presc).map(|(p, _)| *p).collect();
         ps.sort_unstable();
@@ -97,8 +123,9 @@ impl Phase {
         for p in ps {
             let w = p as f64 * self.omega;
             let mut r = self.force.iter().find(|(q, _)| *q == p).map_or_else(|| DVector::zeros(self.n), |(_, v)| v.clone());
-            if let Some((_, xp)) = self.presc.iter().find(|(q, _)| *q == p) {
-                r -= times(&self.k, xp) - times(&self.m, xp) * C::new(w * w, 0.0) + times(&self.c, xp) * C::new(0.0, w);
+            if let Some(j) = self.presc.iter().position(|(q, _)| *q == p) {
+                let [kx, mx, cx] = &self.presc_terms.kmc[j];
+                r -= kx - mx * C::new(w * w, 0.0) + cx * C::new(0.0, w);
             }
             let yb = match &t.k_bb {
                 Some(lu) => {
@@ -138,5 +165,47 @@ impl Phase {
         (p.force, p.presc) = loads(model, &self.stuck, &self.closed);
         p.tune()?;
         Some(p)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Phase;
+    use crate::model::{Compliance, Contact, Harmonic, Model};
+    use std::sync::Arc;
+
+    /// The 2-DOF chain with its stop made rigid and moving (so DOF 1, stuck, has a prescribed
+    /// motion with a static and a first harmonic), at ω.
+    fn chain(omega: f64, motion: f64) -> Model {
+        let mut m = crate::study::chain::model();
+        m.frequency = omega;
+        let mut stop = Contact::on_dof(1, 1.0, 0.3, Compliance::Rigid);
+        stop.motion = vec![Harmonic { amplitude: motion, harmonic: 1, phase: 0.4 }];
+        m.contacts = vec![stop];
+        m
+    }
+
+    #[test]
+    fn retuned_reuses_presc_products_only_for_the_same_motion_and_matches_a_phase_made_anew() {
+        let made = Phase::new(&chain(1.2, 0.05), &[0], &[]).expect("the stuck phase");
+        assert!(made.presc.len() == 2, "the stuck DOF's motion has harmonics 0 and 1");
+        let bits = |p: &Phase| {
+            p.part
+                .iter()
+                .chain(&p.slave_part)
+                .flat_map(|(_, v)| v.iter().flat_map(|z| [z.re.to_bits(), z.im.to_bits()]).collect::<Vec<_>>())
+                .collect::<Vec<_>>()
+        };
+        // Another ω, the same motion: the products are shared and the result is the uncached one's.
+        let retuned = made.retuned(&chain(1.7, 0.05)).expect("re-tuned");
+        assert!(Arc::ptr_eq(&made.presc_terms, &retuned.presc_terms));
+        let anew = Phase::new(&chain(1.7, 0.05), &[0], &[]).expect("made anew");
+        assert_eq!(bits(&retuned), bits(&anew));
+        // A perturbed motion must invalidate them: else the particular solution keeps the old load.
+        let moved = made.retuned(&chain(1.7, 0.05 * (1.0 + 1e-9))).expect("re-tuned, moved");
+        assert!(!Arc::ptr_eq(&made.presc_terms, &moved.presc_terms));
+        let anew = Phase::new(&chain(1.7, 0.05 * (1.0 + 1e-9)), &[0], &[]).expect("made anew, moved");
+        assert_eq!(bits(&moved), bits(&anew));
+        assert_ne!(bits(&moved), bits(&retuned));
     }
 }
