@@ -34,6 +34,8 @@ const VANISH: f64 = 1e-6;
 /// Below this step a corrector failing on a flight's re-impact time alone ([`Family::unresolved_flight`]):
 /// the flight is below resolution, merged, not crawled at (coarse rigid blade, 2338.39 rad/s; README).
 const UNRESOLVED_STEP: f64 = 1e-4;
+/// Above this step a rigid change whose bisection fails is stepped at again shorter, not placed at the step's start.
+const UNLOCATED_STEP: f64 = 1e-4;
 /// The phase of a pair of events just inserted at a grazing (fraction of the period).
 const NEW_PAIR: f64 = 1e-5;
 /// Bisection stops when the bracket is this short (scaled unknowns).
@@ -336,7 +338,7 @@ impl Walk<'_> {
             // A rigid contact's signature broken between here and next: located, the branch goes on past it.
             if rigid::margin(&next) < -1e-9 && rigid::margin(&here) >= -1e-9 {
                 let (sig, count) = (self.fam.sig.clone(), self.points.len());
-                match self.rigid_crossing(&here, &next, to) {
+                match self.rigid_crossing(&here, &next, to, step > UNLOCATED_STEP) {
                     Some(n) if self.ends_here(&n, dir) => return done(self, "a fold at a grazing".into(), false, false),
                     Some(n) => {
                         self.report(on_point);

@@ -97,9 +97,15 @@ impl Walk<'_> {
 
     /// `next` breaks the signature that holds at `here`: the change located between them, the
     /// multiplier events before it recorded, and the first point of the branch past it.
-    pub(super) fn rigid_crossing(&mut self, here: &Node, next: &Node, to: f64) -> Option<Node> {
+    /// `None` where the bisection fails and `retry` (the caller shortens its step): the bracket's
+    /// start is no location (the real blade's 2299.5250 and 2286.4071 rad/s: step points, README).
+    pub(super) fn rigid_crossing(&mut self, here: &Node, next: &Node, to: f64, retry: bool) -> Option<Node> {
         // Where the bisection's corrector fails (close to a singular event), from the bracket itself.
-        let (lo, hi) = locate(&self.fam, here, next, Test::Value(&|n| margin(n) + TOL), false).unwrap_or_else(|| (here.clone(), next.clone()));
+        let (lo, hi) = match locate(&self.fam, here, next, Test::Value(&|n| margin(n) + TOL), false) {
+            Some(bracket) => bracket,
+            None if retry => return None,
+            None => (here.clone(), next.clone()),
+        };
         for (kind, node, detail) in self.events_between(here, &lo) {
             self.push(&node, Some(kind), detail);
         }

@@ -79,7 +79,7 @@ impl Walk<'_> {
                 next.as_ref().and_then(|n| n.orbit.rigid_margin().map(|m| (m.contact, m.what, m.value, m.event, m.time / n.orbit.period())))
             ));
             if let Some(next) = next.filter(|n| margin(n) < -TOL) {
-                return self.rigid_crossing(here, &next, to);
+                return self.rigid_crossing(here, &next, to, false);
             }
         }
         None
