@@ -87,6 +87,38 @@ fn sticking_oscillator_unmerges_where_the_closed_form_changes() {
     assert!((at - onset).abs() < 1e-6, "the un-merge at Ω = {at}, the closed form's change at {onset}");
 }
 
+/// The hand-over refusal on a model (session 25): the impact oscillator (gap 1.5 > F/k) walked up
+/// from 0.9 has its impacting orbit past Ω = 1.2861, where the contact-free orbit's amplitude
+/// F/√((k − mΩ²)² + (cΩ)²) (closed form) is below the gap, so two orbits coexist. The exact walk is
+/// stopped there by the point limit; the discrete walk's cold solve at that Ω takes the
+/// contact-free orbit (its LCP's zero solution), which must be refused, not followed to "reached".
+#[test]
+fn a_hand_over_to_the_contact_free_orbit_is_refused() {
+    let (m, c, k, f, gap) = (1.0, 0.1, 1.0, 1.0, 1.5);
+    let free = |w: f64| f / ((k - m * w * w).powi(2) + (c * w).powi(2)).sqrt();
+    let p = problem(&impact_oscillator(&Oscillator::new(m, c, k, f, 0.9), gap, 512));
+    let whole = continuation::run(&p, Parameter::Frequency, 0.9, 1.8, &ContinuationSettings::default(), &|_| {}).unwrap();
+    // The first point past Ω = 1.3 (free amplitude 1.42 < 1.5), on the way up: the impacting orbit.
+    let stop_at = whole.points.iter().position(|q| q.parameter > 1.3).expect("the walk passes 1.3");
+    let settings = ContinuationSettings { max_points: stop_at + 1, ..ContinuationSettings::default() };
+    let b = continuation::run(&p, Parameter::Frequency, 0.9, 1.8, &settings, &|_| {}).unwrap();
+    let last = b.points.last().unwrap();
+    let w = last.parameter;
+    let impacting = 0.5 * RigidStopOrbit::with_contact(&Oscillator::new(m, c, k, f, w), gap).unwrap().peak_to_peak();
+    eprintln!(
+        "hand-over refused: exact walk stopped at Ω = {w}, amplitude {:.6} (closed form {impacting:.6}), contact-free {:.6}; {}",
+        last.amplitude[0],
+        free(w),
+        b.stop
+    );
+    assert!(w > 1.3 && w < 1.378, "stopped at Ω = {w}, not between the grazing and the fold");
+    assert!((last.amplitude[0] - impacting).abs() < 1e-6 * impacting, "the last exact orbit is the impacting one: {} vs {impacting}", last.amplitude[0]);
+    assert!(free(w) < gap && (impacting - free(w)).abs() > 0.1 * impacting, "two distinct orbits at Ω = {w}");
+    assert!(!b.reached(), "the discrete walk on the contact-free orbit was taken: {}", b.stop);
+    assert!(b.stop.contains("contact-free") && b.stop.contains("refused"), "{}", b.stop);
+    assert!(b.points.iter().all(|q| q.source == Source::Exact), "no discrete point appended: {}", b.stop);
+}
+
 /// The frequency in [a, b] where the closed form's orbit changes between a sticking arc and pure
 /// impacts (the sticking arc Ω t ∈ [Ω t_h, 2π + Ω t_d] shrinking to nothing), by bisection on its regime.
 fn sticking_onset(osc: &Oscillator, gap: f64, a: f64, b: f64) -> f64 {
