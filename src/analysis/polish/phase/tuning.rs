@@ -171,18 +171,24 @@ impl Phase {
 #[cfg(test)]
 mod tests {
     use super::Phase;
-    use crate::model::{Compliance, Contact, Harmonic, Model};
+    use crate::model::{Compliance, Contact, Force, Harmonic, Matrix, Model, Structure};
     use std::sync::Arc;
 
-    /// The 2-DOF chain with its stop made rigid and moving (so DOF 1, stuck, has a prescribed
-    /// motion with a static and a first harmonic), at ω.
+    /// A 2-DOF model (masses 1 and 2, springs 2 and 1, stiffness-proportional damping 5 %) with a
+    /// rigid moving stop on DOF 1 (stuck, it has a prescribed motion with a static and a first
+    /// harmonic), forced on DOF 0, at ω.
     fn chain(omega: f64, motion: f64) -> Model {
-        let mut m = crate::study::chain::model();
-        m.frequency = omega;
         let mut stop = Contact::on_dof(1, 1.0, 0.3, Compliance::Rigid);
         stop.motion = vec![Harmonic { amplitude: motion, harmonic: 1, phase: 0.4 }];
-        m.contacts = vec![stop];
-        m
+        let stiffness = [vec![3.0, -1.0], vec![-1.0, 1.0]];
+        let damping: Vec<Vec<f64>> = stiffness.iter().map(|row| row.iter().map(|v| 0.05 * v).collect()).collect();
+        let structure = Structure {
+            mass: Matrix::from_rows(&[vec![1.0, 0.0], vec![0.0, 2.0]]),
+            stiffness: Matrix::from_rows(&stiffness),
+            damping: Some(Matrix::from_rows(&damping)),
+        };
+        let force = Force { dof: 0, term: Harmonic { amplitude: 1.0, harmonic: 1, phase: 0.0 } };
+        Model { structure, forces: vec![force], contacts: vec![stop], frequency: omega, frictions: Vec::new(), rubbing: Vec::new() }
     }
 
     #[test]
