@@ -40,8 +40,11 @@ impl PrescTerms {
     /// Whether these are the products of `presc`: bit for bit (−0.0 ≠ 0.0), so reuse cannot
     /// change a result.
     fn is_for(&self, presc: &Harmonics) -> bool {
-        let bits = |v: &DVector<C>| v.iter().flat_map(|z| [z.re.to_bits(), z.im.to_bits()]).collect::<Vec<_>>();
-        self.presc.len() == presc.len() && self.presc.iter().zip(presc).all(|((p, a), (q, b))| p == q && a.len() == b.len() && bits(a) == bits(b))
+        // Compared in place: this runs at every re-tuning (no allocation on the walk's hot path).
+        let same = |a: &DVector<C>, b: &DVector<C>| {
+            a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.re.to_bits() == y.re.to_bits() && x.im.to_bits() == y.im.to_bits())
+        };
+        self.presc.len() == presc.len() && self.presc.iter().zip(presc).all(|((p, a), (q, b))| p == q && same(a, b))
     }
 }
 
