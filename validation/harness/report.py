@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import datetime
 import os
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 
 VALIDATION = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 # Where the tests write figures and errors.md: validation/out/figures (ignored by git), so that a
@@ -36,6 +36,16 @@ class Report:
     def note(self, text: str) -> None:
         if text not in self.notes:
             self.notes.append(text)
+
+    def as_dict(self) -> dict:
+        """Plain lists and dicts: what pytest-xdist carries from a worker to the controller."""
+        return {"rows": [asdict(r) for r in self.rows], "notes": list(self.notes)}
+
+    def merge(self, data: dict | None) -> None:
+        if data:
+            self.rows += [Row(**r) for r in data["rows"]]
+            for n in data["notes"]:
+                self.note(n)
 
     def markdown(self) -> str:
         def f(v):
