@@ -108,6 +108,9 @@ pub struct SweepPoint {
     pub active_set: Vec<usize>,
     /// `sweep --exact` ([`exact`]): "exact", "polished" or "grid"; empty otherwise.
     pub source: String,
+    /// A refined point's first-grid answer (amplitudes, largest forces): a seam compares the
+    /// orbit it continues (solved on the first grid) with this, not with the refined answer.
+    pub first_grid: Option<(Vec<f64>, Vec<f64>)>,
 }
 
 impl SweepPoint {
@@ -136,6 +139,7 @@ impl SweepPoint {
             substeps: 0,
             active_set: r.active_set.clone(),
             source: String::new(),
+            first_grid: None,
         }
     }
 }

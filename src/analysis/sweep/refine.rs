@@ -84,6 +84,7 @@ pub(super) fn refine(
         (refined.substeps, refined.warm_start_used, refined.cold_fallback) = (point.substeps, point.warm_start_used, point.cold_fallback);
         // The first grid's active set stays: it warm-starts the neighbours (`refill`).
         (refined.time_s, refined.active_set) = (point.time_s, std::mem::take(&mut point.active_set));
+        refined.first_grid = point.first_grid.take().or_else(|| Some((std::mem::take(&mut point.amplitude), std::mem::take(&mut point.max_force))));
         *point = refined;
         third = Some(coarse.take().unwrap_or_else(|| first.clone()));
         coarse = Some(r);

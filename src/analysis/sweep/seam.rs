@@ -12,12 +12,16 @@ use std::time::Instant;
 /// in amplitude or contact force by far more than this (relative).
 const SAME_ORBIT: f64 = 1e-6;
 
-fn same_orbit(a: &SweepPoint, b: &SweepPoint) -> bool {
+/// Whether `continued` (a first-grid answer) is on the orbit of the chunk's `point`, compared on
+/// the same grid: a refined point's first-grid answer (a k → 2k refinement moves the amplitude by
+/// its discretisation error, ~1e-3, which sent every refined point after a seam to be solved again).
+fn same_orbit(continued: &SweepPoint, point: &SweepPoint) -> bool {
     let close = |x: &[f64], y: &[f64]| {
         let scale = x.iter().chain(y).fold(0.0f64, |s, v| s.max(v.abs()));
         x.len() == y.len() && x.iter().zip(y).all(|(u, v)| (u - v).abs() <= SAME_ORBIT * scale)
     };
-    close(&a.amplitude, &b.amplitude) && close(&a.max_force, &b.max_force)
+    let (amplitude, force) = point.first_grid.as_ref().map_or((&point.amplitude, &point.max_force), |(a, f)| (a, f));
+    close(&continued.amplitude, amplitude) && close(&continued.max_force, force)
 }
 
 /// Re-checks the seams before the chunks starting at `starts` (indices into `points`, in sweep
@@ -68,4 +72,26 @@ pub(super) fn repair_seams(template: &PeriodicProblem, points: &mut [SweepPoint]
         }
     }
     replaced
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn point(amplitude: f64, force: f64, first_grid: Option<(f64, f64)>) -> SweepPoint {
+        SweepPoint { amplitude: vec![amplitude], max_force: vec![force], first_grid: first_grid.map(|(a, f)| (vec![a], vec![f])), ..Default::default() }
+    }
+
+    /// A refined point is compared on its first grid: the continued first-grid answer equal to it
+    /// to round-off is the same orbit although the refined amplitude is 1e-3 away; a first grid
+    /// 1e-4 away (another orbit) is not, nor is an unrefined point 1e-4 away.
+    #[test]
+    fn a_seam_compares_a_refined_point_on_its_first_grid() {
+        let continued = point(1.0e-3, 5.0, None);
+        assert!(same_orbit(&continued, &point(1.001e-3, 5.004, Some((1.0e-3 * (1.0 + 1e-13), 5.0)))));
+        assert!(!same_orbit(&continued, &point(1.0e-3, 5.0, Some((1.0001e-3, 5.0)))));
+        assert!(!same_orbit(&continued, &point(1.0e-3, 5.0, Some((1.0e-3, 5.0005)))));
+        assert!(same_orbit(&continued, &point(1.0e-3 * (1.0 - 1e-12), 5.0, None)));
+        assert!(!same_orbit(&continued, &point(1.0001e-3, 5.0, None)));
+    }
 }
