@@ -140,7 +140,7 @@ impl Walk<'_> {
                 list.remove(e);
                 // Located on the orbit without the impact, regular where the impacting one is singular.
                 let rho = self.fam.rho;
-                if let Some(n) = self.fade((here.lambda(rho), next.lambda(rho)), &lo, list.clone(), &what, "the impact") {
+                if let Some(n) = self.fade((here.lambda(rho), next.lambda(rho)), &lo, list.clone(), &what, ("the impact", None)) {
                     return Some(n);
                 }
                 true
@@ -317,12 +317,14 @@ impl Walk<'_> {
     /// and λ(next); the branch goes on towards the side where that margin is ≥ 0, which reverses λ
     /// when the impacting orbit and the admissible contact-free one lie on the same side (the
     /// unstable impacting orbit from a fold ending at the grazing). `None` without a sign change.
-    fn fade(&mut self, (la, lb): (f64, f64), near: &Node, list: Vec<(f64, Event)>, what: &str, without: &str) -> Option<Node> {
+    /// With `own` (a merge of that contact's phase searched ahead), a change of another contact's
+    /// margin is refused: it is the next change, not this one ([`touch_point`]).
+    fn fade(&mut self, (la, lb): (f64, f64), near: &Node, list: Vec<(f64, Event)>, what: &str, (without, own): (&str, Option<usize>)) -> Option<Node> {
         let guess = signature::guess(&self.fam, &near.orbit, &list, 0.0);
         let sig = Signature { events: list.iter().map(|l| l.1).collect(), always: near.orbit.always_closed().to_vec() };
         let before = self.fam.ne();
         let old = std::mem::replace(&mut self.fam.sig, sig);
-        let located = touch_point(&mut self.fam, &guess, la, lb);
+        let located = touch_point(&mut self.fam, &guess, (la, lb), own);
         match located {
             Some(n) => {
                 let detail = format!("{what}; events per period {before} -> {} (located on the orbit without {without})", self.fam.ne());
@@ -427,8 +429,9 @@ impl Walk<'_> {
             (Switch::Impact { stick: true }, Switch::Release) => {
                 list[e].1.kind = Switch::Impact { stick: false };
                 list.remove((e + 1) % ne);
-                if let Some(n) =
-                    [1e-5, 1e-4, 1e-3].into_iter().find_map(|f| self.fade((lambda, lambda + sense * f * rho), here, list.clone(), what, "the sticking arc"))
+                if let Some(n) = [1e-5, 1e-4, 1e-3]
+                    .into_iter()
+                    .find_map(|f| self.fade((lambda, lambda + sense * f * rho), here, list.clone(), what, ("the sticking arc", Some(ev.contact))))
                 {
                     return Some(n);
                 }
@@ -463,7 +466,9 @@ impl Walk<'_> {
                 let mut reach = vec![1e-5, 1e-4, 1e-3, 1.5 * ahead, 3.0 * ahead, 1e-2];
                 reach.retain(|f| *f > 0.0 && *f <= 1e-2);
                 reach.sort_by(f64::total_cmp);
-                if let Some(n) = reach.into_iter().find_map(|f| self.fade((lambda, lambda + sense * f * rho), here, list.clone(), what, "the impact")) {
+                if let Some(n) =
+                    reach.into_iter().find_map(|f| self.fade((lambda, lambda + sense * f * rho), here, list.clone(), what, ("the impact", Some(ev.contact))))
+                {
                     return Some(n);
                 }
                 let sig = Signature { events: list.iter().map(|l| l.1).collect(), always: here.orbit.always_closed().to_vec() };

@@ -26,7 +26,7 @@ impl Walk<'_> {
         reach.retain(|f| *f > 0.0 && *f <= 1e-2);
         reach.sort_by(f64::total_cmp);
         let list: Vec<_> = timed(&here.orbit).into_iter().enumerate().filter(|(i, _)| *i != e && *i != b).map(|(_, l)| l).collect();
-        if let Some(n) = reach.into_iter().find_map(|f| self.fade((lambda, lambda + sense * f * rho), here, list.clone(), what, "the held arc")) {
+        if let Some(n) = reach.into_iter().find_map(|f| self.fade((lambda, lambda + sense * f * rho), here, list.clone(), what, ("the held arc", None))) {
             return Some(n);
         }
         let (sig, guess) = signature::remove(&self.fam, &here.orbit, e, here.w[here.w.len() - 1])?;

@@ -16,6 +16,9 @@ const ZERO: f64 = 1e-13;
 const STEPS: usize = 40;
 /// A secant step without a bracket goes at most this many times the last step's length.
 const REACH: f64 = 8.0;
+/// A trial whose corrector fails is moved halfway back towards the point it starts from, at most
+/// this many times (2^-16 of the step).
+const HALVINGS: usize = 16;
 
 /// The event `e` of `n`'s orbit is a sticking impact whose holding force is negative at its
 /// landing, and the margin is that landing's lift-off: `Some(e)`.
@@ -45,9 +48,21 @@ pub(in super::super) fn landing_zero(fam: &Family, from: &[f64], e: usize, (la, 
         let h = n.orbit.landing_force(e)?;
         Some((n.w, h))
     };
+    // A trial λ too far from its start for the corrector (the coarse rigid blade at 2398.27 rad/s:
+    // the first trial 0.075 rad/s on, the zero 6e-7 rad/s on) is moved halfway back, in turn.
+    let toward = |w0: &[f64], l0: f64, mut l: f64| -> Option<(f64, f64, Vec<f64>)> {
+        for _ in 0..=HALVINGS {
+            if let Some((w, h)) = at(w0, l) {
+                return Some((l, h, w));
+            }
+            l = 0.5 * (l0 + l);
+        }
+        None
+    };
     let (wa, ha) = at(from, la)?;
-    let (wb, hb) = at(&wa, lb)?;
-    let (mut a, mut b) = ((la, ha, wa), (lb, hb, wb));
+    let b = toward(&wa, la, lb)?;
+    let (lb, hb) = (b.0, b.1);
+    let (mut a, mut b) = ((la, ha, wa), b);
     let rate = (hb - ha) / (lb - la);
     for _ in 0..STEPS {
         if b.1.abs() < ZERO || (a.0 - b.0).abs() <= BRACKET * rho {
@@ -62,7 +77,7 @@ pub(in super::super) fn landing_zero(fam: &Family, from: &[f64], e: usize, (la, 
             let span = REACH * (b.0 - a.0).abs();
             l = l.clamp(b.0 - span, b.0 + span);
         }
-        let (w, h) = at(&b.2, l)?;
+        let (l, h, w) = toward(&b.2, b.0, l)?;
         if bracketed && h * b.1 > 0.0 {
             // Illinois: the end kept has its value halved.
             b = (l, h, w);
@@ -116,6 +131,56 @@ impl Walk<'_> {
                 self.fam.sig = old;
                 None
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::landing_zero;
+    use crate::analysis::continuation::Parameter;
+    use crate::analysis::continuation::exact::family::{Family, Signature, lambda_axis};
+    use crate::analysis::polish::{self, EventKind};
+    use crate::model::{Compliance, Contact, Force, Harmonic, Matrix, Model, Structure};
+    use crate::periodic::{OutputSelection, PeriodicProblem, PeriodicSolver, SolverSettings};
+    use crate::time::{Discretization, Scheme};
+
+    /// The sticking oscillator of tests/rigid_branch.rs: m x'' + 0.1 x' + x = cos Ωt, x ≤ 0.5 (a
+    /// rigid stop, plastic impacts), bds1 with 512 steps.
+    fn sticking_oscillator(omega: f64) -> PeriodicProblem {
+        let structure =
+            Structure { mass: Matrix::from_rows(&[vec![1.0]]), stiffness: Matrix::from_rows(&[vec![1.0]]), damping: Some(Matrix::from_rows(&[vec![0.1]])) };
+        let force = Force { dof: 0, term: Harmonic { amplitude: 1.0, harmonic: 1, phase: 0.0 } };
+        let stop = Contact::on_dof(0, 1.0, 0.5, Compliance::Rigid);
+        let model = Model { structure, forces: vec![force], contacts: vec![stop], frequency: omega, frictions: Vec::new(), rubbing: Vec::new() };
+        let disc = Discretization { scheme: Scheme::Bds1, steps: 512, pairing: None };
+        let outputs = OutputSelection { displacement: vec![0], contacts: true, ..OutputSelection::default() };
+        PeriodicProblem::new(model, disc, outputs, SolverSettings::default()).expect("the oscillator's problem")
+    }
+
+    /// The force holding the sticking oscillator at its landing crosses zero where its merged orbit
+    /// (one sticking impact, then the release) and the orbit with a pure impact and a flight before
+    /// the sticking one meet: at the closed form's change of regime, Ω = 0.6384152319 (src/exact/rigid.rs,
+    /// by bisection on its regime in tests/rigid_branch.rs). Sought from Ω = 0.63 with the first
+    /// trial far out, where the corrector fails (the coarse rigid blade at 2398.27 rad/s: a trial
+    /// 0.075 rad/s on, the zero 6e-7 rad/s on, so the merge fell back to another contact's change
+    /// and the walk turned back; README): the trial is moved back until it converges.
+    #[test]
+    fn the_landing_force_zero_is_found_past_a_trial_the_corrector_cannot_reach() {
+        let p = sticking_oscillator(0.7);
+        let r = PeriodicSolver::new(p.clone()).solve().expect("the grid solve at Ω = 0.7");
+        let orbit = polish::polish(&p, &r).expect("the polish at Ω = 0.7");
+        let e = orbit.events().iter().position(|x| x.kind == (EventKind::Impact { stick: true })).expect("a sticking impact at Ω = 0.7");
+        let sig = Signature { events: orbit.events().to_vec(), always: orbit.always_closed().to_vec() };
+        let mut fam = Family::new(p.model(), Parameter::Frequency, 1.0, 1.0, sig);
+        fam.ys = fam.scale_of(orbit.initial_state());
+        let w = fam.correct(&fam.pack(&orbit, 0.7), &lambda_axis(fam.dim()), 0.7).expect("closed at Ω = 0.7");
+        let closed_form = 0.638_415_231_9;
+        for far in [0.66, 2.0, 6.0] {
+            let (z, rate) = landing_zero(&fam, &w, e, (0.63, far), 1.0).unwrap_or_else(|| panic!("no zero with the first trial at Ω = {far}"));
+            let at = z.lambda(1.0);
+            eprintln!("first trial at Ω = {far}: the landing force's zero at {at:.10} (closed form {closed_form}), its first secant's rate {rate:e}");
+            assert!((at - closed_form).abs() < 1e-6, "the zero at Ω = {at}, the closed form's change at {closed_form}");
         }
     }
 }

@@ -8,8 +8,13 @@ use super::{TOL, landing, margin, trace};
 /// rigid margin, to [`BRACKET`] of the range; the node on the admissible side, its tangent
 /// pointing away from the inadmissible one. Where the margin there is a landing's lift-off (its
 /// micro-flight just visible), the point is where that landing's force crosses zero
-/// ([`landing::landing_zero`]). `None` without a sign change or where the corrector fails.
-pub(super) fn touch_point(fam: &mut Family, guess: &[f64], la: f64, lb: f64) -> Option<Node> {
+/// ([`landing::landing_zero`]). `None` without a sign change or where the corrector fails, and,
+/// with `own`, where the margin that breaks is another contact's: a merge of `own`'s phase
+/// searched ahead whose merged orbit is admissible at `la` already (the merge is there, to
+/// resolution) meets the next change instead, and the branch oriented away from it walks back
+/// over the old one (the coarse rigid blade at 2398.27 rad/s: contact 0's flight merged at
+/// contact 2's landing 0.005 rad/s on, the walk turned back down to 2150; README).
+pub(super) fn touch_point(fam: &mut Family, guess: &[f64], (la, lb): (f64, f64), own: Option<usize>) -> Option<Node> {
     let (rho, d) = (fam.rho, fam.dim());
     let e_l = lambda_axis(d);
     // The orbit at λ from the unknowns `from`: (node, admissible).
@@ -34,6 +39,10 @@ pub(super) fn touch_point(fam: &mut Family, guess: &[f64], la: f64, lb: f64) -> 
             (n, true) => (ok, lok) = (n, mid),
             (n, false) => (bad, lbad) = (n, mid),
         }
+    }
+    if let Some(m) = bad.orbit.rigid_margin().filter(|m| own.is_some_and(|c| m.contact != c)) {
+        trace(format_args!("touch point: {lbad:.10} breaks contact {}'s {}, not the merging contact's: refused", m.contact, m.what));
+        return None;
     }
     let away = (lok - lbad).signum();
     trace(format_args!(
