@@ -4,7 +4,8 @@
 //! the Craig–Bampton reduction, the casing's phases, the output map) and shared by every point:
 //! a point only changes `model.frequency`. The points are cut into contiguous chunks that run in
 //! parallel (rayon); within a chunk each point is warm-started from the previous point's active
-//! set, with a cold re-solve when the warm one fails. FFT plans are made once and shared.
+//! set, with a cold re-solve when the warm one fails, and its estimate and refinement run as a
+//! second stage on whichever thread is free (`stages`). FFT plans are made once and shared.
 //! The contact-free (linear) curve comes from the same assembly ([`Response::linear_displacement`]).
 //!
 //! Several periodic solutions can coexist (the hardening branch of a rubbing blade overhangs
