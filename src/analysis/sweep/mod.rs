@@ -4,7 +4,8 @@
 //! the Craig–Bampton reduction, the casing's phases, the output map) and shared by every point:
 //! a point only changes `model.frequency`. The points are cut into contiguous chunks that run in
 //! parallel (rayon); within a chunk each point is warm-started from the previous point's active
-//! set, with a cold re-solve when the warm one fails. FFT plans are made once and shared.
+//! set, with a cold re-solve when the warm one fails, and its estimate and refinement run as a
+//! second stage on whichever thread is free (`stages`). FFT plans are made once and shared.
 //! The contact-free (linear) curve comes from the same assembly ([`Response::linear_displacement`]).
 //!
 //! Several periodic solutions can coexist (the hardening branch of a rubbing blade overhangs
@@ -19,13 +20,14 @@ mod refill;
 mod refine;
 mod seam;
 pub mod spectrum;
+mod stages;
 
 use crate::analysis::continuation;
 use crate::model::{Labels, Quantity};
 use crate::periodic::limits::AmplitudeMeasure;
 use crate::periodic::{LEMKE_AFTER_SHOOTING_MAX, LcpMethod, PeriodicProblem, PeriodicSolver, SolveError, Tuning, WarmStart};
 use crate::response::Response;
-use rayon::prelude::*;
+use std::sync::Mutex;
 use std::time::Instant;
 
 pub use refill::refill;
@@ -199,81 +201,105 @@ pub fn run(
     let n = frequencies.len();
     let chunks = (threads * settings.chunks_per_thread.max(1)).min(n).max(1);
     let bounds: Vec<(usize, usize)> = (0..chunks).map(|c| (c * n / chunks, (c + 1) * n / chunks)).collect();
-    let results: Vec<Vec<SweepPoint>> = pool.install(|| {
-        bounds
-            .par_iter()
-            .map(|&(lo, hi)| {
-                let mut solver = session.clone();
-                // The second grid of the error estimates, warm-started along the chunk too.
-                let mut second: refine::Coarser = Vec::new();
-                let mut levels = refine::Levels::new();
-                let mut out = Vec::with_capacity(hi - lo);
-                let mut last: Option<(f64, Response)> = None;
-                // Guarded: the last solved frequency, kept past a failure with its active sets
-                // (the next point sub-steps from there instead of starting cold).
-                let mut last_solved: Option<f64> = None;
-                // The k the last point ended at (a tolerance's refinement): the next point's guess.
-                let mut predicted: Option<usize> = None;
-                // A large LCP's sweep never waits for the dense fallback (see `solve_guarded`); its
-                // ω sub-steps follow the branch, and the branch check's continuation, which can
-                // reach the dense fallback, is not run there.
-                let guarded = settings.warm_start && guarded(solver.problem());
-                for &f in &frequencies[lo..hi] {
-                    let t = Instant::now();
-                    let mut substeps = 0;
-                    let mut r = if guarded {
-                        // The cold try stops before the offset homotopy: past a fold it missed
-                        // after 70–100 kinks (2–5 s each), while the branch beyond (2473 rad/s)
-                        // is reached by Newton from the contact-free orbit and the refill follows
-                        // it back. The homotopy waits for the points the refill misses (`refill`).
-                        let (r, n) = solve_guarded(&mut solver, last_solved, f, ColdTry::WithoutHomotopy);
-                        substeps = n;
-                        r
-                    } else {
-                        solver.update_frequency(f).and_then(|()| solver.solve())
-                    };
-                    if let (Some((f0, before)), Ok(now)) = (&last, &r)
-                        && settings.warm_start
-                        && !guarded
-                        && left_the_branch(before, now)
-                    {
-                        // Kept as it is when the branch cannot be followed.
-                        if let Ok(followed) = follow_from(&mut solver, base, *f0, before, f) {
-                            r = Ok(followed);
-                        }
-                    }
-                    let mut point = match &r {
-                        Ok(r) => SweepPoint::from_response(solver.problem(), f, r),
-                        Err(e) => SweepPoint { frequency: f, error: Some(e.to_string()), ..Default::default() },
-                    };
-                    point.substeps = substeps;
-                    point.warm_start_used = r.is_ok() && solver.last_start() == WarmStart::Used;
-                    point.cold_fallback = solver.last_start() == WarmStart::ColdFallback;
-                    if let Ok(r) = &r {
-                        let below = refine::estimate(&mut point, solver.problem(), r, &mut second, settings, predicted);
-                        refine::refine(&mut point, solver.problem(), r, below, (&mut levels, &mut second), settings);
-                    }
-                    predicted = r.is_ok().then_some(point.steps);
-                    point.time_s = t.elapsed().as_secs_f64();
-                    match r {
-                        Ok(r) => {
-                            last_solved = Some(f);
-                            last = Some((f, r));
-                        }
-                        Err(_) if guarded => last = None,
-                        Err(_) => {
-                            // The next point starts cold, as after any failure.
-                            solver.reset_warm_start();
-                            last = None;
-                        }
-                    }
-                    on_point(&point);
-                    out.push(point);
-                }
-                out
-            })
-            .collect()
-    });
+    // A chunk's first-grid pass: the session, the last answer (the branch check) and the last
+    // solved frequency (a guarded point's sub-steps start there).
+    struct First {
+        solver: PeriodicSolver,
+        next: usize,
+        last: Option<(f64, Response)>,
+        last_solved: Option<f64>,
+    }
+    // A chunk's estimates and refinements: the sessions of their grids, warm-started along the
+    // chunk, and the k the last point ended at (the next point's guess), with the points done.
+    struct Second {
+        coarser: refine::Coarser,
+        levels: refine::Levels,
+        predicted: Option<usize>,
+        out: Vec<SweepPoint>,
+    }
+    // A first-grid answer on its way to the second stage, with its problem (at its frequency)
+    // and the seconds it took.
+    type Pending = (SweepPoint, Option<(Response, PeriodicProblem)>, f64);
+    let firsts: Vec<Mutex<First>> =
+        bounds.iter().map(|&(lo, _)| Mutex::new(First { solver: session.clone(), next: lo, last: None, last_solved: None })).collect();
+    let seconds: Vec<Mutex<Second>> = bounds
+        .iter()
+        .map(|&(lo, hi)| Mutex::new(Second { coarser: Vec::new(), levels: refine::Levels::new(), predicted: None, out: Vec::with_capacity(hi - lo) }))
+        .collect();
+    // A large LCP's sweep never waits for the dense fallback (see `solve_guarded`); its
+    // ω sub-steps follow the branch, and the branch check's continuation, which can
+    // reach the dense fallback, is not run there.
+    let guarded_sweep = settings.warm_start && guarded(session.problem());
+    let first = |c: usize| -> Pending {
+        let mut guard = firsts[c].lock().unwrap();
+        let First { solver, next, last, last_solved } = &mut *guard;
+        let f = frequencies[*next];
+        *next += 1;
+        let t = Instant::now();
+        let mut substeps = 0;
+        let mut r = if guarded_sweep {
+            // The cold try stops before the offset homotopy: past a fold it missed
+            // after 70–100 kinks (2–5 s each), while the branch beyond (2473 rad/s)
+            // is reached by Newton from the contact-free orbit and the refill follows
+            // it back. The homotopy waits for the points the refill misses (`refill`).
+            let (r, n) = solve_guarded(solver, *last_solved, f, ColdTry::WithoutHomotopy);
+            substeps = n;
+            r
+        } else {
+            solver.update_frequency(f).and_then(|()| solver.solve())
+        };
+        if let (Some((f0, before)), Ok(now)) = (&*last, &r)
+            && settings.warm_start
+            && !guarded_sweep
+            && left_the_branch(before, now)
+        {
+            // Kept as it is when the branch cannot be followed.
+            if let Ok(followed) = follow_from(solver, base, *f0, before, f) {
+                r = Ok(followed);
+            }
+        }
+        let mut point = match &r {
+            Ok(r) => SweepPoint::from_response(solver.problem(), f, r),
+            Err(e) => SweepPoint { frequency: f, error: Some(e.to_string()), ..Default::default() },
+        };
+        point.substeps = substeps;
+        point.warm_start_used = r.is_ok() && solver.last_start() == WarmStart::Used;
+        point.cold_fallback = solver.last_start() == WarmStart::ColdFallback;
+        let answer = match r {
+            Ok(r) => {
+                *last_solved = Some(f);
+                *last = Some((f, r.clone()));
+                Some((r, solver.problem().clone()))
+            }
+            Err(_) if guarded_sweep => {
+                *last = None;
+                None
+            }
+            Err(_) => {
+                // The next point starts cold, as after any failure.
+                solver.reset_warm_start();
+                *last = None;
+                None
+            }
+        };
+        (point, answer, t.elapsed().as_secs_f64())
+    };
+    let second = |c: usize, (mut point, answer, first_s): Pending| {
+        let t = Instant::now();
+        let mut guard = seconds[c].lock().unwrap();
+        let Second { coarser, levels, predicted, out } = &mut *guard;
+        if let Some((r, problem)) = &answer {
+            let below = refine::estimate(&mut point, problem, r, coarser, settings, *predicted);
+            refine::refine(&mut point, problem, r, below, (levels, coarser), settings);
+        }
+        *predicted = answer.is_some().then_some(point.steps);
+        point.time_s = first_s + t.elapsed().as_secs_f64();
+        on_point(&point);
+        out.push(point);
+    };
+    let lengths: Vec<usize> = bounds.iter().map(|&(lo, hi)| hi - lo).collect();
+    pool.install(|| stages::run(&lengths, threads, &first, &second));
+    let results = seconds.into_iter().map(|s| s.into_inner().unwrap().out);
     let mut points: Vec<SweepPoint> = results.into_iter().flatten().collect();
     if settings.warm_start && bounds.len() > 1 {
         let starts: Vec<usize> = bounds.iter().map(|b| b.0).collect();

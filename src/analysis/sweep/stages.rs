@@ -1,0 +1,146 @@
+//! The chunks' two stages on a few worker threads: a chunk's first-grid pass (each point
+//! warm-started from the one before) and its points' estimates and refinements (the chunk's
+//! coarser and refined sessions, warm-started along the chunk, and `predicted`), each stage
+//! one point at a time in the chunk's order. Why: the refinements of the real blade's folds
+//! (issue 23) sat on one chunk while the other chunk's thread idled; a stage's next point can
+//! run on whichever thread is free, so the two stages of the costliest chunk overlap.
+//! Each stage keeps its state and its order, so the answers are those of the inline loop.
+use std::collections::VecDeque;
+use std::sync::{Condvar, Mutex};
+use std::time::Instant;
+
+/// Which stage of which chunk a worker runs next.
+enum Job<P> {
+    First(usize),
+    Second(usize, P),
+}
+
+struct Chunk<P> {
+    /// Points left to the first stage, and points through the second.
+    first_left: usize,
+    second_done: usize,
+    first_busy: bool,
+    second_busy: bool,
+    /// The first stage's answers waiting for the second, in order.
+    queue: VecDeque<P>,
+    /// Seconds spent in each stage and the points, for the expected remaining work.
+    first_s: f64,
+    second_s: f64,
+    len: usize,
+}
+
+impl<P> Chunk<P> {
+    /// Expected seconds left in both stages, by this chunk's mean cost per point so far
+    /// (1 s per point before any: the chunks start even).
+    fn remaining(&self) -> f64 {
+        let done_first = self.len - self.first_left;
+        let mean = |s: f64, n: usize| if n == 0 { 1.0 } else { s / n as f64 };
+        self.first_left as f64 * mean(self.first_s, done_first) + (self.len - self.second_done) as f64 * mean(self.second_s, self.second_done)
+    }
+}
+
+/// Runs `chunks` (their lengths) on `threads` workers: `first(c)` is chunk c's next first-stage
+/// point, `second(c, p)` that point's second stage (the callers keep the results in their
+/// stages' states). A free worker takes the ready stage of the chunk with the
+/// most expected work left (the critical path first), the second stage before the first.
+pub(super) fn run<P: Send>(lengths: &[usize], threads: usize, first: &(dyn Fn(usize) -> P + Sync), second: &(dyn Fn(usize, P) + Sync)) {
+    let state = Mutex::new(
+        lengths
+            .iter()
+            .map(|&len| Chunk {
+                first_left: len,
+                second_done: 0,
+                first_busy: false,
+                second_busy: false,
+                queue: VecDeque::new(),
+                first_s: 0.0,
+                second_s: 0.0,
+                len,
+            })
+            .collect::<Vec<Chunk<P>>>(),
+    );
+    let ready = Condvar::new();
+    let pick = |chunks: &mut Vec<Chunk<P>>| -> Option<Job<P>> {
+        let mut order: Vec<usize> = (0..chunks.len()).collect();
+        order.sort_by(|&a, &b| chunks[b].remaining().total_cmp(&chunks[a].remaining()));
+        for c in order {
+            let ch = &mut chunks[c];
+            if !ch.second_busy && !ch.queue.is_empty() {
+                ch.second_busy = true;
+                return ch.queue.pop_front().map(|p| Job::Second(c, p));
+            }
+            if !ch.first_busy && ch.first_left > 0 {
+                ch.first_busy = true;
+                return Some(Job::First(c));
+            }
+        }
+        None
+    };
+    let worker = || {
+        loop {
+            let job = {
+                let mut chunks = state.lock().unwrap();
+                loop {
+                    if let Some(job) = pick(&mut chunks) {
+                        break job;
+                    }
+                    if chunks.iter().all(|c| c.second_done == c.len) {
+                        return;
+                    }
+                    chunks = ready.wait(chunks).unwrap();
+                }
+            };
+            let t = Instant::now();
+            match job {
+                Job::First(c) => {
+                    let p = first(c);
+                    let mut chunks = state.lock().unwrap();
+                    let ch = &mut chunks[c];
+                    (ch.first_busy, ch.first_left, ch.first_s) = (false, ch.first_left - 1, ch.first_s + t.elapsed().as_secs_f64());
+                    ch.queue.push_back(p);
+                }
+                Job::Second(c, p) => {
+                    second(c, p);
+                    let mut chunks = state.lock().unwrap();
+                    let ch = &mut chunks[c];
+                    (ch.second_busy, ch.second_done, ch.second_s) = (false, ch.second_done + 1, ch.second_s + t.elapsed().as_secs_f64());
+                }
+            }
+            ready.notify_all();
+        }
+    };
+    // On the caller's rayon pool (a solve's own parallel parts stay there); a worker that waits
+    // for a stage only waits for another worker, so more workers than threads cannot lock.
+    rayon::scope(|s| {
+        for _ in 1..threads.max(1) {
+            s.spawn(|_| worker());
+        }
+        worker();
+    });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every point passes both stages once, in its chunk's order, the second after the first,
+    /// whatever the threads (a shuffled order or a lost point would show in the log).
+    #[test]
+    fn stages_keep_each_chunks_order() {
+        for threads in [1, 2, 3] {
+            let lengths = [5, 0, 7, 1];
+            let next: Vec<Mutex<usize>> = lengths.iter().map(|_| Mutex::new(0)).collect();
+            let log: Vec<Mutex<Vec<usize>>> = lengths.iter().map(|_| Mutex::new(Vec::new())).collect();
+            let first = |c: usize| {
+                let mut n = next[c].lock().unwrap();
+                *n += 1;
+                *n - 1
+            };
+            let second = |c: usize, i: usize| log[c].lock().unwrap().push(i);
+            run(&lengths, threads, &first, &second);
+            for (c, &len) in lengths.iter().enumerate() {
+                assert_eq!(*log[c].lock().unwrap(), (0..len).collect::<Vec<_>>(), "chunk {c}, {threads} threads");
+            }
+        }
+    }
+}
