@@ -6,6 +6,7 @@
 //! run on whichever thread is free, so the two stages of the costliest chunk overlap.
 //! Each stage keeps its state and its order, so the answers are those of the inline loop.
 use std::collections::VecDeque;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Condvar, Mutex};
 use std::time::Instant;
 
@@ -60,6 +61,9 @@ pub(super) fn run<P: Send>(lengths: &[usize], threads: usize, first: &(dyn Fn(us
             .collect::<Vec<Chunk<P>>>(),
     );
     let ready = Condvar::new();
+    // Set when a stage panics: the other workers stop waiting for its chunk (else they would wait
+    // forever on a stage marked busy), and the scope carries the panic to the caller.
+    let aborted = AtomicBool::new(false);
     let pick = |chunks: &mut Vec<Chunk<P>>| -> Option<Job<P>> {
         let mut order: Vec<usize> = (0..chunks.len()).collect();
         order.sort_by(|&a, &b| chunks[b].remaining().total_cmp(&chunks[a].remaining()));
@@ -81,6 +85,9 @@ pub(super) fn run<P: Send>(lengths: &[usize], threads: usize, first: &(dyn Fn(us
             let job = {
                 let mut chunks = state.lock().unwrap();
                 loop {
+                    if aborted.load(Ordering::SeqCst) {
+                        return;
+                    }
                     if let Some(job) = pick(&mut chunks) {
                         break job;
                     }
@@ -91,6 +98,7 @@ pub(super) fn run<P: Send>(lengths: &[usize], threads: usize, first: &(dyn Fn(us
                 }
             };
             let t = Instant::now();
+            let _guard = AbortOnPanic { state: &state, ready: &ready, aborted: &aborted };
             match job {
                 Job::First(c) => {
                     let p = first(c);
@@ -119,6 +127,23 @@ pub(super) fn run<P: Send>(lengths: &[usize], threads: usize, first: &(dyn Fn(us
     });
 }
 
+/// Marks the run aborted (under the lock, so that no waiter misses it) when a stage unwinds.
+struct AbortOnPanic<'a, T> {
+    state: &'a Mutex<T>,
+    ready: &'a Condvar,
+    aborted: &'a AtomicBool,
+}
+
+impl<T> Drop for AbortOnPanic<'_, T> {
+    fn drop(&mut self) {
+        if std::thread::panicking() {
+            let _held = self.state.lock().unwrap_or_else(|e| e.into_inner());
+            self.aborted.store(true, Ordering::SeqCst);
+            self.ready.notify_all();
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -141,6 +166,22 @@ mod tests {
             for (c, &len) in lengths.iter().enumerate() {
                 assert_eq!(*log[c].lock().unwrap(), (0..len).collect::<Vec<_>>(), "chunk {c}, {threads} threads");
             }
+        }
+    }
+
+    /// A stage that panics reaches the caller; the other workers do not wait for its chunk
+    /// forever (its stage stays marked busy).
+    #[test]
+    fn a_panicking_stage_reaches_the_caller() {
+        for threads in [1, 2, 3] {
+            let first = |c: usize| {
+                assert!(c != 1, "stage failure");
+                c
+            };
+            let second = |_: usize, _: usize| std::thread::sleep(std::time::Duration::from_millis(1));
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| pool.install(|| run(&[3, 2, 4], threads, &first, &second))));
+            assert!(outcome.is_err(), "{threads} threads");
         }
     }
 }
