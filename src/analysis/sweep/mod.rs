@@ -268,7 +268,8 @@ pub fn run(
         let answer = match r {
             Ok(r) => {
                 *last_solved = Some(f);
-                *last = Some((f, r.clone()));
+                // Only the branch check reads it (not a guarded sweep's): no copy of the answer otherwise.
+                *last = (settings.warm_start && !guarded_sweep).then(|| (f, r.clone()));
                 Some((r, solver.problem().clone()))
             }
             Err(_) if guarded_sweep => {
