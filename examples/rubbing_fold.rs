@@ -1,4 +1,4 @@
-//! Where the rubbing real blade's branches end near 2278 rad/s (README "Friction", issue 25):
+//! Where the rubbing real blade's branches end near 2278 rad/s (validation/RECORD.md "Friction", issue 25):
 //! walks the lower branch up warm, jumps to the upper one as the sweep does (warm Newton from
 //! the last lower orbit at the next 5 rad/s point), then walks the upper branch DOWN in halved
 //! steps to its end. Prints ω, the flap amplitude (`6843:y`, half its peak-to-peak) per orbit.

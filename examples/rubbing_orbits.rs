@@ -1,4 +1,4 @@
-//! The rubbing real blade's orbits at one frequency (README "Friction", issue 23): the sweep's
+//! The rubbing real blade's orbits at one frequency (validation/RECORD.md "Friction", issue 23): the sweep's
 //! (walked up warm from 2270 rad/s, jumping the fold near 2278 rad/s by warm Newton from the
 //! last orbit before it, as the sweep does) and the lone solve's (`auto`: its μ-homotopy and
 //! frequency walk). For each: the flap amplitude (`6843:y`), the Floquet multipliers of the

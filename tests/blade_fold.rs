@@ -1,5 +1,5 @@
 //! The coarse blade's resonance tip, bracketed by time marching (issue 13). The continuation
-//! (`periodic-contact continue fmu/scenes/blade-casing-coarse.toml --from 2150 --to 2900`, README
+//! (`periodic-contact continue fmu/scenes/blade-casing-coarse.toml --from 2150 --to 2900`, validation/RECORD.md
 //! "Branches") folds at 2796.03 rad/s, 0.986 mm; beyond it only the contact-free orbit exists.
 //! Independent check: explicit time marching of the reduced model (`periodic_contact::marching`),
 //! started on the stable contact orbit at 2792 rad/s (followed from 2300, where it is the only

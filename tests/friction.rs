@@ -127,7 +127,7 @@ fn error_at_instants(r: &Response, orbit: &FrictionOrbit, period: f64, dof: usiz
 /// Measured (this test, load 20): Den Hartog Ω = 0.6, μN = 0.3: 6.77e-5 → 1.98e-5 (k = 256 → 512,
 /// order 1.78, estimate/true 0.92); Ω = 1.7, μN = 0.2: 1.11e-4 → 2.56e-5 (2.11, 1.11); damped
 /// c = 0.1, Ω = 0.7, μN = 0.6: 1.49e-4 → 6.0e-5 (1.31, 0.71); long stick c = 0.167, Ω = 1.324,
-/// μN = 0.885: 1.82e-3 → 1.89e-4 (3.26, 2.89; load 13); the others in README "Friction".
+/// μN = 0.885: 1.82e-3 → 1.89e-4 (3.26, 2.89; load 13); the others in validation/RECORD.md "Friction".
 #[test]
 fn event_fitted_half_steps_are_second_order_and_within_1e_3_at_k_512() {
     // The 2-DOF chain of validation/peers/friction_half_steps_family.py (seed 11, rounded).
@@ -193,7 +193,7 @@ fn event_fitted_half_steps_are_second_order_and_within_1e_3_at_k_512() {
         );
         assert!(runs[1].lcp.path.contains("event-fitted laws"), "{}", runs[1].lcp.path);
         assert!(e[1] < 1e-3, "k = 512: {:.3e}", e[1]);
-        // The order with stops or damping wanders (0.94–2.57 over the family, README "Friction").
+        // The order with stops or damping wanders (0.94–2.57 over the family, validation/RECORD.md "Friction").
         // The members whose k = 256 needed a fallback start: 256 → 512 is off the asymptote
         // (measured 1.04 and 1.52; 512 → 1024 by validation/peers: 3.45 and 2.34).
         assert!(closed.is_none() || name.contains("k = 256") || order > 1.6, "order {order:.2}");

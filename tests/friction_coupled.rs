@@ -152,7 +152,7 @@ fn coupled_friction_scene_keys_are_checked() {
     assert!(e.contains("friction[0].contact") && e.contains('3'), "{e}");
 }
 
-/// Member 3 of the random family of README "Friction" (`coupled_family.py 2031`): k_xy −0.633,
+/// Member 3 of the random family of validation/RECORD.md "Friction" (`coupled_family.py 2031`): k_xy −0.633,
 /// k_c 23.95, μ 0.450, N0 1.496, N1 1.190, drive 0.496, Ω 1.778 (κ 0.229), at `steps` instants.
 fn member_3(steps: usize, method: &str) -> Result<Response, SolveError> {
     let text = format!(

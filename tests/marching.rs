@@ -79,7 +79,7 @@ fn march_stiff_two_dof_stays_second_order_at_fine_steps() {
 fn march_stiff_two_dof_with_coupled_mass_errs_within_its_conditioning_at_fine_steps() {
     // With M coupled, the increment's −ŴK x carries ε‖Ŵ‖‖K‖‖x‖, i.e. a stiffness error of
     // ε(ω₂/ω₁)² ≈ 1.5e-9 of the slow mode's, independent of N (the periodic LCP's steps carry the
-    // same; README "On a family"). Measured excess over the order-2 line: ≤ 4.1e-10 up to N = 2^19.
+    // same; validation/RECORD.md "On a family"). Measured excess over the order-2 line: ≤ 4.1e-10 up to N = 2^19.
     // The two-step form's rounding grows as N² instead (ε/(hω₁)² ≈ 3e-7 at N = 2^18).
     let model = stiff_two_dof([[1.0, 0.5], [0.3, 1.0]]);
     let floor = f64::EPSILON * 1.0001e7 / (1.44 / 1.001);

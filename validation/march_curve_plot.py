@@ -1,4 +1,4 @@
-"""The cost–accuracy curve of issue 23 (README "The cost–accuracy curve"): error against CPU of the
+"""The cost–accuracy curve of issue 23 (validation/RECORD.md "The cost–accuracy curve"): error against CPU of the
 explicit march and of ours (`auto`, `auto` + polish), one panel per march_bench output.
 
     validation/.venv/bin/python validation/march_curve_plot.py out/march-bench/rigid-massless-boundary-2300.txt \

@@ -56,7 +56,7 @@ def test_side_by_side(cli, monkeypatch, tmp_path, name, omega):
 def test_chain_sweep_polish_meets_the_exact_simulation(cli, monkeypatch, tmp_path):
     """The chain across both modes (0.77, 1.85 rad/s), k = 512: the plain LCP and the polish
     against the exact simulation per point. Default 4 points in [0.35, 2.3] (~4 s);
-    PC_FRICTION_SWEEP=40 runs the README's 40 points in [0.3, 2.6] (~1 min).
+    PC_FRICTION_SWEEP=40 runs the record's 40 points (validation/RECORD.md "Friction") in [0.3, 2.6] (~1 min).
     Asserted: the polish succeeds within 1e-8 at every point, whatever its events (the 8-event
     orbit at Ω = 0.595, whose short stops the LCP misses, by marching the exact flows; the orbits
     stuck all period near 2.5, compared up to their means)."""

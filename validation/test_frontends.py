@@ -60,7 +60,7 @@ SLOW = {
 REFUSED = {}
 # Scenes whose lone solve is reached by the frequency walk from below: the CLI's answer must equal
 # the last point of a sweep warm from below on another grid (an independent route to the same
-# orbit): (output DOF, sweep start [rad/s], points), peak amplitude to 1e-9. README "Friction", the
+# orbit): (output DOF, sweep start [rad/s], points), peak amplitude to 1e-9. validation/RECORD.md "Friction", the
 # rubbing real blade: the walk starts cold at 2270 rad/s, this sweep at 2200 (≈ 5 rad/s steps).
 SWEPT = {"examples/rubbing/real-blade-mu0.15.toml": ("20272", 2200.0, 21)}
 # Shipped TOML files that are not scenes to solve, with the reason.
@@ -161,7 +161,7 @@ def _refused_everywhere(cli, scene, path, fmu, k, phrase):
 def _same_as_the_sweep(cli, scene, folder):
     """At the scene's own frequency, the CLI's peak amplitude of SWEPT[scene]'s DOF equals the last
     point of a sweep warm from below. Not at the whole-nanosecond frequency: 0.18 rad/s below
-    2300 the walk crosses the fold by marching and lands on another orbit (README "Friction")."""
+    2300 the walk crosses the fold by marching and lands on another orbit (validation/RECORD.md "Friction")."""
     dof, start, points = SWEPT[scene]
     os.makedirs(folder, exist_ok=True)
     path = _scene_copy(scene, folder, None)

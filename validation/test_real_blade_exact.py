@@ -1,5 +1,5 @@
 """The CalculiX-assembled blade with compliant tip contacts against the grid-free exact orbit
-(issue 23; README "Real-blade benchmark", "Compliant tips against the exact flow").
+(issue 23; validation/RECORD.md "Real-blade benchmark", "Compliant tips against the exact flow").
 
 The reference is validation/exact_flow.py on the model the CLI exports (`periodic-contact
 export`): piecewise-linear flows between contact switches, Newton shooting, no time grid.

@@ -78,7 +78,7 @@ pub fn solve_to_tolerance_within(problem: &mut PeriodicProblem, target: &Accurac
                 Some(r) => Ok(r.clone()),
                 None => {
                     // Warm from this k's active set, as `accuracy::estimate` does (cold, the rigid
-                    // massless blade missed in shooting at 2k = 1024: README "Against time
+                    // massless blade missed in shooting at 2k = 1024: validation/RECORD.md "Against time
                     // marching"), and bounded as it is (an unbounded dense fallback ran minutes).
                     let rs = neighbour::solve(second, &carried_active_set(&active, rows, instants, second.instants()), &budget, note)?;
                     solved.push(rs.clone());

@@ -24,7 +24,7 @@
 //!
 //! Why: the two-step form's Ŵ(2M/h² − K) is 2I − h²M⁻¹K rounded to ε·‖Ŵ‖‖M‖/h², a stiffness
 //! error ε·κ/h² that grows as N²: on the Craig–Bampton blade (h ≈ 1.6e-8 s) it erred 4e-5 at
-//! N = 20 992 and 1.2e-3 at 163 840 instead of falling as N⁻² (README "On a family").
+//! N = 20 992 and 1.2e-3 at 163 840 instead of falling as N⁻² (validation/RECORD.md "On a family").
 //!
 //! λ_n is a force acting in the step equation at t_n; it enforces the clearance at t_{n+1}
 //! (forward increment), and its impulse is λ_n·h. On a contact DOF carrying mass this is a

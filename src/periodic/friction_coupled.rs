@@ -11,7 +11,7 @@ use crate::model::{Compliance, Model};
 use crate::time::Discretization;
 
 /// Fewest instants of the coarsest grid of the k-continuation ([`continued`]). Why: measured on
-/// the random family of README "Friction" (seed 2031, member 3), bds1 at k = 128 and 256 holds
+/// the random family of validation/RECORD.md "Friction" (seed 2031, member 3), bds1 at k = 128 and 256 holds
 /// only the orbit pressed all period, while k ≥ 512 also holds a lift-off orbit (a second exact
 /// periodic orbit of the event-driven simulation) that cold Lemke ends on.
 const CONTINUATION_COARSEST: usize = 128;
@@ -67,7 +67,7 @@ pub(super) fn no_solution(problem: &PeriodicProblem, asm: &Assembly, sol: LcpSol
 /// coarsest grid k0 = k/2ⁿ ≥ [`CONTINUATION_COARSEST`], then at each doubling Lemke from the
 /// complementary basis of the coarser solution's active set, each instant's unknowns copied to its
 /// two children. Why: the coupled LCP is not a P-matrix and can hold several periodic orbits
-/// (README "Friction": two exact orbits of one member); cold Lemke ends on any of them, which can
+/// (validation/RECORD.md "Friction": two exact orbits of one member); cold Lemke ends on any of them, which can
 /// change with k, while the continuation follows one orbit over the grids, the one the coarse
 /// grid (with bds1's larger numerical damping) holds. A failed warm start falls back to cold
 /// Lemke at that grid, and the note (for `lcp.path`) says so. Returns the solution at k and the

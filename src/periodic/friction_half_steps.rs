@@ -63,7 +63,7 @@ fn fit_from_starts(problem: &PeriodicProblem, map: &HalfStepMap, relay_only: boo
     // k/2; bds1's orbit without laws; rest. Why the second: bds1 (numerically damped) reverses
     // 2 steps before the half steps do on Den Hartog c = 0, Ω = 1.310, μN = 0.647 at k = 512, so
     // its laws' window (±1 step) missed the reversal and Newton wandered off (periodicity 1.3e-2
-    // after 60 iterations); the k/2 orbit's laws hold the event (measured, README "Friction").
+    // after 60 iterations); the k/2 orbit's laws hold the event (measured, validation/RECORD.md "Friction").
     // Why the third: from bds1's laws Newton cycled on Den Hartog c = 0, Ω = 1.506, μN = 0.51 at
     // k = 256 (I − P near singular on those sets); from bds1's orbit on the relay it converges.
     let pilot = bds1_start(problem, map);

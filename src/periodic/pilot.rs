@@ -9,7 +9,7 @@
 //! CPU) and missed; galerkin at k = 8192 the same (701, 42 s). bds1 (A-stable, damping the
 //! unresolved modes) solves the coarse grid in 5 Newton iterations from the contact-free orbit,
 //! and its orbit is on the fine grid's pieces or next to them: Newton from its sets then
-//! converged in 6–9 iterations (README "Real-blade benchmark").
+//! converged in 6–9 iterations (validation/RECORD.md "Real-blade benchmark").
 use super::{PeriodFft, PeriodicProblem, SolveError, SolverSettings};
 use crate::lcp::{BlockCirculant, LcpMethod, LcpSolution};
 use crate::time::{Discretization, Pairing, Scheme};
@@ -52,7 +52,7 @@ pub(super) fn warm_start(problem: &PeriodicProblem) -> Option<(Vec<usize>, usize
 /// folds again at 1.2e-6 and closes on the contact-free family after 52 steps (≈ 1500 set
 /// changes): the answer at δ = 0 is on another branch, and block pivoting (ray) and dense Lemke
 /// (1722 pivots, 2.5–4 s) followed. bds1 (A-stable, damped) on the same grid solves cold in
-/// 0.2 s, and Newton from its sets reaches the cds orbit (README "On a family, not one case").
+/// 0.2 s, and Newton from its sets reaches the cds orbit (validation/RECORD.md "On a family, not one case").
 pub(super) fn solve_after_cold_miss(problem: &PeriodicProblem, a: &BlockCirculant, q: &[f64]) -> Option<Result<(LcpSolution, Option<String>), SolveError>> {
     let settings = problem.solver_settings();
     let model = problem.model();

@@ -105,7 +105,7 @@ const HOMOTOPY_MIN_STEP: f64 = 1.0 / 256.0;
 /// affordable dense fallback follows (`shooting` alone, or `auto` on an LCP whose dense Lemke is
 /// refused by its projected cost), the μ-homotopy ([`friction_homotopy`]) gives shooting a warm
 /// start. Why: near the real blade's μ = 0.15 resonance cold shooting's offset homotopy follows a
-/// path that folds and ends at a kink (README "Friction"), where μ = 0 solves at once. Where that
+/// path that folds and ends at a kink (validation/RECORD.md "Friction"), where μ = 0 solves at once. Where that
 /// misses too, a lone solve (`auto`; a sweep's tries are `shooting`) walks up in ω from below
 /// ([`walk::walk_up`]). Returns the solution and, after the walk, a note for `lcp.path`.
 pub(super) fn solve_lcp(

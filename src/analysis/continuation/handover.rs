@@ -7,7 +7,7 @@ use super::BranchPoint;
 
 /// Largest relative difference of the outputs' amplitudes between the last exact orbit and the
 /// discrete walk's first (same λ) for the two to be one orbit: the scheme's O(h^p) error at the
-/// grids used is ≤ 1e-2 (README, the coarse blade's exact vs k = 1024 amplitudes); a change of
+/// grids used is ≤ 1e-2 (validation/RECORD.md, the coarse blade's exact vs k = 1024 amplitudes); a change of
 /// branch is O(1).
 pub(super) const HANDOVER_JUMP: f64 = 5e-2;
 

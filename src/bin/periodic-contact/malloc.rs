@@ -3,7 +3,7 @@
 //! transient buffers (the CalculiX text, Lanczos blocks of n × 4, faer's scratch) are megabytes:
 //! by default glibc maps each with mmap and returns it on free (or trims the heap top), so every
 //! stage touches fresh pages again; page faults were 0.5–1.7 s of system CPU per set-up of the
-//! real blade (README "Real-blade benchmark", set-up round 3). Keeping freed memory in the heap
+//! real blade (validation/RECORD.md "Real-blade benchmark", set-up round 3). Keeping freed memory in the heap
 //! costs peak RSS (≈ 320 → 460 MB there) and saves those faults.
 
 /// Serves every allocation below 2 GiB from the heap and never trims it (mallopt(3):

@@ -1,5 +1,5 @@
 //! The frequency walk of a lone rubbing solve (issue 25): where shooting and the μ-homotopy miss
-//! at ω, the orbit a sweep reaches from below. On the real blade at 2300 rad/s (README
+//! at ω, the orbit a sweep reaches from below. On the real blade at 2300 rad/s (validation/RECORD.md
 //! "Friction") the branch from below folds near 2278.4 rad/s and its orbits there are not joined
 //! by a μ-path to μ = 0; a sweep crosses the fold as Newton from the last orbit before it, at the
 //! next point past it, lands on the branch above. The walk is that sweep, on a grid ending at ω.

@@ -2,7 +2,7 @@
 //! vanish within the step: merged where the merged orbit's landing force crosses zero (located
 //! there to the bracket, [`Walk::held_merge`]) instead of landed on by quarters. On the coarse
 //! rigid blade at 2390–2398 rad/s contacts 0 and 2 open and close such flights every 0.2–0.6
-//! rad/s, and the quarters took 10–15 points per merge (README, session 21).
+//! rad/s, and the quarters took 10–15 points per merge (validation/RECORD.md, session 21).
 use super::family::Node;
 use super::{Switch, Walk, rigid};
 

@@ -263,7 +263,7 @@ mod tests {
 
     #[test]
     fn a_test_flat_on_one_side_is_located_from_the_other() {
-        // A rigid margin near a grazing (README, session 22): 1e-9 and 3 % round-off before, a
+        // A rigid margin near a grazing (validation/RECORD.md, session 22): 1e-9 and 3 % round-off before, a
         // clearance falling at 0.05 per unit past 0.3; the sign changes at 0.3 + 1e-9/0.05.
         let g = |u: f64| (1e-9 + 3e-11 * (1e3 * u).sin()).min(1e-9 - 0.05 * (u - 0.3));
         let root = 0.3 + 1e-9 / 0.05;

@@ -32,7 +32,7 @@ use locate::{Test, detail_of, locate, side, test_value};
 /// A phase shorter than this (fraction of the period) and shrinking has vanished: a grazing.
 const VANISH: f64 = 1e-6;
 /// Below this step a corrector failing on a flight's re-impact time alone ([`Family::unresolved_flight`]):
-/// the flight is below resolution, merged, not crawled at (coarse rigid blade, 2338.39 rad/s; README).
+/// the flight is below resolution, merged, not crawled at (coarse rigid blade, 2338.39 rad/s; validation/RECORD.md).
 const UNRESOLVED_STEP: f64 = 1e-4;
 /// Above this step a rigid change whose bisection fails is stepped at again shorter, not placed at the step's start.
 const UNLOCATED_STEP: f64 = 1e-4;

@@ -98,7 +98,7 @@ impl Walk<'_> {
     /// `next` breaks the signature that holds at `here`: the change located between them, the
     /// multiplier events before it recorded, and the first point of the branch past it.
     /// `None` where the bisection fails and `retry` (the caller shortens its step): the bracket's
-    /// start is no location (the real blade's 2299.5250 and 2286.4071 rad/s: step points, README).
+    /// start is no location (the real blade's 2299.5250 and 2286.4071 rad/s: step points, validation/RECORD.md).
     pub(super) fn rigid_crossing(&mut self, here: &Node, next: &Node, to: f64, retry: bool) -> Option<Node> {
         // Where the bisection's corrector fails (close to a singular event), from the bracket itself.
         let (lo, hi) = match locate(&self.fam, here, next, Test::Value(&|n| margin(n) + TOL), false) {
@@ -164,7 +164,7 @@ impl Walk<'_> {
                 // The held orbit went on while its micro-flight was below resolution: the change
                 // is where the landing force crosses zero, back towards `here` (or just behind).
                 let back = if (here.lambda(rho) - l0).abs() > 1e-9 * rho { here.lambda(rho) } else { l0 - sense * 1e-4 * rho };
-                // Not ahead of `lo`: the secant may run on to the next zero (2351.59 → 2354.03 rad/s, README).
+                // Not ahead of `lo`: the secant may run on to the next zero (2351.59 → 2354.03 rad/s, validation/RECORD.md).
                 let zero = landing::landing_zero(&self.fam, &lo.w, e, (l0, back), sense).map(|z| z.0).filter(|z| (z.lambda(rho) - l0) * sense <= BRACKET * rho);
                 if let Some(n) = self.unmerge(&lo, zero.as_ref(), e, sense, &what) {
                     return Some(n);

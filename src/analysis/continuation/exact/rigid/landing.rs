@@ -164,7 +164,7 @@ mod tests {
     /// by bisection on its regime in tests/rigid_branch.rs). Sought from Ω = 0.63 with the first
     /// trial far out, where the corrector fails (the coarse rigid blade at 2398.27 rad/s: a trial
     /// 0.075 rad/s on, the zero 6e-7 rad/s on, so the merge fell back to another contact's change
-    /// and the walk turned back; README): the trial is moved back until it converges.
+    /// and the walk turned back; validation/RECORD.md): the trial is moved back until it converges.
     #[test]
     fn the_landing_force_zero_is_found_past_a_trial_the_corrector_cannot_reach() {
         let p = sticking_oscillator(0.7);

@@ -13,7 +13,7 @@ use super::{TOL, landing, margin, trace};
 /// searched ahead whose merged orbit is admissible at `la` already (the merge is there, to
 /// resolution) meets the next change instead, and the branch oriented away from it walks back
 /// over the old one (the coarse rigid blade at 2398.27 rad/s: contact 0's flight merged at
-/// contact 2's landing 0.005 rad/s on, the walk turned back down to 2150; README).
+/// contact 2's landing 0.005 rad/s on, the walk turned back down to 2150; validation/RECORD.md).
 pub(super) fn touch_point(fam: &mut Family, guess: &[f64], (la, lb): (f64, f64), own: Option<usize>) -> Option<Node> {
     let (rho, d) = (fam.rho, fam.dim());
     let e_l = lambda_axis(d);
