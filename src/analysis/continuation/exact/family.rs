@@ -525,7 +525,7 @@ mod tests {
         let stop = Contact::on_dof(1, 1.0, 100.0, Compliance::Rigid);
         let model = Model { structure, forces: vec![force], contacts: vec![stop], frequency: omega, frictions: Vec::new(), rubbing: Vec::new() };
         let disc = Discretization { scheme: Scheme::Bds1, steps: 256, pairing: None };
-        let outputs = OutputSelection { displacement: vec![0], ..OutputSelection::default() };
+        let outputs = OutputSelection { displacement: vec![0], contacts: true, ..OutputSelection::default() };
         PeriodicProblem::new(model, disc, outputs, SolverSettings::default()).expect("the tipped oscillator's problem")
     }
 
