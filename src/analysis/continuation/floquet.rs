@@ -93,10 +93,11 @@ pub fn complex_outside(mu: &[Complex64]) -> usize {
     mu.iter().filter(|m| m.im.abs() > 1e-9 * m.norm() && m.norm() > 1.0).count()
 }
 
-/// A real multiplier within 0.1 of −1 on each side of it, one in `a` and one in `b` (a period
-/// doubling between two points, where det(I + M)'s sign change could not be located).
-pub fn crosses_minus_one(a: &[Complex64], b: &[Complex64]) -> bool {
-    let near = |mu: &[Complex64], inside: bool| mu.iter().any(|m| m.im.abs() <= 1e-9 * m.norm() && (m.re + 1.0).abs() < 0.1 && (m.re > -1.0) == inside);
+/// A real multiplier within 0.1 of `at` (−1 or +1) on each side of it, one in `a` and one in
+/// `b`: a period doubling (−1) or a fold (+1, Seydel 2010, §7.4) between two points, where its
+/// test's sign change could not be located.
+pub fn crosses(a: &[Complex64], b: &[Complex64], at: f64) -> bool {
+    let near = |mu: &[Complex64], inside: bool| mu.iter().any(|m| m.im.abs() <= 1e-9 * m.norm() && (m.re - at).abs() < 0.1 && (m.re.abs() < 1.0) == inside);
     (near(a, true) && near(b, false)) || (near(a, false) && near(b, true))
 }
 

@@ -329,7 +329,7 @@ impl Walk<'_> {
                 let pred: Vec<f64> = w0.iter().zip(&next.w).map(|(a, b)| a + f * (b - a)).collect();
                 let d = self.fam.dim();
                 let e_l = lambda_axis(d);
-                self.fam.correct(&pred, &e_l, bound / rho).and_then(|w| self.fam.node_with(w, &self.fam.metric.lower(&next.tangent), false)).unwrap_or(next)
+                self.fam.correct(&pred, &e_l, bound / rho).and_then(|w| self.fam.node_with(w, &next.tangent, false)).unwrap_or(next)
             } else {
                 next
             };
@@ -445,8 +445,8 @@ impl Walk<'_> {
         let along = metric.unit(passed.as_ref().map_or(&here.tangent, |p| &p.tangent));
         let normal = metric.lower(&along);
         let target = dot(&normal, &pred);
-        // Oriented in the metric too: the stiff components' turning must not decide the sense.
-        let n = self.fam.correct(&pred, &normal, target).and_then(|w| self.fam.node_with(w, &normal, false))?;
+        // Oriented in the metric too ([`Family::tangent`]).
+        let n = self.fam.correct(&pred, &normal, target).and_then(|w| self.fam.node_with(w, &along, false))?;
         let metric = &self.fam.metric;
         let drift = metric.norm(&n.w.iter().zip(&pred).map(|(a, b)| a - b).collect::<Vec<_>>());
         let turn = metric.dot(&metric.unit(&n.tangent), &along);
@@ -495,6 +495,16 @@ impl Walk<'_> {
                 continue;
             }
             let s = side(a, kind);
+            if kind == EventKind::Fold && std::env::var_os("PC_TRACE_FOLD").is_some() {
+                let (ta, tb) = (test_value(a, kind), test_value(b, kind));
+                let (raw, met) = (dot(&a.tangent, &b.tangent), self.fam.metric.dot(&a.tangent, &b.tangent));
+                let rho = self.fam.rho;
+                eprintln!(
+                    "fold trace: a λ {:.10} t_λ {ta:e}, b λ {:.10} t_λ {tb:e}; tangents' product {raw:e}, in the metric {met:e}",
+                    a.lambda(rho),
+                    b.lambda(rho)
+                );
+            }
             let value = |n: &Node| if side(n, kind) == s { 1.0 } else { -1.0 } * test_value(n, kind).abs();
             let same = |n: &Node| side(n, kind) == s;
             let test = if kind == EventKind::NeimarkSacker { Test::Side(&same) } else { Test::Point(&value) };
@@ -505,8 +515,14 @@ impl Walk<'_> {
             // velocity fading at a grazing, Nordmark 1991): no multiplier at −1, no doubling.
             // Unlocated (a trial's corrector failed), a real multiplier crossing −1 between the
             // two points is the doubling (the real blade's at 2283.42 rad/s was dropped so).
-            let doubling = if missed { floquet::crosses_minus_one(&a.mu, &b.mu) } else { node.mu.iter().any(|m| (m + 1.0).norm() < 1e-3) };
+            let doubling = if missed { floquet::crosses(&a.mu, &b.mu, -1.0) } else { node.mu.iter().any(|m| (m + 1.0).norm() < 1e-3) };
             if kind == EventKind::PeriodDoubling && !doubling {
+                continue;
+            }
+            // Unlocated, a fold needs a real multiplier through +1 too: the tangent's λ component
+            // alone flips in the corrector's noise where the walk crawls into a singular merge
+            // (the coarse rigid blade at 2402.2578806 rad/s: steps of 2e-11, |μ| 0.9495 on both sides).
+            if kind == EventKind::Fold && missed && !floquet::crosses(&a.mu, &b.mu, 1.0) {
                 continue;
             }
             let mut detail = detail_of(kind, &node);
