@@ -407,7 +407,7 @@ impl Family {
     /// the arclength's metric G, as the walk's steps are. Oriented in the unknowns' own product, a
     /// point located between two steps (a grazing's, a fold's) could get the reverse of the walk's
     /// sense where the stiff components, which the metric leaves out, turn: a fold recorded with λ
-    /// still increasing (the coarse rigid blade at 2481.59 and five more, README).
+    /// still increasing (the coarse rigid blade at 2481.59 and five more, validation/RECORD.md).
     pub fn tangent(&self, jac: &DMatrix<f64>, prev: &[f64]) -> Option<Vec<f64>> {
         let d = self.dim();
         let border = self.metric.lower(prev);
@@ -545,7 +545,7 @@ mod tests {
     /// A point's tangent is oriented along the walk's sense in the arclength's metric, whatever
     /// the stiff components (which the metric leaves out) of the tangent it is oriented along:
     /// the coarse rigid blade's located points took the reverse sense there, and six folds were
-    /// recorded with λ increasing (README, issue 24). Reference: the secant of the closed-form
+    /// recorded with λ increasing (validation/RECORD.md, issue 24). Reference: the secant of the closed-form
     /// linear orbits at Ω ± δ (λ increasing); the previous tangent given is that sense plus a
     /// large stiff-mode component against it in the unknowns' own product.
     #[test]
