@@ -148,9 +148,7 @@ fn a_massless_contact_held_arc_vanishing_ends_in_flight_on_the_exact_branch() {
 /// form's ω_g, no fold, every point exact, amplitudes and multipliers the closed form's.
 fn check_grazing_walk(from: f64, to: f64) {
     let (lo, hi) = (from.min(to), from.max(to));
-    // (k1 − u)² + c²u − (F/g)² = 0, the root below resonance.
-    let (b, c0) = (C * C - 2.0 * K1[0], K1[0] * K1[0] - (F / GRAZE_GAP).powi(2));
-    let graze = ((-b - (b * b - 4.0 * c0).sqrt()) / 2.0).sqrt();
+    let graze = graze_at(GRAZE_GAP);
     let linear = |w: f64| F / ((K1[0] - w * w).powi(2) + (C * w).powi(2)).sqrt();
     assert!(linear(lo) < GRAZE_GAP && linear(hi) > GRAZE_GAP, "the grazing must lie in the range");
     let outputs = OutputSelection { displacement: vec![0], velocity: vec![], acceleration: vec![], contacts: true };
@@ -244,35 +242,77 @@ fn inside_model(omega: f64, lead: f64) -> Model {
 /// exact (measured: 1.2e-12 and 4.6e-13 from the closed forms, 61 points, 0.5 s).
 #[test]
 fn a_massless_held_arc_vanishing_with_another_contacts_closing_inside_it() {
-    // (k1 − u)² + c²u − (F/g)² = 0, the root below resonance: where the linear amplitude is the gap g.
-    let graze_at = |g: f64| {
-        let (b, c0) = (C * C - 2.0 * K1[0], K1[0] * K1[0] - (F / g).powi(2));
-        ((-b - (b * b - 4.0 * c0).sqrt()) / 2.0).sqrt()
-    };
     let graze = graze_at(GRAZE_GAP);
     let psi = (C * graze).atan2(K1[0] - graze * graze);
     let ob = CompliantStopOrbit::solve(&Oscillator::new(1.0, C, K1[0], F, graze), K2, B_GAP, None).unwrap();
     let lead = (ob.entry_time().unwrap() / ob.period() - psi / (2.0 * std::f64::consts::PI)).rem_euclid(1.0);
-    let (from, to) = (0.75, 0.6);
+    eprintln!("lead {lead:.6}");
+    // A's arc vanishing (B's closing inside it), then B's own at its gap's ω_g further down.
+    let br = walk_two_grazings(inside_model(0.75, lead), (0.75, 0.6), (graze, graze_at(B_GAP)));
+    assert!(br.events().all(|e| !e.detail.contains("not traced")), "the branch past the grazing is the exact orbit's");
+}
+
+/// (k1 − u)² + c²u − (F/g)² = 0, the root below resonance: where A's linear amplitude is the gap g.
+fn graze_at(g: f64) -> f64 {
+    let (b, c0) = (C * C - 2.0 * K1[0], K1[0] * K1[0] - (F / g).powi(2));
+    ((-b - (b * b - 4.0 * c0).sqrt()) / 2.0).sqrt()
+}
+
+/// The walk of the two-mass `model` over `from → to`, every point exact and the range reached,
+/// with one grazing of each contact, at `want` (A's, B's) within 1e-8.
+fn walk_two_grazings(model: Model, (from, to): (f64, f64), want: (f64, f64)) -> continuation::Branch {
     let outputs = OutputSelection { displacement: vec![0, 2], velocity: vec![], acceleration: vec![], contacts: true };
     let disc = Discretization { scheme: Scheme::Cds, steps: 256, pairing: None };
-    let p = PeriodicProblem::new(inside_model(from, lead), disc, outputs, SolverSettings::default()).unwrap();
+    let p = PeriodicProblem::new(model, disc, outputs, SolverSettings::default()).unwrap();
     let start = std::time::Instant::now();
     let br = continuation::run(&p, Parameter::Frequency, from, to, &ContinuationSettings::default(), &|_| {}).unwrap();
-    eprintln!("lead {lead:.6}: {} points in {:.2} s: {}", br.points.len(), start.elapsed().as_secs_f64(), br.stop);
+    eprintln!("{} points in {:.2} s: {}", br.points.len(), start.elapsed().as_secs_f64(), br.stop);
     for e in br.events() {
         eprintln!("event at ω = {:.12}: {:?} {}", e.parameter, e.event, e.detail);
     }
     assert!(br.reached(), "{}", br.stop);
     assert!(br.points.iter().all(|q| q.source == Source::Exact), "{}", br.stop);
-    // A's arc vanishing (B's closing inside it), then B's own at its gap's ω_g further down.
     let grazings: Vec<(f64, bool)> =
         br.events().filter(|e| e.event == Some(EventKind::Grazing)).map(|e| (e.parameter, e.detail.starts_with("contact 0"))).collect();
     assert_eq!(grazings.len(), 2, "two grazings: {grazings:?}");
     for (at, a) in grazings {
-        let want = if a { graze } else { graze_at(B_GAP) };
+        let want = if a { want.0 } else { want.1 };
         eprintln!("grazing of {} at {at:.12} (closed form {want:.12})", if a { "A" } else { "B" });
         assert!((at - want).abs() < 1e-8, "grazing at {at} instead of {want}");
     }
-    assert!(br.events().all(|e| !e.detail.contains("not traced")), "the branch past the grazing is the exact orbit's");
+    br
+}
+
+/// Mass B's spring in [`next_model`]: its resonance (√0.05 ≈ 0.22 rad/s) well below A's grazing,
+/// so that B's free amplitude grows as ω falls there (with 0.3 B's branch folds 3e-6 rad/s past its
+/// grazing, a real fold: |μ| through 1).
+const K1_NEXT: f64 = 0.05;
+
+/// Two uncoupled masses with massless contact points: A as [`grazing_model`]'s (stop GRAZE_GAP
+/// away), B of spring K1_NEXT with its stop `gap_b` away.
+fn next_model(omega: f64, gap_b: f64) -> Model {
+    let mut m = inside_model(omega, 0.0);
+    let mut k: Vec<Vec<f64>> = (0..4).map(|i| (0..4).map(|j| m.structure.stiffness.get(i, j)).collect()).collect();
+    k[2][2] = K1_NEXT + K2;
+    m.structure.stiffness = Matrix::from_rows(&k);
+    m.contacts[1].gap = gap_b;
+    m
+}
+
+/// A's held arc vanishing with another contact's change a short way on (the real blade at
+/// 1124.25 rad/s: contact 16's held arc merged, the walk then turned back up and retraced its
+/// events). Walking down, A's arc vanishes at A's ω_g; B (above its resonance) is free there and
+/// its clearance touches zero 2e-5 rad/s lower, at ω_B (its gap is its linear amplitude there,
+/// F/√((k1 − ω²)² + (cω)²)). The orbit without A's arc is admissible where the walk merges it;
+/// the change sought ahead of that point must be A's, not B's (found 1e-3 of the range on):
+/// both grazings at their closed forms, λ falling at every point, the range reached.
+#[test]
+fn a_massless_held_arc_vanishing_just_before_another_contacts_grazing() {
+    let graze = graze_at(GRAZE_GAP);
+    let next = graze - 2e-5;
+    let gap_b = F / ((K1_NEXT - next * next).powi(2) + (C * next).powi(2)).sqrt();
+    eprintln!("gap B {gap_b:.9}");
+    let br = walk_two_grazings(next_model(0.75, gap_b), (0.75, 0.7), (graze, next));
+    let turned = br.points.windows(2).find(|w| w[1].parameter > w[0].parameter + 1e-12);
+    assert!(turned.is_none(), "λ turned back: {:?}", turned.map(|w| (w[0].parameter, w[1].parameter)));
 }

@@ -2,7 +2,10 @@
 //! contact's event inside the arc (the real blade at 2278.97466 rad/s: contact 13's arc with
 //! contact 15's landing in it, holding 15 relieving 13) the arc shrinks linearly in λ, not as a
 //! √, so the point where it is below [`super::super::VANISH`] lies a finite way before its zero
-//! (3e-5 rad/s there, the orbit without it penetrating by 2e-8 of the clearance scale).
+//! (3e-5 rad/s there, the orbit without it penetrating by 2e-8 of the clearance scale). Where the
+//! orbit without the arc is admissible at the merge already, a sign change found further on is
+//! another contact's change, refused (the real blade at 1124.34 rad/s: contact 16's arc merged at
+//! another contact's change 0.09 rad/s on, and the walk turned back up, validation/RECORD.md).
 use super::super::family::Node;
 use super::super::{Walk, signature};
 use super::{timed, trace};
@@ -26,7 +29,9 @@ impl Walk<'_> {
         reach.retain(|f| *f > 0.0 && *f <= 1e-2);
         reach.sort_by(f64::total_cmp);
         let list: Vec<_> = timed(&here.orbit).into_iter().enumerate().filter(|(i, _)| *i != e && *i != b).map(|(_, l)| l).collect();
-        if let Some(n) = reach.into_iter().find_map(|f| self.fade((lambda, lambda + sense * f * rho), here, list.clone(), what, ("the held arc", None))) {
+        // Another contact's change ahead is the next one, not this arc's end (`touch_point`'s `own`).
+        let own = Some(self.fam.sig.events[e].contact);
+        if let Some(n) = reach.into_iter().find_map(|f| self.fade((lambda, lambda + sense * f * rho), here, list.clone(), what, ("the held arc", own))) {
             return Some(n);
         }
         let (sig, guess) = signature::remove(&self.fam, &here.orbit, e, here.w[here.w.len() - 1])?;
