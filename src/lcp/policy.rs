@@ -282,7 +282,7 @@ fn shooting(
     sol.info.warm_start_used = sol.info.warm == WarmOutcome::Accepted;
     sol.info.path = vec![LcpStep { method: LcpMethod::Shooting, size: q.len(), pivots: shot.iterations, outcome: sol.outcome, time_s: sol.info.time_s }];
     let state = solved.then_some(shot.state);
-    sol.info.orbit_state.clone_from(&state);
+    sol.info.orbit_state = state.clone().map(std::sync::Arc::new);
     (sol, state)
 }
 
