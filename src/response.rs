@@ -136,6 +136,10 @@ pub struct Response {
     /// Indices of the LCP unknowns with z > 0 (time-major j·m + i): a warm start for the next solve.
     #[serde(skip)]
     pub active_set: Vec<usize>,
+    /// The closed orbit's initial state when shooting solved it (its step map's state,
+    /// `periodic::state_space`): a warm start for the same orbit on another grid.
+    #[serde(skip)]
+    pub orbit_state: Option<Vec<f64>>,
 }
 
 /// What `scheme = "auto"` chose and why (`analysis::scheme_auto`).

@@ -453,3 +453,77 @@ fn a_warm_start_on_the_answers_sets_stops_at_the_marchs_round_off() {
         assert!(warm.masks == cold.masks && apart <= 1e-10, "{apart:.1e} from the cold answer");
     }
 }
+
+/// The step map's state carried to another grid ([`carried_state`]) against the exact samples of
+/// a smooth orbit x(t) = A sin(ωt + φ): block 0 is x at the newest instant (L − 1)·h and block 1
+/// its backward difference (src/periodic/state_space.rs). For cds (L = 1) and bds1 (L = 0), k →
+/// 2k and k → k/2, every entry is within 3·h²·ω²·A of the other grid's exact state (h the finer
+/// step; by Taylor the midpoint rule, the linear extrapolation and a difference centred 1.5·h
+/// away err by at most 3·h²·max|x''|); a lost h-scaling or a wrong sign of bds1's shift errs by
+/// ≈ h·ω·A, 1/(3hω) ≈ 27 times the bound.
+#[test]
+fn the_carried_orbit_state_is_the_other_grids_to_second_order() {
+    use periodic_contact::periodic::carried_state;
+    let (omega, period) = (3.0, 2.0 * std::f64::consts::PI / 3.0);
+    let amplitude = [1.0, 0.4];
+    let x = |t: f64| -> Vec<f64> { amplitude.iter().zip([0.3, 1.9]).map(|(a, phase)| a * (omega * t + phase).sin()).collect() };
+    // The state at the newest instant (L − 1)·h of a grid of k steps: (x, ∇x).
+    let state = |lead: f64, k: usize| -> Vec<f64> {
+        let h = period / k as f64;
+        let (now, before) = (x((lead - 1.0) * h), x((lead - 2.0) * h));
+        now.iter().cloned().chain(now.iter().zip(&before).map(|(a, b)| a - b)).collect()
+    };
+    for (scheme, lead) in [(Scheme::Cds, 1.0), (Scheme::Bds1, 0.0)] {
+        for (from, to) in [(256, 512), (512, 256)] {
+            let carried = carried_state(scheme, &state(lead, from), from, to).expect("a step-map scheme");
+            let exact = state(lead, to);
+            let h = period / from.max(to) as f64;
+            let bound = 3.0 * h * h * omega * omega * amplitude[0];
+            let error = carried.iter().zip(&exact).fold(0.0f64, |a, (c, e)| a.max((c - e).abs()));
+            eprintln!("{scheme:?} k = {from} → {to}: carried within {error:.2e} of the exact state (bound 3h²ω²A = {bound:.2e}, hωA = {:.2e})", h * omega);
+            assert!(error <= bound, "{scheme:?} k = {from} → {to}: {error:.3e} > {bound:.3e}");
+        }
+    }
+    assert!(carried_state(Scheme::Fourier, &[1.0, 2.0], 8, 16).is_none(), "collocation has no step map");
+}
+
+/// Shooting warm-started on the doubled grid from the coarse answer's carried sets and its
+/// carried orbit state (a sweep's refinement, issue 23) ends on the cold answer of the fine grid
+/// (the reference: the same sets, the state to 1e-10 of ‖s‖) and skips the frozen sets' fixed
+/// point: a march fewer than from the carried sets alone, and no more period Jacobians (here the
+/// carried sets are the answer's, so the frozen start's Jacobian is Newton's too: 3 marches and
+/// 1 Jacobian against 2 and 1, measured).
+#[test]
+fn a_refinement_from_the_carried_orbit_state_ends_on_the_cold_answer_with_less_work() {
+    use periodic_contact::lcp::{ShootingOutcome, ShootingSettings, solve_shooting};
+    use periodic_contact::periodic::carried_state;
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("fmu/scenes/blade-casing-coarse.toml");
+    let mut p = load(&path);
+    let settings = ShootingSettings::default();
+    let k = p.discretization().steps;
+    let coarse = solve_shooting(&step_map(&p).unwrap(), None, &settings);
+    assert_eq!(coarse.outcome, ShootingOutcome::Converged);
+    p.set_discretization(Discretization { steps: 2 * k, ..p.discretization() }).unwrap();
+    let fine = step_map(&p).unwrap();
+    let cold = solve_shooting(&fine, None, &settings);
+    assert_eq!(cold.outcome, ShootingOutcome::Converged);
+    let sets: Vec<u64> = (0..2 * k).map(|j| coarse.masks[j / 2]).collect();
+    let frozen = solve_shooting(&fine, Some(&sets), &settings);
+    let state = carried_state(p.discretization().scheme, &coarse.state, k, 2 * k);
+    let carried = solve_shooting(&fine, Some(&sets), &ShootingSettings { warm_state: state, ..settings.clone() });
+    let size = cold.state.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    for (name, warm) in [("frozen sets' fixed point", &frozen), ("carried state", &carried)] {
+        let apart = warm.state.iter().zip(&cold.state).fold(0.0f64, |a, (x, y)| a.max((x - y).abs())) / size;
+        eprintln!(
+            "k = {} from the {name}: {:?}, {} marches, {} Jacobians, {} iterations; {apart:.1e} of ‖s‖ from the cold answer",
+            2 * k,
+            warm.outcome,
+            warm.marches,
+            warm.jacobians,
+            warm.iterations
+        );
+        assert_eq!(warm.outcome, ShootingOutcome::Converged, "{name}");
+        assert!(warm.masks == cold.masks && apart <= 1e-10, "{name}: {apart:.1e} from the cold answer");
+    }
+    assert!(carried.marches < frozen.marches && carried.jacobians <= frozen.jacobians, "no work saved");
+}

@@ -102,6 +102,9 @@ pub struct BlockCirculant {
     /// The blocks' DFT when the caller had it (Ĝ_p row-major m×m, p = 0..=k/2): the FFT
     /// products then skip the m² transforms of [`super::CirculantOperator`].
     spectrum: Option<Vec<num_complex::Complex64>>,
+    /// [`Self::max_abs_bound`] from the spectrum, once: a solve asks for it two or three times
+    /// (the finiteness check, the certification's round-off bound), each a pass over k/2·m².
+    bound: std::sync::OnceLock<(f64, bool)>,
 }
 
 /// Equal blocks are equal matrices, whether a spectrum came with them or not.
@@ -114,20 +117,21 @@ impl PartialEq for BlockCirculant {
 impl BlockCirculant {
     pub fn new(k: usize, m: usize, blocks: Vec<f64>) -> Self {
         assert_eq!(blocks.len(), k * m * m, "BlockCirculant: {} values for k={k}, m={m}", blocks.len());
-        BlockCirculant { k, m, blocks: blocks.into(), spectrum: None }
+        BlockCirculant { k, m, blocks: blocks.into(), spectrum: None, bound: std::sync::OnceLock::new() }
     }
     /// The matrix of block spectrum Ĝ_p (as [`Self::with_spectrum`]), its blocks formed by inverse
     /// FFT only when something asks for them ([`Self::blocks`]). Why: a shooting solve needs
     /// only the spectrum (the FFT products) and a bound of max|A|; forming the k·m² blocks was
     /// a tenth of the real blade's 200-point sweep (issue 23).
     pub fn from_spectrum(k: usize, m: usize, spectrum: Vec<num_complex::Complex64>) -> Self {
-        BlockCirculant { k, m, blocks: std::sync::OnceLock::new(), spectrum: None }.with_spectrum(spectrum)
+        BlockCirculant { k, m, blocks: std::sync::OnceLock::new(), spectrum: None, bound: std::sync::OnceLock::new() }.with_spectrum(spectrum)
     }
     /// The same matrix with its block spectrum Ĝ_p = Σ_d blocks[d] e^(−2πi pd/k) (row-major m×m,
     /// p = 0..=k/2), e.g. from the frequency-domain assembly it was transformed from.
     pub fn with_spectrum(mut self, spectrum: Vec<num_complex::Complex64>) -> Self {
         assert_eq!(spectrum.len(), (self.k / 2 + 1) * self.m * self.m, "BlockCirculant: spectrum of {} values for k={}, m={}", spectrum.len(), self.k, self.m);
         self.spectrum = Some(spectrum);
+        self.bound = std::sync::OnceLock::new();
         self
     }
     /// The block spectrum, when it came with the matrix.
@@ -164,6 +168,10 @@ impl BlockCirculant {
     /// Exact once the blocks are formed; the blocks are formed where the bound overflows.
     pub fn max_abs_bound(&self) -> (f64, bool) {
         let (Some(spectrum), None) = (self.spectrum.as_deref(), self.blocks.get()) else { return self.max_abs() };
+        *self.bound.get_or_init(|| self.bound_from_spectrum(spectrum))
+    }
+    /// [`Self::max_abs_bound`]'s pass over the spectrum.
+    fn bound_from_spectrum(&self, spectrum: &[num_complex::Complex64]) -> (f64, bool) {
         let (k, mm) = (self.k, self.m * self.m);
         if mm == 0 {
             return (0.0, true);
@@ -185,6 +193,7 @@ impl BlockCirculant {
     /// Adds diag(values) (length m) to every diagonal block: A + I_k ⊗ diag(values).
     pub fn add_block_diagonal(&mut self, values: &[f64]) {
         let m = self.m;
+        self.bound = std::sync::OnceLock::new();
         for (a, v) in values.iter().enumerate() {
             if let Some(blocks) = self.blocks.get_mut() {
                 blocks[a * m + a] += v;

@@ -135,7 +135,7 @@ pub fn solve_periodic_lcp_with(
     method: LcpMethod,
     tolerance: f64,
     warm_start: Option<&[usize]>,
-    reach: ShootingReach,
+    reach: ShootingReach<'_>,
     dense_pivots: Option<usize>,
 ) -> (LcpSolution, Option<Vec<f64>>) {
     if q.is_empty() {
@@ -200,7 +200,14 @@ pub fn solve_periodic_lcp_with(
                 sm,
                 tolerance,
                 warm_start,
-                &ShootingSettings { max_work, warm_only: reach.warm_only, homotopy: reach.homotopy, settle: reach.settle, ..defaults },
+                &ShootingSettings {
+                    max_work,
+                    warm_only: reach.warm_only,
+                    homotopy: reach.homotopy,
+                    settle: reach.settle,
+                    warm_state: reach.state.map(<[f64]>::to_vec),
+                    ..defaults
+                },
             );
             if sol.outcome == LcpOutcome::Solved || method == LcpMethod::Shooting || !dense_ok {
                 return (sol, state);
@@ -275,6 +282,7 @@ fn shooting(
     sol.info.warm_start_used = sol.info.warm == WarmOutcome::Accepted;
     sol.info.path = vec![LcpStep { method: LcpMethod::Shooting, size: q.len(), pivots: shot.iterations, outcome: sol.outcome, time_s: sol.info.time_s }];
     let state = solved.then_some(shot.state);
+    sol.info.orbit_state = state.clone().map(std::sync::Arc::new);
     (sol, state)
 }
 

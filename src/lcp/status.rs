@@ -54,6 +54,11 @@ pub struct LcpInfo {
     /// The methods the policy ran, in order (empty when no policy ran).
     #[serde(skip)]
     pub path: Vec<LcpStep>,
+    /// The closed orbit's initial state s_0 when shooting solved it (its step map's state), to
+    /// warm-start the same orbit on another grid (behind one pointer: `SolveError::Lcp` carries
+    /// this struct, and an error's size is bounded).
+    #[serde(skip)]
+    pub orbit_state: Option<std::sync::Arc<Vec<f64>>>,
 }
 
 /// What became of a warm-start guess.

@@ -30,7 +30,7 @@ pub use problem::{MAX_DENSE_FLOPS, MAX_LCP_SIZE, MAX_STEPS, MIN_STEPS, PeriodicP
 pub use recovery::render_path as render_lcp_path;
 pub use rubbing::TangentialRow;
 pub use session::{PeriodicSolver, WarmStart};
-pub use state_space::{NoStepMap, SHOOTING_MEMORY_MAX, SHOOTING_WORK_MAX, shooting_memory, shooting_work, step_map};
+pub use state_space::{NoStepMap, SHOOTING_MEMORY_MAX, SHOOTING_WORK_MAX, carried_state, shooting_memory, shooting_work, step_map};
 pub use tuning::Tuning;
 
 use crate::error::{Error, ErrorKind};
@@ -105,6 +105,9 @@ pub struct SolverSettings {
     /// estimate's neighbour solve bounds its dense fallback by its CPU budget
     /// (`analysis::accuracy`).
     pub dense_pivots: Option<usize>,
+    /// The orbit state a warm shooting try starts Newton from, with the warm sets (the same orbit
+    /// on another grid, [`carried_state`]); `None`: the warm sets' frozen fixed point.
+    pub shooting_state: Option<Vec<f64>>,
 }
 
 impl Default for SolverSettings {
@@ -117,6 +120,7 @@ impl Default for SolverSettings {
             shooting_homotopy: true,
             shooting_settle: 0,
             dense_pivots: None,
+            shooting_state: None,
         }
     }
 }

@@ -461,6 +461,7 @@ impl PeriodicProblem {
             warm_only: self.solver.shooting_warm_only,
             homotopy: self.solver.shooting_homotopy,
             settle: self.solver.shooting_settle,
+            state: self.solver.shooting_state.as_deref(),
         };
         let (sol, _state) = solve_periodic_lcp_with(a, q, step_map.as_ref(), method, self.solver.tolerance, warm_start, reach, self.solver.dense_pivots);
         match refused {

@@ -130,6 +130,7 @@ pub fn recover(problem: &PeriodicProblem, asm: &Assembly, fft: &PeriodFft, sol: 
         scheme_choice: None,
         linear_displacement,
         active_set,
+        orbit_state: sol.info.orbit_state.as_deref().cloned(),
     })
 }
 

@@ -30,6 +30,9 @@ pub struct PeriodicSolver {
     /// Active set of the last certified solution, the next warm start (`None`: start cold; an
     /// empty set is a guess too: no contact active).
     warm_start: Option<Vec<usize>>,
+    /// The orbit state the next warm shooting try starts from (another grid's answer carried
+    /// here, [`Self::set_warm_state`]); that try alone reads it.
+    warm_state: Option<Vec<f64>>,
     warm_starts: bool,
     last_start: WarmStart,
     /// The last assembly, reused while only gaps, motions or a common force scale change.
@@ -57,7 +60,17 @@ impl PeriodicSolver {
     /// Plans the FFT of the problem's k; the first solve is cold.
     pub fn new(problem: PeriodicProblem) -> Self {
         let fft = PeriodFft::new(problem.instants());
-        PeriodicSolver { problem, fft, warm_start: None, warm_starts: true, last_start: WarmStart::Cold, cache: None, assemblies: 0, misses: Vec::new() }
+        PeriodicSolver {
+            problem,
+            fft,
+            warm_start: None,
+            warm_state: None,
+            warm_starts: true,
+            last_start: WarmStart::Cold,
+            cache: None,
+            assemblies: 0,
+            misses: Vec::new(),
+        }
     }
 
     /// Whether solves start from the previous active set (default true).
@@ -175,9 +188,19 @@ impl PeriodicSolver {
         w.extend_from_slice(active_set);
     }
 
+    /// The orbit state (s_0 of the step map, [`crate::periodic::carried_state`]) the next warm
+    /// shooting try ([`Self::solve_by_shooting_with`]) starts Newton from, with the warm sets,
+    /// before their frozen fixed point; read by that try alone. Why: a sweep's refinement of a
+    /// point has its orbit on the coarser grid, and the fixed point costs a march and a period
+    /// Jacobian (issue 23).
+    pub fn set_warm_state(&mut self, state: Option<Vec<f64>>) {
+        self.warm_state = state;
+    }
+
     /// Solves, warm-started from the last active set when there is one, cold if that fails.
     /// The active set of the answer becomes the next warm start.
     pub fn solve(&mut self) -> Result<Response, SolveError> {
+        self.warm_state = None;
         let guess = self.warm_start.as_deref().filter(|_| self.warm_starts);
         let warm = guess.is_some();
         let result = if let Some(guess) = guess {
@@ -225,6 +248,7 @@ impl PeriodicSolver {
     pub fn solve_by_shooting_with(&mut self, warm: bool, homotopy: bool) -> Result<Response, SolveError> {
         let settings = self.problem.solver_settings().clone();
         let guess = self.warm_start.clone().filter(|_| warm && self.warm_starts);
+        let state = self.warm_state.take().filter(|_| guess.is_some());
         let attempt = Try { frequency: self.problem.model().frequency.to_bits(), warm: guess.clone(), homotopy };
         if let Some((_, e)) = self.misses.iter().find(|(t, _)| *t == attempt) {
             return Err(e.clone());
@@ -233,6 +257,7 @@ impl PeriodicSolver {
             method: crate::lcp::LcpMethod::Shooting,
             shooting_warm_only: guess.is_some(),
             shooting_homotopy: homotopy,
+            shooting_state: state,
             ..settings.clone()
         };
         self.problem.set_solver_settings(quick)?;

@@ -85,6 +85,27 @@ pub(super) fn coefficients(scheme: Scheme) -> Option<Coefficients> {
     })
 }
 
+/// A shooting answer's orbit state `state` (s_0, [`step_map`]'s state under `scheme`) on a grid of
+/// `from` instants, carried to `to` instants over the same period: the difference ∇^b x scales as
+/// h^b, so block b by (from/to)^b, and the newest instant (L − 1)·h moves with h, so x by
+/// (L − 1)·(from/to − 1)·∇x (first order in h, as the carried active set is). A Newton start
+/// for the same orbit on the other grid; `None` where the scheme has no step map or the state is
+/// not of its shape.
+pub fn carried_state(scheme: Scheme, state: &[f64], from: usize, to: usize) -> Option<Vec<f64>> {
+    let (lead, a2, ..) = coefficients(scheme)?;
+    let p = a2.len() - 1;
+    if from == 0 || to == 0 || state.is_empty() || !state.len().is_multiple_of(p) {
+        return None;
+    }
+    let (n, ratio) = (state.len() / p, from as f64 / to as f64);
+    let mut carried: Vec<f64> = state.iter().enumerate().map(|(e, v)| v * ratio.powi((e / n) as i32)).collect();
+    if p > 1 {
+        let shift = (lead as f64 - 1.0) * (ratio - 1.0);
+        (0..n).for_each(|r| carried[r] += shift * state[n + r]);
+    }
+    Some(carried)
+}
+
 /// The step map of `problem`'s LCP, or why there is none.
 pub fn step_map(problem: &PeriodicProblem) -> Result<StepMapLcp, NoStepMap> {
     let model = problem.model();

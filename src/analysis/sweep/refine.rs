@@ -54,6 +54,7 @@ pub(super) fn refine(
         let solver = &mut levels[level];
         let carried = crate::periodic::carried_active_set(&prev.active_set, m, prev.lcp.size / m, solver.problem().instants());
         solver.set_warm_start(&carried);
+        solver.set_warm_state(carried_state(prev, solver.problem(), m));
         let r =
             if guarded(solver.problem()) { solve_guarded(solver, None, f, ColdTry::No).0 } else { solver.update_frequency(f).and_then(|()| solver.solve()) };
         let r = match r {
@@ -214,9 +215,18 @@ fn second_solve(sessions: &mut Coarser, problem: &PeriodicProblem, first: &Respo
     let k_first = first.lcp.size / m.max(1);
     let carried = crate::periodic::carried_active_set(&first.active_set, m, k_first, solver.problem().instants());
     solver.set_warm_start(&carried);
+    solver.set_warm_state(carried_state(first, solver.problem(), m));
     let (r, _) = solve_guarded(solver, *last, f, cold);
     *last = r.as_ref().ok().map(|_| f);
     r
+}
+
+/// The orbit state of `answer` (a shooting answer on another grid of the same orbit, `m` contact
+/// rows) carried to the grid of `to`: Newton there starts from it with the carried active set
+/// instead of that set's frozen fixed point (a march and a period Jacobian saved per solve).
+fn carried_state(answer: &Response, to: &PeriodicProblem, m: usize) -> Option<Vec<f64>> {
+    let state = answer.orbit_state.as_deref()?;
+    crate::periodic::carried_state(to.discretization().scheme, state, answer.lcp.size / m.max(1), to.instants())
 }
 
 fn first_clause(e: &SolveError) -> String {

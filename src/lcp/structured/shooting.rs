@@ -57,20 +57,25 @@ pub struct ShootingSettings {
     /// time marching), then Newton from where they end: the jump onto the attractor past a fold
     /// that Newton from the warm orbit alone misses (a lone rubbing solve's frequency walk).
     pub settle: usize,
+    /// With a warm start, an orbit state s_0 to start Newton from (the same orbit solved on
+    /// another grid, carried here) before the warm sets' frozen fixed point: that fixed point
+    /// costs a march and a period Jacobian (issue 23: a third of a refinement's shooting).
+    pub warm_state: Option<Vec<f64>>,
 }
 
 /// What a shooting solve may try beyond Newton from its warm start ([`ShootingSettings`]'s
-/// `warm_only` and `homotopy`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct ShootingReach {
+/// `warm_only`, `homotopy`, `settle` and `warm_state`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShootingReach<'a> {
     pub warm_only: bool,
     pub homotopy: bool,
     pub settle: usize,
+    pub state: Option<&'a [f64]>,
 }
 
-impl ShootingReach {
+impl ShootingReach<'static> {
     /// Everything: warm Newton, the contact-free start, the offset homotopy.
-    pub const FULL: ShootingReach = ShootingReach { warm_only: false, homotopy: true, settle: 0 };
+    pub const FULL: ShootingReach<'static> = ShootingReach { warm_only: false, homotopy: true, settle: 0, state: None };
 }
 
 impl Default for ShootingSettings {
@@ -85,6 +90,7 @@ impl Default for ShootingSettings {
             warm_only: false,
             homotopy: true,
             settle: 0,
+            warm_state: None,
         }
     }
 }
@@ -342,8 +348,15 @@ fn shoot(nt: &mut Newton<'_>, warm: Option<&[u64]>) -> ShootingSolution {
     {
         return done(nt, it, 0, "warm");
     }
-    // 1. Newton from the warm sets' orbit, then from the contact-free orbit (formed only when
-    // the warm start fails: its Jacobian costs as much as a Newton iteration).
+    // 1. Newton from a carried orbit state with the warm sets, then from the warm sets' orbit,
+    // then from the contact-free orbit (formed only when the warm start fails: its Jacobian
+    // costs as much as a Newton iteration).
+    if let Some(sets) = warm.filter(|w| w.len() == k)
+        && let Some(s) = settings.warm_state.as_ref().filter(|s| s.len() == d)
+        && let Ok(it) = nt.solve(s.clone(), 0.0, sets, settings.max_iterations)
+    {
+        return done(nt, it, 0, "warm");
+    }
     if let Some(sets) = warm.filter(|w| w.len() == k)
         && let Some(s) = fixed_state(nt, Contacts::Frozen(sets))
         && let Ok(it) = nt.solve(s, 0.0, sets, settings.max_iterations)
