@@ -502,7 +502,7 @@ fn state_weights(model: &Model) -> Vec<f64> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::{Family, Signature, lambda_axis};
     use crate::analysis::continuation::Parameter;
     use crate::analysis::polish;
@@ -510,6 +510,17 @@ mod tests {
     use crate::periodic::{OutputSelection, PeriodicProblem, PeriodicSolver, SolverSettings};
     use crate::time::{Discretization, Scheme};
     use num_complex::Complex64;
+
+    /// A model forced by cos Ωt on DOF 0, with a rigid stop (plastic impacts) on `stop_dof` at
+    /// clearance `gap`, bds1 with `steps` steps: the exact walk's small test models.
+    pub(crate) fn forced_with_rigid_stop(structure: Structure, stop_dof: usize, gap: f64, steps: usize, omega: f64) -> PeriodicProblem {
+        let force = Force { dof: 0, term: Harmonic { amplitude: 1.0, harmonic: 1, phase: 0.0 } };
+        let stop = Contact::on_dof(stop_dof, 1.0, gap, Compliance::Rigid);
+        let model = Model { structure, forces: vec![force], contacts: vec![stop], frequency: omega, frictions: Vec::new(), rubbing: Vec::new() };
+        let disc = Discretization { scheme: Scheme::Bds1, steps, pairing: None };
+        let outputs = OutputSelection { displacement: vec![0], contacts: true, ..OutputSelection::default() };
+        PeriodicProblem::new(model, disc, outputs, SolverSettings::default()).expect("the test model's problem")
+    }
 
     /// A unit mass (k = 1, c = 0.1, forced by cos Ωt) carrying a light tip (m = 1e-4) on a stiff
     /// spring (100: its mode at ≈ 1000, far above the metric's cut-off), the tip's rigid stop
@@ -521,12 +532,7 @@ mod tests {
             stiffness: Matrix::from_rows(&[vec![1.0 + ks, -ks], vec![-ks, ks]]),
             damping: Some(Matrix::from_rows(&[vec![0.1, 0.0], vec![0.0, 0.0]])),
         };
-        let force = Force { dof: 0, term: Harmonic { amplitude: 1.0, harmonic: 1, phase: 0.0 } };
-        let stop = Contact::on_dof(1, 1.0, 100.0, Compliance::Rigid);
-        let model = Model { structure, forces: vec![force], contacts: vec![stop], frequency: omega, frictions: Vec::new(), rubbing: Vec::new() };
-        let disc = Discretization { scheme: Scheme::Bds1, steps: 256, pairing: None };
-        let outputs = OutputSelection { displacement: vec![0], contacts: true, ..OutputSelection::default() };
-        PeriodicProblem::new(model, disc, outputs, SolverSettings::default()).expect("the tipped oscillator's problem")
+        forced_with_rigid_stop(structure, 1, 100.0, 256, omega)
     }
 
     /// The state at t = 0 of the linear forced response: x = Re(X e^{iΩt}), X = (K − Ω²M + iΩC)⁻¹ F.

@@ -143,23 +143,18 @@ impl Walk<'_> {
 mod tests {
     use super::landing_zero;
     use crate::analysis::continuation::Parameter;
+    use crate::analysis::continuation::exact::family::tests::forced_with_rigid_stop;
     use crate::analysis::continuation::exact::family::{Family, Signature, lambda_axis};
     use crate::analysis::polish::{self, EventKind};
-    use crate::model::{Compliance, Contact, Force, Harmonic, Matrix, Model, Structure};
-    use crate::periodic::{OutputSelection, PeriodicProblem, PeriodicSolver, SolverSettings};
-    use crate::time::{Discretization, Scheme};
+    use crate::model::{Matrix, Structure};
+    use crate::periodic::{PeriodicProblem, PeriodicSolver};
 
     /// The sticking oscillator of tests/rigid_branch.rs: m x'' + 0.1 x' + x = cos Ωt, x ≤ 0.5 (a
     /// rigid stop, plastic impacts), bds1 with 512 steps.
     fn sticking_oscillator(omega: f64) -> PeriodicProblem {
         let structure =
             Structure { mass: Matrix::from_rows(&[vec![1.0]]), stiffness: Matrix::from_rows(&[vec![1.0]]), damping: Some(Matrix::from_rows(&[vec![0.1]])) };
-        let force = Force { dof: 0, term: Harmonic { amplitude: 1.0, harmonic: 1, phase: 0.0 } };
-        let stop = Contact::on_dof(0, 1.0, 0.5, Compliance::Rigid);
-        let model = Model { structure, forces: vec![force], contacts: vec![stop], frequency: omega, frictions: Vec::new(), rubbing: Vec::new() };
-        let disc = Discretization { scheme: Scheme::Bds1, steps: 512, pairing: None };
-        let outputs = OutputSelection { displacement: vec![0], contacts: true, ..OutputSelection::default() };
-        PeriodicProblem::new(model, disc, outputs, SolverSettings::default()).expect("the oscillator's problem")
+        forced_with_rigid_stop(structure, 0, 0.5, 512, omega)
     }
 
     /// The force holding the sticking oscillator at its landing crosses zero where its merged orbit
