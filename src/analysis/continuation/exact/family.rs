@@ -9,7 +9,7 @@
 use super::super::{Parameter, floquet};
 use super::metric::Metric;
 use super::profile::{Stage, timed};
-use crate::analysis::polish::{Event, EventKind, PolishedOrbit, Touch};
+use crate::analysis::polish::{Event, EventKind, PolishedOrbit, RigidMargin, Touch};
 use crate::model::{Compliance, Model};
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
@@ -91,12 +91,25 @@ pub(super) struct Node {
     pub touches: Vec<Touch>,
     /// The outputs' amplitudes when surveyed with the touches (empty: not yet).
     pub amplitude: Vec<f64>,
+    /// The orbit's rigid margin, made at its first use: a step's and a bisection's ends asked
+    /// for it again (a sampled period each, 7 ms on the coarse rigid blade).
+    margin: std::cell::OnceCell<Option<RigidMargin>>,
 }
 
 impl Node {
     pub fn lambda(&self, rho: f64) -> f64 {
         self.w[self.w.len() - 1] * rho
     }
+    /// The orbit's rigid margin ([`PolishedOrbit::rigid_margin`]), made once.
+    pub fn rigid_margin(&self) -> Option<RigidMargin> {
+        self.margin.get_or_init(|| self.orbit.rigid_margin()).clone()
+    }
+
+    /// A point of `orbit` at the unknowns `w`.
+    pub fn new(w: Vec<f64>, tangent: Vec<f64>, orbit: PolishedOrbit, mu: Vec<Complex64>, touches: Vec<Touch>) -> Node {
+        Node { w, tangent, orbit, mu, touches, amplitude: Vec::new(), margin: Default::default() }
+    }
+
     /// The smallest signed clearance between a contact's events (negative: not admissible).
     pub fn worst_touch(&self) -> Option<&Touch> {
         self.touches.iter().min_by(|a, b| a.value.total_cmp(&b.value))
@@ -440,22 +453,28 @@ impl Family {
         timed(Stage::Node, || {
             let orbit = self.exact_orbit(&w)?;
             let touches = if touches { orbit.touches() } else { Vec::new() };
-            Some(Node { w, tangent: prev.to_vec(), orbit, mu: Vec::new(), touches, amplitude: Vec::new() })
+            Some(Node::new(w, prev.to_vec(), orbit, Vec::new(), touches))
         })
     }
 
     /// The orbit at the solution `w` (its events' states and impulses), its defect recorded.
     fn exact_orbit(&self, w: &[f64]) -> Option<PolishedOrbit> {
-        let orbit = self.orbit(w[w.len() - 1] * self.rho)?;
+        self.exact_orbit_of(self.orbit(w[w.len() - 1] * self.rho)?, w)
+    }
+
+    /// [`Self::exact_orbit`] from `orbit`, the orbit built at w's λ.
+    fn exact_orbit_of(&self, orbit: PolishedOrbit, w: &[f64]) -> Option<PolishedOrbit> {
         let (y, times) = self.unpack(w, orbit.period());
         let defect = self.residual_with(&orbit, w)?.amax() * self.ys;
         orbit.at(&y, &times, defect).ok()
     }
 
     fn solved(&self, w: Vec<f64>, prev: &[f64], touches: bool) -> Option<Node> {
+        // One orbit built at w's λ for the Jacobian and the point (two builds before).
+        let here = self.orbit(w[w.len() - 1] * self.rho)?;
         let jac = match self.last_jacobian.take() {
             Some((at, j)) if at == w => j,
-            _ => self.jacobian(&w)?,
+            _ => self.jacobian_at(&here, &w)?,
         };
         let tangent = self.tangent(&jac, prev)?;
         if std::env::var_os("PC_TRACE_FOLD").is_some() && prev.iter().zip(&tangent).map(|(p, x)| p * x).sum::<f64>() < 0.0 {
@@ -466,14 +485,14 @@ impl Family {
             );
         }
         self.chord.replace(Some(Chord { key: self.key(), jacobian: jac }));
-        let orbit = self.exact_orbit(&w)?;
+        let orbit = self.exact_orbit_of(here, &w)?;
         let mu = floquet::multipliers(orbit.monodromy());
         // No multipliers (the Schur iteration did not converge): no point, the step is shortened.
         if mu.iter().any(|m| !m.is_finite()) {
             return None;
         }
         let touches = if touches { orbit.touches() } else { Vec::new() };
-        Some(Node { w, tangent, orbit, mu, touches, amplitude: Vec::new() })
+        Some(Node::new(w, tangent, orbit, mu, touches))
     }
 }
 
