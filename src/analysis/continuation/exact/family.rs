@@ -91,8 +91,7 @@ pub(super) struct Node {
     pub touches: Vec<Touch>,
     /// The outputs' amplitudes when surveyed with the touches (empty: not yet).
     pub amplitude: Vec<f64>,
-    /// The orbit's rigid margin, made at its first use: a step's and a bisection's ends asked
-    /// for it again (a sampled period each, 7 ms on the coarse rigid blade).
+    /// The orbit's rigid margin, made at its first use (a sampled period; asked for again at steps' ends).
     margin: std::cell::OnceCell<Option<RigidMargin>>,
 }
 
@@ -104,7 +103,6 @@ impl Node {
     pub fn rigid_margin(&self) -> Option<RigidMargin> {
         self.margin.get_or_init(|| self.orbit.rigid_margin()).clone()
     }
-
     /// A point of `orbit` at the unknowns `w`.
     pub fn new(w: Vec<f64>, tangent: Vec<f64>, orbit: PolishedOrbit, mu: Vec<Complex64>, touches: Vec<Touch>) -> Node {
         Node { w, tangent, orbit, mu, touches, amplitude: Vec::new(), margin: Default::default() }
@@ -451,19 +449,15 @@ impl Family {
     /// alone. The tangent's Jacobian and the monodromy's Schur form were two thirds of a trial.
     pub fn orbit_node(&self, w: Vec<f64>, prev: &[f64], touches: bool) -> Option<Node> {
         timed(Stage::Node, || {
-            let orbit = self.exact_orbit(&w)?;
+            let orbit = self.exact_orbit(self.orbit(w[w.len() - 1] * self.rho)?, &w)?;
             let touches = if touches { orbit.touches() } else { Vec::new() };
             Some(Node::new(w, prev.to_vec(), orbit, Vec::new(), touches))
         })
     }
 
-    /// The orbit at the solution `w` (its events' states and impulses), its defect recorded.
-    fn exact_orbit(&self, w: &[f64]) -> Option<PolishedOrbit> {
-        self.exact_orbit_of(self.orbit(w[w.len() - 1] * self.rho)?, w)
-    }
-
-    /// [`Self::exact_orbit`] from `orbit`, the orbit built at w's λ.
-    fn exact_orbit_of(&self, orbit: PolishedOrbit, w: &[f64]) -> Option<PolishedOrbit> {
+    /// The orbit at the solution `w` (its events' states and impulses) from `orbit`, the one built
+    /// at w's λ, its defect recorded.
+    fn exact_orbit(&self, orbit: PolishedOrbit, w: &[f64]) -> Option<PolishedOrbit> {
         let (y, times) = self.unpack(w, orbit.period());
         let defect = self.residual_with(&orbit, w)?.amax() * self.ys;
         orbit.at(&y, &times, defect).ok()
@@ -485,7 +479,7 @@ impl Family {
             );
         }
         self.chord.replace(Some(Chord { key: self.key(), jacobian: jac }));
-        let orbit = self.exact_orbit_of(here, &w)?;
+        let orbit = self.exact_orbit(here, &w)?;
         let mu = floquet::multipliers(orbit.monodromy());
         // No multipliers (the Schur iteration did not converge): no point, the step is shortened.
         if mu.iter().any(|m| !m.is_finite()) {
