@@ -92,22 +92,13 @@ pub(super) struct Node {
     /// The outputs' amplitudes when surveyed with the touches (empty: not yet).
     pub amplitude: Vec<f64>,
     /// The orbit's rigid margin, made at its first use (a sampled period; asked for again at steps' ends).
-    margin: std::cell::OnceCell<Option<RigidMargin>>,
+    pub(super) margin: std::cell::OnceCell<Option<RigidMargin>>,
 }
 
 impl Node {
     pub fn lambda(&self, rho: f64) -> f64 {
         self.w[self.w.len() - 1] * rho
     }
-    /// The orbit's rigid margin ([`PolishedOrbit::rigid_margin`]), made once.
-    pub fn rigid_margin(&self) -> Option<RigidMargin> {
-        self.margin.get_or_init(|| self.orbit.rigid_margin()).clone()
-    }
-    /// A point of `orbit` at the unknowns `w`.
-    pub fn new(w: Vec<f64>, tangent: Vec<f64>, orbit: PolishedOrbit, mu: Vec<Complex64>, touches: Vec<Touch>) -> Node {
-        Node { w, tangent, orbit, mu, touches, amplitude: Vec::new(), margin: Default::default() }
-    }
-
     /// The smallest signed clearance between a contact's events (negative: not admissible).
     pub fn worst_touch(&self) -> Option<&Touch> {
         self.touches.iter().min_by(|a, b| a.value.total_cmp(&b.value))
@@ -451,7 +442,7 @@ impl Family {
         timed(Stage::Node, || {
             let orbit = self.exact_orbit(self.orbit(w[w.len() - 1] * self.rho)?, &w)?;
             let touches = if touches { orbit.touches() } else { Vec::new() };
-            Some(Node::new(w, prev.to_vec(), orbit, Vec::new(), touches))
+            Some(Node { w, tangent: prev.to_vec(), orbit, mu: Vec::new(), touches, amplitude: Vec::new(), margin: Default::default() })
         })
     }
 
@@ -486,7 +477,7 @@ impl Family {
             return None;
         }
         let touches = if touches { orbit.touches() } else { Vec::new() };
-        Some(Node::new(w, tangent, orbit, mu, touches))
+        Some(Node { w, tangent, orbit, mu, touches, amplitude: Vec::new(), margin: Default::default() })
     }
 }
 

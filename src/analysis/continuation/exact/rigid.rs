@@ -84,6 +84,14 @@ pub(super) fn trace_point(n: &Node, lambda: f64) {
     ));
 }
 
+impl Node {
+    /// The orbit's rigid margin ([`polish::PolishedOrbit::rigid_margin`]), made once per point:
+    /// a step's and a bisection's ends asked for it again (a sampled period each).
+    pub fn rigid_margin(&self) -> Option<polish::RigidMargin> {
+        self.margin.get_or_init(|| self.orbit.rigid_margin()).clone()
+    }
+}
+
 /// The node's rigid margin; +∞ without rigid contacts.
 pub(super) fn margin(n: &Node) -> f64 {
     n.rigid_margin().map_or(f64::INFINITY, |m| m.value)
