@@ -51,10 +51,18 @@ impl PolishedOrbit {
                 && model.contacts.len() == o.model.contacts.len()
                 && model.contacts.iter().zip(&o.model.contacts).all(|(a, b)| a.row == b.row && a.compliance == b.compliance)
         };
-        let bank: Vec<&PolishedOrbit> = bank.iter().copied().filter(|o| same(o)).collect();
-        Self::with_phases(model, events, always, |stuck, closed| match bank.iter().flat_map(|o| &o.phases).find(|p| p.is_for(stuck, closed)) {
-            Some(p) => p.retuned(model),
-            None => Phase::new(model, stuck, closed),
+        // Checked only where a bank orbit has the phase sought, once each: the exact walk's bank
+        // grows by an orbit per signature met, and checking all of them was 5 % of the rigid blade's walk.
+        let mut fits: Vec<Option<bool>> = vec![None; bank.len()];
+        Self::with_phases(model, events, always, |stuck, closed| {
+            for (o, fit) in bank.iter().zip(&mut fits) {
+                if let Some(p) = o.phases.iter().find(|p| p.is_for(stuck, closed))
+                    && *fit.get_or_insert_with(|| same(o))
+                {
+                    return p.retuned(model);
+                }
+            }
+            Phase::new(model, stuck, closed)
         })
     }
 
@@ -222,12 +230,25 @@ impl PolishedOrbit {
     /// A contact's own events, where its signed clearance comes down to 0 from both sides, are
     /// not minima: each interval is taken in its phase up to the phase's end (left limit).
     pub fn touches(&self) -> Vec<Touch> {
+        if !self.has_touches() {
+            return Vec::new();
+        }
         self.touches_in(&self.sampled())
+    }
+
+    /// Whether a contact may have a touch: a compliant one (a rigid contact's margins are
+    /// `rigid_margin`'s). Without one no state need be sampled for them.
+    fn has_touches(&self) -> bool {
+        self.model.contacts.iter().any(|c| !c.is_rigid())
     }
 
     /// [`Self::touches`] and [`Self::amplitudes`] from one sampling of the period (a branch
     /// point's: the sampling was most of the exact walk's time, and each point took two).
     pub fn touches_and_amplitudes(&self, map: Option<&OutputMap>, dofs: &[usize]) -> (Vec<Touch>, Vec<Option<f64>>) {
+        // Without touches the amplitudes come in closed form (the sampled states were a fifth of the rigid blade's walk).
+        if !self.has_touches() {
+            return (Vec::new(), self.amplitudes(map, dofs));
+        }
         let sampled = self.sampled();
         (self.touches_in(&sampled), self.amplitudes_in(&sampled, map, dofs))
     }

@@ -239,7 +239,8 @@ impl PolishedOrbit {
 
     pub(super) fn reset(&self, set: &[usize]) -> Option<Reset> {
         let n = self.model.n();
-        let m_inv = super::phase::dense(&self.model.structure.mass, n).try_inverse()?;
+        // The phases' M is the model's (phase.rs): its inverse made once for them all.
+        let m_inv = self.phases[0].mass_inverse()?;
         let b = DMatrix::from_fn(set.len(), n, |r, d| self.model.contacts[set[r]].row.iter().find(|e| e.0 == d).map_or(0.0, |e| e.1));
         let m_inv_bt = m_inv * b.transpose();
         let s_inv = (&b * &m_inv_bt).try_inverse()?;

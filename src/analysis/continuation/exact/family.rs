@@ -9,7 +9,7 @@
 use super::super::{Parameter, floquet};
 use super::metric::Metric;
 use super::profile::{Stage, timed};
-use crate::analysis::polish::{Event, EventKind, PolishedOrbit, Touch};
+use crate::analysis::polish::{Event, EventKind, PolishedOrbit, RigidMargin, Touch};
 use crate::model::{Compliance, Model};
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
@@ -91,6 +91,8 @@ pub(super) struct Node {
     pub touches: Vec<Touch>,
     /// The outputs' amplitudes when surveyed with the touches (empty: not yet).
     pub amplitude: Vec<f64>,
+    /// The orbit's rigid margin, made at its first use (a sampled period; asked for again at steps' ends).
+    pub(super) margin: std::cell::OnceCell<Option<RigidMargin>>,
 }
 
 impl Node {
@@ -438,24 +440,26 @@ impl Family {
     /// alone. The tangent's Jacobian and the monodromy's Schur form were two thirds of a trial.
     pub fn orbit_node(&self, w: Vec<f64>, prev: &[f64], touches: bool) -> Option<Node> {
         timed(Stage::Node, || {
-            let orbit = self.exact_orbit(&w)?;
+            let orbit = self.exact_orbit(self.orbit(w[w.len() - 1] * self.rho)?, &w)?;
             let touches = if touches { orbit.touches() } else { Vec::new() };
-            Some(Node { w, tangent: prev.to_vec(), orbit, mu: Vec::new(), touches, amplitude: Vec::new() })
+            Some(Node { w, tangent: prev.to_vec(), orbit, mu: Vec::new(), touches, amplitude: Vec::new(), margin: Default::default() })
         })
     }
 
-    /// The orbit at the solution `w` (its events' states and impulses), its defect recorded.
-    fn exact_orbit(&self, w: &[f64]) -> Option<PolishedOrbit> {
-        let orbit = self.orbit(w[w.len() - 1] * self.rho)?;
+    /// The orbit at the solution `w` (its events' states and impulses) from `orbit`, the one built
+    /// at w's λ, its defect recorded.
+    fn exact_orbit(&self, orbit: PolishedOrbit, w: &[f64]) -> Option<PolishedOrbit> {
         let (y, times) = self.unpack(w, orbit.period());
         let defect = self.residual_with(&orbit, w)?.amax() * self.ys;
         orbit.at(&y, &times, defect).ok()
     }
 
     fn solved(&self, w: Vec<f64>, prev: &[f64], touches: bool) -> Option<Node> {
+        // One orbit built at w's λ for the Jacobian and the point (two builds before).
+        let here = self.orbit(w[w.len() - 1] * self.rho)?;
         let jac = match self.last_jacobian.take() {
             Some((at, j)) if at == w => j,
-            _ => self.jacobian(&w)?,
+            _ => self.jacobian_at(&here, &w)?,
         };
         let tangent = self.tangent(&jac, prev)?;
         if std::env::var_os("PC_TRACE_FOLD").is_some() && prev.iter().zip(&tangent).map(|(p, x)| p * x).sum::<f64>() < 0.0 {
@@ -466,14 +470,14 @@ impl Family {
             );
         }
         self.chord.replace(Some(Chord { key: self.key(), jacobian: jac }));
-        let orbit = self.exact_orbit(&w)?;
+        let orbit = self.exact_orbit(here, &w)?;
         let mu = floquet::multipliers(orbit.monodromy());
         // No multipliers (the Schur iteration did not converge): no point, the step is shortened.
         if mu.iter().any(|m| !m.is_finite()) {
             return None;
         }
         let touches = if touches { orbit.touches() } else { Vec::new() };
-        Some(Node { w, tangent, orbit, mu, touches, amplitude: Vec::new() })
+        Some(Node { w, tangent, orbit, mu, touches, amplitude: Vec::new(), margin: Default::default() })
     }
 }
 

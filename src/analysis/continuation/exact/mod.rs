@@ -353,7 +353,7 @@ impl Walk<'_> {
                         continue;
                     }
                     None => {
-                        let what = next.orbit.rigid_margin().map_or(String::new(), |m| format!(" (contact {}: the {} reaches zero)", m.contact, m.what));
+                        let what = next.rigid_margin().map_or(String::new(), |m| format!(" (contact {}: the {} reaches zero)", m.contact, m.what));
                         let stop =
                             format!("a change of the rigid contacts' events near λ = {}{what}: the branch past it could not be started", here.lambda(rho));
                         return done(self, stop, false, false);

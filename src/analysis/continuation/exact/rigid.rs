@@ -80,13 +80,21 @@ pub(super) fn trace_point(n: &Node, lambda: f64) {
     trace(format_args!(
         "point: λ {lambda:.10}: {} events, margin {:?}",
         n.orbit.events().len(),
-        n.orbit.rigid_margin().map(|m| (m.contact, m.what, m.value, m.time / n.orbit.period()))
+        n.rigid_margin().map(|m| (m.contact, m.what, m.value, m.time / n.orbit.period()))
     ));
+}
+
+impl Node {
+    /// The orbit's rigid margin ([`polish::PolishedOrbit::rigid_margin`]), made once per point:
+    /// a step's and a bisection's ends asked for it again (a sampled period each).
+    pub fn rigid_margin(&self) -> Option<polish::RigidMargin> {
+        self.margin.get_or_init(|| self.orbit.rigid_margin()).clone()
+    }
 }
 
 /// The node's rigid margin; +∞ without rigid contacts.
 pub(super) fn margin(n: &Node) -> f64 {
-    n.orbit.rigid_margin().map_or(f64::INFINITY, |m| m.value)
+    n.rigid_margin().map_or(f64::INFINITY, |m| m.value)
 }
 
 impl Walk<'_> {
@@ -109,7 +117,7 @@ impl Walk<'_> {
         for (kind, node, detail) in self.events_between(here, &lo) {
             self.push(&node, Some(kind), detail);
         }
-        let m = hi.orbit.rigid_margin()?;
+        let m = hi.rigid_margin()?;
         let what = format!("contact {}: the {} reaches zero", m.contact, m.what);
         // A new pure impact where the clearance touches zero; an impact whose impulse fades, removed.
         let t = lo.orbit.period();
@@ -294,7 +302,7 @@ impl Walk<'_> {
                 "start phase {len:e}: first point λ {:.10} (the grazing at {:.10}), margin {:?}",
                 n.lambda(self.fam.rho),
                 at.lambda(self.fam.rho),
-                n.orbit.rigid_margin().map(|m| (m.contact, m.what, m.value, m.time / n.orbit.period()))
+                n.rigid_margin().map(|m| (m.contact, m.what, m.value, m.time / n.orbit.period()))
             ));
             if margin(&n) >= -TOL {
                 first = Some(n);
@@ -355,7 +363,7 @@ impl Walk<'_> {
             "restart at λ {lambda:.10}: {before} -> {} events, corrected at λ fixed: {}, margin there {:?}",
             self.fam.ne(),
             corrected.is_some(),
-            corrected.as_ref().and_then(|w| self.fam.node_with(w.clone(), &e_l, false)).and_then(|n| n.orbit.rigid_margin().map(|m| (
+            corrected.as_ref().and_then(|w| self.fam.node_with(w.clone(), &e_l, false)).and_then(|n| n.rigid_margin().map(|m| (
                 m.contact,
                 m.what,
                 m.value,
@@ -375,7 +383,7 @@ impl Walk<'_> {
                     trace(format_args!(
                         "restart: sense {s}, trial {step:e}: λ {:?}, margin {:?}",
                         trial.as_ref().map(|t| t.lambda(rho)),
-                        trial.as_ref().and_then(|t| t.orbit.rigid_margin().map(|m| (m.contact, m.what, m.value, m.event)))
+                        trial.as_ref().and_then(|t| t.rigid_margin().map(|m| (m.contact, m.what, m.value, m.event)))
                     ));
                     trial.is_some_and(|t| margin(&t) >= -TOL)
                 });
@@ -511,7 +519,7 @@ impl Walk<'_> {
                 "reseed at λ {l}: {} events, corrected {}, margin {:?}",
                 self.fam.ne(),
                 node.is_some(),
-                node.as_ref().and_then(|n| n.orbit.rigid_margin().map(|m| (m.contact, m.what, m.value)))
+                node.as_ref().and_then(|n| n.rigid_margin().map(|m| (m.contact, m.what, m.value)))
             ));
             match node {
                 Some(n) if margin(&n) >= -TOL => {

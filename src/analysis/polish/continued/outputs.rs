@@ -43,7 +43,10 @@ impl PolishedOrbit {
                     Some((m, dm, ph.particular_along(row)))
                 })
                 .collect();
-            let orders: Vec<u32> = parts.iter().flatten().flat_map(|p| p.2.iter().map(|(q, _)| *q)).collect();
+            let mut orders: Vec<u32> = parts.iter().flatten().flat_map(|p| p.2.iter().map(|(q, _)| *q)).collect();
+            // One e^{ipωt} per order, not per output's harmonic (the same values).
+            orders.sort_unstable();
+            orders.dedup();
             // (value, slope) of every output at t, the transient's exponentials being `modes`.
             let jets = |t: f64, modes: &[C]| {
                 let turns: Vec<(u32, C)> = orders.iter().map(|&p| (p, C::from_polar(1.0, p as f64 * w * t))).collect();

@@ -27,7 +27,7 @@ const HALVINGS: usize = 16;
 /// The event `e` of `n`'s orbit is a sticking impact whose holding force is negative at its
 /// landing, and the margin is that landing's lift-off: `Some(e)`.
 pub(in super::super) fn lifted(n: &Node) -> Option<usize> {
-    let m = n.orbit.rigid_margin()?;
+    let m = n.rigid_margin()?;
     if m.what != polish::STUCK || m.event.is_some() {
         return None;
     }

@@ -21,7 +21,7 @@ impl Walk<'_> {
     /// reaching zero there (then located as a crossing from the old signature's orbit just past
     /// it). `None` without rigid contacts.
     pub(in super::super) fn rigid_stall(&mut self, here: &Node, to: f64) -> Option<Node> {
-        let m = here.orbit.rigid_margin()?;
+        let m = here.rigid_margin()?;
         self.diagnose_stall(here);
         let what = format!("the events merge (the corrector stalls; the smallest margin: contact {}'s {}, {:.1e})", m.contact, m.what, m.value);
         // The shortest phase between two events of one contact: the one merging.
@@ -76,7 +76,7 @@ impl Walk<'_> {
             trace(format_args!(
                 "stall: the old signature at λ {l:.10} ({f:e} of ρ): corrected {}, margin {:?}",
                 next.is_some(),
-                next.as_ref().and_then(|n| n.orbit.rigid_margin().map(|m| (m.contact, m.what, m.value, m.event, m.time / n.orbit.period())))
+                next.as_ref().and_then(|n| n.rigid_margin().map(|m| (m.contact, m.what, m.value, m.event, m.time / n.orbit.period())))
             ));
             if let Some(next) = next.filter(|n| margin(n) < -TOL) {
                 return self.rigid_crossing(here, &next, to, false);

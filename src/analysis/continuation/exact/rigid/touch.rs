@@ -40,14 +40,14 @@ pub(super) fn touch_point(fam: &mut Family, guess: &[f64], (la, lb): (f64, f64),
             (n, false) => (bad, lbad) = (n, mid),
         }
     }
-    if let Some(m) = bad.orbit.rigid_margin().filter(|m| own.is_some_and(|c| m.contact != c)) {
+    if let Some(m) = bad.rigid_margin().filter(|m| own.is_some_and(|c| m.contact != c)) {
         trace(format_args!("touch point: {lbad:.10} breaks contact {}'s {}, not the merging contact's: refused", m.contact, m.what));
         return None;
     }
     let away = (lok - lbad).signum();
     trace(format_args!(
         "touch point: {lok:.10} admissible, {lbad:.10} not: {:?}, lifted {:?}; landing forces {:?} / {:?}",
-        bad.orbit.rigid_margin().map(|m| (m.what, m.value, m.contact, m.time / bad.orbit.period(), m.event)),
+        bad.rigid_margin().map(|m| (m.what, m.value, m.contact, m.time / bad.orbit.period(), m.event)),
         landing::lifted(&bad),
         (0..ok.orbit.events().len()).filter_map(|e| ok.orbit.landing_force(e).map(|h| (e, ok.orbit.times()[e] / ok.orbit.period(), h))).collect::<Vec<_>>(),
         (0..bad.orbit.events().len()).filter_map(|e| bad.orbit.landing_force(e).map(|h| (e, h))).collect::<Vec<_>>()

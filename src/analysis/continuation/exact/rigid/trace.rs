@@ -29,7 +29,7 @@ pub(super) fn merge(here: &Node, list: &[(f64, Event)], (e, ne): (usize, usize),
     for (k, (at, x)) in list.iter().enumerate().filter(|(_, l)| ((l.0 - t0 + 0.5).rem_euclid(1.0) - 0.5).abs() < 2e-3) {
         eprintln!("merge: orbit event {k} at {at:.12} of the period: contact {} {:?}", x.contact, x.kind);
     }
-    if let Some(m) = here.orbit.rigid_margin() {
+    if let Some(m) = here.rigid_margin() {
         eprintln!("merge: the old orbit's margin: contact {} {} {:e} at {:.12}", m.contact, m.what, m.value, m.time / here.orbit.period());
     }
 }
@@ -49,7 +49,7 @@ pub(super) fn stall(here: &Node, rho: f64, pairs: &[(usize, usize, f64, f64)]) {
         eprintln!("stall: phase {e} of contact {c}: {len:e} of the period, shrinking at {rate:e} per unit of arclength");
     }
     // The events within 2e-3 of the period of the smallest margin: is it at a landing?
-    if let Some(m) = here.orbit.rigid_margin() {
+    if let Some(m) = here.rigid_margin() {
         let (p, at) = (here.orbit.period(), m.time / here.orbit.period());
         eprintln!("stall: the smallest margin: contact {} {} {:e} at {at:.9} (event {:?})", m.contact, m.what, m.value, m.event);
         for (k, (x, s)) in here.orbit.events().iter().zip(here.orbit.times()).enumerate() {
