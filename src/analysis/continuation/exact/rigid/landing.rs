@@ -6,6 +6,7 @@
 //! the change of topology.
 use super::super::family::{Family, Node, Signature, lambda_axis};
 use super::super::{BRACKET, EventKind, Walk, signature};
+use super::trace::trace;
 use super::{TOL, margin};
 use crate::analysis::polish;
 use crate::analysis::polish::Event;
@@ -50,6 +51,7 @@ pub(in super::super) fn landing_zero(fam: &Family, from: &[f64], e: usize, (la, 
         let w = fam.correct(&g, &e_l, lambda / rho)?;
         let n = fam.node_with(w, &e_l, false)?;
         let h = n.orbit.landing_force(e)?;
+        trace(format_args!("landing zero: λ {lambda:.13}, force {h:e} of the scale"));
         Some((n.w, h))
     };
     // A trial λ too far from its start for the corrector (the coarse rigid blade at 2398.27 rad/s:
@@ -93,8 +95,10 @@ pub(in super::super) fn landing_zero(fam: &Family, from: &[f64], e: usize, (la, 
     if b.1.abs() >= ZERO && (a.0 - b.0).abs() > BRACKET * rho {
         return None;
     }
-    // The side where the landing holds (h ≥ 0), when bracketed.
-    let best = if a.1 * b.1 < 0.0 && b.1 < 0.0 { a } else { b };
+    // The side where the landing holds (h ≥ 0), when bracketed, unless the last is the zero to
+    // round-off: the other end may be a whole secant step back (3.4e-6 rad/s on the coarse rigid
+    // blade at 2216.26), which put the located grazing where the step path led (validation/RECORD.md).
+    let best = if a.1 * b.1 < 0.0 && b.1 < 0.0 && b.1.abs() >= ZERO { a } else { b };
     let rate = if rate.is_finite() && rate != 0.0 { rate } else { -sense };
     let prev: Vec<f64> = e_l.iter().map(|x| x * sense).collect();
     Some((fam.node(best.2, &prev)?, rate))
