@@ -449,10 +449,7 @@ fn assemble_modal(
 /// 1 / w_p, the residual flexibility's factor at harmonic p (R / w_p of Ẑ_p⁻¹), or why there is none.
 fn residual_scale(w: f64, p: usize, frequency: f64) -> Result<f64, SolveError> {
     let inv_w = 1.0 / w;
-    if !(w != 0.0 && inv_w.is_finite()) {
-        return Err(SolveError::SingularOperator { harmonic: p, frequency: p as f64 * frequency });
-    }
-    Ok(inv_w)
+    (w != 0.0 && inv_w.is_finite()).then_some(inv_w).ok_or(SolveError::SingularOperator { harmonic: p, frequency: p as f64 * frequency })
 }
 
 /// The residual flexibility's part R / w_p of Ẑ_p⁻¹ in a modal assembly, ω-independent but for
@@ -484,9 +481,6 @@ impl Statics {
     /// Adds R F̂_p to X̂lin_p and B R F̂_p to B X̂lin_p.
     fn add_forced(&self, asm: &mut Assembly, forces: &[(usize, Vec<C>)]) {
         let (m, nd, nh) = (asm.m, asm.dofs.len(), asm.k / 2 + 1);
-        if forces.is_empty() {
-            return;
-        }
         for p in 0..nh {
             for row in 0..nd {
                 for (l, (_, spec)) in forces.iter().enumerate() {
