@@ -416,7 +416,7 @@ fn assemble_modal(
     let outs = Mat::<f64>::from_fn(nd * m, n, |rb, i| phio[(rb / m, i)] * bphi[(rb % m, i)]);
     let (hre, him) = (&outs * &dre, &outs * &dim);
     // The residual flexibility's static part / w_p, added as each harmonic is stored (a pass over
-    // Ĝ and Ẑ⁻¹Bᵀ of their own, and one for the finite check, were 5 % of a real-blade sweep, issue 23).
+    // Ĝ and Ẑ⁻¹Bᵀ of its own, and one for the finite check, were 2 % of a real-blade sweep, issue 23).
     let inv_w: Vec<f64> = match statics {
         Some(_) => (0..nh).map(|p| residual_scale(symbols.weight[p], p, model.frequency)).collect::<Result<_, _>>()?,
         None => Vec::new(),

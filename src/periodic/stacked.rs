@@ -13,8 +13,8 @@ impl PeriodicProblem {
         let mut q = vec![0.0; k * m];
         let gaps = self.gap_samples(k);
         // B X̂lin per contact from one pass over its harmonic-major storage; a zero spectrum (no
-        // force: the real blade's casing moves q through the gaps alone) is zero in time. The
-        // m strided passes and transforms were 3 % of a real-blade sweep (issue 23).
+        // force: the real blade's casing moves q through the gaps alone) is zero in time (it was
+        // m strided passes and m transforms per solve, issue 23).
         let mut spectra = vec![vec![num_complex::Complex64::ZERO; nh]; m];
         for (p, harmonic) in asm.bxlin_hat.chunks_exact(m.max(1)).enumerate().take(nh) {
             for (spec, &v) in spectra.iter_mut().zip(harmonic) {

@@ -94,8 +94,8 @@ impl<'a> CirculantOperator<'a> {
                 zh[p * m + b] = buf[p];
             }
         }
-        // Ĝ_p ẑ_p harmonic by harmonic, each block read once in storage order (row by row, it
-        // was m strided passes over the whole spectrum: 7 % of the real blade's sweep, issue 23).
+        // Ĝ_p ẑ_p harmonic by harmonic, each block read once in storage order (row by row, m strided
+        // passes over the whole spectrum: the product was 7 % of the real blade's sweep, issue 23).
         // The sums run over b in the order of `Iterator::sum`, so the products are unchanged.
         for (g, zp) in self.spectrum.chunks_exact(m * m).zip(zh.chunks_exact_mut(m)).take(nh) {
             for (s, row) in gz.iter_mut().zip(g.chunks_exact(m)) {
