@@ -300,9 +300,10 @@ pub fn assemble_with(
         )));
     }
     if let Operator::Modal { phi, lambda, c, residual } = op {
-        let mut asm = assemble_modal(model, symbols, &forces, rows, phi, lambda, c, k)?;
-        if let Some(r) = residual {
-            add_residual(&mut asm, model, &forces, rows, r)?;
+        let statics = residual.as_ref().map(|r| Statics::new(model, &forces, rows, r));
+        let mut asm = assemble_modal(model, symbols, &forces, rows, (phi, lambda, c), statics.as_ref(), k)?;
+        if let Some(st) = &statics {
+            st.add_forced(&mut asm, &forces);
         }
         return Ok(asm);
     }
@@ -370,9 +371,8 @@ fn assemble_modal(
     symbols: Symbols,
     forces: &[(usize, Vec<C>)],
     rows: &[RecoveryRow],
-    phi: &Mat<f64>,
-    lambda: &[f64],
-    c: &[f64],
+    (phi, lambda, c): (&Mat<f64>, &[f64], &[f64]),
+    statics: Option<&Statics>,
     k: usize,
 ) -> Result<Assembly, SolveError> {
     // Modes (columns of Φ): n without massless DOFs, fewer with them.
@@ -415,70 +415,85 @@ fn assemble_modal(
     let (gre, gim) = (&pairs * &dre, &pairs * &dim);
     let outs = Mat::<f64>::from_fn(nd * m, n, |rb, i| phio[(rb / m, i)] * bphi[(rb % m, i)]);
     let (hre, him) = (&outs * &dre, &outs * &dim);
-    let by_harmonic = |re: &Mat<f64>, im: &Mat<f64>| -> Vec<C> {
+    // The residual flexibility's static part / w_p, added as each harmonic is stored (a pass over
+    // Ĝ and Ẑ⁻¹Bᵀ of its own, and one for the finite check, were 2 % of a real-blade sweep, issue 23).
+    let inv_w: Vec<f64> = match statics {
+        Some(_) => (0..nh).map(|p| residual_scale(symbols.weight[p], p, model.frequency)).collect::<Result<_, _>>()?,
+        None => Vec::new(),
+    };
+    // Each harmonic's column, and whether its modal part is finite (B X̂lin's is not checked).
+    let by_harmonic = |re: &Mat<f64>, im: &Mat<f64>, fixed: Option<&[f64]>| -> (Vec<C>, bool) {
         let mut v = Vec::with_capacity(re.nrows() * nh);
+        let mut finite = true;
         for p in 0..nh {
-            v.extend(re.col_as_slice(p).iter().zip(im.col_as_slice(p)).map(|(&a, &b)| C::new(a, b)));
+            let (re, im) = (re.col_as_slice(p), im.col_as_slice(p));
+            finite &= re.iter().chain(im).all(|x| x.is_finite());
+            match fixed {
+                // As `C + C::from(s / w_p)`: the imaginary part gains + 0.0.
+                Some(fixed) => v.extend(re.iter().zip(im).zip(fixed).map(|((&a, &b), &s)| C::new(a + s * inv_w[p], b + 0.0))),
+                None => v.extend(re.iter().zip(im).map(|(&a, &b)| C::new(a, b))),
+            }
         }
-        v
+        (v, finite)
     };
-    let asm = Assembly {
-        k,
-        m,
-        dofs: rows.iter().map(|r| r.0).collect(),
-        symbols,
-        g_hat: by_harmonic(&gre, &gim),
-        xlin_hat: by_harmonic(&xre, &xim),
-        bxlin_hat: by_harmonic(&bre, &bim),
-        h_hat: by_harmonic(&hre, &him),
-        tangential: Vec::new(),
-    };
-    let finite = asm.g_hat.iter().chain(&asm.xlin_hat).chain(&asm.h_hat).all(|v| v.re.is_finite() && v.im.is_finite());
-    if !finite {
+    let (g_hat, g_finite) = by_harmonic(&gre, &gim, statics.map(|st| st.brbt.as_slice()));
+    let (h_hat, h_finite) = by_harmonic(&hre, &him, statics.map(|st| st.rbt_out.as_slice()));
+    let (xlin_hat, x_finite) = by_harmonic(&xre, &xim, None);
+    let (bxlin_hat, _) = by_harmonic(&bre, &bim, None);
+    if !(g_finite && h_finite && x_finite) {
         return Err(SolveError::SingularOperator { harmonic: 0, frequency: 0.0 });
     }
-    Ok(asm)
+    Ok(Assembly { k, m, dofs: rows.iter().map(|r| r.0).collect(), symbols, g_hat, xlin_hat, bxlin_hat, h_hat, tangential: Vec::new() })
 }
 
-/// Adds the residual flexibility's part R / w_p of Ẑ_p⁻¹ to a modal assembly: B R Bᵀ / w_p to Ĝ_p,
-/// R_out Bᵀ / w_p to Ẑ_p⁻¹Bᵀ, and R F̂_p (the right-hand side is w_p F̂_p) to X̂lin_p and B X̂lin_p.
-fn add_residual(asm: &mut Assembly, model: &Model, forces: &[(usize, Vec<C>)], rows: &[RecoveryRow], r: &Mat<f64>) -> Result<(), SolveError> {
-    let (m, nd, nh) = (asm.m, asm.dofs.len(), asm.k / 2 + 1);
-    let n = r.nrows();
-    let rbt = Mat::<f64>::from_fn(n, m, |d, b| model.contacts[b].along(|e| r[(d, e)]));
-    let brbt = Mat::<f64>::from_fn(m, m, |a, b| model.contacts[a].along(|d| rbt[(d, b)]));
-    // B R at each loaded DOF's column: the static response of the contacts to that force.
-    let brf: Vec<Vec<f64>> = forces.iter().map(|(l, _)| (0..m).map(|a| model.contacts[a].along(|d| r[(d, *l)])).collect()).collect();
-    // The rows' R_out Bᵀ and R_out at each loaded DOF.
-    let rrow = |row: usize, col: &dyn Fn(usize) -> f64| along_row(&rows[row].1, col);
-    let rbt_out: Vec<f64> = (0..nd).flat_map(|row| (0..m).map(move |b| (row, b))).map(|(row, b)| rrow(row, &|d| rbt[(d, b)])).collect();
-    let rf_out: Vec<f64> = (0..nd).flat_map(|row| forces.iter().map(move |(l, _)| (row, *l))).map(|(row, l)| rrow(row, &|d| r[(d, l)])).collect();
-    for p in 0..nh {
-        let w = asm.symbols.weight[p];
-        let inv_w = 1.0 / w;
-        if !(w != 0.0 && inv_w.is_finite()) {
-            return Err(SolveError::SingularOperator { harmonic: p, frequency: p as f64 * model.frequency });
-        }
-        for a in 0..m {
-            for b in 0..m {
-                asm.g_hat[(p * m + a) * m + b] += C::from(brbt[(a, b)] * inv_w);
-            }
-        }
-        for row in 0..nd {
-            for b in 0..m {
-                asm.h_hat[(p * nd + row) * m + b] += C::from(rbt_out[row * m + b] * inv_w);
+/// 1 / w_p, the residual flexibility's factor at harmonic p (R / w_p of Ẑ_p⁻¹), or why there is none.
+fn residual_scale(w: f64, p: usize, frequency: f64) -> Result<f64, SolveError> {
+    let inv_w = 1.0 / w;
+    (w != 0.0 && inv_w.is_finite()).then_some(inv_w).ok_or(SolveError::SingularOperator { harmonic: p, frequency: p as f64 * frequency })
+}
+
+/// The residual flexibility's part R / w_p of Ẑ_p⁻¹ in a modal assembly, ω-independent but for
+/// 1 / w_p: B R Bᵀ (added to Ĝ_p) and R_out Bᵀ (to Ẑ_p⁻¹Bᵀ) as [`assemble_modal`] stores each
+/// harmonic, and R F̂_p (the right-hand side is w_p F̂_p) to X̂lin_p and B X̂lin_p ([`Statics::add_forced`]).
+struct Statics {
+    /// B R Bᵀ, m × m row-major (Ĝ_p's storage order).
+    brbt: Vec<f64>,
+    /// R_out Bᵀ, nd × m row-major (Ẑ_p⁻¹Bᵀ's).
+    rbt_out: Vec<f64>,
+    /// B R at each loaded DOF's column: the static response of the contacts to that force.
+    brf: Vec<Vec<f64>>,
+    /// The rows' R_out at each loaded DOF, nd × forces row-major.
+    rf_out: Vec<f64>,
+}
+
+impl Statics {
+    fn new(model: &Model, forces: &[(usize, Vec<C>)], rows: &[RecoveryRow], r: &Mat<f64>) -> Statics {
+        let (m, nd, n) = (model.contacts.len(), rows.len(), r.nrows());
+        let rbt = Mat::<f64>::from_fn(n, m, |d, b| model.contacts[b].along(|e| r[(d, e)]));
+        let brbt = (0..m * m).map(|ab| model.contacts[ab / m].along(|d| rbt[(d, ab % m)])).collect();
+        let brf = forces.iter().map(|(l, _)| (0..m).map(|a| model.contacts[a].along(|d| r[(d, *l)])).collect()).collect();
+        let rrow = |row: usize, col: &dyn Fn(usize) -> f64| along_row(&rows[row].1, col);
+        let rbt_out = (0..nd).flat_map(|row| (0..m).map(move |b| (row, b))).map(|(row, b)| rrow(row, &|d| rbt[(d, b)])).collect();
+        let rf_out = (0..nd).flat_map(|row| forces.iter().map(move |(l, _)| (row, *l))).map(|(row, l)| rrow(row, &|d| r[(d, l)])).collect();
+        Statics { brbt, rbt_out, brf, rf_out }
+    }
+
+    /// Adds R F̂_p to X̂lin_p and B R F̂_p to B X̂lin_p.
+    fn add_forced(&self, asm: &mut Assembly, forces: &[(usize, Vec<C>)]) {
+        let (m, nd, nh) = (asm.m, asm.dofs.len(), asm.k / 2 + 1);
+        for p in 0..nh {
+            for row in 0..nd {
+                for (l, (_, spec)) in forces.iter().enumerate() {
+                    asm.xlin_hat[p * nd + row] += spec[p] * self.rf_out[row * forces.len() + l];
+                }
             }
             for (l, (_, spec)) in forces.iter().enumerate() {
-                asm.xlin_hat[p * nd + row] += spec[p] * rf_out[row * forces.len() + l];
-            }
-        }
-        for (l, (_, spec)) in forces.iter().enumerate() {
-            for a in 0..m {
-                asm.bxlin_hat[p * m + a] += spec[p] * brf[l][a];
+                for a in 0..m {
+                    asm.bxlin_hat[p * m + a] += spec[p] * self.brf[l][a];
+                }
             }
         }
     }
-    Ok(())
 }
 
 /// From this many DOFs a dense model with modal damping is solved in its modes.

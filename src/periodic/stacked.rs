@@ -11,18 +11,22 @@ impl PeriodicProblem {
         let (k, m) = (asm.k, asm.m);
         let nh = k / 2 + 1;
         let mut q = vec![0.0; k * m];
-        let mut spec = vec![num_complex::Complex64::ZERO; nh];
         let gaps = self.gap_samples(k);
-        for (a, ca) in self.model().contacts.iter().enumerate() {
-            let s = self.pairing_of(ca).offset();
-            for (p, v) in spec.iter_mut().enumerate() {
-                *v = asm.bxlin_hat[p * m + a];
+        // B X̂lin per contact from one pass over its harmonic-major storage; a zero spectrum (no
+        // force: the real blade's casing moves q through the gaps alone) is zero in time (it was
+        // m strided passes and m transforms per solve, issue 23).
+        let mut spectra = vec![vec![num_complex::Complex64::ZERO; nh]; m];
+        for (p, harmonic) in asm.bxlin_hat.chunks_exact(m.max(1)).enumerate().take(nh) {
+            for (spec, &v) in spectra.iter_mut().zip(harmonic) {
+                spec[p] = v;
             }
-            let bx = fft.inverse(&spec);
-            let gap = &gaps[a];
-            for j in 0..k {
-                let jj = (j + s) % k;
-                q[j * m + a] = gap[jj] - bx[jj];
+        }
+        let bx: Vec<Option<Vec<f64>>> = spectra.iter().map(|spec| spec.iter().any(|v| *v != num_complex::Complex64::ZERO).then(|| fft.inverse(spec))).collect();
+        let shifts: Vec<usize> = self.model().contacts.iter().map(|ca| self.pairing_of(ca).offset()).collect();
+        for (j, row) in q.chunks_exact_mut(m.max(1)).enumerate() {
+            for (a, (v, &shift)) in row.iter_mut().zip(&shifts).enumerate() {
+                let jj = (j + shift) % k;
+                *v = gaps[a][jj] - bx[a].as_ref().map_or(0.0, |b| b[jj]);
             }
         }
         // The blocks are formed from the spectrum only if a solver asks for them.
@@ -37,14 +41,25 @@ impl PeriodicProblem {
     fn lcp_spectrum(&self, asm: &Assembly) -> Vec<num_complex::Complex64> {
         let (k, m) = (asm.k, asm.m);
         let mut spectrum = asm.g_hat.clone();
-        for (a, ca) in self.model().contacts.iter().enumerate() {
-            let s = self.pairing_of(ca).offset();
-            let compliance = match ca.compliance {
-                crate::model::Compliance::Compliant { stiffness } => 1.0 / stiffness,
-                crate::model::Compliance::Rigid => 0.0,
-            };
-            for p in 0..=k / 2 {
-                let row = &mut spectrum[(p * m + a) * m..(p * m + a + 1) * m];
+        if m == 0 {
+            return spectrum;
+        }
+        let rows: Vec<(usize, f64)> = self
+            .model()
+            .contacts
+            .iter()
+            .map(|ca| {
+                let compliance = match ca.compliance {
+                    crate::model::Compliance::Compliant { stiffness } => 1.0 / stiffness,
+                    crate::model::Compliance::Rigid => 0.0,
+                };
+                (self.pairing_of(ca).offset(), compliance)
+            })
+            .collect();
+        // Harmonic by harmonic, each block in storage order (contact by contact, these were m
+        // strided passes over the whole spectrum, issue 23).
+        for (p, block) in spectrum.chunks_exact_mut(m * m).enumerate().take(k / 2 + 1) {
+            for (a, (row, &(s, compliance))) in block.chunks_exact_mut(m).zip(&rows).enumerate() {
                 // Unshifted rows skip the sin/cos (k/2 + 1 per contact, every solve).
                 if s != 0 {
                     let turn = 2.0 * std::f64::consts::PI * ((p * s) % k) as f64 / k as f64;

@@ -27,6 +27,8 @@ struct Work {
     series: Vec<f64>,
     /// ẑ_p for p = 0..=k/2, m values each.
     zh: Vec<C>,
+    /// One harmonic's Ĝ_p ẑ_p (m values).
+    gz: Vec<C>,
     /// One spectrum of k/2 + 1 bins.
     buf: Vec<C>,
     scratch: Vec<C>,
@@ -34,7 +36,13 @@ struct Work {
 
 impl Work {
     fn new(fft: &PeriodFft, m: usize) -> Self {
-        Work { series: vec![0.0; fft.k()], zh: vec![C::ZERO; fft.bins() * m], buf: vec![C::ZERO; fft.bins()], scratch: fft.make_scratch() }
+        Work {
+            series: vec![0.0; fft.k()],
+            zh: vec![C::ZERO; fft.bins() * m],
+            gz: vec![C::ZERO; m],
+            buf: vec![C::ZERO; fft.bins()],
+            scratch: fft.make_scratch(),
+        }
     }
 }
 
@@ -72,8 +80,11 @@ impl<'a> CirculantOperator<'a> {
     /// out = A z with the buffers `w`.
     fn product(&self, z: &[f64], out: &mut [f64], w: &mut Work) {
         let (k, m) = (self.a.k(), self.a.m());
+        if m == 0 {
+            return;
+        }
         let nh = self.fft.bins();
-        let Work { series, zh, buf, scratch } = w;
+        let Work { series, zh, gz, buf, scratch } = w;
         for b in 0..m {
             for (j, s) in series.iter_mut().enumerate() {
                 *s = z[j * m + b];
@@ -83,9 +94,18 @@ impl<'a> CirculantOperator<'a> {
                 zh[p * m + b] = buf[p];
             }
         }
+        // Ĝ_p ẑ_p harmonic by harmonic, each block read once in storage order (row by row, m strided
+        // passes over the whole spectrum: the product was 7 % of the real blade's sweep, issue 23).
+        // The sums run over b in the order of `Iterator::sum`, so the products are unchanged.
+        for (g, zp) in self.spectrum.chunks_exact(m * m).zip(zh.chunks_exact_mut(m)).take(nh) {
+            for (s, row) in gz.iter_mut().zip(g.chunks_exact(m)) {
+                *s = row.iter().zip(zp.iter()).fold(C::ZERO, |acc, (&x, &y)| acc + x * y);
+            }
+            zp.copy_from_slice(gz);
+        }
         for a in 0..m {
             for p in 0..nh {
-                buf[p] = (0..m).map(|b| self.spectrum[(p * m + a) * m + b] * zh[p * m + b]).sum();
+                buf[p] = zh[p * m + a];
             }
             self.fft.inverse_unscaled_with_scratch(buf, series, scratch);
             for j in 0..k {
