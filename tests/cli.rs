@@ -208,3 +208,38 @@ fn solve_draws_the_friction_dampers_hysteresis_loop_and_refuses_a_scene_without_
     assert!(err.contains("--hysteresis") && err.contains("[[friction]]"), "{err}");
     assert!(!tmp.join("no.png").exists());
 }
+
+/// `continue` writes each point's CSV row as the point comes, so that a walk stopped short (a
+/// timeout's signal, Ctrl-C) leaves its points: killed after its third point line, the CSV holds
+/// the header and at least those three rows, each a frequency between --from and --to.
+#[test]
+fn a_continuation_killed_mid_walk_leaves_the_rows_of_its_points() {
+    use std::io::BufRead;
+    let dir = crate::common::host::scratch("killed-walk");
+    let csv = dir.join("branch.csv");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("fmu/scenes/compliant-stop.toml");
+    // Steps of 1e-4 over 0.5: thousands of points, far more than reach the kill.
+    let mut child = cli()
+        .args(["continue", scene.to_str().unwrap(), "--param", "frequency", "--from", "1.3", "--to", "0.8", "--max-step", "1e-4", "--no-plot", "-o"])
+        .arg(&csv)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let lines = std::io::BufReader::new(child.stderr.take().unwrap()).lines();
+    let printed = lines.map_while(Result::ok).filter(|l| l.trim_start().starts_with("point frequency")).take(3).count();
+    child.kill().unwrap();
+    let status = child.wait().unwrap();
+    assert_eq!(printed, 3, "the walk printed fewer than 3 points");
+    assert!(status.code().is_none(), "the walk ended before it was killed ({status}): the test did not stop it mid-walk");
+    let text = std::fs::read_to_string(&csv).expect("the killed walk left no CSV");
+    let mut rows = text.lines();
+    let header = rows.next().unwrap_or_default();
+    assert!(header.starts_with("frequency ") && header.contains(",amplitude_0 "), "header: {text}");
+    let rows: Vec<&str> = rows.collect();
+    assert!(rows.len() >= 3, "{} rows after 3 points printed: {text}", rows.len());
+    for r in rows {
+        let f: f64 = r.split(',').next().unwrap().parse().unwrap_or(f64::NAN);
+        assert!((0.8..=1.3).contains(&f), "a row's frequency {f} is off the walk's range: {r}");
+        assert_eq!(r.split(',').count(), header.split(',').count(), "a row not whole: {r}");
+    }
+}

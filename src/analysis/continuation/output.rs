@@ -1,5 +1,5 @@
 //! The branch as CSV, its events as JSON, and its response curves as PNG.
-use super::Branch;
+use super::{Branch, BranchPoint, Parameter};
 use crate::model::{Labels, Quantity};
 use crate::periodic::PeriodicProblem;
 
@@ -9,27 +9,37 @@ use crate::periodic::PeriodicProblem;
 /// `event`, `certified`, `branch` (its index: 0 the T branch, then the switched ones), `source`
 /// (`exact`: the exact orbit's branch; `discrete`: the grid's).
 pub fn to_csv(branches: &[Branch], problem: &PeriodicProblem, labels: &Labels) -> String {
-    let mm = labels.unit(Quantity::Length);
     let Some(first) = branches.first() else { return String::new() };
-    let mut head = vec![format!("{} {}", first.parameter.name(), labels.unit(first.parameter.describe().1))];
-    head.extend(problem.outputs().displacement.iter().map(|d| format!("amplitude_{d} {mm}")));
-    head.extend(["stable", "multiplier", "period_multiple", "event", "certified", "branch", "source"].map(String::from));
-    let mut s = head.join(",") + "\n";
-    for (b, p) in branches.iter().enumerate().flat_map(|(b, branch)| branch.points.iter().map(move |p| (b, p))) {
-        let mut row = vec![format!("{:e}", p.parameter)];
-        row.extend(p.amplitude.iter().map(|a| format!("{a:e}")));
-        row.push(p.stable.to_string());
-        // Friction orbits have no multipliers (no step map): the cell stays empty.
-        row.push(if p.multipliers.is_empty() { String::new() } else { format!("{:e}", p.max_multiplier) });
-        row.push(p.period_multiple.to_string());
-        row.push(p.event.map_or(String::new(), |e| e.name().to_string()));
-        row.push(p.certified.to_string());
-        row.push(b.to_string());
-        row.push(p.source.name().to_string());
-        s.push_str(&row.join(","));
-        s.push('\n');
+    let mut s = csv_header(first.parameter, problem, labels);
+    for (b, branch) in branches.iter().enumerate() {
+        branch.points.iter().for_each(|p| s.push_str(&csv_row(p, b)));
     }
     s
+}
+
+/// The CSV's header line ([`to_csv`]), newline included.
+pub fn csv_header(parameter: Parameter, problem: &PeriodicProblem, labels: &Labels) -> String {
+    let mm = labels.unit(Quantity::Length);
+    let mut head = vec![format!("{} {}", parameter.name(), labels.unit(parameter.describe().1))];
+    head.extend(problem.outputs().displacement.iter().map(|d| format!("amplitude_{d} {mm}")));
+    head.extend(["stable", "multiplier", "period_multiple", "event", "certified", "branch", "source"].map(String::from));
+    head.join(",") + "\n"
+}
+
+/// One point's CSV row ([`to_csv`]) on the branch of index `branch`, newline included: a front
+/// end writes the rows as the points come, so that a walk stopped short leaves them.
+pub fn csv_row(p: &BranchPoint, branch: usize) -> String {
+    let mut row = vec![format!("{:e}", p.parameter)];
+    row.extend(p.amplitude.iter().map(|a| format!("{a:e}")));
+    row.push(p.stable.to_string());
+    // Friction orbits have no multipliers (no step map): the cell stays empty.
+    row.push(if p.multipliers.is_empty() { String::new() } else { format!("{:e}", p.max_multiplier) });
+    row.push(p.period_multiple.to_string());
+    row.push(p.event.map_or(String::new(), |e| e.name().to_string()));
+    row.push(p.certified.to_string());
+    row.push(branch.to_string());
+    row.push(p.source.name().to_string());
+    row.join(",") + "\n"
 }
 
 /// The events as JSON: per event its branch (index and label), period_multiple, kind, parameter,

@@ -34,6 +34,10 @@ pub struct Args {
     /// orbit's branch, 2e-2 for the discrete walk.
     #[arg(long)]
     pub max_step: Option<f64>,
+    /// Most points of a branch (events included) before the walk stops: the real blade's exact
+    /// walk makes ≈ 45 points per rad/s of speed, past the default over 150 rad/s.
+    #[arg(long, default_value_t = ContinuationSettings::default().max_points)]
+    pub max_points: usize,
     /// At each period doubling of the T branch, switch to the 2T branch and continue it too
     /// (same CSV with a `branch` column, same events JSON and PNG).
     #[arg(long)]
@@ -85,7 +89,10 @@ pub fn run(a: &Args) -> Result<(), Failure> {
         },
         other => Parameter::parse(other).map_err(Failure::from)?,
     };
-    let defaults = ContinuationSettings::default();
+    if a.max_points == 0 {
+        return Err(Failure::input("--max-points: is 0, must be at least 1".to_string()));
+    }
+    let defaults = ContinuationSettings { max_points: a.max_points, ..ContinuationSettings::default() };
     let settings = match a.max_step {
         Some(s) => ContinuationSettings { max_step: s, exact_max_step: s, ..defaults },
         None => defaults,
@@ -103,9 +110,21 @@ pub fn run(a: &Args) -> Result<(), Failure> {
         bar.set_position((((v - from) / (to - from)).clamp(0.0, 1.0) * 1000.0) as u64);
         bar.set_message(format!("{} = {v:.6}", a.param));
     };
+    // The CSV's rows written as the points come, so that a walk stopped short (timeout, Ctrl-C)
+    // leaves them; the whole CSV replaces them at the end. Not with --switch-at-pd (its branches'
+    // rows are known at the end) nor to stdout.
+    let rows = (!a.switch_at_pd && peak_range.is_none() && a.output.as_os_str() != "-")
+        .then(|| streamed(&a.output, &output::csv_header(param, problem, &built.labels)))
+        .transpose()?
+        .map(std::cell::RefCell::new);
     // Each point on its own line (not with --quiet), also where the bar is hidden (a log file):
     // a walk of minutes per point shows where it is and what it found.
     let on_point = |p: &continuation::BranchPoint| {
+        if let Some(w) = &rows
+            && let Err(e) = std::io::Write::write_all(&mut *w.borrow_mut(), output::csv_row(p, 0).as_bytes())
+        {
+            bar.suspend(|| eprintln!("warning: {}: a row not written as it came ({e}); the whole CSV is written at the end", a.output.display()));
+        }
         on_value(p.parameter);
         if !a.quiet {
             let event = p.event.map_or(String::new(), |k| format!(", {}: {}", k.name(), p.detail));
@@ -189,6 +208,15 @@ pub fn run(a: &Args) -> Result<(), Failure> {
         return Err(Failure::solver(format!("the continuation stopped before {} = {}: {}", a.param, a.to, branch.stop)));
     }
     Ok(())
+}
+
+/// `path` opened for the rows written as they come, with `header` in it; each row reaches the
+/// file at its newline.
+fn streamed(path: &std::path::Path, header: &str) -> Result<std::io::LineWriter<std::fs::File>, Failure> {
+    let cannot = |e: std::io::Error| Failure::input(format!("{}: cannot write the output: {e}", path.display()));
+    let mut w = std::io::LineWriter::new(std::fs::File::create(path).map_err(cannot)?);
+    std::io::Write::write_all(&mut w, header.as_bytes()).map_err(cannot)?;
+    Ok(w)
 }
 
 /// `frequency:A:B` → (A, B).

@@ -8,6 +8,7 @@
 //! Continuation", ch. 19) with a fixed segment signature.
 use super::super::{Parameter, floquet};
 use super::metric::Metric;
+use super::modes::{Modes, SignatureKey};
 use super::profile::{Stage, timed};
 use crate::analysis::polish::{Event, EventKind, PolishedOrbit, RigidMargin, Touch};
 use crate::model::{Compliance, Model};
@@ -60,18 +61,13 @@ pub(super) struct Family {
     last_jacobian: std::cell::RefCell<Option<(Vec<f64>, DMatrix<f64>)>>,
     /// The Jacobian of the last point solved, for the next corrector's chord iterations.
     chord: std::cell::RefCell<Option<Chord>>,
-    /// The first orbit built of each signature met, whose phases' eigendecompositions every later
-    /// orbit shares (the phase matrices do not depend on the parameter: one decomposition per
-    /// contact set). With the first orbit's only, every orbit past the coarse blade's first
-    /// grazing decomposed its new phases again: a quarter of the walk's time.
-    modes: std::cell::RefCell<Vec<(SignatureKey, PolishedOrbit)>>,
+    /// The orbits whose phases the builds share.
+    modes: std::cell::RefCell<Modes>,
     /// The flight (its phase) whose re-impact time alone kept the last corrector from
     /// converging ([`Self::unresolved_flight`]).
     unresolved: std::cell::Cell<Option<usize>>,
 }
 
-/// A signature's events (contact, kind) and its contacts closed all period long.
-type SignatureKey = (Vec<(usize, EventKind)>, Vec<usize>);
 type ChordKey = (SignatureKey, f64);
 
 struct Chord {
@@ -200,17 +196,7 @@ impl Family {
     }
 
     fn build(&self, lambda: f64) -> Option<PolishedOrbit> {
-        let key = self.signature_key();
-        let mut modes = self.modes.borrow_mut();
-        // The signature's first orbit first: its phases in order, then those of any signature met before.
-        let mut bank: Vec<&PolishedOrbit> = modes.iter().filter(|(k, _)| *k == key).map(|(_, o)| o).collect();
-        let known = !bank.is_empty();
-        bank.extend(modes.iter().filter(|(k, _)| *k != key).map(|(_, o)| o));
-        let orbit = PolishedOrbit::unsolved_retuning(&self.model_at(lambda), self.sig.events.clone(), &self.sig.always, &bank).ok()?;
-        if !known {
-            modes.push((key, orbit.clone()));
-        }
-        Some(orbit)
+        self.modes.borrow_mut().build(self.signature_key(), &self.model_at(lambda), self.sig.events.clone(), &self.sig.always)
     }
 
     fn unpack(&self, w: &[f64], period: f64) -> (Vec<f64>, Vec<f64>) {
@@ -326,11 +312,11 @@ impl Family {
     pub fn correct(&self, pred: &[f64], normal: &[f64], target: f64) -> Option<Vec<f64>> {
         let chord = self.chord.borrow().as_ref().filter(|c| c.key == self.key()).map(|c| c.jacobian.clone());
         if chord.is_some()
-            && let Some(w) = self.newton(pred, normal, target, chord)
+            && let Some(w) = timed(Stage::Chord, || self.newton(pred, normal, target, chord))
         {
             return Some(w);
         }
-        self.newton(pred, normal, target, None)
+        timed(Stage::Newton, || self.newton(pred, normal, target, None))
     }
 
     /// The flight (its phase, from a pure impact to a re-impact of one contact with mass) whose

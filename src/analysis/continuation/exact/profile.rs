@@ -24,9 +24,13 @@ pub(super) enum Stage {
     Trial,
     /// An event's test function at a bisection's point (e.g. the rigid margin's sampled period).
     Test,
+    /// A corrector's chord iterations (the last point's Jacobian), converged or not.
+    Chord,
+    /// A corrector's Newton iterations (fresh Jacobians): where the chord failed or had none.
+    Newton,
 }
 
-const NAMES: [&str; 9] = [
+const NAMES: [&str; 11] = [
     "orbit built",
     "residual",
     "variational flow",
@@ -36,10 +40,12 @@ const NAMES: [&str; 9] = [
     "bisections (inclusive)",
     "bisection trial points (inclusive)",
     "bisection test functions",
+    "correctors by chord (inclusive)",
+    "correctors by Newton (inclusive)",
 ];
 
 thread_local! {
-    static TOTALS: RefCell<Option<[(f64, usize); 9]>> = const { RefCell::new(None) };
+    static TOTALS: RefCell<Option<[(f64, usize); 11]>> = const { RefCell::new(None) };
 }
 
 pub(super) fn enabled() -> bool {
@@ -61,7 +67,7 @@ pub(super) fn timed<T>(stage: Stage, f: impl FnOnce() -> T) -> T {
     let spent = cpu() - start;
     TOTALS.with(|t| {
         let mut t = t.borrow_mut();
-        let row = &mut t.get_or_insert([(0.0, 0); 9])[stage as usize];
+        let row = &mut t.get_or_insert([(0.0, 0); 11])[stage as usize];
         row.0 += spent;
         row.1 += 1;
     });
