@@ -57,8 +57,9 @@ const MAX_DRIFT: f64 = 0.5;
 const TOUCH_TOL: f64 = 1e-10;
 /// The step's growth after a point: each change of signature restarts it at `initial_step`, and the
 /// real blade's walk (a grazing every ≈ 17 points) spent most points growing back; over 1150 → 1145
-/// rad/s ×1.5 took 146 points and 94.0 s CPU, ×2 103 and 75.6 s, ×3 83 and 78.1 s (validation/RECORD.md).
-const GROWTH: f64 = 2.0;
+/// rad/s ×1.5 took 146 points and 94.0 s CPU, ×2 103 and 75.6 s, ×3 83 and 78.1 s; but ×2's walk down
+/// lost the period doubling at 1141.60 (a trial failed in its wider bracket): ×1.5 kept (validation/RECORD.md).
+const GROWTH: f64 = 1.5;
 
 /// One exact walk: its points, why it stopped, and whether it reached `to`.
 pub(super) struct Walked {
