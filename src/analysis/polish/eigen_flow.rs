@@ -180,32 +180,6 @@ impl EigenFlow {
         re.zip_map(&im, C::new)
     }
 
-    /// The first `rows` rows of (iν − Â)⁻¹ [0; u] (u on Â's last u.len() coordinates), as
-    /// V (iν − Λ)⁻¹ V⁻¹ [0; u]: the periodic response of ŷ' = Âŷ + [0; u] e^{iνt} in
-    /// O(n (rows + u.len())), where an LU of iν − Â costs O(n³). `None` where iν is an eigenvalue.
-    pub fn resolvent(&self, nu: f64, u: &[C], rows: usize) -> Option<DVector<C>> {
-        let n = self.lambda.len();
-        let off = n - u.len();
-        let mut c = vec![C::new(0.0, 0.0); n];
-        for (k, uk) in u.iter().enumerate() {
-            let (re, im) = (self.inv_re.column(off + k), self.inv_im.column(off + k));
-            c.iter_mut().zip(re.iter().zip(im.iter())).for_each(|(cj, (a, b))| *cj += C::new(*a, *b) * uk);
-        }
-        for (cj, l) in c.iter_mut().zip(&self.lambda) {
-            let d = C::new(-l.re, nu - l.im);
-            if d.re == 0.0 && d.im == 0.0 {
-                return None;
-            }
-            *cj /= d;
-        }
-        let mut out = DVector::zeros(rows);
-        for (j, cj) in c.iter().enumerate() {
-            let (re, im) = (self.v_re.column(j), self.v_im.column(j));
-            out.iter_mut().zip(re.iter().zip(im.iter())).for_each(|(o, (a, b))| *o += C::new(*a, *b) * cj);
-        }
-        Some(out)
-    }
-
     /// e^{Âτ} u in O(n_a²): V (e^{Λτ} ⊙ V⁻¹ u).
     pub fn apply(&self, tau: f64, u: &DVector<f64>) -> DVector<f64> {
         let (w_re, w_im) = (&self.inv_re * u, &self.inv_im * u);

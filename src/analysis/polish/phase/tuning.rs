@@ -2,7 +2,6 @@
 //! frequency: its matrices, basis, condensation and Â (so its eigendecomposition) do not depend on
 //! ω; only the loads' harmonics and the particular solution do (one n_a-sized complex solve per
 //! harmonic), so a sweep makes each contact set's phase once and re-tunes it per point.
-use super::super::eigen_flow::EigenFlow;
 use super::{Harmonics, Phase, add, force_harmonics, gap_harmonics};
 use crate::model::{Compliance, Model};
 use nalgebra::{DMatrix, DVector, Dyn, LU};
@@ -27,26 +26,51 @@ pub(super) struct Tuning {
     pub statics: std::sync::OnceLock<(DVector<C>, DVector<C>)>,
 }
 
-/// The products K x_p, M x_p, C x_p of each harmonic x_p of a phase's prescribed motion: with
-/// the same loads they do not depend on ω (a frequency walk), so re-tunings reuse them.
+/// A phase's loads reduced to the free coordinates, per harmonic p, as three ω-independent parts:
+/// with r_p(w) = f_p − (K − w² M + i w C) x_p (x_p the prescribed motion) and the massless rows
+/// condensed, y_b = K_bb⁻¹ N_bᵀ r_p and g_a = N_aᵀ r_p − K_ab y_b are linear in r_p, so each is
+/// v₀ + w² v₂ − i w v₁ with v₀, v₂, v₁ the images of f_p − K x_p, M x_p and C x_p. With the same
+/// loads (a frequency walk) re-tunings reuse them: the massless solves and products were most of
+/// a re-tuning (the real blade's n_b = 49 against n_a = 20; its walk's builds, validation/RECORD.md).
 #[derive(Clone, Debug, Default)]
 pub(super) struct PrescTerms {
+    force: Harmonics,
     presc: Harmonics,
-    kmc: Vec<[DVector<C>; 3]>,
+    /// Per harmonic (ascending): p, the parts of y_b, those of g_a.
+    parts: Vec<(u32, [DVector<C>; 3], [DVector<C>; 3])>,
 }
 
 impl PrescTerms {
-    fn new(phase: &Phase) -> PrescTerms {
-        let kmc = phase.presc.iter().map(|(_, xp)| [times(&phase.k, xp), times(&phase.m, xp), times(&phase.c, xp)]).collect();
-        PrescTerms { presc: phase.presc.clone(), kmc }
+    fn new(phase: &Phase) -> Option<PrescTerms> {
+        let n = phase.n;
+        let mut ps: Vec<u32> = phase.force.iter().chain(&phase.presc).map(|(p, _)| *p).collect();
+        ps.sort_unstable();
+        ps.dedup();
+        let mut parts = Vec::with_capacity(ps.len());
+        for p in ps {
+            let f = phase.force.iter().find(|(q, _)| *q == p).map_or_else(|| DVector::zeros(n), |(_, v)| v.clone());
+            let (r0, r2, r1) = match phase.presc.iter().find(|(q, _)| *q == p) {
+                Some((_, xp)) => (f - times(&phase.k, xp), times(&phase.m, xp), times(&phase.c, xp)),
+                None => (f, DVector::zeros(n), DVector::zeros(n)),
+            };
+            let ((b0, a0), (b2, a2), (b1, a1)) = (phase.reduced(&r0)?, phase.reduced(&r2)?, phase.reduced(&r1)?);
+            parts.push((p, [b0, b2, b1], [a0, a2, a1]));
+        }
+        Some(PrescTerms { force: phase.force.clone(), presc: phase.presc.clone(), parts })
     }
 
-    /// Whether these are the products of `presc`: bit for bit (−0.0 ≠ 0.0), so reuse cannot
-    /// change a result.
-    fn is_for(&self, presc: &Harmonics) -> bool {
+    /// Whether these are the parts of the loads `force` and `presc`: bit for bit (−0.0 ≠ 0.0),
+    /// so reuse cannot change a result.
+    fn is_for(&self, force: &Harmonics, presc: &Harmonics) -> bool {
         // Compared in place: this runs at every re-tuning (no allocation on the walk's hot path).
-        self.presc.len() == presc.len() && self.presc.iter().zip(presc).all(|((p, a), (q, b))| p == q && same_bits(a, b))
+        let same = |x: &Harmonics, y: &Harmonics| x.len() == y.len() && x.iter().zip(y).all(|((p, a), (q, b))| p == q && same_bits(a, b));
+        same(&self.force, force) && same(&self.presc, presc)
     }
+}
+
+/// v₀ + w² v₂ − i w v₁ of the parts [v₀, v₂, v₁] ([`PrescTerms`]).
+fn at_frequency(v: &[DVector<C>; 3], w: f64) -> DVector<C> {
+    DVector::from_fn(v[0].len(), |i, _| v[0][i] + v[1][i] * (w * w) - C::new(0.0, w) * v[2][i])
 }
 
 /// `a` and `b` bit for bit (−0.0 ≠ 0.0).
@@ -113,26 +137,6 @@ fn tr_times(a: &DMatrix<f64>, x: &DVector<C>) -> DVector<C> {
     DVector::from_fn(a.ncols(), |i, _| C::new(re[i], im[i]))
 }
 
-/// (K_cond − w² M_aa + i w C_aa) x = g by Â's modes, O(n_a²) where an LU is O(n_a³): the
-/// first-order form's x rows of (iw − A)⁻¹ [0; M_aa⁻¹ g] (balanced: the velocity rows over the
-/// speed s; [`EigenFlow::resolvent`]), then one step of iterative refinement on the operator
-/// itself (Higham, "Accuracy and Stability of Numerical Algorithms", ch. 12). Alone, the modal
-/// solve carries the balanced Â's eigenvalue error, ε(s/ω₁)² relative for a slow mode (eigen_flow.rs),
-/// 2e-11 on the coarse blade (its events moved by 6e-8 rad/s); one refinement brings it to the
-/// residual's round-off, an LU's accuracy, while the modal error is far below 1.
-fn modal_solve(f: &EigenFlow, t: &Tuning, mff_inv: &DMatrix<f64>, speed: f64, w: f64, g: &DVector<C>) -> Option<DVector<C>> {
-    let nf = g.len();
-    let solve = |g: &DVector<C>| {
-        let u: Vec<C> = (0..nf).map(|i| (0..nf).map(|k| g[k] * mff_inv[(i, k)]).sum::<C>() / speed).collect();
-        f.resolvent(w, &u, nf)
-    };
-    let x = solve(g)?;
-    // r = g − (K_cond x − w² M_aa x + i w C_aa x).
-    let (kx, mx, cx) = (times(&t.k_cond, &x), times(&t.m_aa, &x), times(&t.c_aa, &x));
-    let r = DVector::from_fn(nf, |i, _| g[i] - kx[i] + mx[i] * (w * w) - cx[i] * C::new(0.0, w));
-    Some(x + solve(&r)?)
-}
-
 impl Phase {
     /// The particular solution of the phase's loads at its ω (`part`, `slave_part`): per harmonic,
     /// g = Nᵀ(f − (−(pω)² M + ipω C + K) x_presc); the massless rows are static,
@@ -140,41 +144,22 @@ impl Phase {
     /// (−(pω)² M_aa + ipω C_aa + K_cond) x_a = g_a − K_ab K_bb⁻¹ g_b. `None` when that operator
     /// is singular (an undamped resonance).
     pub(super) fn tune(&mut self) -> Option<()> {
-        let (nf, nb) = (self.free.ncols(), self.slave.ncols());
-        if !self.presc_terms.is_for(&self.presc) {
-            self.presc_terms = Arc::new(PrescTerms::new(self));
+        let nf = self.free.ncols();
+        if !self.presc_terms.is_for(&self.force, &self.presc) {
+            self.presc_terms = Arc::new(PrescTerms::new(self)?);
         }
         let t = &self.tuning;
-        // Â's eigendecomposition where it is made and accepted (a re-tuned phase's: [`Phase::retuned`]).
-        let eigen = Arc::clone(&self.eigen);
-        let modes = eigen.get().and_then(|f| f.as_ref());
-        let mut ps: Vec<u32> = self.force.iter().chain(&self.presc).map(|(p, _)| *p).collect();
-        ps.sort_unstable();
-        ps.dedup();
         let (mut part, mut slave_part) = (Vec::new(), Vec::new());
-        for p in ps {
-            let w = p as f64 * self.omega;
-            let mut r = self.force.iter().find(|(q, _)| *q == p).map_or_else(|| DVector::zeros(self.n), |(_, v)| v.clone());
-            if let Some(j) = self.presc.iter().position(|(q, _)| *q == p) {
-                let [kx, mx, cx] = &self.presc_terms.kmc[j];
-                r -= kx - mx * C::new(w * w, 0.0) + cx * C::new(0.0, w);
-            }
-            let yb = match &t.k_bb {
-                Some(lu) => {
-                    let gb = projected(&self.slave, t.slave_rows.as_deref(), &r);
-                    let (re, im) = (lu.solve(&gb.map(|z| z.re))?, lu.solve(&gb.map(|z| z.im))?);
-                    DVector::from_fn(nb, |i, _| C::new(re[i], im[i]))
-                }
-                None => DVector::zeros(nb),
-            };
+        for (p, b, a) in &self.presc_terms.parts {
+            let (p, w) = (*p, *p as f64 * self.omega);
+            let yb = at_frequency(b, w);
             let xa = if nf == 0 {
                 DVector::zeros(0)
             } else {
-                let ga = projected(&self.free, t.free_rows.as_deref(), &r) - times(&t.k_ab, &yb);
-                match (t.statics.get().filter(|(g, _)| p == 0 && same_bits(g, &ga)), modes) {
-                    (Some((_, x)), _) => x.clone(),
-                    (None, Some(f)) => modal_solve(f, t, &self.mff_inv, self.speed, w, &ga)?,
-                    (None, None) => {
+                let ga = at_frequency(a, w);
+                match t.statics.get().filter(|(g, _)| p == 0 && same_bits(g, &ga)) {
+                    Some((_, x)) => x.clone(),
+                    None => {
                         let op = DMatrix::from_fn(nf, nf, |i, j| C::new(t.k_cond[(i, j)] - w * w * t.m_aa[(i, j)], w * t.c_aa[(i, j)]));
                         let x = op.lu().solve(&ga)?;
                         if p == 0 {
@@ -198,15 +183,28 @@ impl Phase {
         Some(())
     }
 
+    /// The load r (complex, full model) condensed: y_b = K_bb⁻¹ N_bᵀ r (the massless rows' static
+    /// answer to it) and g_a = N_aᵀ r − K_ab y_b (the massive rows' load), per the module doc of
+    /// [`Phase::tune`]; `None` where K_bb's solve fails.
+    fn reduced(&self, r: &DVector<C>) -> Option<(DVector<C>, DVector<C>)> {
+        let (t, nb) = (&self.tuning, self.slave.ncols());
+        let yb = match &t.k_bb {
+            Some(lu) => {
+                let gb = projected(&self.slave, t.slave_rows.as_deref(), r);
+                let (re, im) = (lu.solve(&gb.map(|z| z.re))?, lu.solve(&gb.map(|z| z.im))?);
+                DVector::from_fn(nb, |i, _| C::new(re[i], im[i]))
+            }
+            None => DVector::zeros(nb),
+        };
+        let ga = if self.free.ncols() == 0 { DVector::zeros(0) } else { projected(&self.free, t.free_rows.as_deref(), r) - times(&t.k_ab, &yb) };
+        Some((yb, ga))
+    }
+
     /// This phase at `model`'s frequency and loads, `model` being the phase's own at another
     /// frequency (the same structure and contacts): the particular solution made again, the rest
     /// (the eigendecomposition included) shared. `None` as for [`Phase::new`].
     pub fn retuned(&self, model: &Model) -> Option<Phase> {
         let mut p = self.clone();
-        // A re-tuned phase flows (a sweep's, a walk's): its eigendecomposition is made here if
-        // not yet, for the particular solution by modes (`tune`). A phase made anew takes the LU:
-        // some only give their forces (a hold phase's), and never need the decomposition.
-        let _ = p.eigen();
         p.omega = model.frequency;
         (p.force, p.presc) = loads(model, &self.stuck, &self.closed);
         p.tune()?;
@@ -237,63 +235,38 @@ mod tests {
         Model { structure, forces: vec![force], contacts: vec![stop], frequency: omega, frictions: Vec::new(), rubbing: Vec::new() }
     }
 
-    /// A re-tuned phase's particular solution is the modal one ([`super::modal_solve`]): on the
-    /// chain with DOF 1 stuck (a 1-DOF phase: m = 1, k = 3, c = 0.15, driven by the unit force and
-    /// by the stop's motion X₁ through K₀₁ = −1, C₀₁ = −0.05), against the closed form
-    /// X₀ = (F − (K₀₁ + ipω C₀₁) X₁) / (3 − (pω)² + 0.15 ipω) per harmonic, and against the LU
-    /// of a phase made anew at that ω.
+    /// A re-tuned phase's particular solution (its loads' reduced parts reused, [`super::PrescTerms`])
+    /// against the closed form, on a unit mass (k = 2 to ground through a massless DOF: K = [[3, −1],
+    /// [−1, 1]], c = 0.15) forced on both DOFs, 1·cos ωt on the massless one and 0.5·cos 2ωt on the
+    /// mass: per harmonic w = pω, x₀ = (f₀ + f₁)/(2 − w² + 0.15 i w) (the massless row condensed,
+    /// x₁ = f₁ + x₀), re-tuned from ω = 1.2 to 1.7.
     #[test]
-    fn a_retuned_one_dof_phase_matches_its_closed_form_harmonic_response() {
+    fn a_retuned_phase_with_a_massless_dof_matches_its_closed_form_harmonic_response() {
         use num_complex::Complex64 as C;
-        let (omega, motion) = (1.7, 0.05);
-        let retuned = Phase::new(&chain(1.2, motion), &[0], &[]).expect("the stuck phase").retuned(&chain(omega, motion)).expect("re-tuned");
-        assert!(retuned.eigen.get().is_some_and(|f| f.is_some()), "the re-tuning takes the modal path");
-        let anew = Phase::new(&chain(omega, motion), &[0], &[]).expect("made anew (LU)");
-        let exact = |p: u32| {
+        let model = |omega: f64| {
+            let structure = Structure {
+                mass: Matrix::from_rows(&[vec![1.0, 0.0], vec![0.0, 0.0]]),
+                stiffness: Matrix::from_rows(&[vec![3.0, -1.0], vec![-1.0, 1.0]]),
+                damping: Some(Matrix::from_rows(&[vec![0.15, 0.0], vec![0.0, 0.0]])),
+            };
+            let forces = vec![
+                Force { dof: 1, term: Harmonic { amplitude: 1.0, harmonic: 1, phase: 0.0 } },
+                Force { dof: 0, term: Harmonic { amplitude: 0.5, harmonic: 2, phase: 0.0 } },
+            ];
+            Model { structure, forces, contacts: Vec::new(), frequency: omega, frictions: Vec::new(), rubbing: Vec::new() }
+        };
+        let omega = 1.7;
+        let made = Phase::new(&model(1.2), &[], &[]).expect("the free phase");
+        let retuned = made.retuned(&model(omega)).expect("re-tuned");
+        assert!(Arc::ptr_eq(&made.presc_terms, &retuned.presc_terms), "the same loads: the parts are reused");
+        for (p, f0, f1) in [(1, 0.0, 1.0), (2, 0.5, 0.0)] {
             let w = p as f64 * omega;
-            let (f, x1) = if p == 0 { (C::new(0.0, 0.0), C::new(0.3, 0.0)) } else { (C::new(1.0, 0.0), C::from_polar(motion, 0.4)) };
-            (f - C::new(-1.0, -0.05 * w) * x1) / C::new(3.0 - w * w, 0.15 * w)
-        };
-        for p in [0, 1] {
-            let at = |ph: &Phase| ph.part.iter().find(|(q, _)| *q == p).expect("the harmonic")[0].1[0];
-            let x = exact(p);
-            let (modal, lu) = ((at(&retuned) - x).norm() / x.norm(), (at(&anew) - x).norm() / x.norm());
-            println!("harmonic {p}: modal {modal:.1e}, LU {lu:.1e} relative to the closed form");
-            assert!(modal < 1e-14 && lu < 1e-14, "harmonic {p}: modal {modal:e}, LU {lu:e}");
+            let x0 = C::new(f0 + f1, 0.0) / C::new(2.0 - w * w, 0.15 * w);
+            let x1 = x0 + f1;
+            let at = |h: &super::Harmonics| h.iter().find(|(q, _)| *q == p).expect("the harmonic").1[0];
+            let (e0, e1) = ((at(&retuned.part) - x0).norm() / x0.norm(), (at(&retuned.slave_part) - x1).norm() / x1.norm());
+            assert!(e0 < 1e-14 && e1 < 1e-14, "harmonic {p}: mass {e0:e}, massless DOF {e1:e}");
         }
-    }
-
-    /// The modal solve against the LU and the closed form on a stiff spread: a unit mass (k = 1,
-    /// c = 0.1) carrying a tip of 1e-6 on a spring of 100 (its mode at 1e4 rad/s, the balancing
-    /// speed s = 1.4e4) at ω = 0.9, s/ω ≈ 1.6e4 (a Craig–Bampton blade's 3.6e3 beyond): the modal
-    /// solve alone is off by ≈ ε(s/ω)² (eigen_flow.rs), the refined one must be at an LU's
-    /// accuracy. Closed form: Cramer's rule on the 2 × 2 operator.
-    #[test]
-    fn the_refined_modal_solve_matches_the_lu_on_a_stiff_spread() {
-        use crate::model::Model;
-        use nalgebra::DVector;
-        use num_complex::Complex64 as C;
-        let (m1, ks, omega) = (1e-6, 100.0, 0.9);
-        let structure = Structure {
-            mass: Matrix::from_rows(&[vec![1.0, 0.0], vec![0.0, m1]]),
-            stiffness: Matrix::from_rows(&[vec![1.0 + ks, -ks], vec![-ks, ks]]),
-            damping: Some(Matrix::from_rows(&[vec![0.1, 0.0], vec![0.0, 0.0]])),
-        };
-        let force = Force { dof: 0, term: Harmonic { amplitude: 1.0, harmonic: 1, phase: 0.0 } };
-        let model = Model { structure, forces: vec![force], contacts: Vec::new(), frequency: omega, frictions: Vec::new(), rubbing: Vec::new() };
-        let phase = Phase::new(&model, &[], &[]).expect("the free phase");
-        let f = phase.eigen().expect("Â's modes accepted");
-        let op = [[C::new(1.0 + ks - omega * omega, 0.1 * omega), C::new(-ks, 0.0)], [C::new(-ks, 0.0), C::new(ks - m1 * omega * omega, 0.0)]];
-        let det = op[0][0] * op[1][1] - op[0][1] * op[1][0];
-        let exact = [op[1][1] / det, -op[1][0] / det];
-        let g = DVector::from_column_slice(&[C::new(1.0, 0.0), C::new(0.0, 0.0)]);
-        let error = |x: &DVector<C>| ((x[0] - exact[0]).norm().max((x[1] - exact[1]).norm())) / exact[0].norm().max(exact[1].norm());
-        let u: Vec<C> = (0..2).map(|i| (0..2).map(|k| g[k] * phase.mff_inv[(i, k)]).sum::<C>() / phase.speed).collect();
-        let alone = error(&f.resolvent(omega, &u, 2).expect("not an eigenvalue"));
-        let refined = error(&super::modal_solve(f, &phase.tuning, &phase.mff_inv, phase.speed, omega, &g).expect("not an eigenvalue"));
-        let lu = error(&phase.part[0].1.rows(0, 2).into_owned());
-        println!("s/ω = {:.1e}: modal alone {alone:.1e}, refined {refined:.1e}, LU {lu:.1e} relative to Cramer's rule", phase.speed / omega);
-        assert!(refined < 1e-13 && lu < 1e-13, "refined {refined:e}, LU {lu:e}");
     }
 
     #[test]
@@ -310,13 +283,12 @@ mod tests {
         // Another ω, the same motion: the products are shared and the result is the uncached one's.
         let retuned = made.retuned(&chain(1.7, 0.05)).expect("re-tuned");
         assert!(Arc::ptr_eq(&made.presc_terms, &retuned.presc_terms));
-        // Made anew and re-tuned at its own ω: the particular solution by the same (modal) path.
-        let anew = Phase::new(&chain(1.7, 0.05), &[0], &[]).and_then(|p| p.retuned(&chain(1.7, 0.05))).expect("made anew");
+        let anew = Phase::new(&chain(1.7, 0.05), &[0], &[]).expect("made anew");
         assert_eq!(bits(&retuned), bits(&anew));
         // A perturbed motion must invalidate them: else the particular solution keeps the old load.
         let moved = made.retuned(&chain(1.7, 0.05 * (1.0 + 1e-9))).expect("re-tuned, moved");
         assert!(!Arc::ptr_eq(&made.presc_terms, &moved.presc_terms));
-        let anew = Phase::new(&chain(1.7, 0.05 * (1.0 + 1e-9)), &[0], &[]).and_then(|p| p.retuned(&chain(1.7, 0.05 * (1.0 + 1e-9)))).expect("made anew, moved");
+        let anew = Phase::new(&chain(1.7, 0.05 * (1.0 + 1e-9)), &[0], &[]).expect("made anew, moved");
         assert_eq!(bits(&moved), bits(&anew));
         assert_ne!(bits(&moved), bits(&retuned));
     }
