@@ -300,7 +300,7 @@ impl Phase {
 
     /// Â's eigendecomposition, made once per phase (shared by its clones); `None` where refused.
     fn eigen(&self) -> Option<&EigenFlow> {
-        self.eigen.get_or_init(|| EigenFlow::new(&*self.a)).as_ref()
+        self.eigen.get_or_init(|| EigenFlow::new(&self.a)).as_ref()
     }
 
     /// Every DOF free and massive: N_a = I, no prescribed motion, nothing condensed.
@@ -423,14 +423,14 @@ impl Phase {
         let (free_rows, slave_rows) = (self.tuning.free_rows.as_deref(), self.tuning.slave_rows.as_deref());
         let mut x = eval(&self.presc, self.omega, t, 0, n);
         let mut v = eval(&self.presc, self.omega, t, 1, n);
-        Self::add_in_basis(&mut x, &*self.free, free_rows, &yf.rows(0, nf));
-        Self::add_in_basis(&mut v, &*self.free, free_rows, &yf.rows(nf, nf));
+        Self::add_in_basis(&mut x, &self.free, free_rows, &yf.rows(0, nf));
+        Self::add_in_basis(&mut v, &self.free, free_rows, &yf.rows(nf, nf));
         if self.slave.ncols() > 0 {
             let (nb, pa) = (self.slave.ncols(), eval(&self.part, self.omega, t, 0, 2 * nf));
             let xb = eval(&self.slave_part, self.omega, t, 0, nb) + &*self.slave_map * (yf.rows(0, nf) - pa.rows(0, nf));
             let vb = eval(&self.slave_part, self.omega, t, 1, nb) + &*self.slave_map * (yf.rows(nf, nf) - pa.rows(nf, nf));
-            Self::add_in_basis(&mut x, &*self.slave, slave_rows, &xb.rows(0, nb));
-            Self::add_in_basis(&mut v, &*self.slave, slave_rows, &vb.rows(0, nb));
+            Self::add_in_basis(&mut x, &self.slave, slave_rows, &xb.rows(0, nb));
+            Self::add_in_basis(&mut v, &self.slave, slave_rows, &vb.rows(0, nb));
         }
         y.rows_mut(0, n).copy_from(&x);
         y.rows_mut(n, n).copy_from(&v);

@@ -7,12 +7,12 @@ use num_complex::Complex64 as C;
 impl Phase {
     /// N_a (n × n_a, orthonormal columns): the massive free coordinates x_a = N_aᵀ x.
     pub fn massive_basis(&self) -> &DMatrix<f64> {
-        &*self.free
+        &self.free
     }
 
     /// N_b (n × n_b, orthonormal columns): the massless free coordinates, condensed.
     pub fn massless_basis(&self) -> &DMatrix<f64> {
-        &*self.slave
+        &self.slave
     }
 
     /// L = N_a + N_b S (n × n_a): every DOF's displacement (velocity) from the massive
