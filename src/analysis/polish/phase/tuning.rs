@@ -37,8 +37,11 @@ pub(super) struct PrescTerms {
     force: Harmonics,
     presc: Harmonics,
     /// Per harmonic (ascending): p, the parts of y_b, those of g_a.
-    parts: Vec<(u32, [DVector<C>; 3], [DVector<C>; 3])>,
+    parts: Vec<(u32, Parts, Parts)>,
 }
+
+/// A reduced load's parts [v₀, v₂, v₁] ([`PrescTerms`]).
+type Parts = [DVector<C>; 3];
 
 impl PrescTerms {
     fn new(phase: &Phase) -> Option<PrescTerms> {
@@ -69,7 +72,7 @@ impl PrescTerms {
 }
 
 /// v₀ + w² v₂ − i w v₁ of the parts [v₀, v₂, v₁] ([`PrescTerms`]).
-fn at_frequency(v: &[DVector<C>; 3], w: f64) -> DVector<C> {
+fn at_frequency(v: &Parts, w: f64) -> DVector<C> {
     DVector::from_fn(v[0].len(), |i, _| v[0][i] + v[1][i] * (w * w) - C::new(0.0, w) * v[2][i])
 }
 
