@@ -34,10 +34,11 @@ pub(super) struct Phase {
     pub n: usize,
     omega: f64,
     /// The massive free coordinates' basis N_a (n × n_a, orthonormal columns) and the stuck contacts.
-    free: DMatrix<f64>,
+    /// This and the other ω-independent matrices are shared: a walk's build clones ~50 phases.
+    free: Arc<DMatrix<f64>>,
     stuck: Vec<usize>,
     /// Rows of B of the stuck contacts, dense (|stuck| × n).
-    b_stuck: DMatrix<f64>,
+    b_stuck: Arc<DMatrix<f64>>,
     /// Closed compliant contacts.
     closed: Vec<usize>,
     /// The full-model matrices of this phase (K with the closed compliant springs), shared by
@@ -50,18 +51,18 @@ pub(super) struct Phase {
     /// Prescribed displacement of every DOF (nonzero only at stuck DOFs).
     presc: Harmonics,
     /// First-order form of the free DOFs, balanced: ŷ = [x_f; v_f/speed] (see [`Phase::exp`]).
-    a: DMatrix<f64>,
+    a: Arc<DMatrix<f64>>,
     /// The balancing rate [rad/s]: √‖M_ff⁻¹K_ff‖∞ ≥ ω_max of the phase.
     speed: f64,
     /// ‖Â‖₁, which sets the Taylor substeps of a short flow ([`Phase::flow`]).
     a_norm: f64,
-    mff_inv: DMatrix<f64>,
+    mff_inv: Arc<DMatrix<f64>>,
     /// Particular periodic solution of the massive free state [x_a; v_a].
     part: Harmonics,
     /// The massless free coordinates' basis N_b (n × n_b), their static condensation
     /// x_b = S x_a + (particular part), S = −K_bb⁻¹ K_ba, and their particular solution X_b.
-    slave: DMatrix<f64>,
-    slave_map: DMatrix<f64>,
+    slave: Arc<DMatrix<f64>>,
+    slave_map: Arc<DMatrix<f64>>,
     slave_part: Harmonics,
     /// What the particular solution needs at any ω (tuning.rs), shared by the phase's clones.
     tuning: Arc<Tuning>,
@@ -199,22 +200,22 @@ impl Phase {
         let mut phase = Phase {
             n,
             omega,
-            free,
+            free: Arc::new(free),
             stuck: stuck.to_vec(),
-            b_stuck,
+            b_stuck: Arc::new(b_stuck),
             closed: closed.to_vec(),
             m: Arc::new(m),
             c: Arc::new(c),
             k: Arc::new(k),
             force,
             presc,
-            a,
+            a: Arc::new(a),
             speed,
             a_norm,
-            mff_inv,
+            mff_inv: Arc::new(mff_inv),
             part: Vec::new(),
-            slave,
-            slave_map,
+            slave: Arc::new(slave),
+            slave_map: Arc::new(slave_map),
             slave_part: Vec::new(),
             tuning,
             presc_terms: Arc::default(),
@@ -283,7 +284,7 @@ impl Phase {
     pub fn exp(&self, tau: f64) -> DMatrix<f64> {
         self.unbalanced(match self.eigen() {
             Some(f) => f.exp(tau),
-            None => (&self.a * tau).exp(),
+            None => (&*self.a * tau).exp(),
         })
     }
 
@@ -400,7 +401,7 @@ impl Phase {
         for _ in 0..substeps as usize {
             let mut term = u.clone();
             for k in 1..=40 {
-                term = &self.a * term * (h / k as f64);
+                term = &*self.a * term * (h / k as f64);
                 u += &term;
                 if term.amax() <= 1e-18 * u.amax() {
                     break;
@@ -426,8 +427,8 @@ impl Phase {
         Self::add_in_basis(&mut v, &self.free, free_rows, &yf.rows(nf, nf));
         if self.slave.ncols() > 0 {
             let (nb, pa) = (self.slave.ncols(), eval(&self.part, self.omega, t, 0, 2 * nf));
-            let xb = eval(&self.slave_part, self.omega, t, 0, nb) + &self.slave_map * (yf.rows(0, nf) - pa.rows(0, nf));
-            let vb = eval(&self.slave_part, self.omega, t, 1, nb) + &self.slave_map * (yf.rows(nf, nf) - pa.rows(nf, nf));
+            let xb = eval(&self.slave_part, self.omega, t, 0, nb) + &*self.slave_map * (yf.rows(0, nf) - pa.rows(0, nf));
+            let vb = eval(&self.slave_part, self.omega, t, 1, nb) + &*self.slave_map * (yf.rows(nf, nf) - pa.rows(nf, nf));
             Self::add_in_basis(&mut x, &self.slave, slave_rows, &xb.rows(0, nb));
             Self::add_in_basis(&mut v, &self.slave, slave_rows, &vb.rows(0, nb));
         }
@@ -490,13 +491,13 @@ impl Phase {
         let (x, v) = (y.rows(0, n).into_owned(), y.rows(n, n).into_owned());
         let acc = eval(&self.presc, self.omega, t, 2, n);
         let rhs = eval(&self.force, self.omega, t, 0, n) - &*self.c * &v - &*self.k * &x - &*self.m * &acc;
-        let af = &self.mff_inv * (self.free.transpose() * rhs);
-        let mut out = acc + &self.free * &af;
+        let af = &*self.mff_inv * (self.free.transpose() * rhs);
+        let mut out = acc + &*self.free * &af;
         if self.slave.ncols() > 0 {
             // ẍ_b = Ẍ_b(t) + S (ẍ_a − Ẍ_a(t)).
             let nf = self.free.ncols();
             let pa = eval(&self.part, self.omega, t, 1, 2 * nf);
-            out += &self.slave * (eval(&self.slave_part, self.omega, t, 2, self.slave.ncols()) + &self.slave_map * (af - pa.rows(nf, nf)));
+            out += &*self.slave * (eval(&self.slave_part, self.omega, t, 2, self.slave.ncols()) + &*self.slave_map * (af - pa.rows(nf, nf)));
         }
         out
     }
@@ -509,7 +510,7 @@ impl Phase {
         let acc = self.acceleration_condensed(&y, t);
         let (x, v) = (y.rows(0, n).into_owned(), y.rows(n, n).into_owned());
         let r = eval(&self.force, self.omega, t, 0, n) - &*self.m * acc - &*self.c * v - &*self.k * x;
-        let z = &self.b_stuck * r;
+        let z = &*self.b_stuck * r;
         self.stuck.iter().enumerate().map(|(a, &i)| (i, z[a])).collect()
     }
 }
@@ -529,8 +530,8 @@ impl Phase {
             let ml = &*self.m * lift;
             let block = |a: &DMatrix<f64>| {
                 let al = a * lift;
-                let acc = &self.mff_inv * (self.free.transpose() * &al);
-                -(&self.b_stuck * (al - &ml * acc)) * self.free.transpose()
+                let acc = &*self.mff_inv * (self.free.transpose() * &al);
+                -(&*self.b_stuck * (al - &ml * acc)) * self.free.transpose()
             };
             let mut g = DMatrix::zeros(self.stuck.len(), 2 * n);
             g.columns_mut(0, n).copy_from(&block(&self.k));

@@ -24,7 +24,7 @@ impl Phase {
 
     /// [`Self::lift`], made once per phase (shared by its clones and re-tunings).
     pub fn lifted(&self) -> &DMatrix<f64> {
-        self.lift.get_or_init(|| &self.free + &self.slave * &self.slave_map)
+        self.lift.get_or_init(|| &*self.free + &*self.slave * &*self.slave_map)
     }
 
     /// e^{Ah} for the switch search's grid step `h` (detect/grid.rs), made once per phase for

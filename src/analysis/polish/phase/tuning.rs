@@ -26,26 +26,54 @@ pub(super) struct Tuning {
     pub statics: std::sync::OnceLock<(DVector<C>, DVector<C>)>,
 }
 
-/// The products K x_p, M x_p, C x_p of each harmonic x_p of a phase's prescribed motion: with
-/// the same loads they do not depend on ω (a frequency walk), so re-tunings reuse them.
+/// A phase's loads reduced to the free coordinates, per harmonic p, as three ω-independent parts:
+/// with r_p(w) = f_p − (K − w² M + i w C) x_p (x_p the prescribed motion) and the massless rows
+/// condensed, y_b = K_bb⁻¹ N_bᵀ r_p and g_a = N_aᵀ r_p − K_ab y_b are linear in r_p, so each is
+/// v₀ + w² v₂ − i w v₁ with v₀, v₂, v₁ the images of f_p − K x_p, M x_p and C x_p. With the same
+/// loads (a frequency walk) re-tunings reuse them: the massless solves and products were most of
+/// a re-tuning (the real blade's n_b = 49 against n_a = 20; its walk's builds, validation/RECORD.md).
 #[derive(Clone, Debug, Default)]
 pub(super) struct PrescTerms {
+    force: Harmonics,
     presc: Harmonics,
-    kmc: Vec<[DVector<C>; 3]>,
+    /// Per harmonic (ascending): p, the parts of y_b, those of g_a.
+    parts: Vec<(u32, Parts, Parts)>,
 }
 
+/// A reduced load's parts [v₀, v₂, v₁] ([`PrescTerms`]).
+type Parts = [DVector<C>; 3];
+
 impl PrescTerms {
-    fn new(phase: &Phase) -> PrescTerms {
-        let kmc = phase.presc.iter().map(|(_, xp)| [times(&phase.k, xp), times(&phase.m, xp), times(&phase.c, xp)]).collect();
-        PrescTerms { presc: phase.presc.clone(), kmc }
+    fn new(phase: &Phase) -> Option<PrescTerms> {
+        let n = phase.n;
+        let mut ps: Vec<u32> = phase.force.iter().chain(&phase.presc).map(|(p, _)| *p).collect();
+        ps.sort_unstable();
+        ps.dedup();
+        let mut parts = Vec::with_capacity(ps.len());
+        for p in ps {
+            let f = phase.force.iter().find(|(q, _)| *q == p).map_or_else(|| DVector::zeros(n), |(_, v)| v.clone());
+            let (r0, r2, r1) = match phase.presc.iter().find(|(q, _)| *q == p) {
+                Some((_, xp)) => (f - times(&phase.k, xp), times(&phase.m, xp), times(&phase.c, xp)),
+                None => (f, DVector::zeros(n), DVector::zeros(n)),
+            };
+            let ((b0, a0), (b2, a2), (b1, a1)) = (phase.reduced(&r0)?, phase.reduced(&r2)?, phase.reduced(&r1)?);
+            parts.push((p, [b0, b2, b1], [a0, a2, a1]));
+        }
+        Some(PrescTerms { force: phase.force.clone(), presc: phase.presc.clone(), parts })
     }
 
-    /// Whether these are the products of `presc`: bit for bit (−0.0 ≠ 0.0), so reuse cannot
-    /// change a result.
-    fn is_for(&self, presc: &Harmonics) -> bool {
+    /// Whether these are the parts of the loads `force` and `presc`: bit for bit (−0.0 ≠ 0.0),
+    /// so reuse cannot change a result.
+    fn is_for(&self, force: &Harmonics, presc: &Harmonics) -> bool {
         // Compared in place: this runs at every re-tuning (no allocation on the walk's hot path).
-        self.presc.len() == presc.len() && self.presc.iter().zip(presc).all(|((p, a), (q, b))| p == q && same_bits(a, b))
+        let same = |x: &Harmonics, y: &Harmonics| x.len() == y.len() && x.iter().zip(y).all(|((p, a), (q, b))| p == q && same_bits(a, b));
+        same(&self.force, force) && same(&self.presc, presc)
     }
+}
+
+/// v₀ + w² v₂ − i w v₁ of the parts [v₀, v₂, v₁] ([`PrescTerms`]).
+fn at_frequency(v: &Parts, w: f64) -> DVector<C> {
+    DVector::from_fn(v[0].len(), |i, _| v[0][i] + v[1][i] * (w * w) - C::new(0.0, w) * v[2][i])
 }
 
 /// `a` and `b` bit for bit (−0.0 ≠ 0.0).
@@ -119,34 +147,19 @@ impl Phase {
     /// (−(pω)² M_aa + ipω C_aa + K_cond) x_a = g_a − K_ab K_bb⁻¹ g_b. `None` when that operator
     /// is singular (an undamped resonance).
     pub(super) fn tune(&mut self) -> Option<()> {
-        let (nf, nb) = (self.free.ncols(), self.slave.ncols());
-        if !self.presc_terms.is_for(&self.presc) {
-            self.presc_terms = Arc::new(PrescTerms::new(self));
+        let nf = self.free.ncols();
+        if !self.presc_terms.is_for(&self.force, &self.presc) {
+            self.presc_terms = Arc::new(PrescTerms::new(self)?);
         }
         let t = &self.tuning;
-        let mut ps: Vec<u32> = self.force.iter().chain(&self.presc).map(|(p, _)| *p).collect();
-        ps.sort_unstable();
-        ps.dedup();
         let (mut part, mut slave_part) = (Vec::new(), Vec::new());
-        for p in ps {
-            let w = p as f64 * self.omega;
-            let mut r = self.force.iter().find(|(q, _)| *q == p).map_or_else(|| DVector::zeros(self.n), |(_, v)| v.clone());
-            if let Some(j) = self.presc.iter().position(|(q, _)| *q == p) {
-                let [kx, mx, cx] = &self.presc_terms.kmc[j];
-                r -= kx - mx * C::new(w * w, 0.0) + cx * C::new(0.0, w);
-            }
-            let yb = match &t.k_bb {
-                Some(lu) => {
-                    let gb = projected(&self.slave, t.slave_rows.as_deref(), &r);
-                    let (re, im) = (lu.solve(&gb.map(|z| z.re))?, lu.solve(&gb.map(|z| z.im))?);
-                    DVector::from_fn(nb, |i, _| C::new(re[i], im[i]))
-                }
-                None => DVector::zeros(nb),
-            };
+        for (p, b, a) in &self.presc_terms.parts {
+            let (p, w) = (*p, *p as f64 * self.omega);
+            let yb = at_frequency(b, w);
             let xa = if nf == 0 {
                 DVector::zeros(0)
             } else {
-                let ga = projected(&self.free, t.free_rows.as_deref(), &r) - times(&t.k_ab, &yb);
+                let ga = at_frequency(a, w);
                 match t.statics.get().filter(|(g, _)| p == 0 && same_bits(g, &ga)) {
                     Some((_, x)) => x.clone(),
                     None => {
@@ -171,6 +184,23 @@ impl Phase {
         }
         (self.part, self.slave_part) = (part, slave_part);
         Some(())
+    }
+
+    /// The load r (complex, full model) condensed: y_b = K_bb⁻¹ N_bᵀ r (the massless rows' static
+    /// answer to it) and g_a = N_aᵀ r − K_ab y_b (the massive rows' load), per the module doc of
+    /// [`Phase::tune`]; `None` where K_bb's solve fails.
+    fn reduced(&self, r: &DVector<C>) -> Option<(DVector<C>, DVector<C>)> {
+        let (t, nb) = (&self.tuning, self.slave.ncols());
+        let yb = match &t.k_bb {
+            Some(lu) => {
+                let gb = projected(&self.slave, t.slave_rows.as_deref(), r);
+                let (re, im) = (lu.solve(&gb.map(|z| z.re))?, lu.solve(&gb.map(|z| z.im))?);
+                DVector::from_fn(nb, |i, _| C::new(re[i], im[i]))
+            }
+            None => DVector::zeros(nb),
+        };
+        let ga = if self.free.ncols() == 0 { DVector::zeros(0) } else { projected(&self.free, t.free_rows.as_deref(), r) - times(&t.k_ab, &yb) };
+        Some((yb, ga))
     }
 
     /// This phase at `model`'s frequency and loads, `model` being the phase's own at another
@@ -206,6 +236,40 @@ mod tests {
         };
         let force = Force { dof: 0, term: Harmonic { amplitude: 1.0, harmonic: 1, phase: 0.0 } };
         Model { structure, forces: vec![force], contacts: vec![stop], frequency: omega, frictions: Vec::new(), rubbing: Vec::new() }
+    }
+
+    /// A re-tuned phase's particular solution (its loads' reduced parts reused, [`super::PrescTerms`])
+    /// against the closed form, on a unit mass (k = 2 to ground through a massless DOF: K = [[3, −1],
+    /// [−1, 1]], c = 0.15) forced on both DOFs, 1·cos ωt on the massless one and 0.5·cos 2ωt on the
+    /// mass: per harmonic w = pω, x₀ = (f₀ + f₁)/(2 − w² + 0.15 i w) (the massless row condensed,
+    /// x₁ = f₁ + x₀), re-tuned from ω = 1.2 to 1.7.
+    #[test]
+    fn a_retuned_phase_with_a_massless_dof_matches_its_closed_form_harmonic_response() {
+        use num_complex::Complex64 as C;
+        let model = |omega: f64| {
+            let structure = Structure {
+                mass: Matrix::from_rows(&[vec![1.0, 0.0], vec![0.0, 0.0]]),
+                stiffness: Matrix::from_rows(&[vec![3.0, -1.0], vec![-1.0, 1.0]]),
+                damping: Some(Matrix::from_rows(&[vec![0.15, 0.0], vec![0.0, 0.0]])),
+            };
+            let forces = vec![
+                Force { dof: 1, term: Harmonic { amplitude: 1.0, harmonic: 1, phase: 0.0 } },
+                Force { dof: 0, term: Harmonic { amplitude: 0.5, harmonic: 2, phase: 0.0 } },
+            ];
+            Model { structure, forces, contacts: Vec::new(), frequency: omega, frictions: Vec::new(), rubbing: Vec::new() }
+        };
+        let omega = 1.7;
+        let made = Phase::new(&model(1.2), &[], &[]).expect("the free phase");
+        let retuned = made.retuned(&model(omega)).expect("re-tuned");
+        assert!(Arc::ptr_eq(&made.presc_terms, &retuned.presc_terms), "the same loads: the parts are reused");
+        for (p, f0, f1) in [(1, 0.0, 1.0), (2, 0.5, 0.0)] {
+            let w = p as f64 * omega;
+            let x0 = C::new(f0 + f1, 0.0) / C::new(2.0 - w * w, 0.15 * w);
+            let x1 = x0 + f1;
+            let at = |h: &super::Harmonics| h.iter().find(|(q, _)| *q == p).expect("the harmonic").1[0];
+            let (e0, e1) = ((at(&retuned.part) - x0).norm() / x0.norm(), (at(&retuned.slave_part) - x1).norm() / x1.norm());
+            assert!(e0 < 1e-14 && e1 < 1e-14, "harmonic {p}: mass {e0:e}, massless DOF {e1:e}");
+        }
     }
 
     #[test]
