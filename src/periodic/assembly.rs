@@ -25,8 +25,9 @@ pub struct Assembly {
     /// or the output map's labels: each row is its combination of model DOFs, [`RecoveryRow`]).
     pub dofs: Vec<usize>,
     pub symbols: Symbols,
-    /// Ĝ_p, row-major m×m, for p = 0..=k/2.
-    pub g_hat: Vec<C>,
+    /// Ĝ_p, row-major m×m, for p = 0..=k/2; shared with the LCP's spectrum where that needs no
+    /// change (`PeriodicProblem::lcp`: a 4.7 MB copy per solve at k = 2048, issue 23).
+    pub g_hat: std::sync::Arc<Vec<C>>,
     /// X̂lin_p at `dofs`: [p][dofs.len()].
     pub xlin_hat: Vec<C>,
     /// B X̂lin_p: [p][m].
@@ -285,6 +286,44 @@ pub fn assemble_with(
     fft: &PeriodFft,
     parallel: bool,
 ) -> Result<Assembly, SolveError> {
+    assemble_reusing(model, op, scheme, period, rows, fft, parallel, &mut ModalProducts::default())
+}
+
+/// The modal assembly's largest products (Ĝ's, Ẑ⁻¹Bᵀ's, X̂lin's and B X̂lin's real and imaginary
+/// parts over the harmonics), kept between a session's assemblies and overwritten: faer's
+/// `a * b` allocated and zeroed each (4.7 MB for Ĝ at k = 2048, m = 17), a third of the real
+/// blade's `memset` (issue 23).
+#[derive(Clone, Debug)]
+pub struct ModalProducts([Mat<f64>; 8]);
+
+impl Default for ModalProducts {
+    fn default() -> Self {
+        ModalProducts(std::array::from_fn(|_| Mat::new()))
+    }
+}
+
+/// out = a·b as faer's `&a * &b` forms it (the same call into a matrix of the same shape), into
+/// `out`'s storage when it has that shape already.
+fn product_into<'a>(out: &'a mut Mat<f64>, a: &Mat<f64>, b: &Mat<f64>) -> &'a Mat<f64> {
+    if (out.nrows(), out.ncols()) != (a.nrows(), b.ncols()) {
+        *out = Mat::zeros(a.nrows(), b.ncols());
+    }
+    faer::linalg::matmul::matmul(out.as_mut(), faer::Accum::Replace, a.as_ref(), b.as_ref(), 1.0, faer::get_global_parallelism());
+    out
+}
+
+/// [`assemble_with`] with a session's [`ModalProducts`].
+#[allow(clippy::too_many_arguments)]
+pub(super) fn assemble_reusing(
+    model: &Model,
+    op: &StructureOperator,
+    scheme: Scheme,
+    period: f64,
+    rows: &[RecoveryRow],
+    fft: &PeriodFft,
+    parallel: bool,
+    products: &mut ModalProducts,
+) -> Result<Assembly, SolveError> {
     let op = &op.0;
     let k = fft.k();
     let n = model.n();
@@ -301,7 +340,7 @@ pub fn assemble_with(
     }
     if let Operator::Modal { phi, lambda, c, residual } = op {
         let statics = residual.as_ref().map(|r| Statics::new(model, &forces, rows, r));
-        let mut asm = assemble_modal(model, symbols, &forces, rows, (phi, lambda, c), statics.as_ref(), k)?;
+        let mut asm = assemble_modal(model, symbols, &forces, rows, (phi, lambda, c), statics.as_ref(), k, products)?;
         if let Some(st) = &statics {
             st.add_forced(&mut asm, &forces);
         }
@@ -342,24 +381,15 @@ pub fn assemble_with(
     } else {
         (0..nh).map(one).collect::<Result<_, _>>()?
     };
-    let mut asm = Assembly {
-        k,
-        m,
-        dofs: rows.iter().map(|r| r.0).collect(),
-        symbols,
-        g_hat: Vec::with_capacity(nh * m * m),
-        xlin_hat: Vec::with_capacity(nh * nd),
-        bxlin_hat: Vec::with_capacity(nh * m),
-        h_hat: Vec::with_capacity(nh * nd * m),
-        tangential: Vec::new(),
-    };
+    let (mut g_hat, mut xlin_hat) = (Vec::with_capacity(nh * m * m), Vec::with_capacity(nh * nd));
+    let (mut bxlin_hat, mut h_hat) = (Vec::with_capacity(nh * m), Vec::with_capacity(nh * nd * m));
     for b in blocks {
-        asm.g_hat.extend(b.g);
-        asm.bxlin_hat.extend(b.bx);
-        asm.xlin_hat.extend(b.xl);
-        asm.h_hat.extend(b.h);
+        g_hat.extend(b.g);
+        bxlin_hat.extend(b.bx);
+        xlin_hat.extend(b.xl);
+        h_hat.extend(b.h);
     }
-    Ok(asm)
+    Ok(Assembly { k, m, dofs: rows.iter().map(|r| r.0).collect(), symbols, g_hat: g_hat.into(), xlin_hat, bxlin_hat, h_hat, tangential: Vec::new() })
 }
 
 /// The modal operator for every harmonic at once: with D_p = diag(1/(σ2 + σ1 c_i + w λ_i)),
@@ -374,6 +404,7 @@ fn assemble_modal(
     (phi, lambda, c): (&Mat<f64>, &[f64], &[f64]),
     statics: Option<&Statics>,
     k: usize,
+    products: &mut ModalProducts,
 ) -> Result<Assembly, SolveError> {
     // Modes (columns of Φ): n without massless DOFs, fewer with them.
     let n = phi.ncols();
@@ -406,15 +437,16 @@ fn assemble_modal(
     let uim = Mat::<f64>::from_fn(n, nh, |i, p| dre[(i, p)] * fim[(i, p)] + dim[(i, p)] * fre[(i, p)]);
     let bphi = Mat::<f64>::from_fn(m, n, |a, i| model.contacts[a].along(|d| phi[(d, i)]));
     let phio = Mat::<f64>::from_fn(nd, n, |r, i| along_row(&rows[r].1, |d| phi[(d, i)]));
-    let (xre, xim) = (&phio * &ure, &phio * &uim);
-    let (bre, bim) = (&bphi * &ure, &bphi * &uim);
+    let [xre, xim, bre, bim, gre, gim, hre, him] = &mut products.0;
+    let (xre, xim) = (product_into(xre, &phio, &ure), product_into(xim, &phio, &uim));
+    let (bre, bim) = (product_into(bre, &bphi, &ure), product_into(bim, &bphi, &uim));
     // Ĝ_p[a][b] = Σ_i (BΦ)[a,i] (BΦ)[b,i] D_p[i] and Ẑ_p⁻¹Bᵀ[r][b] = Σ_i Φ_out[r,i] (BΦ)[b,i] D_p[i]:
     // one product each, rows the pairs' mode products, so that column p is harmonic p's block in
     // storage order (one sequential write; 2m products and m strided passes before, issue 23).
     let pairs = Mat::<f64>::from_fn(m * m, n, |ab, i| bphi[(ab / m, i)] * bphi[(ab % m, i)]);
-    let (gre, gim) = (&pairs * &dre, &pairs * &dim);
+    let (gre, gim) = (product_into(gre, &pairs, &dre), product_into(gim, &pairs, &dim));
     let outs = Mat::<f64>::from_fn(nd * m, n, |rb, i| phio[(rb / m, i)] * bphi[(rb % m, i)]);
-    let (hre, him) = (&outs * &dre, &outs * &dim);
+    let (hre, him) = (product_into(hre, &outs, &dre), product_into(him, &outs, &dim));
     // The residual flexibility's static part / w_p, added as each harmonic is stored (a pass over
     // Ĝ and Ẑ⁻¹Bᵀ of its own, and one for the finite check, were 2 % of a real-blade sweep, issue 23).
     let inv_w: Vec<f64> = match statics {
@@ -436,14 +468,14 @@ fn assemble_modal(
         }
         (v, finite)
     };
-    let (g_hat, g_finite) = by_harmonic(&gre, &gim, statics.map(|st| st.brbt.as_slice()));
-    let (h_hat, h_finite) = by_harmonic(&hre, &him, statics.map(|st| st.rbt_out.as_slice()));
-    let (xlin_hat, x_finite) = by_harmonic(&xre, &xim, None);
-    let (bxlin_hat, _) = by_harmonic(&bre, &bim, None);
+    let (g_hat, g_finite) = by_harmonic(gre, gim, statics.map(|st| st.brbt.as_slice()));
+    let (h_hat, h_finite) = by_harmonic(hre, him, statics.map(|st| st.rbt_out.as_slice()));
+    let (xlin_hat, x_finite) = by_harmonic(xre, xim, None);
+    let (bxlin_hat, _) = by_harmonic(bre, bim, None);
     if !(g_finite && h_finite && x_finite) {
         return Err(SolveError::SingularOperator { harmonic: 0, frequency: 0.0 });
     }
-    Ok(Assembly { k, m, dofs: rows.iter().map(|r| r.0).collect(), symbols, g_hat, xlin_hat, bxlin_hat, h_hat, tangential: Vec::new() })
+    Ok(Assembly { k, m, dofs: rows.iter().map(|r| r.0).collect(), symbols, g_hat: g_hat.into(), xlin_hat, bxlin_hat, h_hat, tangential: Vec::new() })
 }
 
 /// 1 / w_p, the residual flexibility's factor at harmonic p (R / w_p of Ẑ_p⁻¹), or why there is none.
