@@ -253,7 +253,7 @@ struct HarmonicBlock {
 /// (k instants over `period`: T, or p·T for an orbit of p forcing periods).
 /// `parallel`: spread the harmonics over rayon's threads (never from inside an FMU).
 pub fn assemble(model: &Model, scheme: Scheme, period: f64, dofs: &[usize], fft: &PeriodFft, parallel: bool) -> Result<Assembly, SolveError> {
-    assemble_with(model, &StructureOperator::new(model)?, scheme, period, &unit_rows(dofs), fft, parallel)
+    assemble_with(model, &StructureOperator::new(model)?, scheme, period, &unit_rows(dofs), fft, parallel, &mut ModalProducts::default())
 }
 
 /// The ω-independent part of the assembly, built once per structure (M, C, K) and reused at every
@@ -280,22 +280,10 @@ impl std::fmt::Debug for StructureOperator {
 }
 
 /// [`assemble`] on a structure operator built before (by [`StructureOperator::new`] on a model
-/// with the same M, C and K; the contacts, forces and frequency are `model`'s), recovering `rows`.
-pub fn assemble_with(
-    model: &Model,
-    op: &StructureOperator,
-    scheme: Scheme,
-    period: f64,
-    rows: &[RecoveryRow],
-    fft: &PeriodFft,
-    parallel: bool,
-) -> Result<Assembly, SolveError> {
-    assemble_reusing(model, op, scheme, period, rows, fft, parallel, &mut ModalProducts::default())
-}
-
-/// [`assemble_with`] with a session's [`ModalProducts`].
+/// with the same M, C and K; the contacts, forces and frequency are `model`'s), recovering `rows`,
+/// the modal products into a session's `products`.
 #[allow(clippy::too_many_arguments)]
-pub(super) fn assemble_reusing(
+pub(super) fn assemble_with(
     model: &Model,
     op: &StructureOperator,
     scheme: Scheme,

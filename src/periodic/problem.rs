@@ -372,7 +372,7 @@ impl PeriodicProblem {
         let model = super::friction::with_rows(&self.model)?;
         // Rubbing contacts' tangential rows too, folded into their contacts' columns.
         let model = super::rubbing::with_rows(&model);
-        let wide = assembly::assemble_reusing(&model, op, self.disc.scheme, self.period(), &self.recovery_rows(), fft, self.solver.parallel, products)?;
+        let wide = assembly::assemble_with(&model, op, self.disc.scheme, self.period(), &self.recovery_rows(), fft, self.solver.parallel, products)?;
         Ok(super::rubbing::fold(&self.model, wide))
     }
 
