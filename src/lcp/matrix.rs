@@ -101,7 +101,11 @@ pub struct BlockCirculant {
     blocks: std::sync::OnceLock<Vec<f64>>,
     /// The blocks' DFT when the caller had it (Ĝ_p row-major m×m, p = 0..=k/2): the FFT
     /// products then skip the m² transforms of [`super::CirculantOperator`].
-    spectrum: Option<Vec<num_complex::Complex64>>,
+    /// Shared: it is often the frequency-domain assembly's own (`PeriodicProblem::lcp`).
+    spectrum: Option<std::sync::Arc<Vec<num_complex::Complex64>>>,
+    /// The DC and Nyquist bins' imaginary parts of `spectrum` are read as 0 (a real block's
+    /// transform has none; an assembly's are round-off it keeps), [`Self::with_real_ends`].
+    real_ends: bool,
     /// [`Self::max_abs_bound`] from the spectrum, once: a solve asks for it two or three times
     /// (the finiteness check, the certification's round-off bound), each a pass over k/2·m².
     bound: std::sync::OnceLock<(f64, bool)>,
@@ -117,26 +121,40 @@ impl PartialEq for BlockCirculant {
 impl BlockCirculant {
     pub fn new(k: usize, m: usize, blocks: Vec<f64>) -> Self {
         assert_eq!(blocks.len(), k * m * m, "BlockCirculant: {} values for k={k}, m={m}", blocks.len());
-        BlockCirculant { k, m, blocks: blocks.into(), spectrum: None, bound: std::sync::OnceLock::new() }
+        BlockCirculant { k, m, blocks: blocks.into(), spectrum: None, real_ends: false, bound: std::sync::OnceLock::new() }
     }
     /// The matrix of block spectrum Ĝ_p (as [`Self::with_spectrum`]), its blocks formed by inverse
     /// FFT only when something asks for them ([`Self::blocks`]). Why: a shooting solve needs
     /// only the spectrum (the FFT products) and a bound of max|A|; forming the k·m² blocks was
     /// a tenth of the real blade's 200-point sweep (issue 23).
-    pub fn from_spectrum(k: usize, m: usize, spectrum: Vec<num_complex::Complex64>) -> Self {
-        BlockCirculant { k, m, blocks: std::sync::OnceLock::new(), spectrum: None, bound: std::sync::OnceLock::new() }.with_spectrum(spectrum)
+    pub fn from_spectrum(k: usize, m: usize, spectrum: impl Into<std::sync::Arc<Vec<num_complex::Complex64>>>) -> Self {
+        BlockCirculant { k, m, blocks: std::sync::OnceLock::new(), spectrum: None, real_ends: false, bound: std::sync::OnceLock::new() }.with_spectrum(spectrum)
     }
     /// The same matrix with its block spectrum Ĝ_p = Σ_d blocks[d] e^(−2πi pd/k) (row-major m×m,
     /// p = 0..=k/2), e.g. from the frequency-domain assembly it was transformed from.
-    pub fn with_spectrum(mut self, spectrum: Vec<num_complex::Complex64>) -> Self {
+    pub fn with_spectrum(mut self, spectrum: impl Into<std::sync::Arc<Vec<num_complex::Complex64>>>) -> Self {
+        let spectrum = spectrum.into();
         assert_eq!(spectrum.len(), (self.k / 2 + 1) * self.m * self.m, "BlockCirculant: spectrum of {} values for k={}, m={}", spectrum.len(), self.k, self.m);
         self.spectrum = Some(spectrum);
         self.bound = std::sync::OnceLock::new();
         self
     }
-    /// The block spectrum, when it came with the matrix.
+    /// The same matrix with the imaginary parts of its spectrum's DC and Nyquist bins read as 0:
+    /// a spectrum shared with an assembly that keeps their round-off, instead of a copy with them
+    /// zeroed (4.7 MB per solve on the real blade at k = 2048, issue 23).
+    pub fn with_real_ends(mut self) -> Self {
+        self.real_ends = true;
+        self.bound = std::sync::OnceLock::new();
+        self
+    }
+    /// The block spectrum, when it came with the matrix; where [`Self::real_ends`], the DC and
+    /// Nyquist bins' imaginary parts in it are to be read as 0.
     pub fn spectrum(&self) -> Option<&[num_complex::Complex64]> {
-        self.spectrum.as_deref()
+        self.spectrum.as_deref().map(Vec::as_slice)
+    }
+    /// Whether the DC and Nyquist bins' imaginary parts of [`Self::spectrum`] are read as 0.
+    pub fn real_ends(&self) -> bool {
+        self.real_ends
     }
     pub fn k(&self) -> usize {
         self.k
@@ -151,7 +169,7 @@ impl BlockCirculant {
     /// The blocks by inverse FFT of the spectrum, entry by entry (a, b).
     fn blocks_from_spectrum(&self) -> Vec<f64> {
         let (k, m) = (self.k, self.m);
-        let spectrum = self.spectrum.as_deref().expect("a BlockCirculant without blocks has its spectrum");
+        let spectrum = self.spectrum().expect("a BlockCirculant without blocks has its spectrum");
         let fft = crate::linalg::fft::PeriodFft::new(k);
         let mut blocks = vec![0.0; k * m * m];
         let mut column = vec![num_complex::Complex64::ZERO; k / 2 + 1];
@@ -167,7 +185,7 @@ impl BlockCirculant {
     /// when they are not formed: |a_d| ≤ (1/k)·Σ_p |Ĝ_p| over the full (Hermitian) spectrum.
     /// Exact once the blocks are formed; the blocks are formed where the bound overflows.
     pub fn max_abs_bound(&self) -> (f64, bool) {
-        let (Some(spectrum), None) = (self.spectrum.as_deref(), self.blocks.get()) else { return self.max_abs() };
+        let (Some(spectrum), None) = (self.spectrum(), self.blocks.get()) else { return self.max_abs() };
         *self.bound.get_or_init(|| self.bound_from_spectrum(spectrum))
     }
     /// [`Self::max_abs_bound`]'s pass over the spectrum.
@@ -179,9 +197,11 @@ impl BlockCirculant {
         let mut sums = vec![0.0f64; mm];
         for (p, block) in spectrum.chunks_exact(mm).enumerate() {
             // The bins 1..k/2 (but Nyquist) stand for their conjugates too.
-            let weight = if p == 0 || 2 * p == k { 1.0 } else { 2.0 };
+            let end = p == 0 || 2 * p == k;
+            let weight = if end { 1.0 } else { 2.0 };
             // |re| + |im| ≥ |g|: a bound still, without hypot's cost.
-            sums.iter_mut().zip(block).for_each(|(s, g)| *s += weight * (g.re.abs() + g.im.abs()));
+            let real = end && self.real_ends;
+            sums.iter_mut().zip(block).for_each(|(s, g)| *s += weight * (g.re.abs() + if real { 0.0 } else { g.im.abs() }));
         }
         let sum = sums.iter().fold(0.0f64, |a, s| a.max(*s));
         // Near overflow the inverse FFT's own sums may not be finite: the blocks decide.
@@ -199,7 +219,7 @@ impl BlockCirculant {
                 blocks[a * m + a] += v;
             }
             // Block 0 alone changes: every harmonic's diagonal by the same value.
-            if let Some(s) = self.spectrum.as_mut() {
+            if let Some(s) = self.spectrum.as_mut().map(std::sync::Arc::make_mut) {
                 s.chunks_exact_mut(m * m).for_each(|block| block[a * m + a] += v);
             }
         }

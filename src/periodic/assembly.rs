@@ -12,6 +12,10 @@ use faer::sparse::linalg::solvers::SymbolicLu;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat, Triplet};
 use num_complex::Complex64 as C;
 
+mod modal;
+pub use modal::ModalProducts;
+use modal::assemble_modal;
+
 /// Pivot ratio below which Ẑ_p counts as singular (undamped resonance, rigid-body mode).
 const SINGULAR_PIVOT_RATIO: f64 = 1e-13;
 
@@ -25,8 +29,9 @@ pub struct Assembly {
     /// or the output map's labels: each row is its combination of model DOFs, [`RecoveryRow`]).
     pub dofs: Vec<usize>,
     pub symbols: Symbols,
-    /// Ĝ_p, row-major m×m, for p = 0..=k/2.
-    pub g_hat: Vec<C>,
+    /// Ĝ_p, row-major m×m, for p = 0..=k/2; shared with the LCP's spectrum where that needs no
+    /// change (`PeriodicProblem::lcp`: a 4.7 MB copy per solve at k = 2048, issue 23).
+    pub g_hat: std::sync::Arc<Vec<C>>,
     /// X̂lin_p at `dofs`: [p][dofs.len()].
     pub xlin_hat: Vec<C>,
     /// B X̂lin_p: [p][m].
@@ -248,7 +253,7 @@ struct HarmonicBlock {
 /// (k instants over `period`: T, or p·T for an orbit of p forcing periods).
 /// `parallel`: spread the harmonics over rayon's threads (never from inside an FMU).
 pub fn assemble(model: &Model, scheme: Scheme, period: f64, dofs: &[usize], fft: &PeriodFft, parallel: bool) -> Result<Assembly, SolveError> {
-    assemble_with(model, &StructureOperator::new(model)?, scheme, period, &unit_rows(dofs), fft, parallel)
+    assemble_with(model, &StructureOperator::new(model)?, scheme, period, &unit_rows(dofs), fft, parallel, &mut ModalProducts::default())
 }
 
 /// The ω-independent part of the assembly, built once per structure (M, C, K) and reused at every
@@ -275,8 +280,10 @@ impl std::fmt::Debug for StructureOperator {
 }
 
 /// [`assemble`] on a structure operator built before (by [`StructureOperator::new`] on a model
-/// with the same M, C and K; the contacts, forces and frequency are `model`'s), recovering `rows`.
-pub fn assemble_with(
+/// with the same M, C and K; the contacts, forces and frequency are `model`'s), recovering `rows`,
+/// the modal products into a session's `products`.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn assemble_with(
     model: &Model,
     op: &StructureOperator,
     scheme: Scheme,
@@ -284,6 +291,7 @@ pub fn assemble_with(
     rows: &[RecoveryRow],
     fft: &PeriodFft,
     parallel: bool,
+    products: &mut ModalProducts,
 ) -> Result<Assembly, SolveError> {
     let op = &op.0;
     let k = fft.k();
@@ -301,7 +309,7 @@ pub fn assemble_with(
     }
     if let Operator::Modal { phi, lambda, c, residual } = op {
         let statics = residual.as_ref().map(|r| Statics::new(model, &forces, rows, r));
-        let mut asm = assemble_modal(model, symbols, &forces, rows, (phi, lambda, c), statics.as_ref(), k)?;
+        let mut asm = assemble_modal(model, symbols, &forces, rows, (phi, lambda, c), statics.as_ref(), k, products)?;
         if let Some(st) = &statics {
             st.add_forced(&mut asm, &forces);
         }
@@ -342,114 +350,15 @@ pub fn assemble_with(
     } else {
         (0..nh).map(one).collect::<Result<_, _>>()?
     };
-    let mut asm = Assembly {
-        k,
-        m,
-        dofs: rows.iter().map(|r| r.0).collect(),
-        symbols,
-        g_hat: Vec::with_capacity(nh * m * m),
-        xlin_hat: Vec::with_capacity(nh * nd),
-        bxlin_hat: Vec::with_capacity(nh * m),
-        h_hat: Vec::with_capacity(nh * nd * m),
-        tangential: Vec::new(),
-    };
+    let (mut g_hat, mut xlin_hat) = (Vec::with_capacity(nh * m * m), Vec::with_capacity(nh * nd));
+    let (mut bxlin_hat, mut h_hat) = (Vec::with_capacity(nh * m), Vec::with_capacity(nh * nd * m));
     for b in blocks {
-        asm.g_hat.extend(b.g);
-        asm.bxlin_hat.extend(b.bx);
-        asm.xlin_hat.extend(b.xl);
-        asm.h_hat.extend(b.h);
+        g_hat.extend(b.g);
+        bxlin_hat.extend(b.bx);
+        xlin_hat.extend(b.xl);
+        h_hat.extend(b.h);
     }
-    Ok(asm)
-}
-
-/// The modal operator for every harmonic at once: with D_p = diag(1/(σ2 + σ1 c_i + w λ_i)),
-/// Ĝ_p = (BΦ) D_p (BΦ)ᵀ, X̂lin_p = Φ_out D_p Φᵀ w_p F̂_p and Ẑ_p⁻¹Bᵀ at the outputs
-/// Φ_out D_p (BΦ)ᵀ, as real matrix products over all harmonics (real and imaginary parts apart).
-#[allow(clippy::too_many_arguments)]
-fn assemble_modal(
-    model: &Model,
-    symbols: Symbols,
-    forces: &[(usize, Vec<C>)],
-    rows: &[RecoveryRow],
-    (phi, lambda, c): (&Mat<f64>, &[f64], &[f64]),
-    statics: Option<&Statics>,
-    k: usize,
-) -> Result<Assembly, SolveError> {
-    // Modes (columns of Φ): n without massless DOFs, fewer with them.
-    let n = phi.ncols();
-    let m = model.contacts.len();
-    let nd = rows.len();
-    let nh = k / 2 + 1;
-    // D_p[i], stored [i][p] as real and imaginary parts.
-    let mut dre = Mat::<f64>::zeros(n, nh);
-    let mut dim = Mat::<f64>::zeros(n, nh);
-    for p in 0..nh {
-        let (s1, s2, w) = (symbols.sigma1[p], symbols.sigma2[p], symbols.weight[p]);
-        for i in 0..n {
-            let d = s2 + s1 * c[i] + C::from(w * lambda[i]);
-            // |d| against the size of its terms (squared norms: no hypot in this loop).
-            let scale = s2.norm_sqr() + s1.norm_sqr() * c[i] * c[i] + (w * lambda[i]).powi(2);
-            if !(d.norm_sqr() > 1e-26 * scale) {
-                return Err(SolveError::SingularOperator { harmonic: p, frequency: p as f64 * model.frequency });
-            }
-            let inv = d.inv();
-            dre[(i, p)] = inv.re;
-            dim[(i, p)] = inv.im;
-        }
-    }
-    // Modal force f̃_p = Φᵀ w_p F̂_p (n × nh), and u = D ∘ f̃.
-    let nl = forces.len();
-    let phil = Mat::<f64>::from_fn(n, nl, |i, l| phi[(forces[l].0, i)]);
-    let fre = &phil * Mat::<f64>::from_fn(nl, nh, |l, p| (forces[l].1[p] * symbols.weight[p]).re);
-    let fim = &phil * Mat::<f64>::from_fn(nl, nh, |l, p| (forces[l].1[p] * symbols.weight[p]).im);
-    let ure = Mat::<f64>::from_fn(n, nh, |i, p| dre[(i, p)] * fre[(i, p)] - dim[(i, p)] * fim[(i, p)]);
-    let uim = Mat::<f64>::from_fn(n, nh, |i, p| dre[(i, p)] * fim[(i, p)] + dim[(i, p)] * fre[(i, p)]);
-    let bphi = Mat::<f64>::from_fn(m, n, |a, i| model.contacts[a].along(|d| phi[(d, i)]));
-    let phio = Mat::<f64>::from_fn(nd, n, |r, i| along_row(&rows[r].1, |d| phi[(d, i)]));
-    let (xre, xim) = (&phio * &ure, &phio * &uim);
-    let (bre, bim) = (&bphi * &ure, &bphi * &uim);
-    // Ĝ_p[a][b] = Σ_i (BΦ)[a,i] (BΦ)[b,i] D_p[i] and Ẑ_p⁻¹Bᵀ[r][b] = Σ_i Φ_out[r,i] (BΦ)[b,i] D_p[i]:
-    // one product each, rows the pairs' mode products, so that column p is harmonic p's block in
-    // storage order (one sequential write; 2m products and m strided passes before, issue 23).
-    let pairs = Mat::<f64>::from_fn(m * m, n, |ab, i| bphi[(ab / m, i)] * bphi[(ab % m, i)]);
-    let (gre, gim) = (&pairs * &dre, &pairs * &dim);
-    let outs = Mat::<f64>::from_fn(nd * m, n, |rb, i| phio[(rb / m, i)] * bphi[(rb % m, i)]);
-    let (hre, him) = (&outs * &dre, &outs * &dim);
-    // The residual flexibility's static part / w_p, added as each harmonic is stored (a pass over
-    // Ĝ and Ẑ⁻¹Bᵀ of its own, and one for the finite check, were 2 % of a real-blade sweep, issue 23).
-    let inv_w: Vec<f64> = match statics {
-        Some(_) => (0..nh).map(|p| residual_scale(symbols.weight[p], p, model.frequency)).collect::<Result<_, _>>()?,
-        None => Vec::new(),
-    };
-    // Each harmonic's column, and whether its modal part is finite (B X̂lin's is not checked).
-    let by_harmonic = |re: &Mat<f64>, im: &Mat<f64>, fixed: Option<&[f64]>| -> (Vec<C>, bool) {
-        let mut v = Vec::with_capacity(re.nrows() * nh);
-        let mut finite = true;
-        for p in 0..nh {
-            let (re, im) = (re.col_as_slice(p), im.col_as_slice(p));
-            finite &= re.iter().chain(im).all(|x| x.is_finite());
-            match fixed {
-                // As `C + C::from(s / w_p)`: the imaginary part gains + 0.0.
-                Some(fixed) => v.extend(re.iter().zip(im).zip(fixed).map(|((&a, &b), &s)| C::new(a + s * inv_w[p], b + 0.0))),
-                None => v.extend(re.iter().zip(im).map(|(&a, &b)| C::new(a, b))),
-            }
-        }
-        (v, finite)
-    };
-    let (g_hat, g_finite) = by_harmonic(&gre, &gim, statics.map(|st| st.brbt.as_slice()));
-    let (h_hat, h_finite) = by_harmonic(&hre, &him, statics.map(|st| st.rbt_out.as_slice()));
-    let (xlin_hat, x_finite) = by_harmonic(&xre, &xim, None);
-    let (bxlin_hat, _) = by_harmonic(&bre, &bim, None);
-    if !(g_finite && h_finite && x_finite) {
-        return Err(SolveError::SingularOperator { harmonic: 0, frequency: 0.0 });
-    }
-    Ok(Assembly { k, m, dofs: rows.iter().map(|r| r.0).collect(), symbols, g_hat, xlin_hat, bxlin_hat, h_hat, tangential: Vec::new() })
-}
-
-/// 1 / w_p, the residual flexibility's factor at harmonic p (R / w_p of Ẑ_p⁻¹), or why there is none.
-fn residual_scale(w: f64, p: usize, frequency: f64) -> Result<f64, SolveError> {
-    let inv_w = 1.0 / w;
-    (w != 0.0 && inv_w.is_finite()).then_some(inv_w).ok_or(SolveError::SingularOperator { harmonic: p, frequency: p as f64 * frequency })
+    Ok(Assembly { k, m, dofs: rows.iter().map(|r| r.0).collect(), symbols, g_hat: g_hat.into(), xlin_hat, bxlin_hat, h_hat, tangential: Vec::new() })
 }
 
 /// The residual flexibility's part R / w_p of Ẑ_p⁻¹ in a modal assembly, ω-independent but for

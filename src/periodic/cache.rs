@@ -7,7 +7,7 @@
 //! B X̂lin. So a gap, motion or force-scale change (the FMU's tunables) re-solves without
 //! re-assembling; anything else builds the assembly again, on the structure's ω-independent
 //! part ([`StructureOperator`]: modes, residual flexibility) kept while M, C, K are the same.
-use super::assembly::StructureOperator;
+use super::assembly::{ModalProducts, StructureOperator};
 use super::{Assembly, PeriodFft, PeriodicProblem, SolveError};
 use crate::model::Compliance;
 use std::hash::{Hash, Hasher};
@@ -24,6 +24,8 @@ pub(super) struct AssemblyCache {
     /// was built from: a new frequency or grid rebuilds only the per-harmonic part on it.
     /// Shared (`Arc`) by the sessions a sweep clones per chunk.
     structure: Option<(u64, Arc<StructureOperator>)>,
+    /// The modal assembly's products, overwritten by the next build.
+    products: ModalProducts,
 }
 
 /// The hash of the structure's M, C and K (what [`StructureOperator`] depends on).
@@ -87,8 +89,9 @@ pub(super) fn assembled<'a>(cache: &'a mut Option<AssemblyCache>, p: &PeriodicPr
             Some((k, op)) if k == skey => op,
             _ => Arc::new(StructureOperator::new(p.model())?),
         };
-        let assembly = p.assemble_with(fft, &operator)?;
-        let fresh = AssemblyCache { key, force_reference: reference, assembly, structure: Some((skey, operator)) };
+        let mut products = cache.as_mut().map(|c| std::mem::take(&mut c.products)).unwrap_or_default();
+        let assembly = p.assemble_reusing(fft, &operator, &mut products)?;
+        let fresh = AssemblyCache { key, force_reference: reference, assembly, structure: Some((skey, operator)), products };
         return Ok((&cache.insert(fresh).assembly, true));
     }
     let c = cache.as_mut().expect("checked above");

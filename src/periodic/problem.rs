@@ -358,11 +358,21 @@ impl PeriodicProblem {
     /// [`Self::assemble`] on the structure operator of this problem's M, C, K built before (a
     /// session keeps it across frequencies and grids).
     pub(super) fn assemble_with(&self, fft: &PeriodFft, op: &assembly::StructureOperator) -> Result<Assembly, SolveError> {
+        self.assemble_reusing(fft, op, &mut assembly::ModalProducts::default())
+    }
+
+    /// [`Self::assemble_with`] into a session's kept products ([`assembly::ModalProducts`]).
+    pub(super) fn assemble_reusing(
+        &self,
+        fft: &PeriodFft,
+        op: &assembly::StructureOperator,
+        products: &mut assembly::ModalProducts,
+    ) -> Result<Assembly, SolveError> {
         // Friction contacts ride as extra rows of B (src/formulation.md §9).
         let model = super::friction::with_rows(&self.model)?;
         // Rubbing contacts' tangential rows too, folded into their contacts' columns.
         let model = super::rubbing::with_rows(&model);
-        let wide = assembly::assemble_with(&model, op, self.disc.scheme, self.period(), &self.recovery_rows(), fft, self.solver.parallel)?;
+        let wide = assembly::assemble_with(&model, op, self.disc.scheme, self.period(), &self.recovery_rows(), fft, self.solver.parallel, products)?;
         Ok(super::rubbing::fold(&self.model, wide))
     }
 

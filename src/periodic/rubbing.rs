@@ -64,7 +64,7 @@ pub(super) fn fold(model: &Model, wide: Assembly) -> Assembly {
         })
         .collect();
     let bxlin_hat = (0..nh).flat_map(|p| (0..m).map(move |a| (p, a))).map(|(p, a)| wide.bxlin_hat[p * mw + a]).collect();
-    Assembly { m, g_hat, h_hat, bxlin_hat, tangential, ..wide }
+    Assembly { m, g_hat: g_hat.into(), h_hat, bxlin_hat, tangential, ..wide }
 }
 
 /// Gross slip holds only while the structure's tangential speed stays below |V|: checked at the

@@ -2,6 +2,7 @@
 //! contacts' responses with its spectrum, and q.
 use super::{Assembly, PeriodFft, PeriodicProblem};
 use crate::lcp::BlockCirculant;
+use std::sync::Arc;
 
 impl PeriodicProblem {
     /// The LCP of the period: A block-circulant of spectrum Ĝ (its blocks, the inverse FFT, formed
@@ -30,7 +31,9 @@ impl PeriodicProblem {
             }
         }
         // The blocks are formed from the spectrum only if a solver asks for them.
-        (BlockCirculant::from_spectrum(k, m, self.lcp_spectrum(asm)), q)
+        let (spectrum, real_ends) = self.lcp_spectrum(asm);
+        let a = BlockCirculant::from_spectrum(k, m, spectrum);
+        (if real_ends { a.with_real_ends() } else { a }, q)
     }
 
     /// The DFT of [`Self::lcp`]'s blocks from Ĝ directly: row a shifted by its pairing offset s
@@ -38,11 +41,12 @@ impl PeriodicProblem {
     /// every harmonic's diagonal; the DC and Nyquist bins keep their real parts, as the blocks'
     /// real transform does. Why: the FFT products' m² forward transforms of the blocks were a
     /// tenth of a real-blade sweep point (issue 23).
-    fn lcp_spectrum(&self, asm: &Assembly) -> Vec<num_complex::Complex64> {
+    /// Returns it, and whether its DC and Nyquist bins' imaginary parts are to be read as 0
+    /// ([`BlockCirculant::with_real_ends`]: Ĝ shared, unchanged otherwise).
+    fn lcp_spectrum(&self, asm: &Assembly) -> (Arc<Vec<num_complex::Complex64>>, bool) {
         let (k, m) = (asm.k, asm.m);
-        let mut spectrum = asm.g_hat.clone();
         if m == 0 {
-            return spectrum;
+            return (Arc::clone(&asm.g_hat), false);
         }
         let rows: Vec<(usize, f64)> = self
             .model()
@@ -56,6 +60,10 @@ impl PeriodicProblem {
                 (self.pairing_of(ca).offset(), compliance)
             })
             .collect();
+        if unchanged_by_lcp(&asm.g_hat, m, &rows) {
+            return (Arc::clone(&asm.g_hat), true);
+        }
+        let mut spectrum = asm.g_hat.as_ref().clone();
         // Harmonic by harmonic, each block in storage order (contact by contact, these were m
         // strided passes over the whole spectrum, issue 23).
         for (p, block) in spectrum.chunks_exact_mut(m * m).enumerate().take(k / 2 + 1) {
@@ -72,8 +80,17 @@ impl PeriodicProblem {
                 }
             }
         }
-        spectrum
+        (Arc::new(spectrum), false)
     }
+}
+
+/// Whether [`PeriodicProblem::lcp_spectrum`]'s changes but the DC and Nyquist bins' imaginary
+/// parts leave Ĝ bit for bit as it is: no shifted row, no compliance (adding +0.0 keeps every
+/// diagonal but a −0.0). Why: the real blade's rigid, same-paired contacts then share the
+/// assembly's spectrum instead of copying it (4.7 MB per solve at k = 2048, issue 23).
+fn unchanged_by_lcp(g_hat: &[num_complex::Complex64], m: usize, rows: &[(usize, f64)]) -> bool {
+    rows.iter().all(|&(s, compliance)| s == 0 && compliance.to_bits() == 0)
+        && g_hat.chunks_exact(m * m).all(|block| (0..m).all(|a| block[a * m + a].re.to_bits() != (-0.0f64).to_bits()))
 }
 
 #[cfg(test)]
@@ -125,6 +142,36 @@ mod tests {
             assert!(bound.1 && bound.0 >= block_scale, "{pairing:?}: bound {:e} below max|A| {block_scale:e}", bound.0);
             assert_eq!(a.max_abs_bound(), a.max_abs(), "{pairing:?}: once the blocks are formed the bound is their max|A|");
         }
+    }
+
+    /// With rigid, same-paired contacts the LCP shares the assembly's Ĝ, its DC and Nyquist
+    /// imaginary parts read as 0 ([`BlockCirculant::with_real_ends`]): its products and bound
+    /// equal bit for bit those of a copy of Ĝ with them zeroed, and its blocks the ones built in time.
+    #[test]
+    fn a_shared_spectrum_reads_its_ends_as_real() {
+        let model = chain_with_massless_boundary();
+        let disc = Discretization { scheme: Scheme::Bds1, steps: 64, pairing: Some(Pairing::Same) };
+        let p = PeriodicProblem::new(model, disc, OutputSelection::default(), SolverSettings::default()).unwrap();
+        let fft = PeriodFft::new(64);
+        let (a, _) = p.assemble_lcp(&fft).unwrap();
+        assert!(a.real_ends(), "rigid contacts under the same pairing share Ĝ");
+        let (k, m) = (a.k(), a.m());
+        let mut zeroed = a.spectrum().unwrap().to_vec();
+        let ends = zeroed.chunks_exact_mut(m * m).enumerate().filter(|(p, _)| *p == 0 || 2 * p == k);
+        let dropped = ends.fold(0.0f64, |w, (_, block)| block.iter_mut().fold(w, |w, v| w.max(std::mem::take(&mut v.im).abs())));
+        let copy = BlockCirculant::from_spectrum(k, m, zeroed);
+        let z: Vec<f64> = (0..a.dim()).map(|i| ((i * 37 % 11) as f64 - 3.0).max(0.0)).collect();
+        let (mut shared, mut copied) = (vec![0.0; a.dim()], vec![0.0; a.dim()]);
+        CirculantOperator::new(&a).mul_into(&z, &mut shared);
+        CirculantOperator::new(&copy).mul_into(&z, &mut copied);
+        eprintln!("largest DC/Nyquist imaginary part read as 0: {dropped:.1e}");
+        assert!(dropped > 0.0, "bds1's Nyquist bin has imaginary round-off: the test reads some as 0");
+        assert!(shared.iter().zip(&copied).all(|(x, y)| x.to_bits() == y.to_bits()), "the shared spectrum's product differs from the copy's");
+        assert_eq!(a.max_abs_bound(), copy.max_abs_bound());
+        let direct = BlockCirculant::new(k, m, blocks_by_time_shift(&p, &fft));
+        let scale = direct.max_abs().0;
+        let gap = a.blocks().iter().zip(direct.blocks()).fold(0.0f64, |w, (x, y)| w.max((x - y).abs()));
+        assert!(gap <= 1e-12 * scale, "blocks differ by {gap:e} of {scale:e}");
     }
 
     /// The LCP's blocks built in time: column (a, b) of Ĝ transformed back, row a read s_a

@@ -183,7 +183,8 @@ pub fn step_map(problem: &PeriodicProblem) -> Result<StepMapLcp, NoStepMap> {
     // W row by row (the products below read rows), and no product at an unloaded instant (c_j
     // stays 0): the real blade's casing is its only excitation (issue 23).
     let w_rows: Vec<f64> = (0..n * n).map(|e| w[(e / n, e % n)]).collect();
-    for j in 0..k {
+    // No force: every c_j stays 0 without reading the k·n zero samples.
+    for j in (0..k).filter(|_| !model.forces.is_empty()) {
         for (dof, f) in fbar.iter_mut().enumerate() {
             let at = |jj: usize| forces[jj * n + dof];
             *f = if galerkin { (at((j + 1) % k) + 4.0 * at(j) + at((j + k - 1) % k)) / 6.0 } else { at(j) };
@@ -309,9 +310,13 @@ impl Condensed {
     /// f̃(t_j) on the massive DOFs (k × n_a) and the gap shift −B_b K_bb⁻¹ f_b(t_j) (k × m).
     fn force_samples(&self, model: &Model, k: usize, h: f64) -> (Vec<f64>, Vec<f64>) {
         let (n, m, na, nb) = (model.n(), model.contacts.len(), self.massive.len(), self.massless.len());
-        let full = force_samples(model, k, h);
         let mut f = vec![0.0; k * na];
         let mut shift = vec![0.0; k * m];
+        // No force, no samples to read (the real blade's casing is its only excitation, issue 23).
+        if model.forces.is_empty() {
+            return (f, shift);
+        }
+        let full = force_samples(model, k, h);
         for j in 0..k {
             let row = &full[j * n..(j + 1) * n];
             for (i, &a) in self.massive.iter().enumerate() {

@@ -97,9 +97,15 @@ impl<'a> CirculantOperator<'a> {
         // Ĝ_p ẑ_p harmonic by harmonic, each block read once in storage order (row by row, m strided
         // passes over the whole spectrum: the product was 7 % of the real blade's sweep, issue 23).
         // The sums run over b in the order of `Iterator::sum`, so the products are unchanged.
-        for (g, zp) in self.spectrum.chunks_exact(m * m).zip(zh.chunks_exact_mut(m)).take(nh) {
+        for (p, (g, zp)) in self.spectrum.chunks_exact(m * m).zip(zh.chunks_exact_mut(m)).take(nh).enumerate() {
+            // The DC and Nyquist blocks as if their imaginary parts were zeroed (`real_ends`).
+            let real = self.a.real_ends() && (p == 0 || 2 * p == k);
             for (s, row) in gz.iter_mut().zip(g.chunks_exact(m)) {
-                *s = row.iter().zip(zp.iter()).fold(C::ZERO, |acc, (&x, &y)| acc + x * y);
+                *s = if real {
+                    row.iter().zip(zp.iter()).fold(C::ZERO, |acc, (&x, &y)| acc + C::new(x.re, 0.0) * y)
+                } else {
+                    row.iter().zip(zp.iter()).fold(C::ZERO, |acc, (&x, &y)| acc + x * y)
+                };
             }
             zp.copy_from_slice(gz);
         }
