@@ -513,3 +513,25 @@ fn multipliers_of_a_bad_monodromy_are_nan() {
     // Unknown multipliers are not a stable orbit: the largest is NaN, not f64::max's 0.
     assert!(continuation::largest_multiplier(&continuation::multipliers(&bad)).is_nan());
 }
+
+/// The real blade's exact walk down from 1150 rad/s crosses a period doubling near 1141.6 rad/s:
+/// located where a real multiplier is −1 (its definition, Seydel 2010 §7.4), not given at a
+/// step's end. Session 30's walk with steps grown ×2 lost it: a trial's corrector failed in the
+/// 0.45 rad/s bracket, and the event was recorded unlocated at 1141.33 (validation/RECORD.md).
+#[test]
+#[ignore = "opt-in: needs examples/real-blade/job (CalculiX matrices, untracked) and ≈ 200 s CPU"]
+fn the_real_blades_period_doubling_is_located_on_the_walk_down() {
+    use periodic_contact::analysis::continuation::EventKind;
+    use periodic_contact::scene::Scene;
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/real-blade/blade.toml");
+    let (scene, dir) = Scene::load(&path).unwrap();
+    let p = scene.build_in("blade.toml", &dir).unwrap().problem;
+    let b = continuation::run(&p, Parameter::Speed { lobes: 2 }, 1150.0, 1140.0, &ContinuationSettings::default(), &|_| {}).unwrap();
+    let doublings: Vec<_> = b.events().filter(|e| e.event == Some(EventKind::PeriodDoubling)).collect();
+    assert_eq!(doublings.len(), 1, "period doublings: {:?}", doublings.iter().map(|e| (e.parameter, &e.detail)).collect::<Vec<_>>());
+    let pd = doublings[0];
+    assert!(!pd.detail.contains("not located"), "{} rad/s: {}", pd.parameter, pd.detail);
+    let off = pd.multipliers.iter().map(|m| (m + 1.0).norm()).fold(f64::INFINITY, f64::min);
+    assert!(off < 1e-5, "{} rad/s: the multiplier nearest −1 is {off:e} from it", pd.parameter);
+    assert!((1141.3..1141.8).contains(&pd.parameter), "{} rad/s", pd.parameter);
+}

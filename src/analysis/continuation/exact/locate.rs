@@ -13,7 +13,7 @@
 //! trial points without tangent nor multipliers ([`Family::orbit_node`]); the two ends found
 //! are completed as points.
 use super::family::{Family, Node};
-use super::{BRACKET, NEWTON_NOISE, dot, profile};
+use super::{BRACKET, NEWTON_NOISE, Walk, dot, profile};
 use crate::analysis::continuation::{EventKind, floquet};
 
 /// What tells the two sides of an event apart.
@@ -99,6 +99,70 @@ fn locate_on(fam: &Family, a: &Node, b: &Node, test: &Test, touches: bool) -> Op
         }
     }
     complete(fam, a, lo, hi, orbit_only, touches)
+}
+
+impl Walk<'_> {
+    /// The events between two points of one signature, each located by bisection, in order.
+    pub(super) fn events_between(&self, a: &Node, b: &Node) -> Vec<(EventKind, Node, String)> {
+        self.events_on(a, b).0
+    }
+
+    /// [`Self::events_between`], and whether one of them was not located (a trial's corrector
+    /// failed inside its bracket).
+    pub(super) fn events_on(&self, a: &Node, b: &Node) -> (Vec<(EventKind, Node, String)>, bool) {
+        let mut found = Vec::new();
+        let mut unlocated = false;
+        for kind in [EventKind::Fold, EventKind::PeriodDoubling, EventKind::NeimarkSacker] {
+            if side(a, kind) == side(b, kind) {
+                continue;
+            }
+            let s = side(a, kind);
+            if kind == EventKind::Fold && std::env::var_os("PC_TRACE_FOLD").is_some() {
+                let (ta, tb) = (test_value(a, kind), test_value(b, kind));
+                let (raw, met) = (dot(&a.tangent, &b.tangent), self.fam.metric.dot(&a.tangent, &b.tangent));
+                let rho = self.fam.rho;
+                eprintln!(
+                    "fold trace: a λ {:.10} t_λ {ta:e}, b λ {:.10} t_λ {tb:e}; tangents' product {raw:e}, in the metric {met:e}",
+                    a.lambda(rho),
+                    b.lambda(rho)
+                );
+            }
+            let value = |n: &Node| if side(n, kind) == s { 1.0 } else { -1.0 } * test_value(n, kind).abs();
+            let same = |n: &Node| side(n, kind) == s;
+            let test = if kind == EventKind::NeimarkSacker { Test::Side(&same) } else { Test::Point(&value) };
+            let located = locate(&self.fam, a, b, test, false);
+            let missed = located.is_none();
+            let node = located.map_or_else(|| b.clone(), |(_, hi)| hi);
+            // det(I + M) also changes sign when a multiplier passes through ∞ (an impact's
+            // velocity fading at a grazing, Nordmark 1991): no multiplier at −1, no doubling.
+            // Unlocated (a trial's corrector failed), a real multiplier crossing −1 between the
+            // two points is the doubling (the real blade's at 2283.42 rad/s was dropped so).
+            let doubling = if missed { floquet::crosses(&a.mu, &b.mu, -1.0) } else { node.mu.iter().any(|m| (m + 1.0).norm() < 1e-3) };
+            if kind == EventKind::PeriodDoubling && !doubling {
+                continue;
+            }
+            // Unlocated, a fold needs a real multiplier through +1 too: the tangent's λ component
+            // alone flips in the corrector's noise where the walk crawls into a singular merge
+            // (the coarse rigid blade at 2402.2578806 rad/s: steps of 2e-11, |μ| 0.9495 on both sides).
+            if kind == EventKind::Fold && missed && !floquet::crosses(&a.mu, &b.mu, 1.0) {
+                continue;
+            }
+            let mut detail = detail_of(kind, &node);
+            unlocated |= missed;
+            if missed {
+                detail += &format!(
+                    "; not located: between λ = {} and {} (a trial's corrector failed), given at the latter",
+                    a.lambda(self.fam.rho),
+                    b.lambda(self.fam.rho)
+                );
+            }
+            found.push((kind, node, detail));
+        }
+        let sec: Vec<f64> = b.w.iter().zip(&a.w).map(|(x, y)| x - y).collect();
+        let coord = |n: &Node| n.w.iter().zip(&a.w).zip(&sec).map(|((x, y), s)| (x - y) * s).sum::<f64>();
+        found.sort_by(|x, y| coord(&x.1).total_cmp(&coord(&y.1)));
+        (found, unlocated)
+    }
 }
 
 /// One end of a [`Bracket`]: its coordinate, its test value (scaled by Illinois' rule), the

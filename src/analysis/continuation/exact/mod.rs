@@ -28,14 +28,16 @@ use crate::analysis::polish::{self, EventKind as Switch, PolishedOrbit};
 use crate::error::Error;
 use crate::periodic::{PeriodicProblem, PeriodicSolver};
 use family::{Family, Node, Signature, lambda_axis};
-use locate::{Test, detail_of, locate, side, test_value};
+use locate::{Test, locate};
 
 /// A phase shorter than this (fraction of the period) and shrinking has vanished: a grazing.
 const VANISH: f64 = 1e-6;
 /// Below this step a corrector failing on a flight's re-impact time alone ([`Family::unresolved_flight`]):
 /// the flight is below resolution, merged, not crawled at (coarse rigid blade, 2338.39 rad/s; validation/RECORD.md).
 const UNRESOLVED_STEP: f64 = 1e-4;
-/// Above this step a rigid change whose bisection fails is stepped at again shorter, not placed at the step's start.
+/// Above this step a rigid change or a multiplier event whose bisection fails (a trial's corrector
+/// failed in the bracket) is stepped at again shorter, not placed at the step's start (rigid) or
+/// recorded unlocated at its end (fold, period doubling, Neimark–Sacker).
 const UNLOCATED_STEP: f64 = 1e-4;
 /// The phase of a pair of events just inserted at a grazing (fraction of the period).
 const NEW_PAIR: f64 = 1e-5;
@@ -250,6 +252,7 @@ impl Walk<'_> {
                 let (ev, ne) = (self.fam.sig.events[e], self.fam.ne());
                 let end = signature::partner(self.fam.base(), &self.fam.sig.events, e).unwrap_or((e + 1) % ne);
                 let which = format!("contact {}: {:?} → {:?}, {len:.1e} of the period", ev.contact, ev.kind, self.fam.sig.events[end].kind);
+                self.trace_reversed(&here, &which);
                 let _ = rate;
                 let next = if self.rigid_event(e) { self.rigid_vanish(&here, e, to) } else { self.remove_pair(&here, e) };
                 match next {
@@ -399,7 +402,15 @@ impl Walk<'_> {
                     }
                 }
             }
-            for (kind, node, detail) in self.events_between(&here, &next) {
+            let (events, missed) = self.events_on(&here, &next);
+            // A trial's corrector failed in the bracket of an event the step crossed: the step
+            // is tried again shorter, where the bracket is (the real blade's period doubling at
+            // 1141.6022585 rad/s, 1150 → 1140: bracketed by 0.31 rad/s and given at its end).
+            if missed && step > UNLOCATED_STEP {
+                ds = step / 2.0;
+                continue;
+            }
+            for (kind, node, detail) in events {
                 if self.stop_at_fold && kind == EventKind::Fold {
                     self.fold = Some(node.lambda(rho));
                     return done(self, "a fold".into(), false, false);
@@ -493,58 +504,19 @@ impl Walk<'_> {
         (sectioned, Some(moved))
     }
 
-    /// The events between two points of one signature, each located by bisection, in order.
-    fn events_between(&self, a: &Node, b: &Node) -> Vec<(EventKind, Node, String)> {
-        let mut found = Vec::new();
-        for kind in [EventKind::Fold, EventKind::PeriodDoubling, EventKind::NeimarkSacker] {
-            if side(a, kind) == side(b, kind) {
-                continue;
-            }
-            let s = side(a, kind);
-            if kind == EventKind::Fold && std::env::var_os("PC_TRACE_FOLD").is_some() {
-                let (ta, tb) = (test_value(a, kind), test_value(b, kind));
-                let (raw, met) = (dot(&a.tangent, &b.tangent), self.fam.metric.dot(&a.tangent, &b.tangent));
-                let rho = self.fam.rho;
-                eprintln!(
-                    "fold trace: a λ {:.10} t_λ {ta:e}, b λ {:.10} t_λ {tb:e}; tangents' product {raw:e}, in the metric {met:e}",
-                    a.lambda(rho),
-                    b.lambda(rho)
-                );
-            }
-            let value = |n: &Node| if side(n, kind) == s { 1.0 } else { -1.0 } * test_value(n, kind).abs();
-            let same = |n: &Node| side(n, kind) == s;
-            let test = if kind == EventKind::NeimarkSacker { Test::Side(&same) } else { Test::Point(&value) };
-            let located = locate(&self.fam, a, b, test, false);
-            let missed = located.is_none();
-            let node = located.map_or_else(|| b.clone(), |(_, hi)| hi);
-            // det(I + M) also changes sign when a multiplier passes through ∞ (an impact's
-            // velocity fading at a grazing, Nordmark 1991): no multiplier at −1, no doubling.
-            // Unlocated (a trial's corrector failed), a real multiplier crossing −1 between the
-            // two points is the doubling (the real blade's at 2283.42 rad/s was dropped so).
-            let doubling = if missed { floquet::crosses(&a.mu, &b.mu, -1.0) } else { node.mu.iter().any(|m| (m + 1.0).norm() < 1e-3) };
-            if kind == EventKind::PeriodDoubling && !doubling {
-                continue;
-            }
-            // Unlocated, a fold needs a real multiplier through +1 too: the tangent's λ component
-            // alone flips in the corrector's noise where the walk crawls into a singular merge
-            // (the coarse rigid blade at 2402.2578806 rad/s: steps of 2e-11, |μ| 0.9495 on both sides).
-            if kind == EventKind::Fold && missed && !floquet::crosses(&a.mu, &b.mu, 1.0) {
-                continue;
-            }
-            let mut detail = detail_of(kind, &node);
-            if missed {
-                detail += &format!(
-                    "; not located: between λ = {} and {} (a trial's corrector failed), given at the latter",
-                    a.lambda(self.fam.rho),
-                    b.lambda(self.fam.rho)
-                );
-            }
-            found.push((kind, node, detail));
+    /// PC_TRACE_VANISH: the event times and pair phases of `n` where one is ≤ 0 long, which no
+    /// corrected point of the family's signature has (its times increase within the period).
+    fn trace_reversed(&self, n: &Node, at: &str) {
+        if std::env::var_os("PC_TRACE_VANISH").is_none() || !signature::reversed(&self.fam, &n.w) {
+            return;
         }
-        let sec: Vec<f64> = b.w.iter().zip(&a.w).map(|(x, y)| x - y).collect();
-        let coord = |n: &Node| n.w.iter().zip(&a.w).zip(&sec).map(|((x, y), s)| (x - y) * s).sum::<f64>();
-        found.sort_by(|x, y| coord(&x.1).total_cmp(&coord(&y.1)));
-        found
+        let ne = self.fam.ne();
+        let n2 = n.w.len() - 1 - ne;
+        eprintln!("vanish trace ({at}): λ {:.10}, {ne} events, {} unknowns", n.lambda(self.fam.rho), n.w.len());
+        for (e, ev) in self.fam.sig.events.iter().enumerate() {
+            let pair = signature::pair_phase(&self.fam, &n.w, e);
+            eprintln!("  {e}: contact {} {:?} θ {:.12} pair {pair:?}", ev.contact, ev.kind, n.w[n2 + e]);
+        }
     }
 }
 
