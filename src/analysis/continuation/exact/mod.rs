@@ -292,10 +292,14 @@ impl Walk<'_> {
                 let toggled = signature::toggled(&self.fam, self.problem.model(), &here.w, &pred)?;
                 self.try_step(&here, toggled, step, settings.min_step)
             });
+            // The step's own start and signature where a pass re-expressed `here` in its events' new
+            // order: a retry goes back to them, since `here` has not crossed that pair (its times
+            // out of order: a phase −0.93 of the period long taken for a vanishing one, 1200.86 rad/s).
+            let mut origin = None;
             let next = match tried {
                 Some((n, moved)) => {
                     if let Some(m) = moved {
-                        here = m;
+                        origin = Some((std::mem::replace(&mut here, m), old));
                     }
                     n
                 }
@@ -359,6 +363,7 @@ impl Walk<'_> {
                     None if step > settings.min_step => {
                         (self.fam.sig, ds) = (sig, step / 2.0);
                         self.points.truncate(count.max(self.reported));
+                        self.back(&mut here, origin);
                         continue;
                     }
                     None => {
@@ -381,6 +386,7 @@ impl Walk<'_> {
                 let Some((lo, _)) = locate(&self.fam, &here, &next, Test::Value(&least), true) else {
                     if step > settings.min_step {
                         ds = step / 2.0;
+                        self.back(&mut here, origin);
                         continue;
                     }
                     let stop = format!("a grazing near λ = {}: it could not be located on the arc", here.lambda(rho));
@@ -408,6 +414,7 @@ impl Walk<'_> {
             // 1141.6022585 rad/s, 1150 → 1140: bracketed by 0.31 rad/s and given at its end).
             if missed && step > UNLOCATED_STEP {
                 ds = step / 2.0;
+                self.back(&mut here, origin);
                 continue;
             }
             for (kind, node, detail) in events {
@@ -472,6 +479,14 @@ impl Walk<'_> {
             && !signature::reversed(&self.fam, &n.w)
             && !signature::collapsed(&self.fam, &pred, &n.w))
         .then_some((n, passed))
+    }
+
+    /// A step retried shorter starts again from its own start and signature (`origin`, where a
+    /// pass had re-expressed `here` in a new order of its events).
+    fn back(&mut self, here: &mut Node, origin: Option<(Node, Signature)>) {
+        if let Some((start, sig)) = origin {
+            (*here, self.fam.sig) = (start, sig);
+        }
     }
 
     /// The predictor `pred` from `here` and, when events with identity state maps of different
