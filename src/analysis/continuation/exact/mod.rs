@@ -293,8 +293,9 @@ impl Walk<'_> {
                 self.try_step(&here, toggled, step, settings.min_step)
             });
             // The step's own start and signature where a pass re-expressed `here` in its events' new
-            // order: a retry goes back to them, since `here` has not crossed that pair (its times
-            // out of order: a phase −0.93 of the period long taken for a vanishing one, 1200.86 rad/s).
+            // order: a retry goes back to them, since `here` has not crossed that pair (its times out
+            // of order make a pair phase negative, read as vanishing: suspected of session 30's stop
+            // at 1200.86 rad/s, "−9.3e-1 of the period"; validation/RECORD.md).
             let mut origin = None;
             let next = match tried {
                 Some((n, moved)) => {
