@@ -23,7 +23,7 @@ pub(super) use particular::Transient;
 mod massive;
 // The particular solution at a frequency, and a phase re-tuned to another one.
 mod tuning;
-use tuning::{PrescTerms, Tuning, loads};
+use tuning::{ReducedLoads, Tuning, loads};
 
 /// Complex amplitudes of a harmonic signal: value(t) = Re Σ_p amp_p e^{i p ω t}.
 pub(super) type Harmonics = Vec<(u32, DVector<C>)>;
@@ -68,7 +68,7 @@ pub(super) struct Phase {
     tuning: Arc<Tuning>,
     /// K x_p, M x_p, C x_p of the prescribed motion's harmonics (tuning.rs), shared by the
     /// phase's re-tunings while their prescribed motion is bitwise the same.
-    presc_terms: Arc<PrescTerms>,
+    reduced_loads: Arc<ReducedLoads>,
     /// Â's eigendecomposition, made at the first flow and shared by the phase's clones (a
     /// reordered orbit's, a continuation step's); `None` inside where Â is refused
     /// ([`EigenFlow::new`]): the Padé and Taylor paths then.
@@ -218,7 +218,7 @@ impl Phase {
             slave_map: Arc::new(slave_map),
             slave_part: Vec::new(),
             tuning,
-            presc_terms: Arc::default(),
+            reduced_loads: Arc::default(),
             eigen: Arc::default(),
             force_gradient: Arc::default(),
             lift: Arc::default(),

@@ -100,12 +100,9 @@ impl<'a> CirculantOperator<'a> {
         for (p, (g, zp)) in self.spectrum.chunks_exact(m * m).zip(zh.chunks_exact_mut(m)).take(nh).enumerate() {
             // The DC and Nyquist blocks as if their imaginary parts were zeroed (`real_ends`).
             let real = self.a.real_ends() && (p == 0 || 2 * p == k);
+            let read = |x: C| if real { C::new(x.re, 0.0) } else { x };
             for (s, row) in gz.iter_mut().zip(g.chunks_exact(m)) {
-                *s = if real {
-                    row.iter().zip(zp.iter()).fold(C::ZERO, |acc, (&x, &y)| acc + C::new(x.re, 0.0) * y)
-                } else {
-                    row.iter().zip(zp.iter()).fold(C::ZERO, |acc, (&x, &y)| acc + x * y)
-                };
+                *s = row.iter().zip(zp.iter()).fold(C::ZERO, |acc, (&x, &y)| acc + read(x) * y);
             }
             zp.copy_from_slice(gz);
         }

@@ -33,18 +33,18 @@ pub(super) struct Tuning {
 /// loads (a frequency walk) re-tunings reuse them: the massless solves and products were most of
 /// a re-tuning (the real blade's n_b = 49 against n_a = 20; its walk's builds, validation/RECORD.md).
 #[derive(Clone, Debug, Default)]
-pub(super) struct PrescTerms {
+pub(super) struct ReducedLoads {
     force: Harmonics,
     presc: Harmonics,
     /// Per harmonic (ascending): p, the parts of y_b, those of g_a.
     parts: Vec<(u32, Parts, Parts)>,
 }
 
-/// A reduced load's parts [v₀, v₂, v₁] ([`PrescTerms`]).
+/// A reduced load's parts [v₀, v₂, v₁] ([`ReducedLoads`]).
 type Parts = [DVector<C>; 3];
 
-impl PrescTerms {
-    fn new(phase: &Phase) -> Option<PrescTerms> {
+impl ReducedLoads {
+    fn new(phase: &Phase) -> Option<ReducedLoads> {
         let n = phase.n;
         let mut ps: Vec<u32> = phase.force.iter().chain(&phase.presc).map(|(p, _)| *p).collect();
         ps.sort_unstable();
@@ -59,7 +59,7 @@ impl PrescTerms {
             let ((b0, a0), (b2, a2), (b1, a1)) = (phase.reduced(&r0)?, phase.reduced(&r2)?, phase.reduced(&r1)?);
             parts.push((p, [b0, b2, b1], [a0, a2, a1]));
         }
-        Some(PrescTerms { force: phase.force.clone(), presc: phase.presc.clone(), parts })
+        Some(ReducedLoads { force: phase.force.clone(), presc: phase.presc.clone(), parts })
     }
 
     /// Whether these are the parts of the loads `force` and `presc`: bit for bit (−0.0 ≠ 0.0),
@@ -71,7 +71,7 @@ impl PrescTerms {
     }
 }
 
-/// v₀ + w² v₂ − i w v₁ of the parts [v₀, v₂, v₁] ([`PrescTerms`]).
+/// v₀ + w² v₂ − i w v₁ of the parts [v₀, v₂, v₁] ([`ReducedLoads`]).
 fn at_frequency(v: &Parts, w: f64) -> DVector<C> {
     DVector::from_fn(v[0].len(), |i, _| v[0][i] + v[1][i] * (w * w) - C::new(0.0, w) * v[2][i])
 }
@@ -148,12 +148,12 @@ impl Phase {
     /// is singular (an undamped resonance).
     pub(super) fn tune(&mut self) -> Option<()> {
         let nf = self.free.ncols();
-        if !self.presc_terms.is_for(&self.force, &self.presc) {
-            self.presc_terms = Arc::new(PrescTerms::new(self)?);
+        if !self.reduced_loads.is_for(&self.force, &self.presc) {
+            self.reduced_loads = Arc::new(ReducedLoads::new(self)?);
         }
         let t = &self.tuning;
         let (mut part, mut slave_part) = (Vec::new(), Vec::new());
-        for (p, b, a) in &self.presc_terms.parts {
+        for (p, b, a) in &self.reduced_loads.parts {
             let (p, w) = (*p, *p as f64 * self.omega);
             let yb = at_frequency(b, w);
             let xa = if nf == 0 {
@@ -238,7 +238,7 @@ mod tests {
         Model { structure, forces: vec![force], contacts: vec![stop], frequency: omega, frictions: Vec::new(), rubbing: Vec::new() }
     }
 
-    /// A re-tuned phase's particular solution (its loads' reduced parts reused, [`super::PrescTerms`])
+    /// A re-tuned phase's particular solution (its loads' reduced parts reused, [`super::ReducedLoads`])
     /// against the closed form, on a unit mass (k = 2 to ground through a massless DOF: K = [[3, −1],
     /// [−1, 1]], c = 0.15) forced on both DOFs, 1·cos ωt on the massless one and 0.5·cos 2ωt on the
     /// mass: per harmonic w = pω, x₀ = (f₀ + f₁)/(2 − w² + 0.15 i w) (the massless row condensed,
@@ -261,7 +261,7 @@ mod tests {
         let omega = 1.7;
         let made = Phase::new(&model(1.2), &[], &[]).expect("the free phase");
         let retuned = made.retuned(&model(omega)).expect("re-tuned");
-        assert!(Arc::ptr_eq(&made.presc_terms, &retuned.presc_terms), "the same loads: the parts are reused");
+        assert!(Arc::ptr_eq(&made.reduced_loads, &retuned.reduced_loads), "the same loads: the parts are reused");
         for (p, f0, f1) in [(1, 0.0, 1.0), (2, 0.5, 0.0)] {
             let w = p as f64 * omega;
             let x0 = C::new(f0 + f1, 0.0) / C::new(2.0 - w * w, 0.15 * w);
@@ -285,12 +285,12 @@ mod tests {
         };
         // Another ω, the same motion: the products are shared and the result is the uncached one's.
         let retuned = made.retuned(&chain(1.7, 0.05)).expect("re-tuned");
-        assert!(Arc::ptr_eq(&made.presc_terms, &retuned.presc_terms));
+        assert!(Arc::ptr_eq(&made.reduced_loads, &retuned.reduced_loads));
         let anew = Phase::new(&chain(1.7, 0.05), &[0], &[]).expect("made anew");
         assert_eq!(bits(&retuned), bits(&anew));
         // A perturbed motion must invalidate them: else the particular solution keeps the old load.
         let moved = made.retuned(&chain(1.7, 0.05 * (1.0 + 1e-9))).expect("re-tuned, moved");
-        assert!(!Arc::ptr_eq(&made.presc_terms, &moved.presc_terms));
+        assert!(!Arc::ptr_eq(&made.reduced_loads, &moved.reduced_loads));
         let anew = Phase::new(&chain(1.7, 0.05 * (1.0 + 1e-9)), &[0], &[]).expect("made anew, moved");
         assert_eq!(bits(&moved), bits(&anew));
         assert_ne!(bits(&moved), bits(&retuned));
