@@ -253,3 +253,84 @@ fn first_clause(e: &SolveError) -> String {
     let s = e.to_string();
     s.split(':').next().unwrap_or(&s).to_string()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The coarse blade with rigid tip contacts on massless DOFs (massless boundary, cds, the
+    /// same pairing: the two-grid estimate is the plain difference), k = 2048 (k/2 and k/4 within
+    /// cds's stability limit), at ω.
+    fn blade(omega: f64) -> PeriodicProblem {
+        let text = std::fs::read_to_string(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fmu/scenes/blade-casing-rigid.toml")).unwrap();
+        let text: Vec<String> = text
+            .lines()
+            .filter(|l| !l.starts_with("pairing ="))
+            .map(|l| match l {
+                l if l.starts_with("method =") => "method = \"massless-boundary\"".to_string(),
+                l if l.starts_with("steps =") => "steps = 2048".to_string(),
+                l => l.to_string(),
+            })
+            .collect();
+        let mut p = crate::scene::Scene::parse(&text.join("\n"), "t.toml").unwrap().to_problem("t.toml").unwrap();
+        p.set_frequency(omega).unwrap();
+        p
+    }
+
+    /// A point whose previous point was refined skips k/4 exactly where its two-grid estimate
+    /// exceeds the tolerance (here set between Richardson at order 2 and the plain difference,
+    /// 3× apart), and is then refined to the answer the climb with k/4 refines it to, bit for
+    /// bit, when that climb refines too; where k/4 would have kept it at k, its 2k answer is
+    /// within the tolerance and within the k answer's estimate of it. With the tolerance above
+    /// the two grids' estimate, or no refined previous point, k/4 is solved as before.
+    #[test]
+    fn after_a_refined_point_k4_is_skipped_only_where_two_grids_exceed_the_tolerance() {
+        let mut skipped = 0;
+        for omega in [2300.0, 2340.0] {
+            let p = blade(omega);
+            let r = PeriodicSolver::new(p.clone()).solve().unwrap();
+            let (grid, note) = accuracy::second_grid(&p, &r).unwrap();
+            let half = PeriodicSolver::new(grid).solve().unwrap();
+            let (least, two) =
+                (accuracy::least_estimate(&p, &r, &half, &note).relative.unwrap(), accuracy::estimate_from(&p, &r, &half, None, &note).relative.unwrap());
+            assert!(two > 2.5 * least, "ω = {omega}: the plain difference {two:e} against Richardson {least:e}");
+            let k = p.discretization().steps;
+            let run = |tolerance: f64, predicted: Option<usize>| {
+                let settings = SweepSettings { estimate: true, tolerance: Some(tolerance), max_steps: 2 * k, threads: 1, ..Default::default() };
+                let (mut coarser, mut levels) = (Coarser::new(), Levels::new());
+                let mut point = SweepPoint::from_response(&p, omega, &r);
+                let below = estimate(&mut point, &p, &r, &mut coarser, &settings, predicted);
+                let quarter = coarser.iter().any(|s| s.0.problem().discretization().steps == k / 4);
+                let noted = point.estimate_method.contains("k/4 not solved: the previous point needed");
+                let kept = point.clone();
+                refine(&mut point, &p, &r, below, (&mut levels, &mut coarser), &settings);
+                (kept, point, quarter, noted)
+            };
+            let between = (least * two).sqrt();
+            let (first, skip, quarter, noted) = run(between, Some(2 * k));
+            eprintln!("ω = {omega}: Richardson {least:.3e}, two grids {two:.3e}; skipped: k = {}, {:.3e}", skip.steps, skip.estimate_relative.unwrap());
+            assert!(!quarter && noted, "ω = {omega}: k/4 solved ({})", first.estimate_method);
+            assert_eq!(first.estimate_relative, Some(two), "ω = {omega}");
+            assert_eq!(skip.steps, 2 * k, "ω = {omega}: not refined");
+            skipped += 1;
+            let (climb_first, climb, quarter, noted) = run(between, None);
+            assert!(quarter && !noted, "ω = {omega}: without a refined previous point k/4 is solved");
+            if climb.steps == 2 * k {
+                assert_eq!(skip.amplitude, climb.amplitude, "ω = {omega}");
+                assert_eq!(skip.estimate_relative, climb.estimate_relative, "ω = {omega}");
+            } else {
+                let e = climb_first.estimate_relative.unwrap();
+                let ptp = 2.0 * climb.amplitude.iter().copied().fold(0.0, f64::max);
+                let moved = skip.amplitude.iter().zip(&climb.amplitude).fold(0.0f64, |w, (a, b)| w.max((a - b).abs()));
+                eprintln!("  the climb keeps k = {k} ({e:.3e}); the 2k answer moved {:.3e} of the peak-to-peak", moved / ptp);
+                assert!(skip.estimate_relative.unwrap() <= between && moved <= e * ptp, "ω = {omega}: moved {moved:e}, estimate {e:e}");
+            }
+            // Above the two grids' estimate, or after a point kept at k: k/4 as before.
+            for (tolerance, predicted) in [(1.01 * two, Some(2 * k)), (between, Some(k))] {
+                let (_, _, quarter, noted) = run(tolerance, predicted);
+                assert!(quarter && !noted, "ω = {omega}: tolerance {tolerance:e}, previous k {predicted:?}");
+            }
+        }
+        assert_eq!(skipped, 2);
+    }
+}
