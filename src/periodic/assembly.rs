@@ -433,7 +433,7 @@ pub(super) mod tests {
 
     /// A 20-DOF spring chain whose first 4 DOFs are massless (a massless-boundary model), mass-
     /// proportional damping, contacts on massless and massive DOFs, forces on both.
-    pub(in crate::periodic) fn chain_with_massless_boundary() -> Model {
+    pub(crate) fn chain_with_massless_boundary() -> Model {
         let n = 20;
         let massless = 4;
         let stiffness = |i: usize| 1.0e4 * (1.0 + 0.3 * i as f64);

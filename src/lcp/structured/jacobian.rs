@@ -92,14 +92,36 @@ fn blocked(a: &Mat<f64>, b: &Mat<f64>, c: &mut Mat<f64>) {
                 c.col_as_slice_mut(j + cc)[i..i + BLOCK_ROWS].copy_from_slice(acc);
             }
         }
-        for jj in j..j + BLOCK_COLS {
-            for i in rows..n {
-                c[(i, jj)] = entry(i, jj);
+        // The rows left (the augmented row at d + 1 = 41): BLOCK_COLS sums side by side, not one
+        // entry's chain of dependent adds at a time (that tail took as long as the blocks).
+        for i in rows..n {
+            let mut acc = [0.0f64; BLOCK_COLS];
+            for (l, a_column) in a_columns.iter().enumerate() {
+                let ail = a_column[i];
+                for (cc, acc) in acc.iter_mut().enumerate() {
+                    *acc += ail * columns[cc][l];
+                }
+            }
+            for (cc, acc) in acc.iter().enumerate() {
+                c[(i, j + cc)] = *acc;
             }
         }
     }
+    // The columns left: BLOCK_ROWS rows at a time, as the blocks.
     for j in cols..m {
-        for i in 0..n {
+        let column = b.col_as_slice(j);
+        for i in (0..rows).step_by(BLOCK_ROWS) {
+            let mut acc = [0.0f64; BLOCK_ROWS];
+            for (l, a_column) in a_columns.iter().enumerate() {
+                let ail: &[f64; BLOCK_ROWS] = a_column[i..i + BLOCK_ROWS].try_into().expect("a block of rows");
+                let blj = column[l];
+                for x in 0..BLOCK_ROWS {
+                    acc[x] += ail[x] * blj;
+                }
+            }
+            c.col_as_slice_mut(j)[i..i + BLOCK_ROWS].copy_from_slice(&acc);
+        }
+        for i in rows..n {
             c[(i, j)] = entry(i, j);
         }
     }
