@@ -22,6 +22,7 @@ mod pairs;
 mod profile;
 mod rigid;
 mod signature;
+mod steps;
 
 use super::{BranchPoint, ContinuationSettings, EventKind, Parameter, Source, floquet};
 use crate::analysis::polish::{self, EventKind as Switch, PolishedOrbit};
@@ -29,6 +30,7 @@ use crate::error::Error;
 use crate::periodic::{PeriodicProblem, PeriodicSolver};
 use family::{Family, Node, Signature, lambda_axis};
 use locate::{Test, locate};
+use steps::StepTrace;
 
 /// A phase shorter than this (fraction of the period) and shrinking has vanished: a grazing.
 const VANISH: f64 = 1e-6;
@@ -258,8 +260,6 @@ impl Walk<'_> {
         // The first step since a change of signature not yet taken; it was cut short by failures.
         let (mut fresh, mut cut) = (false, false);
         let mut trace = StepTrace::new();
-        let knob = |name: &str, default: f64| std::env::var(name).ok().and_then(|g| g.parse().ok()).unwrap_or(default);
-        let (regrowth, straight) = (knob("PC_REGROWTH", REGROWTH), knob("PC_STRAIGHT", STRAIGHT));
         loop {
             if self.points.len() >= settings.max_points {
                 let stop = format!("{} points (the limit)", settings.max_points);
@@ -470,7 +470,7 @@ impl Walk<'_> {
             }
             here = next;
             self.rescale(&mut here);
-            let grown = if cut && step < cap { (step * (straight / self.drift).clamp(GROWTH, regrowth)).min(cap) } else { step * GROWTH };
+            let grown = if cut && step < cap { (step * (STRAIGHT / self.drift).clamp(GROWTH, REGROWTH)).min(cap) } else { step * GROWTH };
             (fresh, cut) = (false, cut && step < cap);
             ds = grown.min(settings.exact_max_step);
         }
@@ -569,47 +569,6 @@ impl Walk<'_> {
             let pair = signature::pair_phase(&self.fam, &n.w, e);
             eprintln!("  {e}: contact {} {:?} θ {:.12} pair {pair:?}", ev.contact, ev.kind, n.w[n2 + e]);
         }
-    }
-}
-
-/// PC_TRACE_STEP: per point of the walk, its step and what bound it (the controller growing
-/// ×GROWTH or regrowing ×REGROWTH after a change, the maximum step, a landing on a vanishing
-/// phase) and the retries shorter before it (why each).
-struct StepTrace {
-    on: bool,
-    landing: bool,
-    retries: Vec<&'static str>,
-}
-
-impl StepTrace {
-    fn new() -> StepTrace {
-        StepTrace { on: std::env::var_os("PC_TRACE_STEP").is_some(), landing: false, retries: Vec::new() }
-    }
-
-    fn bound(&mut self, landing: bool) {
-        self.landing = landing;
-    }
-
-    fn retry(&mut self, why: &'static str) {
-        if self.on {
-            self.retries.push(why);
-        }
-    }
-
-    fn point(&mut self, lambda: f64, step: f64, ds: f64, cap: f64, max: f64, drift: f64) {
-        if self.on {
-            let by = if self.landing {
-                "landing"
-            } else if ds >= max {
-                "max"
-            } else if step < cap {
-                "regrowth"
-            } else {
-                "controller"
-            };
-            eprintln!("step trace: λ {lambda:.10} step {step:.3e} by {by}, drift/step {drift:.2e}; retries {:?}", self.retries);
-        }
-        self.retries.clear();
     }
 }
 
