@@ -22,6 +22,7 @@ mod pairs;
 mod profile;
 mod rigid;
 mod signature;
+mod steps;
 
 use super::{BranchPoint, ContinuationSettings, EventKind, Parameter, Source, floquet};
 use crate::analysis::polish::{self, EventKind as Switch, PolishedOrbit};
@@ -29,6 +30,7 @@ use crate::error::Error;
 use crate::periodic::{PeriodicProblem, PeriodicSolver};
 use family::{Family, Node, Signature, lambda_axis};
 use locate::{Test, locate};
+use steps::StepTrace;
 
 /// A phase shorter than this (fraction of the period) and shrinking has vanished: a grazing.
 const VANISH: f64 = 1e-6;
@@ -62,6 +64,17 @@ const TOUCH_TOL: f64 = 1e-10;
 /// rad/s ×1.5 took 146 points and 94.0 s CPU, ×2 103 and 75.6 s, ×3 83 and 78.1 s; but ×2's walk down
 /// lost the period doubling at 1141.60 (a trial failed in its wider bracket): ×1.5 kept (validation/RECORD.md).
 const GROWTH: f64 = 1.5;
+/// The step's growth after a change of signature whose first step failed and was cut short, up to the
+/// controller's step before the change: after a grazing that inserts a pair (its phase 1e-5 of the
+/// period, opening as √σ) the real blade's first step was cut from `initial_step` to 7.8e-6 by eight
+/// failed correctors and grew back ×1.5 over ≈ 25 points, its predictor error falling as the phase
+/// opened. Not after a change whose first step holds (the coarse rigid walk): growing faster there
+/// lost events (session 31's restart at the last step; session 32's ×3, validation/RECORD.md).
+const REGROWTH: f64 = 3.0;
+/// The regrowth keeps the next corrector within this × the step of its predictor, from the last
+/// one's distance (½·κ·step² on an arc of curvature κ: linear in the step; Allgower & Georg 1990,
+/// §6.1): the tangent turns by ≈ 2·this, within [`MIN_COS`]'s 0.45 rad.
+const STRAIGHT: f64 = 0.1;
 
 /// One exact walk: its points, why it stopped, and whether it reached `to`.
 pub(super) struct Walked {
@@ -84,6 +97,8 @@ struct Walk<'a> {
     end: Option<PolishedOrbit>,
     /// How many of `points` went to the progress callback.
     reported: usize,
+    /// The last corrector's distance from its predictor over the step (metric): ½·κ·step on an arc.
+    drift: f64,
 }
 
 /// The scenes the exact walk takes: orbits of one forcing period.
@@ -130,7 +145,7 @@ fn begin<'a>(problem: &'a PeriodicProblem, param: Parameter, from: f64, to: f64,
     let dir = (to - from).signum();
     let prev: Vec<f64> = e_l.iter().map(|x| x * dir).collect();
     let here = fam.node(w0, &prev).ok_or_else(|| Error::solve(format!("singular Jacobian at {} = {from}", param.name())))?;
-    Ok((Walk { problem, fam, points: Vec::new(), stop_at_fold: false, fold: None, end: None, reported: 0 }, here))
+    Ok((Walk { problem, fam, points: Vec::new(), stop_at_fold: false, fold: None, end: None, reported: 0, drift: 0.0 }, here))
 }
 
 /// Where a front end's step along the exact branch ends ([`step`]).
@@ -239,6 +254,12 @@ impl Walk<'_> {
         let rho = self.fam.rho;
         let dir = (to - from).signum();
         let mut ds = settings.initial_step;
+        // The controller's step before the last change of signature (the regrowth's cap), and the
+        // controller's step of the last point it bound (not a landing, not a retry).
+        let (mut cap, mut regular) = (0.0, settings.initial_step);
+        // The first step since a change of signature not yet taken; it was cut short by failures.
+        let (mut fresh, mut cut) = (false, false);
+        let mut trace = StepTrace::new();
         loop {
             if self.points.len() >= settings.max_points {
                 let stop = format!("{} points (the limit)", settings.max_points);
@@ -259,7 +280,7 @@ impl Walk<'_> {
                     Some(next) if self.ends_here(&next, dir) => return done(self, "a fold at a grazing".into(), false, false),
                     Some(next) => {
                         here = next;
-                        ds = settings.initial_step;
+                        (ds, cap, fresh) = (settings.initial_step, regular, true);
                         continue;
                     }
                     None => {
@@ -274,7 +295,7 @@ impl Walk<'_> {
                     return done(self, "a fold at a grazing".into(), false, false);
                 }
                 self.report(on_point);
-                (here, ds) = (next, settings.initial_step);
+                (here, ds, cap, fresh) = (next, settings.initial_step, regular, true);
                 continue;
             }
             // Land on a vanishing phase by quarters.
@@ -282,6 +303,7 @@ impl Walk<'_> {
             for &(_, len, rate) in &shrinking {
                 step = step.min(0.75 * len / rate);
             }
+            trace.bound(step < ds);
             let pred: Vec<f64> = here.w.iter().zip(&along).map(|(w, t)| w + step * t).collect();
             // Events that may pass each other did: the same step in their new order (not a change);
             // the corrector may cross a close pair the predictor did not, or the reverse: then the
@@ -306,7 +328,11 @@ impl Walk<'_> {
                 }
                 None => {
                     self.fam.sig = old;
-                    ds = step / 2.0;
+                    // Right after a change, by quarters: the failures of the first step after a
+                    // pair's insertion run from `initial_step` to ≈ 1e-5, the new phase's length.
+                    ds = step / if fresh { 4.0 } else { 2.0 };
+                    cut |= fresh;
+                    trace.retry("corrector");
                     let merged = self.fam.unresolved_flight().filter(|_| step < UNRESOLVED_STEP).and_then(|e| {
                         let c = self.fam.sig.events[e].contact;
                         self.merge(&here, e, &format!("contact {c}: its free phase below resolution (its re-impact's time unresolved)"))
@@ -322,7 +348,7 @@ impl Walk<'_> {
                         }
                         self.report(on_point);
                         here = n;
-                        ds = settings.initial_step;
+                        (ds, cap, fresh) = (settings.initial_step, regular, true);
                         continue;
                     }
                     if ds < settings.min_step {
@@ -357,12 +383,13 @@ impl Walk<'_> {
                     Some(n) => {
                         self.report(on_point);
                         here = n;
-                        ds = settings.initial_step;
+                        (ds, cap, fresh) = (settings.initial_step, regular, true);
                         continue;
                     }
                     // A long step across several changes (2355.54 → 2358.46 rad/s on the rigid coarse blade): shorter.
                     None if step > settings.min_step => {
                         (self.fam.sig, ds) = (sig, step / 2.0);
+                        trace.retry("rigid crossing");
                         self.points.truncate(count.max(self.reported));
                         self.back(&mut here, origin);
                         continue;
@@ -387,6 +414,7 @@ impl Walk<'_> {
                 let Some((lo, _)) = locate(&self.fam, &here, &next, Test::Value(&least), true) else {
                     if step > settings.min_step {
                         ds = step / 2.0;
+                        trace.retry("grazing unlocated");
                         self.back(&mut here, origin);
                         continue;
                     }
@@ -400,7 +428,7 @@ impl Walk<'_> {
                             return done(self, "a fold at a grazing".into(), false, false);
                         }
                         here = n;
-                        ds = settings.initial_step;
+                        (ds, cap, fresh) = (settings.initial_step, regular, true);
                         continue;
                     }
                     None => {
@@ -415,6 +443,7 @@ impl Walk<'_> {
             // 1141.6022585 rad/s, 1150 → 1140: bracketed by 0.31 rad/s and given at its end).
             if missed && step > UNLOCATED_STEP {
                 ds = step / 2.0;
+                trace.retry("multiplier event unlocated");
                 self.back(&mut here, origin);
                 continue;
             }
@@ -435,9 +464,15 @@ impl Walk<'_> {
                 let stop = format!("the branch turned back below {from}");
                 return done(self, stop, false, true);
             }
+            trace.point(lambda, step, ds, if cut { cap } else { 0.0 }, settings.exact_max_step, self.drift);
+            if step == ds {
+                regular = ds;
+            }
             here = next;
             self.rescale(&mut here);
-            ds = (step * GROWTH).min(settings.exact_max_step);
+            let grown = if cut && step < cap { (step * (STRAIGHT / self.drift).clamp(GROWTH, REGROWTH)).min(cap) } else { step * GROWTH };
+            (fresh, cut) = (false, cut && step < cap);
+            ds = grown.min(settings.exact_max_step);
         }
     }
 
@@ -475,6 +510,7 @@ impl Walk<'_> {
         let metric = &self.fam.metric;
         let drift = metric.norm(&n.w.iter().zip(&pred).map(|(a, b)| a - b).collect::<Vec<_>>());
         let turn = metric.dot(&metric.unit(&n.tangent), &along);
+        self.drift = drift / step;
         ((turn >= MIN_COS || step <= min_step)
             && drift <= MAX_DRIFT * step
             && !signature::reversed(&self.fam, &n.w)
