@@ -40,6 +40,9 @@ fn parts(n: &Node) -> &[MarginPart] {
     n.margins().map_or(&[], |m| &m.parts[..])
 }
 
+/// A part whose parabola dips inside the step: its predicted minimum, key and three points (arclength, value).
+type Suspect<'a> = (f64, &'a MarginPart, [(f64, f64); 3]);
+
 /// The vertex (x, value) of the parabola through three points of distinct abscissas, when it is convex.
 fn vertex(p: [(f64, f64); 3]) -> Option<(f64, f64)> {
     let [(x0, f0), (x1, f1), (x2, f2)] = p;
@@ -68,7 +71,7 @@ impl Walk<'_> {
         }
         let behind = behind.filter(|b| b.at == here.w)?;
         let model = self.problem.model();
-        let mut suspects: Vec<(f64, &MarginPart, [(f64, f64); 3])> = behind
+        let mut suspects: Vec<Suspect> = behind
             .parts
             .iter()
             // A massless point's held force is round-off at 1e-9 of its scale (tests/event_swap.rs: −1.2e-9 … −6e-10 a step apart).
