@@ -27,7 +27,7 @@ pub use continued::Touch;
 pub use detect::{PhaseBank, follow_detected, follow_detected_with};
 pub use events::{Event, EventKind};
 pub use orbit::{OrbitParts, PolishedOrbit, user_value};
-pub use rigid::{CLEARANCE, HOLD, RigidMargin, STUCK};
+pub use rigid::{CLEARANCE, HOLD, MarginPart, RigidMargin, RigidMargins, STUCK};
 
 use crate::model::Model;
 use crate::periodic::PeriodicProblem;

@@ -33,11 +33,36 @@ pub const STUCK: &str = "force of the stuck contact";
 /// where that force reaches zero).
 pub const HOLD: &str = "force that would hold the contact after its impact";
 
-impl RigidMargin {
-    /// Keeps the margin if it is below this one.
-    fn keep(&mut self, value: f64, contact: usize, what: &'static str, time: f64, event: Option<usize>) {
-        if value < self.value {
-            *self = RigidMargin { value, contact, what, time, event };
+/// An orbit's rigid margins: the smallest ([`RigidMargin`]) and each part's own smallest value
+/// (a contact's clearance or held force along one phase, an impact's impulse or holding force),
+/// keyed by (contact, what, the phase's or event's index). A part's value is smooth in the
+/// parameter between the signature's changes: the walk reads a dip below zero between two
+/// points from its values at three (continuation/exact/rigid.rs).
+#[derive(Clone, Debug)]
+pub struct RigidMargins {
+    pub least: RigidMargin,
+    pub parts: Vec<MarginPart>,
+}
+
+/// One part of [`RigidMargins`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct MarginPart {
+    pub contact: usize,
+    pub what: &'static str,
+    /// The phase's index (a clearance, a stuck force) or the event's (an impulse, a holding force).
+    pub at: usize,
+    pub value: f64,
+}
+
+impl RigidMargins {
+    /// Keeps the value as its part's if below it, and as the least if below that.
+    fn keep(&mut self, value: f64, (contact, what, at): (usize, &'static str, usize), time: f64, event: Option<usize>) {
+        match self.parts.iter_mut().find(|p| p.contact == contact && p.what == what && p.at == at) {
+            Some(p) => p.value = p.value.min(value),
+            None => self.parts.push(MarginPart { contact, what, at, value }),
+        }
+        if value < self.least.value {
+            self.least = RigidMargin { value, contact, what, time, event };
         }
     }
 }
@@ -45,6 +70,11 @@ impl RigidMargin {
 impl PolishedOrbit {
     /// The smallest rigid margin of the orbit ([`RigidMargin`]); `None` without rigid contacts.
     pub fn rigid_margin(&self) -> Option<RigidMargin> {
+        self.rigid_margins().map(|m| m.least)
+    }
+
+    /// The orbit's rigid margins, the smallest and each part's ([`RigidMargins`]); `None` without rigid contacts.
+    pub fn rigid_margins(&self) -> Option<RigidMargins> {
         let model = &self.model;
         if !model.contacts.iter().any(|c| c.is_rigid()) {
             return None;
@@ -52,13 +82,14 @@ impl PolishedOrbit {
         // The scales of verify.rs: the largest normal displacement and the largest force met.
         let xs = self.after.iter().flat_map(|y| model.contacts.iter().map(move |c| c.along(|d| y[d]).abs())).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
         let fs = self.force_scale();
-        let mut best = RigidMargin { value: f64::INFINITY, contact: 0, what: "", time: 0.0, event: None };
+        let least = RigidMargin { value: f64::INFINITY, contact: 0, what: "", time: 0.0, event: None };
+        let mut best = RigidMargins { least, parts: Vec::new() };
         for (e, (&p, ev)) in self.impulses.iter().zip(&self.events).enumerate() {
             // A massless contact closes without impulse: its margins are its clearance and force.
             if let EventKind::Impact { stick } = ev.kind
                 && !model.contact_is_massless(&model.contacts[ev.contact])
             {
-                best.keep(p * model.frequency / fs, ev.contact, "impulse of the impact", self.times[e], Some(e));
+                best.keep(p * model.frequency / fs, (ev.contact, "impulse of the impact", e), self.times[e], Some(e));
                 if !stick {
                     // The force that would hold the contact just after a pure impact (≤ 0 for a pure impact).
                     let mut stuck: Vec<usize> = self.phases[e].stuck_contacts().collect();
@@ -66,7 +97,7 @@ impl PolishedOrbit {
                     let closed: Vec<usize> = (0..model.contacts.len()).filter(|&i| self.phases[e].closed(i)).collect();
                     if let Some(hold) = Phase::new(model, &stuck, &closed) {
                         let z = hold.stuck_forces(&self.after[e], self.times[e]).into_iter().find(|(k, _)| *k == ev.contact).map_or(0.0, |(_, z)| z);
-                        best.keep(-z / fs, ev.contact, HOLD, self.times[e], Some(e));
+                        best.keep(-z / fs, (ev.contact, HOLD, e), self.times[e], Some(e));
                     }
                 }
             }

@@ -10,7 +10,7 @@ use super::super::{Parameter, floquet};
 use super::metric::Metric;
 use super::modes::{Modes, SignatureKey};
 use super::profile::{Stage, timed};
-use crate::analysis::polish::{Event, EventKind, PolishedOrbit, RigidMargin, Touch};
+use crate::analysis::polish::{Event, EventKind, PolishedOrbit, RigidMargins, Touch};
 use crate::model::{Compliance, Model};
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
@@ -88,7 +88,7 @@ pub(super) struct Node {
     /// The outputs' amplitudes when surveyed with the touches (empty: not yet).
     pub amplitude: Vec<f64>,
     /// The orbit's rigid margin, made at its first use (a sampled period; asked for again at steps' ends).
-    pub(super) margin: std::cell::OnceCell<Option<RigidMargin>>,
+    pub(super) margin: std::cell::OnceCell<Option<RigidMargins>>,
 }
 
 impl Node {

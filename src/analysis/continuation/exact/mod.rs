@@ -99,6 +99,8 @@ struct Walk<'a> {
     reported: usize,
     /// The last corrector's distance from its predictor over the step (metric): ½·κ·step on an arc.
     drift: f64,
+    /// The point before the current one, for a rigid margin's dip within a step ([`rigid::Behind`]).
+    behind: Option<rigid::Behind>,
 }
 
 /// The scenes the exact walk takes: orbits of one forcing period.
@@ -145,7 +147,7 @@ fn begin<'a>(problem: &'a PeriodicProblem, param: Parameter, from: f64, to: f64,
     let dir = (to - from).signum();
     let prev: Vec<f64> = e_l.iter().map(|x| x * dir).collect();
     let here = fam.node(w0, &prev).ok_or_else(|| Error::solve(format!("singular Jacobian at {} = {from}", param.name())))?;
-    Ok((Walk { problem, fam, points: Vec::new(), stop_at_fold: false, fold: None, end: None, reported: 0, drift: 0.0 }, here))
+    Ok((Walk { problem, fam, points: Vec::new(), stop_at_fold: false, fold: None, end: None, reported: 0, drift: 0.0, behind: None }, here))
 }
 
 /// Where a front end's step along the exact branch ends ([`step`]).
@@ -402,6 +404,15 @@ impl Walk<'_> {
                     }
                 }
             }
+            // A part of the rigid margin dipping below zero within the step, neither end seeing it: the step up to it.
+            if step > settings.min_step
+                && let Some(s) = self.dip(self.behind.as_ref(), &here, &next, step)
+            {
+                ds = s;
+                trace.retry("rigid margin dip");
+                self.back(&mut here, origin);
+                continue;
+            }
             // A contact's clearance crossed zero between its events: a grazing on the way.
             let tol = TOUCH_TOL * self.fam.ys;
             let crossed = |n: &Node| n.touches.iter().any(|t| t.value < -tol);
@@ -468,8 +479,10 @@ impl Walk<'_> {
             if step == ds {
                 regular = ds;
             }
-            here = next;
+            let before = std::mem::replace(&mut here, next);
             self.rescale(&mut here);
+            // Not across a pass: `before`'s margins are keyed by its events' old order.
+            self.behind = if origin.is_none() { rigid::Behind::of(&before, &here, step) } else { None };
             let grown = if cut && step < cap { (step * (STRAIGHT / self.drift).clamp(GROWTH, REGROWTH)).min(cap) } else { step * GROWTH };
             (fresh, cut) = (false, cut && step < cap);
             ds = grown.min(settings.exact_max_step);

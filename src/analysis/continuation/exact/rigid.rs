@@ -23,11 +23,13 @@ use crate::periodic::{PeriodicProblem, PeriodicSolver};
 use crate::time::Discretization;
 
 mod diagnose;
+mod dip;
 mod held;
 mod landing;
 mod stall;
 mod touch;
 mod trace;
+pub(super) use dip::Behind;
 use touch::touch_point;
 use trace::trace;
 
@@ -88,7 +90,12 @@ impl Node {
     /// The orbit's rigid margin ([`polish::PolishedOrbit::rigid_margin`]), made once per point:
     /// a step's and a bisection's ends asked for it again (a sampled period each).
     pub fn rigid_margin(&self) -> Option<polish::RigidMargin> {
-        self.margin.get_or_init(|| self.orbit.rigid_margin()).clone()
+        self.margins().map(|m| m.least.clone())
+    }
+
+    /// The orbit's rigid margins, the least and each part's, made once per point.
+    pub fn margins(&self) -> Option<&polish::RigidMargins> {
+        self.margin.get_or_init(|| self.orbit.rigid_margins()).as_ref()
     }
 }
 

@@ -10,7 +10,7 @@
 use super::super::orbit::PolishedOrbit;
 use super::super::signals::Samples;
 use super::super::verify::{self, Along};
-use super::{CLEARANCE, RigidMargin, STUCK};
+use super::{CLEARANCE, RigidMargins, STUCK};
 
 /// Samples per radian of the phase's fastest rate (its balancing speed, ≥ ω_max), for the sampled
 /// phases (and the start of a held arc after its micro-flight). A plastic impact rings the stiff
@@ -45,7 +45,7 @@ struct Candidate {
 
 impl PolishedOrbit {
     /// The phases' margins (see the module) into `best`, with the clearance and force scales.
-    pub(super) fn phase_margins(&self, (xs, fs): (f64, f64), best: &mut RigidMargin) {
+    pub(super) fn phase_margins(&self, (xs, fs): (f64, f64), best: &mut RigidMargins) {
         let model = &self.model;
         let ne = self.events.len().max(1);
         let (mut phases, mut sought) = (Vec::with_capacity(ne), Vec::new());
@@ -64,7 +64,7 @@ impl PolishedOrbit {
                     let lift = self.lift_off(e, i);
                     let from = lift.map_or(0, |(_, flight)| ts.iter().position(|&t| t >= a + flight).unwrap_or(ts.len()));
                     if let Some((height, _)) = lift {
-                        best.keep(-height / xs, i, STUCK, a, None);
+                        best.keep(-height / xs, (i, STUCK, e), a, None);
                     }
                     if ts.len() - from >= 3 {
                         sought.push(Sought { e, contact: i, what: STUCK, scale: fs, from, values: Vec::new() });
@@ -79,7 +79,7 @@ impl PolishedOrbit {
                     let signal = along.signal(self, s.contact, 1.0);
                     let samples = Samples::new(a, &transient.lambda, (ts[s.from], ts[ts.len() - 1]), signal.rates());
                     let (v, t) = signal.minimum(&samples, TOL * s.scale);
-                    best.keep(v / s.scale, s.contact, s.what, t, None);
+                    best.keep(v / s.scale, (s.contact, s.what, s.e), t, None);
                 }
                 phases.push(None);
                 continue;
@@ -100,7 +100,7 @@ impl PolishedOrbit {
             let Some((ts, ..)) = &phases[s.e] else { continue };
             let vs = &s.values[s.from..];
             let (v, t) = vs.iter().zip(&ts[s.from..]).fold((f64::INFINITY, 0.0), |m, (&v, &t)| if v < m.0 { (v, t) } else { m });
-            best.keep(v / s.scale, s.contact, s.what, t, None);
+            best.keep(v / s.scale, (s.contact, s.what, s.e), t, None);
             let mut minima: Vec<usize> = (1..vs.len().saturating_sub(1)).filter(|&i| vs[i] <= vs[i - 1] && vs[i] <= vs[i + 1]).collect();
             minima.sort_by(|&x, &y| vs[x].total_cmp(&vs[y]));
             candidates.extend(minima.iter().take(REFINED).map(|&i| Candidate { sought: k, index: s.from + i }));
@@ -115,7 +115,7 @@ impl PolishedOrbit {
                 if stuck { ph.stuck_forces(&y, t).into_iter().find(|(k, _)| *k == s.contact).map_or(0.0, |(_, z)| z) } else { self.clearance(s.contact, &y, t) }
             };
             let (t, v) = verify::golden(t0, ts[c.index + 1], GOLDEN, &at);
-            best.keep(v / s.scale, s.contact, s.what, t, None);
+            best.keep(v / s.scale, (s.contact, s.what, s.e), t, None);
         }
     }
 }
