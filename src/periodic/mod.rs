@@ -1,7 +1,7 @@
 //! The periodic contact problem: assembly in the frequency domain, one LCP over the period,
 //! recovery of the requested responses (src/formulation.md §2–3).
 mod assembly;
-/// A massless-boundary test model for the rooms above (`analysis`'s sweep tests).
+/// A massless-boundary test model for the layers above (`analysis`'s sweep tests).
 #[cfg(test)]
 pub(crate) use assembly::tests::chain_with_massless_boundary;
 mod cache;
