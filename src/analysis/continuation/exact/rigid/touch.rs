@@ -14,6 +14,10 @@ use super::{TOL, landing, margin, trace};
 /// resolution) meets the next change instead, and the branch oriented away from it walks back
 /// over the old one (the coarse rigid blade at 2398.27 rad/s: contact 0's flight merged at
 /// contact 2's landing 0.005 rad/s on, the walk turned back down to 2150; validation/RECORD.md).
+/// The same holds where it is `own`'s margin that breaks further on: `own` touching again is its
+/// next change, and a merge is only sought where the merged orbit turns admissible (the real blade
+/// at 1247.0821284 rad/s: contact 1's held arc merged at its own re-touch 0.06 rad/s on, and the
+/// walk turned back up to 1300).
 pub(super) fn touch_point(fam: &mut Family, guess: &[f64], (la, lb): (f64, f64), own: Option<usize>) -> Option<Node> {
     let (rho, d) = (fam.rho, fam.dim());
     let e_l = lambda_axis(d);
@@ -29,6 +33,10 @@ pub(super) fn touch_point(fam: &mut Family, guess: &[f64], (la, lb): (f64, f64),
     let a = at(fam, guess, la)?;
     let b = at(fam, &a.0.w, lb)?;
     let (mut ok, mut bad, mut lok, mut lbad) = match (a.1, b.1) {
+        (true, false) if own.is_some() => {
+            trace(format_args!("touch point: the merged orbit is admissible at {la:.10} already (the merge is there), not at {lb:.10}: refused"));
+            return None;
+        }
         (true, false) => (a.0, b.0, la, lb),
         (false, true) => (b.0, a.0, lb, la),
         _ => return None,
