@@ -9,7 +9,9 @@
 //! times, the state by the periodic fixed point of the affine map those times give. The result
 //! is verified (clearance ≥ 0 of free rigid contacts and force ≥ 0 of stuck ones between the
 //! events, checked densely and at every local minimum; impulses ≥ 0; a pure impact may not call
-//! for sticking); otherwise the LCP's orbit is kept, with a warning that says why.
+//! for sticking). Where the grid's sequence is not the orbit's, the phases it missed are put back
+//! where the orbit dips, else a finer grid's sequence is taken ([`repair`]); failing that, the
+//! LCP's orbit is kept, with a warning that says why.
 mod continued;
 mod detect;
 mod eigen_flow;
@@ -19,6 +21,7 @@ pub mod friction;
 mod massive;
 mod orbit;
 mod phase;
+mod repair;
 mod rigid;
 mod signals;
 mod verify;
@@ -27,6 +30,7 @@ pub use continued::Touch;
 pub use detect::{PhaseBank, follow_detected, follow_detected_with};
 pub use events::{Event, EventKind};
 pub use orbit::{OrbitParts, PolishedOrbit, user_value};
+pub use repair::Polished;
 pub use rigid::{CLEARANCE, HOLD, MarginPart, RigidMargin, RigidMargins, STUCK};
 
 use crate::model::Model;
@@ -41,6 +45,12 @@ pub struct PolishFailure(pub String);
 
 /// Polishes the orbit of `r` (solved from `problem`).
 pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<PolishedOrbit, PolishFailure> {
+    polish_noted(problem, r).map(|p| p.orbit)
+}
+
+/// [`polish`], and how the event sequence was had when the grid's did not hold as read
+/// (phases put back, a finer grid's: [`repair`]).
+pub fn polish_noted(problem: &PeriodicProblem, r: &Response) -> Result<Polished, PolishFailure> {
     let model = problem.model();
     let damped: Vec<usize> =
         model.massless_dofs().into_iter().filter(|&d| (0..model.n()).any(|j| model.structure.damping.as_ref().is_some_and(|c| c.get(d, j) != 0.0))).collect();
@@ -64,28 +74,7 @@ pub fn polish(problem: &PeriodicProblem, r: &Response) -> Result<PolishedOrbit, 
     if r.contacts.len() != model.contacts.len() {
         return Err(PolishFailure("the result has no contact outputs ([output] contacts = false): the event sequence cannot be read".into()));
     }
-    let offsets: Vec<usize> = (0..model.contacts.len()).map(|i| problem.pairing_at(i).offset()).collect();
-    let (evs, always) = events::from_response(model, r, &offsets);
-    let evs = events::isolated_first(evs, model.period());
-    let clock = Instant::now();
-    profile("start", clock);
-    let orbit = match PolishedOrbit::solve(model, evs.clone(), &always) {
-        Ok(orbit) => orbit,
-        Err(e) => {
-            // Once more without the runs of at most two steps at a near-grazing (events.rs).
-            let span = 2.5 * model.period() / r.steps as f64;
-            let fewer = events::without_short_runs(model, &evs, span, model.period());
-            if fewer.len() == evs.len() {
-                return Err(e);
-            }
-            PolishedOrbit::solve(model, events::isolated_first(fewer, model.period()), &always).map_err(|_| e)?
-        }
-    };
-    profile("Newton", clock);
-    let clock = Instant::now();
-    verify::check(&orbit)?;
-    profile("admissibility check", clock);
-    Ok(orbit)
+    repair::polish_grid(problem, r)
 }
 
 /// Prints a stage's wall time, and the thread's CPU time so far (Linux: /proc/thread-self/schedstat,
@@ -211,8 +200,11 @@ pub fn apply(problem: &PeriodicProblem, r: &mut Response) -> Option<PolishedOrbi
         }
         return None;
     }
-    match polish(problem, r) {
-        Ok(orbit) => {
+    match polish_noted(problem, r) {
+        Ok(Polished { orbit, note }) => {
+            if !note.is_empty() {
+                r.warnings.push(format!("polish: {note}"));
+            }
             let clock = Instant::now();
             orbit.write(problem, r);
             profile("writing the series", clock);

@@ -127,7 +127,12 @@ pub fn run(a: &Args) -> Result<(), Failure> {
         }
         on_value(p.parameter);
         if !a.quiet {
-            let event = p.event.map_or(String::new(), |k| format!(", {}: {}", k.name(), p.detail));
+            // A point without an event may carry a note too (the exact walk's start: how its events were had).
+            let event = match p.event {
+                Some(k) => format!(", {}: {}", k.name(), p.detail),
+                None if !p.detail.is_empty() => format!(" ({})", p.detail),
+                None => String::new(),
+            };
             bar.suspend(|| eprintln!("  point {} = {:.7}: {}, max |μ| = {:.6}{event}", a.param, p.parameter, p.source.name(), p.max_multiplier));
         }
     };

@@ -126,9 +126,10 @@ pub(super) fn walk(
     param.apply(&mut start, from)?;
     let mut solver = PeriodicSolver::new(start.clone());
     let r = solver.solve().map_err(|e| Error::from(e).context(format!("the start of the continuation at {} = {from}", param.name())))?;
-    let orbit = polish::polish(&start, &r).map_err(|e| Error::solve(format!("no exact orbit at {} = {from}: {e}", param.name())))?;
-    let (mut walk, here) = begin(problem, param, from, to, (to - from).abs(), &orbit)?;
-    walk.push(&here, None, String::new());
+    let polished = polish::polish_noted(&start, &r).map_err(|e| Error::solve(format!("no exact orbit at {} = {from}: {e}", param.name())))?;
+    let (mut walk, here) = begin(problem, param, from, to, (to - from).abs(), &polished.orbit)?;
+    // Say how the start's event sequence was had where the grid's did not hold as read.
+    walk.push(&here, None, polished.note);
     walk.report(on_point);
     Ok(walk.follow(here, from, to, settings, on_point))
 }
