@@ -196,7 +196,13 @@ impl Family {
     }
 
     fn build(&self, lambda: f64) -> Option<PolishedOrbit> {
-        self.modes.borrow_mut().build(self.signature_key(), &self.model_at(lambda), self.sig.events.clone(), &self.sig.always)
+        let (mut modes, key) = (self.modes.borrow_mut(), self.signature_key());
+        if let Some(orbit) = modes.again(&key, &self.sig.events, &self.sig.always, lambda) {
+            return Some(orbit);
+        }
+        let orbit = modes.build(key, &self.model_at(lambda), self.sig.events.clone(), &self.sig.always)?;
+        modes.remember(self.sig.events.clone(), &self.sig.always, lambda, &orbit);
+        Some(orbit)
     }
 
     fn unpack(&self, w: &[f64], period: f64) -> (Vec<f64>, Vec<f64>) {
