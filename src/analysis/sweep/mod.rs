@@ -304,12 +304,25 @@ pub fn run(
     let mut points: Vec<SweepPoint> = results.into_iter().flatten().collect();
     if settings.warm_start && bounds.len() > 1 {
         let starts: Vec<usize> = bounds.iter().map(|b| b.0).collect();
-        seam::repair_seams(base, &mut points, &starts, settings);
+        profiled("seams", || seam::repair_seams(base, &mut points, &starts, settings));
     }
     if settings.warm_start && guarded(session.problem()) {
-        refill(base, &mut points, settings);
+        profiled("refill", || refill(base, &mut points, settings));
     }
     Ok(points)
+}
+
+/// Runs `part` of a sweep; under `PERIODIC_CONTACT_PROFILE` prints its wall and this thread's CPU
+/// (the seams and the refill run on one thread: the two-thread wall's serial tail).
+fn profiled<T>(what: &str, part: impl FnOnce() -> T) -> T {
+    if std::env::var_os("PERIODIC_CONTACT_PROFILE").is_none() {
+        return part();
+    }
+    let (clock, cpu) = (Instant::now(), crate::analysis::polish::thread_cpu());
+    let out = part();
+    let spent = crate::analysis::polish::thread_cpu().zip(cpu).map_or(f64::NAN, |(b, a)| b - a);
+    eprintln!("sweep profile: {what} {:.3} s wall, {spent:.3} s CPU on the calling thread", clock.elapsed().as_secs_f64());
+    out
 }
 
 /// The last try of [`solve_guarded`]: none, cold shooting, or cold shooting without its offset

@@ -64,6 +64,8 @@ pub(super) fn run<P: Send>(lengths: &[usize], threads: usize, first: &(dyn Fn(us
     // Set when a stage panics: the other workers stop waiting for its chunk (else they would wait
     // forever on a stage marked busy), and the scope carries the panic to the caller.
     let aborted = AtomicBool::new(false);
+    // `PERIODIC_CONTACT_PROFILE`: each job's wall span and thread CPU (the two-thread wall's idle time).
+    let profile = std::env::var_os("PERIODIC_CONTACT_PROFILE").is_some().then(Instant::now);
     let pick = |chunks: &mut Vec<Chunk<P>>| -> Option<Job<P>> {
         let mut order: Vec<usize> = (0..chunks.len()).collect();
         order.sort_by(|&a, &b| chunks[b].remaining().total_cmp(&chunks[a].remaining()));
@@ -81,6 +83,8 @@ pub(super) fn run<P: Send>(lengths: &[usize], threads: usize, first: &(dyn Fn(us
         None
     };
     let worker = || {
+        // Seconds this worker waited for a ready stage and its thread CPU in stages (`profile`).
+        let (mut waited, mut worked) = (0.0, 0.0);
         loop {
             let job = {
                 let mut chunks = state.lock().unwrap();
@@ -89,16 +93,32 @@ pub(super) fn run<P: Send>(lengths: &[usize], threads: usize, first: &(dyn Fn(us
                         return;
                     }
                     if let Some(job) = pick(&mut chunks) {
-                        break job;
+                        break Some(job);
                     }
                     if chunks.iter().all(|c| c.second_done == c.len) {
-                        return;
+                        break None;
                     }
+                    let since = Instant::now();
                     chunks = ready.wait(chunks).unwrap();
+                    waited += since.elapsed().as_secs_f64();
                 }
             };
+            let Some(job) = job else {
+                if let Some(t0) = profile {
+                    eprintln!(
+                        "stage profile: a worker ends at {:.3} s wall: {worked:.3} s CPU in stages, {waited:.3} s waiting for a ready stage",
+                        t0.elapsed().as_secs_f64()
+                    );
+                }
+                return;
+            };
             let t = Instant::now();
+            let cpu = profile.and(crate::analysis::polish::thread_cpu());
             let _guard = AbortOnPanic { state: &state, ready: &ready, aborted: &aborted };
+            let job_name = match &job {
+                Job::First(c) => ("first", *c),
+                Job::Second(c, _) => ("second", *c),
+            };
             match job {
                 Job::First(c) => {
                     let p = first(c);
@@ -113,6 +133,12 @@ pub(super) fn run<P: Send>(lengths: &[usize], threads: usize, first: &(dyn Fn(us
                     let ch = &mut chunks[c];
                     (ch.second_busy, ch.second_done, ch.second_s) = (false, ch.second_done + 1, ch.second_s + t.elapsed().as_secs_f64());
                 }
+            }
+            if let (Some(t0), Some(cpu)) = (profile, cpu) {
+                let (kind, c) = job_name;
+                let spent = crate::analysis::polish::thread_cpu().unwrap_or(f64::NAN) - cpu;
+                worked += spent;
+                eprintln!("stage profile: chunk {c} {kind} from {:.3} to {:.3} s wall, {spent:.3} s CPU", (t - t0).as_secs_f64(), t0.elapsed().as_secs_f64());
             }
             ready.notify_all();
         }
