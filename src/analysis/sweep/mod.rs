@@ -230,10 +230,11 @@ pub fn run(
     // ω sub-steps follow the branch, and the branch check's continuation, which can
     // reach the dense fallback, is not run there.
     let guarded_sweep = settings.warm_start && guarded(session.problem());
+    let early = refill::Early::new(if guarded_sweep { n } else { 0 });
     let first = |c: usize| -> Pending {
         let mut guard = firsts[c].lock().unwrap();
         let First { solver, next, last, last_solved } = &mut *guard;
-        let f = frequencies[*next];
+        let (index, f) = (*next, frequencies[*next]);
         *next += 1;
         let t = Instant::now();
         let mut substeps = 0;
@@ -283,6 +284,7 @@ pub fn run(
                 None
             }
         };
+        early.record(index, &point);
         (point, answer, t.elapsed().as_secs_f64())
     };
     let second = |c: usize, (mut point, answer, first_s): Pending| {
@@ -299,15 +301,18 @@ pub fn run(
         out.push(point);
     };
     let lengths: Vec<usize> = bounds.iter().map(|&(lo, hi)| hi - lo).collect();
-    pool.install(|| stages::run(&lengths, threads, &first, &second));
+    let refill_early = || early.run(base, settings);
+    let after_firsts: Option<&(dyn Fn() + Sync)> = if guarded_sweep { Some(&refill_early) } else { None };
+    pool.install(|| stages::run(&lengths, threads, &first, &second, after_firsts));
     let results = seconds.into_iter().map(|s| s.into_inner().unwrap().out);
     let mut points: Vec<SweepPoint> = results.into_iter().flatten().collect();
+    let mut replaced = 0;
     if settings.warm_start && bounds.len() > 1 {
         let starts: Vec<usize> = bounds.iter().map(|b| b.0).collect();
-        seam::repair_seams(base, &mut points, &starts, settings);
+        replaced = stages::profiled("seams", || seam::repair_seams(base, &mut points, &starts, settings));
     }
-    if settings.warm_start && guarded(session.problem()) {
-        refill(base, &mut points, settings);
+    if guarded_sweep {
+        early.apply(base, &mut points, replaced, settings);
     }
     Ok(points)
 }

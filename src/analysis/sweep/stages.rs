@@ -10,10 +10,20 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Condvar, Mutex};
 use std::time::Instant;
 
-/// Which stage of which chunk a worker runs next.
+/// Which stage of which chunk a worker runs next, or the job run once every first stage is done.
 enum Job<P> {
     First(usize),
     Second(usize, P),
+    AfterFirsts,
+}
+
+/// The job run once every chunk's first stage is done, if any.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum AfterFirsts {
+    None,
+    Waiting,
+    Running,
+    Done,
 }
 
 struct Chunk<P> {
@@ -44,7 +54,16 @@ impl<P> Chunk<P> {
 /// point, `second(c, p)` that point's second stage (the callers keep the results in their
 /// stages' states). A free worker takes the ready stage of the chunk with the
 /// most expected work left (the critical path first), the second stage before the first.
-pub(super) fn run<P: Send>(lengths: &[usize], threads: usize, first: &(dyn Fn(usize) -> P + Sync), second: &(dyn Fn(usize, P) + Sync)) {
+/// `after_firsts` runs once, as soon as every first stage is done, before any stage still waiting
+/// (a guarded sweep's refill: else a serial tail after the second stages, issue 23).
+pub(super) fn run<P: Send>(
+    lengths: &[usize],
+    threads: usize,
+    first: &(dyn Fn(usize) -> P + Sync),
+    second: &(dyn Fn(usize, P) + Sync),
+    after_firsts: Option<&(dyn Fn() + Sync)>,
+) {
+    let after = Mutex::new(if after_firsts.is_some() { AfterFirsts::Waiting } else { AfterFirsts::None });
     let state = Mutex::new(
         lengths
             .iter()
@@ -64,7 +83,15 @@ pub(super) fn run<P: Send>(lengths: &[usize], threads: usize, first: &(dyn Fn(us
     // Set when a stage panics: the other workers stop waiting for its chunk (else they would wait
     // forever on a stage marked busy), and the scope carries the panic to the caller.
     let aborted = AtomicBool::new(false);
+    // `PERIODIC_CONTACT_PROFILE`: each job's wall span and thread CPU (the two-thread wall's idle time).
+    let profile = std::env::var_os("PERIODIC_CONTACT_PROFILE").is_some().then(Instant::now);
     let pick = |chunks: &mut Vec<Chunk<P>>| -> Option<Job<P>> {
+        // Under the state's lock, so that `after` changes with the stages it waits for.
+        let mut after = after.lock().unwrap();
+        if *after == AfterFirsts::Waiting && chunks.iter().all(|c| c.first_left == 0 && !c.first_busy) {
+            *after = AfterFirsts::Running;
+            return Some(Job::AfterFirsts);
+        }
         let mut order: Vec<usize> = (0..chunks.len()).collect();
         order.sort_by(|&a, &b| chunks[b].remaining().total_cmp(&chunks[a].remaining()));
         for c in order {
@@ -81,6 +108,8 @@ pub(super) fn run<P: Send>(lengths: &[usize], threads: usize, first: &(dyn Fn(us
         None
     };
     let worker = || {
+        // Seconds this worker waited for a ready stage and its thread CPU in stages (`profile`).
+        let (mut waited, mut worked) = (0.0, 0.0);
         loop {
             let job = {
                 let mut chunks = state.lock().unwrap();
@@ -89,16 +118,33 @@ pub(super) fn run<P: Send>(lengths: &[usize], threads: usize, first: &(dyn Fn(us
                         return;
                     }
                     if let Some(job) = pick(&mut chunks) {
-                        break job;
+                        break Some(job);
                     }
-                    if chunks.iter().all(|c| c.second_done == c.len) {
-                        return;
+                    if chunks.iter().all(|c| c.second_done == c.len) && matches!(*after.lock().unwrap(), AfterFirsts::None | AfterFirsts::Done) {
+                        break None;
                     }
+                    let since = Instant::now();
                     chunks = ready.wait(chunks).unwrap();
+                    waited += since.elapsed().as_secs_f64();
                 }
             };
+            let Some(job) = job else {
+                if let Some(t0) = profile {
+                    eprintln!(
+                        "stage profile: a worker ends at {:.3} s wall: {worked:.3} s CPU in stages, {waited:.3} s waiting for a ready stage",
+                        t0.elapsed().as_secs_f64()
+                    );
+                }
+                return;
+            };
             let t = Instant::now();
+            let cpu = profile.and(crate::analysis::polish::thread_cpu());
             let _guard = AbortOnPanic { state: &state, ready: &ready, aborted: &aborted };
+            let what = profile.map(|_| match &job {
+                Job::First(c) => format!("chunk {c} first"),
+                Job::Second(c, _) => format!("chunk {c} second"),
+                Job::AfterFirsts => "the job after the first stages".to_string(),
+            });
             match job {
                 Job::First(c) => {
                     let p = first(c);
@@ -113,6 +159,18 @@ pub(super) fn run<P: Send>(lengths: &[usize], threads: usize, first: &(dyn Fn(us
                     let ch = &mut chunks[c];
                     (ch.second_busy, ch.second_done, ch.second_s) = (false, ch.second_done + 1, ch.second_s + t.elapsed().as_secs_f64());
                 }
+                Job::AfterFirsts => {
+                    if let Some(job) = after_firsts {
+                        job();
+                    }
+                    let _held = state.lock().unwrap();
+                    *after.lock().unwrap() = AfterFirsts::Done;
+                }
+            }
+            if let (Some(t0), Some(cpu), Some(what)) = (profile, cpu, what) {
+                let spent = crate::analysis::polish::thread_cpu().unwrap_or(f64::NAN) - cpu;
+                worked += spent;
+                eprintln!("stage profile: {what} from {:.3} to {:.3} s wall, {spent:.3} s CPU", (t - t0).as_secs_f64(), t0.elapsed().as_secs_f64());
             }
             ready.notify_all();
         }
@@ -125,6 +183,19 @@ pub(super) fn run<P: Send>(lengths: &[usize], threads: usize, first: &(dyn Fn(us
         }
         worker();
     });
+}
+
+/// Runs `part` of a sweep; under `PERIODIC_CONTACT_PROFILE` prints its wall and this thread's CPU
+/// (the seams and the refill run on one thread: the two-thread wall's serial tail).
+pub(super) fn profiled<T>(what: &str, part: impl FnOnce() -> T) -> T {
+    if std::env::var_os("PERIODIC_CONTACT_PROFILE").is_none() {
+        return part();
+    }
+    let (clock, cpu) = (Instant::now(), crate::analysis::polish::thread_cpu());
+    let out = part();
+    let spent = crate::analysis::polish::thread_cpu().zip(cpu).map_or(f64::NAN, |(b, a)| b - a);
+    eprintln!("sweep profile: {what} {:.3} s wall, {spent:.3} s CPU on the calling thread", clock.elapsed().as_secs_f64());
+    out
 }
 
 /// Marks the run aborted (under the lock, so that no waiter misses it) when a stage unwinds.
@@ -162,7 +233,33 @@ mod tests {
                 *n - 1
             };
             let second = |c: usize, i: usize| log[c].lock().unwrap().push(i);
-            run(&lengths, threads, &first, &second);
+            run(&lengths, threads, &first, &second, None);
+            for (c, &len) in lengths.iter().enumerate() {
+                assert_eq!(*log[c].lock().unwrap(), (0..len).collect::<Vec<_>>(), "chunk {c}, {threads} threads");
+            }
+        }
+    }
+
+    /// The job after the first stages runs once, when every first stage is done and before `run`
+    /// returns, whatever the threads; the stages still keep their order.
+    #[test]
+    fn the_job_after_the_first_stages_runs_once_after_all_of_them() {
+        for threads in [1, 2, 3] {
+            let lengths = [5, 0, 7, 1];
+            let firsts = std::sync::atomic::AtomicUsize::new(0);
+            let seen: Mutex<Vec<usize>> = Mutex::new(Vec::new());
+            let log: Vec<Mutex<Vec<usize>>> = lengths.iter().map(|_| Mutex::new(Vec::new())).collect();
+            let next: Vec<Mutex<usize>> = lengths.iter().map(|_| Mutex::new(0)).collect();
+            let first = |c: usize| {
+                firsts.fetch_add(1, Ordering::SeqCst);
+                let mut n = next[c].lock().unwrap();
+                *n += 1;
+                *n - 1
+            };
+            let second = |c: usize, i: usize| log[c].lock().unwrap().push(i);
+            let after = || seen.lock().unwrap().push(firsts.load(Ordering::SeqCst));
+            run(&lengths, threads, &first, &second, Some(&after));
+            assert_eq!(*seen.lock().unwrap(), vec![13], "{threads} threads");
             for (c, &len) in lengths.iter().enumerate() {
                 assert_eq!(*log[c].lock().unwrap(), (0..len).collect::<Vec<_>>(), "chunk {c}, {threads} threads");
             }
@@ -180,7 +277,7 @@ mod tests {
             };
             let second = |_: usize, _: usize| std::thread::sleep(std::time::Duration::from_millis(1));
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-            let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| pool.install(|| run(&[3, 2, 4], threads, &first, &second))));
+            let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| pool.install(|| run(&[3, 2, 4], threads, &first, &second, None))));
             assert!(outcome.is_err(), "{threads} threads");
         }
     }
