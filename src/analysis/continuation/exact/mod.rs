@@ -307,16 +307,25 @@ impl Walk<'_> {
                 step = step.min(0.75 * len / rate);
             }
             trace.bound(step < ds);
-            let pred: Vec<f64> = here.w.iter().zip(&along).map(|(w, t)| w + step * t).collect();
-            // Events that may pass each other did: the same step in their new order (not a change);
-            // the corrector may cross a close pair the predictor did not, or the reverse: then the
-            // pair's order toggled.
             let old = self.fam.sig.clone();
-            let tried = self.try_step(&here, pred.clone(), step, settings.min_step).or_else(|| {
-                self.fam.sig = old.clone();
-                let toggled = signature::toggled(&self.fam, self.problem.model(), &here.w, &pred)?;
-                self.try_step(&here, toggled, step, settings.min_step)
-            });
+            let landed = if step < ds { self.land(&here, &shrinking, &along) } else { None };
+            let tried = match landed {
+                Some((n, s)) => {
+                    step = s;
+                    Some((n, None))
+                }
+                None => {
+                    let pred: Vec<f64> = here.w.iter().zip(&along).map(|(w, t)| w + step * t).collect();
+                    // Events that may pass each other did: the same step in their new order (not a change);
+                    // the corrector may cross a close pair the predictor did not, or the reverse: then the
+                    // pair's order toggled.
+                    self.try_step(&here, pred.clone(), step, settings.min_step).or_else(|| {
+                        self.fam.sig = old.clone();
+                        let toggled = signature::toggled(&self.fam, self.problem.model(), &here.w, &pred)?;
+                        self.try_step(&here, toggled, step, settings.min_step)
+                    })
+                }
+            };
             // The step's own start and signature where a pass re-expressed `here` in its events' new
             // order: a retry goes back to them, since `here` has not crossed that pair (its times out
             // of order make a pair phase negative, read as vanishing: suspected of session 30's stop
