@@ -72,7 +72,10 @@ impl Walk<'_> {
                 if near { "kept" } else { "refused" }
             );
         }
-        if !near || signature::reversed(&self.fam, &n.w) {
+        // Events that passed each other in the step are the quarters' to re-order (`Walk::pass`).
+        let theta = &n.w[n2..n2 + ne];
+        let ordered = theta.windows(2).all(|p| p[1] > p[0]) && theta.last().zip(theta.first()).is_some_and(|(l, f)| l - f < 1.0);
+        if !near || !ordered || signature::reversed(&self.fam, &n.w) {
             return None;
         }
         self.drift = drift / h;
