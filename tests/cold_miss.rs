@@ -53,7 +53,7 @@ fn a_cold_shooting_miss_is_solved_from_a_bds1_pilot_and_agrees_with_lemke() {
 }
 
 /// Where the pilot misses too (gap 1, ω = 1.39: bds1's cold shooting misses as cds's does, found
-/// by the same scan), `auto` falls back to dense Lemke as before the pilot: the path shows the
+/// by the same scan) and so do the neighbouring ω's, `auto` falls back to dense Lemke as before the pilot: the path shows the
 /// missed shooting and the fallback, and the answer is certified.
 #[test]
 fn where_the_pilot_misses_too_auto_falls_back_to_lemke() {
@@ -64,4 +64,22 @@ fn where_the_pilot_misses_too_auto_falls_back_to_lemke() {
     assert!(first.contains("shooting") && !first.ends_with("→ solved"), "{}", r.lcp.path);
     assert!(fallback.starts_with("dense lexicographic Lemke") && fallback.contains("→ solved"), "{}", r.lcp.path);
     assert!(r.lcp.residual <= 1e-9);
+}
+
+/// Where cold shooting and the bds1 pilot miss, `auto` solves cold at a neighbouring ω (± 0.5 … 2 %)
+/// and steps back warm (`pilot.rs`'s `from_neighbour`): certified, equal to dense Lemke, no dense
+/// fallback. Found by scanning gap ∈ {0.5, 1, 1.5, 2, 3}, ω ∈ [0.9, 1.7) (8 such cases, all within
+/// 5e-14 of Lemke); the real blade, N = 17 408, is where Lemke is refused (validation/RECORD.md).
+#[test]
+fn where_the_pilot_misses_a_neighbouring_cold_solve_is_stepped_back_and_agrees_with_lemke() {
+    for (gap, omega) in [(0.5, 1.39), (1.0, 1.30), (2.0, 1.15)] {
+        assert!(at(gap, omega, LcpMethod::Shooting).solve().is_err(), "gap {gap}, ω {omega}: cold shooting solved it");
+        let r = at(gap, omega, LcpMethod::Auto).solve().unwrap();
+        let lemke = at(gap, omega, LcpMethod::Lemke).solve().unwrap();
+        let d = difference(&r, &lemke);
+        eprintln!("gap {gap}, ω {omega}: {}; difference {d:.1e}", r.lcp.path);
+        assert!(r.lcp.path.contains("reached from a cold solve at ω") && !r.lcp.path.contains("fallback"), "{}", r.lcp.path);
+        assert!(max_abs(&r.contacts[0].force) > 0.0, "the stop is never reached");
+        assert!(d <= 1e-10 && r.lcp.residual <= 1e-9, "gap {gap}, ω {omega}: differs from lemke by {d:.3e}");
+    }
 }
