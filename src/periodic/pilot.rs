@@ -78,8 +78,13 @@ pub(super) fn solve_after_cold_miss(problem: &PeriodicProblem, a: &BlockCirculan
     {
         return Some(Ok((sol, Some(format!("cold shooting missed; started from a bds1 pilot's active sets at k = {}", disc.steps)))));
     }
-    crate::lcp::progress(&format!("the bds1 pilot missed too at ω = {} rad/s; a cold solve at a neighbouring ω and warm steps back next", model.frequency));
-    if let Some((sets, from)) = from_neighbour(&shooting)
+    // Where dense Lemke is cheap (small N), it answers before the neighbours' cold solves would.
+    let worth = crate::lcp::dense_lemke_seconds(q.len()) > NEIGHBOUR_AFTER_LEMKE_S;
+    if worth {
+        crate::lcp::progress(&format!("the bds1 pilot missed too at ω = {} rad/s; a cold solve at a neighbouring ω and warm steps back next", model.frequency));
+    }
+    if worth
+        && let Some((sets, from)) = from_neighbour(&shooting)
         && let Ok(sol) = shooting.solve_lcp(a, q, Some(&sets))
     {
         let note = format!("cold shooting and its bds1 pilot missed; reached from a cold solve at ω = {from:.3} rad/s by warm-started steps");
@@ -90,6 +95,10 @@ pub(super) fn solve_after_cold_miss(problem: &PeriodicProblem, a: &BlockCirculan
     Some(problem.solve_lcp(a, q, pilot.as_deref()).map(|sol| (sol, note)))
 }
 
+/// The neighbours are tried only where dense Lemke is projected to take longer than this [s]
+/// (N ≳ 2 700): below, the dense fallback is cheaper than up to six cold solves (≈ 0.3–0.5 s
+/// each on a 2-DOF model at k = 4096), and the test suite's random families ran 2× slower.
+const NEIGHBOUR_AFTER_LEMKE_S: f64 = 2.0;
 /// Relative offsets of ω tried for a cold solve when the cold solve at ω and its bds1 pilot miss,
 /// nearest first, above then below.
 const NEIGHBOUR_OFFSETS: [f64; 6] = [5e-3, -5e-3, 1e-2, -1e-2, 2e-2, -2e-2];
