@@ -73,25 +73,24 @@ pub(super) fn solve_after_cold_miss(problem: &PeriodicProblem, a: &BlockCirculan
     }
     crate::lcp::progress(&format!("cold shooting missed at k = {}; a bds1 pilot on the same grid next", disc.steps));
     let pilot = bds1_active_set(problem, disc.steps);
+    let note = pilot.as_ref().map(|_| format!("cold shooting missed; started from a bds1 pilot's active sets at k = {}", disc.steps));
+    // Where dense Lemke is cheap (small N), `auto` from the pilot's sets and its dense fallback, as before.
+    if crate::lcp::dense_lemke_seconds(q.len()) <= NEIGHBOUR_AFTER_LEMKE_S {
+        return Some(problem.solve_lcp(a, q, pilot.as_deref()).map(|sol| (sol, note)));
+    }
     if let Some(sets) = &pilot
         && let Ok(sol) = shooting.solve_lcp(a, q, Some(sets))
     {
-        return Some(Ok((sol, Some(format!("cold shooting missed; started from a bds1 pilot's active sets at k = {}", disc.steps)))));
+        return Some(Ok((sol, note)));
     }
-    // Where dense Lemke is cheap (small N), it answers before the neighbours' cold solves would.
-    let worth = crate::lcp::dense_lemke_seconds(q.len()) > NEIGHBOUR_AFTER_LEMKE_S;
-    if worth {
-        crate::lcp::progress(&format!("the bds1 pilot missed too at ω = {} rad/s; a cold solve at a neighbouring ω and warm steps back next", model.frequency));
-    }
-    if worth
-        && let Some((sets, from)) = from_neighbour(&shooting)
+    crate::lcp::progress(&format!("the bds1 pilot missed too at ω = {} rad/s; a cold solve at a neighbouring ω and warm steps back next", model.frequency));
+    if let Some((sets, from)) = from_neighbour(&shooting)
         && let Ok(sol) = shooting.solve_lcp(a, q, Some(&sets))
     {
         let note = format!("cold shooting and its bds1 pilot missed; reached from a cold solve at ω = {from:.3} rad/s by warm-started steps");
         return Some(Ok((sol, Some(note))));
     }
     // The dense fallbacks (or their refusal, with its remedies) as before.
-    let note = pilot.as_ref().map(|_| format!("cold shooting missed; started from a bds1 pilot's active sets at k = {}", disc.steps));
     Some(problem.solve_lcp(a, q, pilot.as_deref()).map(|sol| (sol, note)))
 }
 
