@@ -349,9 +349,6 @@ impl PolishedOrbit {
     }
 }
 
-/// A signal's (value, slope) at the samples, or at the phases' ends.
-type Jets<'a> = &'a [(f64, f64)];
-
 /// A signal's value, slope and curvature at a state and time of a phase.
 type Jet<'a> = &'a dyn Fn(usize, &DVector<f64>, f64) -> (f64, f64, f64);
 
@@ -381,19 +378,6 @@ impl Sampled {
         // interval before's end, and a phase's end also feeds the kink test after it).
         let at: Vec<(f64, f64)> = self.samples.iter().zip(&self.states).map(|(&(t, e), y)| quick(e, y, t)).map(|(v, d, _)| (v, d)).collect();
         let at_end: Vec<(f64, f64)> = self.ends.iter().enumerate().map(|(e, y)| quick(e, y, orbit.end_of(e))).map(|(v, d, _)| (v, d)).collect();
-        self.smallest_of(orbit, (&at, &at_end), full, own, samples_count)
-    }
-
-    /// [`Self::smallest`] from the signal's value and slope at the samples and the phases' ends
-    /// (`at`, `at_end`); without the states (`states` empty) a refinement flows from its phase's start.
-    fn smallest_of(
-        &self,
-        orbit: &PolishedOrbit,
-        (at, at_end): (Jets, Jets),
-        full: Jet,
-        own: &dyn Fn(usize) -> bool,
-        samples_count: bool,
-    ) -> Option<(f64, f64)> {
         let len = self.samples.len();
         let phases = at_end.len();
         let mut best: Option<(f64, f64)> = None;
@@ -431,8 +415,7 @@ impl Sampled {
                 continue;
             }
             let (t0, e) = self.samples[j];
-            let (ts, y0) = if self.states.is_empty() { (orbit.times[e], &orbit.after[e]) } else { (t0, &self.states[j]) };
-            let (t, v) = refine(t0, t1, t0 + s * (t1 - t0), &|t| full(e, &orbit.phases[e].flow(ts, y0, t), t));
+            let (t, v) = refine(t0, t1, t0 + s * (t1 - t0), &|t| full(e, &orbit.phases[e].flow(t0, &self.states[j], t), t));
             keep(&mut best, v, t);
         }
         best
