@@ -117,15 +117,28 @@ impl PolishedOrbit {
 
     /// This orbit at the solution (`y0`, `times`) of [`Self::shooting_residual`]: the states after
     /// the events and the monodromy; `residual` is the solution's, for the record.
-    pub fn at(mut self, y0: &[f64], times: &[f64], residual: f64) -> Result<Self, PolishFailure> {
+    pub fn at(self, y0: &[f64], times: &[f64], residual: f64) -> Result<Self, PolishFailure> {
+        let mut o = self.placed(y0, times, residual);
+        o.finish()?;
+        Ok(o)
+    }
+
+    /// [`Self::at`] without the monodromy, made where [`Self::monodromy`] asks for it: a
+    /// located event's trial orbit is read for its margin or a force alone.
+    pub fn at_states(self, y0: &[f64], times: &[f64], residual: f64) -> Result<Self, PolishFailure> {
+        let mut o = self.placed(y0, times, residual);
+        o.finish_states()?;
+        Ok(o)
+    }
+
+    fn placed(mut self, y0: &[f64], times: &[f64], residual: f64) -> Self {
         self.y0 = DVector::from_column_slice(y0);
         if !self.events.is_empty() {
             self.times = times.to_vec();
         }
         self.residual = residual;
         self.correction = residual;
-        self.finish()?;
-        Ok(self)
+        self
     }
 
     /// The state `y` at `t` as the phase before event 0 carries it (the last one: the shooting

@@ -12,7 +12,7 @@ use super::modes::{Modes, SignatureKey};
 use super::profile::{Stage, timed};
 use crate::analysis::polish::{Event, EventKind, PolishedOrbit, RigidMargins, Touch};
 use crate::model::{Compliance, Model};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{DMatrix, DVector, Dyn, LU};
 use num_complex::Complex64;
 
 /// The event signature: the events in time order (their seeds unused) and the contacts closed
@@ -348,23 +348,32 @@ impl Family {
         let mut w = pred.to_vec();
         let mut last = f64::INFINITY;
         self.unresolved.set(None);
+        // The chord's bordered matrix is the same at every chord iteration: factorised once.
+        let mut chord_lu: Option<LU<f64, Dyn, Dyn>> = None;
+        let bordered = |jac: &DMatrix<f64>| {
+            let mut a = DMatrix::zeros(d, d);
+            a.view_mut((0, 0), (d - 1, d)).copy_from(jac);
+            for c in 0..d {
+                a[(d - 1, c)] = normal[c];
+            }
+            a.lu()
+        };
         for _ in 0..MAX_ITERATIONS {
             let here = self.orbit(w[d - 1] * self.rho)?;
             let f = self.residual_with(&here, &w)?;
             let fresh = chord.is_none();
-            let jac = match &chord {
-                Some(j) => j.clone(),
-                None => self.jacobian_at(&here, &w)?,
+            let (jac, lu) = match &chord {
+                Some(j) => (None, &*chord_lu.get_or_insert_with(|| bordered(j))),
+                None => {
+                    let jac = self.jacobian_at(&here, &w)?;
+                    let lu = bordered(&jac);
+                    (Some(jac), &*chord_lu.insert(lu))
+                }
             };
-            let mut a = DMatrix::zeros(d, d);
-            a.view_mut((0, 0), (d - 1, d)).copy_from(&jac);
             let mut rhs = DVector::zeros(d);
             rhs.rows_mut(0, d - 1).copy_from(&(-&f));
-            for c in 0..d {
-                a[(d - 1, c)] = normal[c];
-            }
             rhs[d - 1] = target - normal.iter().zip(&w).map(|(n, x)| n * x).sum::<f64>();
-            let dw = a.lu().solve(&rhs)?;
+            let dw = lu.solve(&rhs)?;
             self.unresolved.set(self.unresolved_in(&dw));
             w.iter_mut().zip(dw.iter()).for_each(|(x, s)| *x += s);
             let step = dw.amax();
@@ -373,7 +382,7 @@ impl Family {
             }
             // A chord step is exact to Θ/(1 − Θ) of itself: CONVERGED holds it below 1e-10/3.
             if step < CONVERGED || (step < ATTAINABLE && step >= last && f.amax() < NOISE_DEFECT) {
-                if fresh {
+                if let Some(jac) = jac {
                     // The Jacobian of the last iterate, ‖Δw‖ away: the tangent's.
                     self.last_jacobian.replace(Some((w.clone(), jac)));
                 }
@@ -382,6 +391,9 @@ impl Family {
             }
             if !fresh && step > CHORD_CONTRACTION * last && step >= ATTAINABLE {
                 chord = None;
+            }
+            if chord.is_none() {
+                chord_lu = None;
             }
             last = step;
         }
@@ -432,21 +444,33 @@ impl Family {
     /// alone. The tangent's Jacobian and the monodromy's Schur form were two thirds of a trial.
     pub fn orbit_node(&self, w: Vec<f64>, prev: &[f64], touches: bool) -> Option<Node> {
         timed(Stage::Node, || {
-            let orbit = self.exact_orbit(self.orbit(w[w.len() - 1] * self.rho)?, &w)?;
+            let orbit = self.exact_orbit(self.orbit(w[w.len() - 1] * self.rho)?, &w, false)?;
             let touches = if touches { orbit.touches() } else { Vec::new() };
             Some(Node { w, tangent: prev.to_vec(), orbit, mu: Vec::new(), touches, amplitude: Vec::new(), margin: Default::default() })
         })
     }
 
     /// The orbit at the solution `w` (its events' states and impulses) from `orbit`, the one built
-    /// at w's λ, its defect recorded.
-    fn exact_orbit(&self, orbit: PolishedOrbit, w: &[f64]) -> Option<PolishedOrbit> {
+    /// at w's λ, its defect recorded; its monodromy made now when `monodromy`, else where asked.
+    fn exact_orbit(&self, orbit: PolishedOrbit, w: &[f64], monodromy: bool) -> Option<PolishedOrbit> {
         let (y, times) = self.unpack(w, orbit.period());
         let defect = self.residual_with(&orbit, w)?.amax() * self.ys;
-        orbit.at(&y, &times, defect).ok()
+        if monodromy { orbit.at(&y, &times, defect).ok() } else { orbit.at_states(&y, &times, defect).ok() }
+    }
+
+    /// [`Self::node_with`] without the multipliers (nor touches): a secant's trial point whose
+    /// orbit alone is read (a landing force), the next corrector's chord set as a point sets it,
+    /// so that the iterates are a point's bit for bit. The trials' monodromies and their Schur
+    /// forms were a tenth of the coarse rigid walk.
+    pub fn trial_node(&self, w: Vec<f64>, prev: &[f64]) -> Option<Node> {
+        timed(Stage::Node, || self.solved_as(w, prev, false, false))
     }
 
     fn solved(&self, w: Vec<f64>, prev: &[f64], touches: bool) -> Option<Node> {
+        self.solved_as(w, prev, touches, true)
+    }
+
+    fn solved_as(&self, w: Vec<f64>, prev: &[f64], touches: bool, multipliers: bool) -> Option<Node> {
         // One orbit built at w's λ for the Jacobian and the point (two builds before).
         let here = self.orbit(w[w.len() - 1] * self.rho)?;
         let jac = match self.last_jacobian.take() {
@@ -462,7 +486,10 @@ impl Family {
             );
         }
         self.chord.replace(Some(Chord { key: self.key(), jacobian: jac }));
-        let orbit = self.exact_orbit(here, &w)?;
+        let orbit = self.exact_orbit(here, &w, multipliers)?;
+        if !multipliers {
+            return Some(Node { w, tangent, orbit, mu: Vec::new(), touches: Vec::new(), amplitude: Vec::new(), margin: Default::default() });
+        }
         let mu = floquet::multipliers(orbit.monodromy());
         // No multipliers (the Schur iteration did not converge): no point, the step is shortened.
         if mu.iter().any(|m| !m.is_finite()) {
