@@ -383,10 +383,16 @@ impl PolishedOrbit {
 
     /// The states after the events, the impulses and the monodromy of the orbit at y0 and times.
     pub(super) fn finish(&mut self) -> Result<(), PolishFailure> {
+        self.finish_kept(None)
+    }
+
+    /// [`Self::finish`], the monodromy from `kept` where it was flowed from this orbit's unknowns.
+    pub(super) fn finish_kept(&mut self, kept: Option<super::rigid::KeptVariation>) -> Result<(), PolishFailure> {
         self.finish_states()?;
         if !self.identity_saltation() {
             let fail = |w: &str| PolishFailure(w.to_string());
-            let m = self.event_monodromy().ok_or_else(|| fail("the monodromy could not be formed (an event condition is singular in its time: grazing)"))?;
+            let m =
+                self.event_monodromy(kept).ok_or_else(|| fail("the monodromy could not be formed (an event condition is singular in its time: grazing)"))?;
             self.monodromy = m.into();
         }
         Ok(())
@@ -424,7 +430,7 @@ impl PolishedOrbit {
             if self.identity_saltation() {
                 self.flow_product().expect("identity saltations")
             } else {
-                self.event_monodromy().expect("the monodromy (an event condition singular in its time: grazing)")
+                self.event_monodromy(None).expect("the monodromy (an event condition singular in its time: grazing)")
             }
         })
     }

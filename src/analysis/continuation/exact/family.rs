@@ -10,7 +10,7 @@ use super::super::{Parameter, floquet};
 use super::metric::Metric;
 use super::modes::{Modes, SignatureKey};
 use super::profile::{Stage, timed};
-use crate::analysis::polish::{Event, EventKind, PolishedOrbit, RigidMargins, Touch};
+use crate::analysis::polish::{Event, EventKind, KeptVariation, PolishedOrbit, RigidMargins, Touch};
 use crate::model::{Compliance, Model};
 use nalgebra::{DMatrix, DVector, Dyn, LU};
 use num_complex::Complex64;
@@ -264,10 +264,15 @@ impl Family {
 
     /// [`Self::jacobian`] with the orbit at w's λ already built.
     fn jacobian_at(&self, here: &PolishedOrbit, w: &[f64]) -> Option<DMatrix<f64>> {
+        self.jacobian_kept(here, w).map(|(j, _)| j)
+    }
+
+    /// [`Self::jacobian_at`] and its period's variation (for the monodromy of the orbit at w).
+    fn jacobian_kept(&self, here: &PolishedOrbit, w: &[f64]) -> Option<(DMatrix<f64>, Option<KeptVariation>)> {
         let d = self.dim();
         let (y, times) = self.unpack(w, here.period());
         let mut j = DMatrix::zeros(d - 1, d);
-        if let Some((_, dr)) = timed(Stage::Variational, || here.shooting_jacobian(&y, &times)) {
+        if let Some((_, dr, kept)) = timed(Stage::Variational, || here.shooting_jacobian_kept(&y, &times)) {
             for c in 0..d - 1 {
                 let scale = if c < self.n2 { self.ys / self.weight[c] } else { here.period() };
                 j.set_column(c, &(dr.column(c) * scale));
@@ -293,7 +298,7 @@ impl Family {
             dn[d - 1] -= DIFF;
             let col = timed(Stage::LambdaColumn, || Some((self.residual(&up)? - self.residual(&dn)?) / (2.0 * DIFF)))?;
             j.set_column(d - 1, &col);
-            return Some(j);
+            return Some((j, Some(kept)));
         }
         for c in 0..d - 1 {
             let (mut up, mut dn) = (w.to_vec(), w.to_vec());
@@ -307,7 +312,7 @@ impl Family {
         dn[d - 1] -= DIFF;
         let col = (self.residual_with(&self.orbit(up[d - 1] * self.rho)?, &up)? - self.residual_with(&self.orbit(dn[d - 1] * self.rho)?, &dn)?) / (2.0 * DIFF);
         j.set_column(d - 1, &col);
-        Some(j)
+        Some((j, None))
     }
 
     /// Newton on F(w) = 0, normal·w = target, from `pred`. Chord iterations first, with the
@@ -453,9 +458,14 @@ impl Family {
     /// The orbit at the solution `w` (its events' states and impulses) from `orbit`, the one built
     /// at w's λ, its defect recorded; its monodromy made now when `monodromy`, else where asked.
     fn exact_orbit(&self, orbit: PolishedOrbit, w: &[f64], monodromy: bool) -> Option<PolishedOrbit> {
+        self.exact_orbit_kept(orbit, w, monodromy, None)
+    }
+
+    /// [`Self::exact_orbit`], its monodromy from `kept` (the variation of a Jacobian at w).
+    fn exact_orbit_kept(&self, orbit: PolishedOrbit, w: &[f64], monodromy: bool, kept: Option<KeptVariation>) -> Option<PolishedOrbit> {
         let (y, times) = self.unpack(w, orbit.period());
         let defect = self.residual_with(&orbit, w)?.amax() * self.ys;
-        if monodromy { orbit.at(&y, &times, defect).ok() } else { orbit.at_states(&y, &times, defect).ok() }
+        if monodromy { orbit.at_kept(&y, &times, defect, kept).ok() } else { orbit.at_states(&y, &times, defect).ok() }
     }
 
     /// [`Self::node_with`] without the multipliers (nor touches): a secant's trial point whose
@@ -473,9 +483,9 @@ impl Family {
     fn solved_as(&self, w: Vec<f64>, prev: &[f64], touches: bool, multipliers: bool) -> Option<Node> {
         // One orbit built at w's λ for the Jacobian and the point (two builds before).
         let here = self.orbit(w[w.len() - 1] * self.rho)?;
-        let jac = match self.last_jacobian.take() {
-            Some((at, j)) if at == w => j,
-            _ => self.jacobian_at(&here, &w)?,
+        let (jac, kept) = match self.last_jacobian.take() {
+            Some((at, j)) if at == w => (j, None),
+            _ => self.jacobian_kept(&here, &w)?,
         };
         let tangent = self.tangent(&jac, prev)?;
         if std::env::var_os("PC_TRACE_FOLD").is_some() && prev.iter().zip(&tangent).map(|(p, x)| p * x).sum::<f64>() < 0.0 {
@@ -486,7 +496,7 @@ impl Family {
             );
         }
         self.chord.replace(Some(Chord { key: self.key(), jacobian: jac }));
-        let orbit = self.exact_orbit(here, &w, multipliers)?;
+        let orbit = self.exact_orbit_kept(here, &w, multipliers, kept)?;
         if !multipliers {
             return Some(Node { w, tangent, orbit, mu: Vec::new(), touches: Vec::new(), amplitude: Vec::new(), margin: Default::default() });
         }
