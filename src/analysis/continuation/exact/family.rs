@@ -14,6 +14,7 @@ use crate::analysis::polish::{Event, EventKind, KeptVariation, PolishedOrbit, Ri
 use crate::model::{Compliance, Model};
 use nalgebra::{DMatrix, DVector, Dyn, LU};
 use num_complex::Complex64;
+use std::rc::Rc;
 
 /// The event signature: the events in time order (their seeds unused) and the contacts closed
 /// all period long.
@@ -188,19 +189,19 @@ impl Family {
         w
     }
 
-    fn orbit(&self, lambda: f64) -> Option<PolishedOrbit> {
+    fn orbit(&self, lambda: f64) -> Option<Rc<PolishedOrbit>> {
         if !lambda.is_finite() {
             return None;
         }
         timed(Stage::Build, || self.build(lambda))
     }
 
-    fn build(&self, lambda: f64) -> Option<PolishedOrbit> {
+    fn build(&self, lambda: f64) -> Option<Rc<PolishedOrbit>> {
         let (mut modes, key) = (self.modes.borrow_mut(), self.signature_key());
         if let Some(orbit) = modes.again(&key, &self.sig.events, &self.sig.always, lambda) {
             return Some(orbit);
         }
-        let orbit = modes.build(key, &self.model_at(lambda), self.sig.events.clone(), &self.sig.always)?;
+        let orbit = Rc::new(modes.build(key, &self.model_at(lambda), self.sig.events.clone(), &self.sig.always)?);
         modes.remember(self.sig.events.clone(), &self.sig.always, lambda, &orbit);
         Some(orbit)
     }
@@ -251,7 +252,7 @@ impl Family {
     }
 
     pub fn residual(&self, w: &[f64]) -> Option<DVector<f64>> {
-        self.residual_with(&self.orbit(w[w.len() - 1] * self.rho)?, w)
+        self.residual_with(&*self.orbit(w[w.len() - 1] * self.rho)?, w)
     }
 
     /// [∂F/∂w]: the state and time columns from the variational flow of one period
@@ -259,7 +260,7 @@ impl Family {
     /// on orbits rebuilt at λ ± h·ρ. By central differences throughout where the variational flow
     /// does not apply.
     pub fn jacobian(&self, w: &[f64]) -> Option<DMatrix<f64>> {
-        self.jacobian_at(&self.orbit(w[w.len() - 1] * self.rho)?, w)
+        self.jacobian_at(&*self.orbit(w[w.len() - 1] * self.rho)?, w)
     }
 
     /// [`Self::jacobian`] with the orbit at w's λ already built.
@@ -310,7 +311,8 @@ impl Family {
         let (mut up, mut dn) = (w.to_vec(), w.to_vec());
         up[d - 1] += DIFF;
         dn[d - 1] -= DIFF;
-        let col = (self.residual_with(&self.orbit(up[d - 1] * self.rho)?, &up)? - self.residual_with(&self.orbit(dn[d - 1] * self.rho)?, &dn)?) / (2.0 * DIFF);
+        let col =
+            (self.residual_with(&*self.orbit(up[d - 1] * self.rho)?, &up)? - self.residual_with(&*self.orbit(dn[d - 1] * self.rho)?, &dn)?) / (2.0 * DIFF);
         j.set_column(d - 1, &col);
         Some((j, None))
     }
@@ -449,7 +451,7 @@ impl Family {
     /// alone. The tangent's Jacobian and the monodromy's Schur form were two thirds of a trial.
     pub fn orbit_node(&self, w: Vec<f64>, prev: &[f64], touches: bool) -> Option<Node> {
         timed(Stage::Node, || {
-            let orbit = self.exact_orbit(self.orbit(w[w.len() - 1] * self.rho)?, &w, false)?;
+            let orbit = self.exact_orbit(Rc::unwrap_or_clone(self.orbit(w[w.len() - 1] * self.rho)?), &w, false)?;
             let touches = if touches { orbit.touches() } else { Vec::new() };
             Some(Node { w, tangent: prev.to_vec(), orbit, mu: Vec::new(), touches, amplitude: Vec::new(), margin: Default::default() })
         })
@@ -496,7 +498,7 @@ impl Family {
             );
         }
         self.chord.replace(Some(Chord { key: self.key(), jacobian: jac }));
-        let orbit = self.exact_orbit_kept(here, &w, multipliers, kept)?;
+        let orbit = self.exact_orbit_kept(Rc::unwrap_or_clone(here), &w, multipliers, kept)?;
         if !multipliers {
             return Some(Node { w, tangent, orbit, mu: Vec::new(), touches: Vec::new(), amplitude: Vec::new(), margin: Default::default() });
         }
