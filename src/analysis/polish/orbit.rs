@@ -426,13 +426,8 @@ impl PolishedOrbit {
     /// multipliers (a plastic impact adds zeros).
     pub fn monodromy(&self) -> &DMatrix<f64> {
         // An orbit made without it (`at_states`) forms it here, as `finish` would have.
-        self.monodromy.get_or_init(|| {
-            if self.identity_saltation() {
-                self.flow_product().expect("identity saltations")
-            } else {
-                self.event_monodromy(None).expect("the monodromy (an event condition singular in its time: grazing)")
-            }
-        })
+        let made = || if self.identity_saltation() { self.flow_product() } else { self.event_monodromy(None) };
+        self.monodromy.get_or_init(|| made().expect("the monodromy (an event condition singular in its time: grazing)"))
     }
 
     /// The period T [s].
