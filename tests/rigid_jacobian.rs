@@ -129,3 +129,26 @@ fn rigid_jacobian_and_monodromy_match_differences_on_the_coarse_rigid_blade() {
     // Jacobian agrees to 4e-12 and 1e-8 there).
     check("coarse rigid blade", &rigid_blade(2300.0), 1e-5);
 }
+
+/// A monodromy formed where asked (`PolishedOrbit::at_states`, the exact walk's located trials) or
+/// from a shooting Jacobian's variation at the same unknowns (`at_kept`, the walk's points) matches
+/// the event-driven map's five-point differences, and is the one `at` flows, bit for bit.
+#[test]
+fn a_monodromy_made_late_or_from_the_jacobians_variation_matches_differences() {
+    for (name, p) in [("1-DOF impact and sticking", oscillator(0.7, 0.5)), ("2-DOF chain, rigid stop", chain(1.0, 0.3))] {
+        let orbit = polished(&p);
+        let (y, times, residual) = (orbit.initial_state().to_vec(), orbit.times().to_vec(), orbit.residual());
+        let (_, _, kept) = orbit.shooting_jacobian_kept(&y, &times).expect("the period's variation");
+        let anew = orbit.clone().at(&y, &times, residual).expect("the orbit with its monodromy");
+        let reused = orbit.clone().at_kept(&y, &times, residual, Some(kept)).expect("the orbit, its monodromy from the Jacobian's variation");
+        let late = orbit.clone().at_states(&y, &times, residual).expect("the orbit without its monodromy");
+        let bits = |o: &PolishedOrbit| o.monodromy().iter().map(|x| x.to_bits()).collect::<Vec<u64>>();
+        assert_eq!(bits(&reused), bits(&anew), "{name}: the monodromy from the Jacobian's variation");
+        assert_eq!(bits(&late), bits(&anew), "{name}: the monodromy formed where asked");
+        for (how, o) in [("kept", &reused), ("late", &late)] {
+            let err = monodromy_error(&p, o, 1e-4);
+            eprintln!("{name} ({how}): monodromy vs five-point differences of the event-driven map: {err:.2e}");
+            assert!(err < 1e-9, "{name} ({how}): the monodromy is off the event-driven map's differences by {err:.2e}");
+        }
+    }
+}

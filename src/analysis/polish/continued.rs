@@ -7,6 +7,7 @@ use super::PolishFailure;
 use super::events::{Event, EventKind};
 use super::orbit::{PolishedOrbit, user_value};
 use super::phase::Phase;
+pub use super::rigid::KeptVariation;
 use crate::model::Model;
 use crate::periodic::OutputMap;
 use nalgebra::{DMatrix, DVector};
@@ -54,15 +55,20 @@ impl PolishedOrbit {
         // Checked only where a bank orbit has the phase sought, once each: the exact walk's bank
         // grows by an orbit per signature met, and checking all of them was 5 % of the rigid blade's walk.
         let mut fits: Vec<Option<bool>> = vec![None; bank.len()];
+        // Phases of one contact set are the same phase: made once per build, the others its copies
+        // (the same function of the same bank and model, so the same bits).
+        let mut made: Vec<Phase> = Vec::new();
         Self::with_phases(model, events, always, |stuck, closed| {
-            for (o, fit) in bank.iter().zip(&mut fits) {
-                if let Some(p) = o.phases.iter().find(|p| p.is_for(stuck, closed))
-                    && *fit.get_or_insert_with(|| same(o))
-                {
-                    return p.retuned(model);
-                }
+            if let Some(p) = made.iter().find(|p| p.is_for(stuck, closed)) {
+                return Some(p.clone());
             }
-            Phase::new(model, stuck, closed)
+            let phase = bank
+                .iter()
+                .zip(&mut fits)
+                .find_map(|(o, fit)| o.phases.iter().find(|p| p.is_for(stuck, closed)).filter(|_| *fit.get_or_insert_with(|| same(o))))
+                .map_or_else(|| Phase::new(model, stuck, closed), |p| p.retuned(model))?;
+            made.push(phase.clone());
+            Some(phase)
         })
     }
 
@@ -85,6 +91,11 @@ impl PolishedOrbit {
     /// phase 0's start and as its return a period later). `None` when the times are not
     /// increasing within one period, or where a flow or a reset fails.
     pub fn shooting_jacobian(&self, y0: &[f64], times: &[f64]) -> Option<(DVector<f64>, DMatrix<f64>)> {
+        self.shooting_jacobian_kept(y0, times).map(|(r, j, _)| (r, j))
+    }
+
+    /// [`Self::shooting_jacobian`] with its period's variation, for [`Self::at_kept`] at the same unknowns.
+    pub fn shooting_jacobian_kept(&self, y0: &[f64], times: &[f64]) -> Option<(DVector<f64>, DMatrix<f64>, KeptVariation)> {
         let (n2, ne) = (2 * self.model.n(), self.events.len());
         let tau: &[f64] = if ne == 0 { &[0.0] } else { times };
         if tau.windows(2).any(|w| w[0] >= w[1]) || (ne > 0 && tau[ne - 1] >= tau[0] + self.period) {
@@ -112,20 +123,40 @@ impl PolishedOrbit {
                 jac[(n2 + r, n2)] += cond[r];
             }
         }
-        Some((res, jac))
+        let ret = tau[0] + self.period;
+        Some((res, jac, KeptVariation { start, tau: tau.to_vec(), ret, v }))
     }
 
     /// This orbit at the solution (`y0`, `times`) of [`Self::shooting_residual`]: the states after
     /// the events and the monodromy; `residual` is the solution's, for the record.
-    pub fn at(mut self, y0: &[f64], times: &[f64], residual: f64) -> Result<Self, PolishFailure> {
+    pub fn at(self, y0: &[f64], times: &[f64], residual: f64) -> Result<Self, PolishFailure> {
+        self.at_kept(y0, times, residual, None)
+    }
+
+    /// [`Self::at`], its monodromy from `kept` (a Jacobian's variation) where that was flowed from
+    /// these unknowns: a point's Jacobian and monodromy flowed the same period twice.
+    pub fn at_kept(self, y0: &[f64], times: &[f64], residual: f64, kept: Option<KeptVariation>) -> Result<Self, PolishFailure> {
+        let mut o = self.placed(y0, times, residual);
+        o.finish_kept(kept)?;
+        Ok(o)
+    }
+
+    /// [`Self::at`] without the monodromy, made where [`Self::monodromy`] asks for it: a
+    /// located event's trial orbit is read for its margin or a force alone.
+    pub fn at_states(self, y0: &[f64], times: &[f64], residual: f64) -> Result<Self, PolishFailure> {
+        let mut o = self.placed(y0, times, residual);
+        o.finish_states()?;
+        Ok(o)
+    }
+
+    fn placed(mut self, y0: &[f64], times: &[f64], residual: f64) -> Self {
         self.y0 = DVector::from_column_slice(y0);
         if !self.events.is_empty() {
             self.times = times.to_vec();
         }
         self.residual = residual;
         self.correction = residual;
-        self.finish()?;
-        Ok(self)
+        self
     }
 
     /// The state `y` at `t` as the phase before event 0 carries it (the last one: the shooting

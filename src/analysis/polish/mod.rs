@@ -26,7 +26,7 @@ mod rigid;
 mod signals;
 mod verify;
 
-pub use continued::Touch;
+pub use continued::{KeptVariation, Touch};
 pub use detect::{PhaseBank, follow_detected, follow_detected_with};
 pub use events::{Event, EventKind};
 pub use orbit::{OrbitParts, PolishedOrbit, user_value};

@@ -383,15 +383,27 @@ impl PolishedOrbit {
 
     /// The states after the events, the impulses and the monodromy of the orbit at y0 and times.
     pub(super) fn finish(&mut self) -> Result<(), PolishFailure> {
-        let fail = |w: &str| PolishFailure(w.to_string());
-        let shot = self.shoot(&self.y0, &self.times).ok_or_else(|| fail("the converged orbit cannot be flowed"))?;
+        self.finish_kept(None)
+    }
+
+    /// [`Self::finish`], the monodromy from `kept` where it was flowed from this orbit's unknowns.
+    pub(super) fn finish_kept(&mut self, kept: Option<super::rigid::KeptVariation>) -> Result<(), PolishFailure> {
+        self.finish_states()?;
+        if !self.identity_saltation() {
+            let fail = |w: &str| PolishFailure(w.to_string());
+            let m =
+                self.event_monodromy(kept).ok_or_else(|| fail("the monodromy could not be formed (an event condition is singular in its time: grazing)"))?;
+            self.monodromy = m.into();
+        }
+        Ok(())
+    }
+
+    /// [`Self::finish`] without the monodromy: the states after the events and the impulses.
+    pub(super) fn finish_states(&mut self) -> Result<(), PolishFailure> {
+        let shot = self.shoot(&self.y0, &self.times).ok_or_else(|| PolishFailure("the converged orbit cannot be flowed".to_string()))?;
         self.after = shot.after;
         self.impulses = shot.impulses;
         self.monodromy = std::sync::OnceLock::new();
-        if !self.identity_saltation() {
-            let m = self.event_monodromy().ok_or_else(|| fail("the monodromy could not be formed (an event condition is singular in its time: grazing)"))?;
-            self.monodromy = m.into();
-        }
         Ok(())
     }
 
@@ -413,7 +425,9 @@ impl PolishedOrbit {
     /// variational flow of `rigid.rs`). Its eigenvalues are the orbit's Floquet
     /// multipliers (a plastic impact adds zeros).
     pub fn monodromy(&self) -> &DMatrix<f64> {
-        self.monodromy.get_or_init(|| self.flow_product().expect("identity saltations (finish made the others)"))
+        // An orbit made without it (`at_states`) forms it here, as `finish` would have.
+        let made = || if self.identity_saltation() { self.flow_product() } else { self.event_monodromy(None) };
+        self.monodromy.get_or_init(|| made().expect("the monodromy (an event condition singular in its time: grazing)"))
     }
 
     /// The period T [s].

@@ -469,12 +469,28 @@ impl Phase {
         if self.stuck.is_empty() && self.slave.ncols() == 0 {
             return e * dy;
         }
-        let mut reduced = DMatrix::zeros(2 * nf, dy.ncols());
-        reduced.rows_mut(0, nf).copy_from(&self.free.tr_mul(&dy.rows(0, n)));
-        reduced.rows_mut(nf, nf).copy_from(&self.free.tr_mul(&dy.rows(n, n)));
+        // N_a's columns unit vectors: R dy a gather, and L = N_a without massless DOFs a scatter
+        // (the products' exact values: the variation's products by N_a were a sixth of the rigid walk).
+        let rows = self.tuning.free_rows.as_deref();
+        let reduced = match rows {
+            Some(rows) => dy.select_rows(rows.iter().copied().chain(rows.iter().map(|d| n + d)).collect::<Vec<_>>().iter()),
+            None => {
+                let mut reduced = DMatrix::zeros(2 * nf, dy.ncols());
+                reduced.rows_mut(0, nf).copy_from(&self.free.tr_mul(&dy.rows(0, n)));
+                reduced.rows_mut(nf, nf).copy_from(&self.free.tr_mul(&dy.rows(n, n)));
+                reduced
+            }
+        };
         let moved = e * reduced;
-        let lift = self.lifted();
         let mut out = DMatrix::zeros(2 * n, dy.ncols());
+        if let Some(rows) = rows.filter(|_| self.slave.ncols() == 0) {
+            for (k, &d) in rows.iter().enumerate() {
+                out.row_mut(d).copy_from(&moved.row(k));
+                out.row_mut(n + d).copy_from(&moved.row(nf + k));
+            }
+            return out;
+        }
+        let lift = self.lifted();
         out.rows_mut(0, n).copy_from(&(lift * moved.rows(0, nf)));
         out.rows_mut(n, n).copy_from(&(lift * moved.rows(nf, nf)));
         out
@@ -491,8 +507,15 @@ impl Phase {
         let (x, v) = (y.rows(0, n).into_owned(), y.rows(n, n).into_owned());
         let acc = eval(&self.presc, self.omega, t, 2, n);
         let rhs = eval(&self.force, self.omega, t, 0, n) - &*self.c * &v - &*self.k * &x - &*self.m * &acc;
-        let af = &*self.mff_inv * (self.free.transpose() * rhs);
-        let mut out = acc + &*self.free * &af;
+        // N_aᵀ rhs a gather, + N_a a_f a scatter-add (their exact values) where N_a's columns are unit vectors.
+        let rows = self.tuning.free_rows.as_deref();
+        let projected = rows.map_or_else(|| self.free.transpose() * &rhs, |r| DVector::from_iterator(r.len(), r.iter().map(|&d| rhs[d])));
+        let af = &*self.mff_inv * projected;
+        let mut out = acc;
+        match rows {
+            Some(rows) => rows.iter().zip(af.iter()).for_each(|(&d, a)| out[d] += a),
+            None => out += &*self.free * &af,
+        }
         if self.slave.ncols() > 0 {
             // ẍ_b = Ẍ_b(t) + S (ẍ_a − Ẍ_a(t)).
             let nf = self.free.ncols();

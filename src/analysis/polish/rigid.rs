@@ -225,6 +225,15 @@ pub(super) struct Variation {
     pub d_conditions: DMatrix<f64>,
 }
 
+/// A period's [`Variation`] kept with what it was flowed from (state, event times, return):
+/// a shooting Jacobian's, for the monodromy of the orbit placed at the same unknowns.
+pub struct KeptVariation {
+    pub(super) start: DVector<f64>,
+    pub(super) tau: Vec<f64>,
+    pub(super) ret: f64,
+    pub(super) v: Variation,
+}
+
 /// A plastic impact's velocity reset (src/formulation.md §5 in one instant) on the contacts `set`
 /// (the stuck ones and the impacting one): v⁺ = v⁻ − W (B v⁻ − ġ_set(t)), W = M⁻¹Bᵀ(BM⁻¹Bᵀ)⁻¹,
 /// the impulses (BM⁻¹Bᵀ)⁻¹(B v⁻ − ġ). (B, M⁻¹Bᵀ, (BM⁻¹Bᵀ)⁻¹); `None` with a singular M or BM⁻¹Bᵀ.
@@ -384,10 +393,15 @@ impl PolishedOrbit {
     /// relocated (with w = (τ_1 … τ_{ne−1}, event 0's return) and G(z, w) = 0 the event
     /// conditions: dy/dz = Y_z − Y_w G_w⁻¹ G_z) from [`Self::variation`]. `None` where G_w is
     /// singular (an event condition tangent in its time: a grazing).
-    pub(super) fn event_monodromy(&self) -> Option<DMatrix<f64>> {
+    pub(super) fn event_monodromy(&self, kept: Option<KeptVariation>) -> Option<DMatrix<f64>> {
         let (n2, ne) = (2 * self.model.n(), self.events.len());
         let (s, t) = (self.times[0], self.period);
-        let v = self.variation(&self.y0, &self.times, s + t)?;
+        let bits = |a: &[f64], b: &[f64]| a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
+        let v = match kept {
+            // The Jacobian's variation from the same unknowns: the one flowed here, bit for bit.
+            Some(k) if bits(k.start.as_slice(), self.y0.as_slice()) && bits(&k.tau, &self.times) && k.ret.to_bits() == (s + t).to_bits() => k.v,
+            _ => self.variation(&self.y0, &self.times, s + t)?,
+        };
         if ne == 0 {
             return Some(v.d_end.columns(0, n2).into_owned());
         }

@@ -10,10 +10,11 @@ use super::super::{Parameter, floquet};
 use super::metric::Metric;
 use super::modes::{Modes, SignatureKey};
 use super::profile::{Stage, timed};
-use crate::analysis::polish::{Event, EventKind, PolishedOrbit, RigidMargins, Touch};
+use crate::analysis::polish::{Event, EventKind, KeptVariation, PolishedOrbit, RigidMargins, Touch};
 use crate::model::{Compliance, Model};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{DMatrix, DVector, Dyn, LU};
 use num_complex::Complex64;
+use std::rc::Rc;
 
 /// The event signature: the events in time order (their seeds unused) and the contacts closed
 /// all period long.
@@ -188,19 +189,19 @@ impl Family {
         w
     }
 
-    fn orbit(&self, lambda: f64) -> Option<PolishedOrbit> {
+    fn orbit(&self, lambda: f64) -> Option<Rc<PolishedOrbit>> {
         if !lambda.is_finite() {
             return None;
         }
         timed(Stage::Build, || self.build(lambda))
     }
 
-    fn build(&self, lambda: f64) -> Option<PolishedOrbit> {
+    fn build(&self, lambda: f64) -> Option<Rc<PolishedOrbit>> {
         let (mut modes, key) = (self.modes.borrow_mut(), self.signature_key());
         if let Some(orbit) = modes.again(&key, &self.sig.events, &self.sig.always, lambda) {
             return Some(orbit);
         }
-        let orbit = modes.build(key, &self.model_at(lambda), self.sig.events.clone(), &self.sig.always)?;
+        let orbit = Rc::new(modes.build(key, &self.model_at(lambda), self.sig.events.clone(), &self.sig.always)?);
         modes.remember(self.sig.events.clone(), &self.sig.always, lambda, &orbit);
         Some(orbit)
     }
@@ -251,7 +252,7 @@ impl Family {
     }
 
     pub fn residual(&self, w: &[f64]) -> Option<DVector<f64>> {
-        self.residual_with(&self.orbit(w[w.len() - 1] * self.rho)?, w)
+        self.residual_with(&*self.orbit(w[w.len() - 1] * self.rho)?, w)
     }
 
     /// [∂F/∂w]: the state and time columns from the variational flow of one period
@@ -259,15 +260,20 @@ impl Family {
     /// on orbits rebuilt at λ ± h·ρ. By central differences throughout where the variational flow
     /// does not apply.
     pub fn jacobian(&self, w: &[f64]) -> Option<DMatrix<f64>> {
-        self.jacobian_at(&self.orbit(w[w.len() - 1] * self.rho)?, w)
+        self.jacobian_at(&*self.orbit(w[w.len() - 1] * self.rho)?, w)
     }
 
     /// [`Self::jacobian`] with the orbit at w's λ already built.
     fn jacobian_at(&self, here: &PolishedOrbit, w: &[f64]) -> Option<DMatrix<f64>> {
+        self.jacobian_kept(here, w).map(|(j, _)| j)
+    }
+
+    /// [`Self::jacobian_at`] and its period's variation (for the monodromy of the orbit at w).
+    fn jacobian_kept(&self, here: &PolishedOrbit, w: &[f64]) -> Option<(DMatrix<f64>, Option<KeptVariation>)> {
         let d = self.dim();
         let (y, times) = self.unpack(w, here.period());
         let mut j = DMatrix::zeros(d - 1, d);
-        if let Some((_, dr)) = timed(Stage::Variational, || here.shooting_jacobian(&y, &times)) {
+        if let Some((_, dr, kept)) = timed(Stage::Variational, || here.shooting_jacobian_kept(&y, &times)) {
             for c in 0..d - 1 {
                 let scale = if c < self.n2 { self.ys / self.weight[c] } else { here.period() };
                 j.set_column(c, &(dr.column(c) * scale));
@@ -293,7 +299,7 @@ impl Family {
             dn[d - 1] -= DIFF;
             let col = timed(Stage::LambdaColumn, || Some((self.residual(&up)? - self.residual(&dn)?) / (2.0 * DIFF)))?;
             j.set_column(d - 1, &col);
-            return Some(j);
+            return Some((j, Some(kept)));
         }
         for c in 0..d - 1 {
             let (mut up, mut dn) = (w.to_vec(), w.to_vec());
@@ -305,9 +311,10 @@ impl Family {
         let (mut up, mut dn) = (w.to_vec(), w.to_vec());
         up[d - 1] += DIFF;
         dn[d - 1] -= DIFF;
-        let col = (self.residual_with(&self.orbit(up[d - 1] * self.rho)?, &up)? - self.residual_with(&self.orbit(dn[d - 1] * self.rho)?, &dn)?) / (2.0 * DIFF);
+        let col =
+            (self.residual_with(&*self.orbit(up[d - 1] * self.rho)?, &up)? - self.residual_with(&*self.orbit(dn[d - 1] * self.rho)?, &dn)?) / (2.0 * DIFF);
         j.set_column(d - 1, &col);
-        Some(j)
+        Some((j, None))
     }
 
     /// Newton on F(w) = 0, normal·w = target, from `pred`. Chord iterations first, with the
@@ -348,23 +355,32 @@ impl Family {
         let mut w = pred.to_vec();
         let mut last = f64::INFINITY;
         self.unresolved.set(None);
+        // The chord's bordered matrix is the same at every chord iteration: factorised once.
+        let mut chord_lu: Option<LU<f64, Dyn, Dyn>> = None;
+        let bordered = |jac: &DMatrix<f64>| {
+            let mut a = DMatrix::zeros(d, d);
+            a.view_mut((0, 0), (d - 1, d)).copy_from(jac);
+            for c in 0..d {
+                a[(d - 1, c)] = normal[c];
+            }
+            a.lu()
+        };
         for _ in 0..MAX_ITERATIONS {
             let here = self.orbit(w[d - 1] * self.rho)?;
             let f = self.residual_with(&here, &w)?;
             let fresh = chord.is_none();
-            let jac = match &chord {
-                Some(j) => j.clone(),
-                None => self.jacobian_at(&here, &w)?,
+            let (jac, lu) = match &chord {
+                Some(j) => (None, &*chord_lu.get_or_insert_with(|| bordered(j))),
+                None => {
+                    let jac = self.jacobian_at(&here, &w)?;
+                    let lu = bordered(&jac);
+                    (Some(jac), &*chord_lu.insert(lu))
+                }
             };
-            let mut a = DMatrix::zeros(d, d);
-            a.view_mut((0, 0), (d - 1, d)).copy_from(&jac);
             let mut rhs = DVector::zeros(d);
             rhs.rows_mut(0, d - 1).copy_from(&(-&f));
-            for c in 0..d {
-                a[(d - 1, c)] = normal[c];
-            }
             rhs[d - 1] = target - normal.iter().zip(&w).map(|(n, x)| n * x).sum::<f64>();
-            let dw = a.lu().solve(&rhs)?;
+            let dw = lu.solve(&rhs)?;
             self.unresolved.set(self.unresolved_in(&dw));
             w.iter_mut().zip(dw.iter()).for_each(|(x, s)| *x += s);
             let step = dw.amax();
@@ -373,7 +389,7 @@ impl Family {
             }
             // A chord step is exact to Θ/(1 − Θ) of itself: CONVERGED holds it below 1e-10/3.
             if step < CONVERGED || (step < ATTAINABLE && step >= last && f.amax() < NOISE_DEFECT) {
-                if fresh {
+                if let Some(jac) = jac {
                     // The Jacobian of the last iterate, ‖Δw‖ away: the tangent's.
                     self.last_jacobian.replace(Some((w.clone(), jac)));
                 }
@@ -382,6 +398,9 @@ impl Family {
             }
             if !fresh && step > CHORD_CONTRACTION * last && step >= ATTAINABLE {
                 chord = None;
+            }
+            if chord.is_none() {
+                chord_lu = None;
             }
             last = step;
         }
@@ -432,26 +451,43 @@ impl Family {
     /// alone. The tangent's Jacobian and the monodromy's Schur form were two thirds of a trial.
     pub fn orbit_node(&self, w: Vec<f64>, prev: &[f64], touches: bool) -> Option<Node> {
         timed(Stage::Node, || {
-            let orbit = self.exact_orbit(self.orbit(w[w.len() - 1] * self.rho)?, &w)?;
+            let orbit = self.exact_orbit(Rc::unwrap_or_clone(self.orbit(w[w.len() - 1] * self.rho)?), &w, false)?;
             let touches = if touches { orbit.touches() } else { Vec::new() };
             Some(Node { w, tangent: prev.to_vec(), orbit, mu: Vec::new(), touches, amplitude: Vec::new(), margin: Default::default() })
         })
     }
 
     /// The orbit at the solution `w` (its events' states and impulses) from `orbit`, the one built
-    /// at w's λ, its defect recorded.
-    fn exact_orbit(&self, orbit: PolishedOrbit, w: &[f64]) -> Option<PolishedOrbit> {
+    /// at w's λ, its defect recorded; its monodromy made now when `monodromy`, else where asked.
+    fn exact_orbit(&self, orbit: PolishedOrbit, w: &[f64], monodromy: bool) -> Option<PolishedOrbit> {
+        self.exact_orbit_kept(orbit, w, monodromy, None)
+    }
+
+    /// [`Self::exact_orbit`], its monodromy from `kept` (the variation of a Jacobian at w).
+    fn exact_orbit_kept(&self, orbit: PolishedOrbit, w: &[f64], monodromy: bool, kept: Option<KeptVariation>) -> Option<PolishedOrbit> {
         let (y, times) = self.unpack(w, orbit.period());
         let defect = self.residual_with(&orbit, w)?.amax() * self.ys;
-        orbit.at(&y, &times, defect).ok()
+        if monodromy { orbit.at_kept(&y, &times, defect, kept).ok() } else { orbit.at_states(&y, &times, defect).ok() }
+    }
+
+    /// [`Self::node_with`] without the multipliers (nor touches): a secant's trial point whose
+    /// orbit alone is read (a landing force), the next corrector's chord set as a point sets it,
+    /// so that the iterates are a point's bit for bit. The trials' monodromies and their Schur
+    /// forms were a tenth of the coarse rigid walk.
+    pub fn trial_node(&self, w: Vec<f64>, prev: &[f64]) -> Option<Node> {
+        timed(Stage::Node, || self.solved_as(w, prev, false, false))
     }
 
     fn solved(&self, w: Vec<f64>, prev: &[f64], touches: bool) -> Option<Node> {
+        self.solved_as(w, prev, touches, true)
+    }
+
+    fn solved_as(&self, w: Vec<f64>, prev: &[f64], touches: bool, multipliers: bool) -> Option<Node> {
         // One orbit built at w's λ for the Jacobian and the point (two builds before).
         let here = self.orbit(w[w.len() - 1] * self.rho)?;
-        let jac = match self.last_jacobian.take() {
-            Some((at, j)) if at == w => j,
-            _ => self.jacobian_at(&here, &w)?,
+        let (jac, kept) = match self.last_jacobian.take() {
+            Some((at, j)) if at == w => (j, None),
+            _ => self.jacobian_kept(&here, &w)?,
         };
         let tangent = self.tangent(&jac, prev)?;
         if std::env::var_os("PC_TRACE_FOLD").is_some() && prev.iter().zip(&tangent).map(|(p, x)| p * x).sum::<f64>() < 0.0 {
@@ -462,7 +498,10 @@ impl Family {
             );
         }
         self.chord.replace(Some(Chord { key: self.key(), jacobian: jac }));
-        let orbit = self.exact_orbit(here, &w)?;
+        let orbit = self.exact_orbit_kept(Rc::unwrap_or_clone(here), &w, multipliers, kept)?;
+        if !multipliers {
+            return Some(Node { w, tangent, orbit, mu: Vec::new(), touches: Vec::new(), amplitude: Vec::new(), margin: Default::default() });
+        }
         let mu = floquet::multipliers(orbit.monodromy());
         // No multipliers (the Schur iteration did not converge): no point, the step is shortened.
         if mu.iter().any(|m| !m.is_finite()) {
@@ -498,92 +537,4 @@ fn state_weights(model: &Model) -> Vec<f64> {
 }
 
 #[cfg(test)]
-pub(crate) mod tests {
-    use super::{Family, Signature, lambda_axis};
-    use crate::analysis::continuation::Parameter;
-    use crate::analysis::polish;
-    use crate::model::{Compliance, Contact, Force, Harmonic, Matrix, Model, Structure};
-    use crate::periodic::{OutputSelection, PeriodicProblem, PeriodicSolver, SolverSettings};
-    use crate::time::{Discretization, Scheme};
-    use num_complex::Complex64;
-
-    /// A model forced by cos Ωt on DOF 0, with a rigid stop (plastic impacts) on `stop_dof` at
-    /// clearance `gap`, bds1 with `steps` steps: the exact walk's small test models.
-    pub(crate) fn forced_with_rigid_stop(structure: Structure, stop_dof: usize, gap: f64, steps: usize, omega: f64) -> PeriodicProblem {
-        let force = Force { dof: 0, term: Harmonic { amplitude: 1.0, harmonic: 1, phase: 0.0 } };
-        let stop = Contact::on_dof(stop_dof, 1.0, gap, Compliance::Rigid);
-        let model = Model { structure, forces: vec![force], contacts: vec![stop], frequency: omega, frictions: Vec::new(), rubbing: Vec::new() };
-        let disc = Discretization { scheme: Scheme::Bds1, steps, pairing: None };
-        let outputs = OutputSelection { displacement: vec![0], contacts: true, ..OutputSelection::default() };
-        PeriodicProblem::new(model, disc, outputs, SolverSettings::default()).expect("the test model's problem")
-    }
-
-    /// A unit mass (k = 1, c = 0.1, forced by cos Ωt) carrying a light tip (m = 1e-4) on a stiff
-    /// spring (100: its mode at ≈ 1000, far above the metric's cut-off), the tip's rigid stop
-    /// far away (never touched): the contact-free orbit, linear in closed form.
-    fn tipped(omega: f64) -> PeriodicProblem {
-        let (m1, ks) = (1e-4, 100.0);
-        let structure = Structure {
-            mass: Matrix::from_rows(&[vec![1.0, 0.0], vec![0.0, m1]]),
-            stiffness: Matrix::from_rows(&[vec![1.0 + ks, -ks], vec![-ks, ks]]),
-            damping: Some(Matrix::from_rows(&[vec![0.1, 0.0], vec![0.0, 0.0]])),
-        };
-        forced_with_rigid_stop(structure, 1, 100.0, 256, omega)
-    }
-
-    /// The state at t = 0 of the linear forced response: x = Re(X e^{iΩt}), X = (K − Ω²M + iΩC)⁻¹ F.
-    fn closed_form(omega: f64) -> Vec<f64> {
-        let (m1, ks) = (1e-4, 100.0);
-        let a = [
-            [Complex64::new(1.0 + ks - omega * omega, 0.1 * omega), Complex64::new(-ks, 0.0)],
-            [Complex64::new(-ks, 0.0), Complex64::new(ks - m1 * omega * omega, 0.0)],
-        ];
-        let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
-        let x = [a[1][1] / det, -a[1][0] / det];
-        let i_omega = Complex64::new(0.0, omega);
-        vec![x[0].re, x[1].re, (i_omega * x[0]).re, (i_omega * x[1]).re]
-    }
-
-    /// A point's tangent is oriented along the walk's sense in the arclength's metric, whatever
-    /// the stiff components (which the metric leaves out) of the tangent it is oriented along:
-    /// the coarse rigid blade's located points took the reverse sense there, and six folds were
-    /// recorded with λ increasing (validation/RECORD.md, issue 24). Reference: the secant of the closed-form
-    /// linear orbits at Ω ± δ (λ increasing); the previous tangent given is that sense plus a
-    /// large stiff-mode component against it in the unknowns' own product.
-    #[test]
-    fn a_tangent_keeps_the_walks_sense_in_the_metric() {
-        let omega = 0.9;
-        let p = tipped(omega);
-        let r = PeriodicSolver::new(p.clone()).solve().expect("the grid solve");
-        let orbit = polish::polish(&p, &r).expect("the polish of the contact-free orbit");
-        assert!(orbit.events().is_empty(), "the stop is never touched");
-        let sig = Signature { events: Vec::new(), always: orbit.always_closed().to_vec() };
-        let mut fam = Family::new(p.model(), Parameter::Frequency, 1.0, 1.0, sig);
-        fam.ys = fam.scale_of(orbit.initial_state());
-        let d = fam.dim();
-        let w = fam.correct(&fam.pack(&orbit, omega), &lambda_axis(d), omega).expect("closed at Ω = 0.9");
-        let jac = fam.jacobian(&w).expect("the Jacobian");
-        // The closed form's secant in the unknowns, λ increasing.
-        let h = 1e-5;
-        let (up, dn) = (fam.scaled(&closed_form(omega + h)), fam.scaled(&closed_form(omega - h)));
-        let mut secant: Vec<f64> = up.iter().zip(&dn).map(|(a, b)| (a - b) / (2.0 * h)).collect();
-        secant.push(1.0);
-        // A displacement direction the metric does not see (the stiff mode's): its null vector
-        // in the displacement block, from the Gram matrix of the two unit displacements.
-        let unit = |i: usize| (0..d).map(|j| if j == i { 1.0 } else { 0.0 }).collect::<Vec<f64>>();
-        let (e0, e1) = (unit(0), unit(1));
-        let (g00, g01) = (fam.metric.dot(&e0, &e0), fam.metric.dot(&e0, &e1));
-        let stiff: Vec<f64> = (0..d).map(|j| [-g01, g00].get(j).copied().unwrap_or(0.0)).collect();
-        assert!(fam.metric.norm(&stiff) < 1e-9 * stiff.iter().map(|x| x * x).sum::<f64>().sqrt(), "the metric sees the stiff direction");
-        let raw = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
-        // The walk's sense plus the stiff direction, large enough to reverse the unknowns' product.
-        let c = -3.0 * raw(&secant, &secant) / raw(&stiff, &secant);
-        let prev: Vec<f64> = secant.iter().zip(&stiff).map(|(s, q)| s + c * q).collect();
-        assert!(raw(&prev, &secant) < 0.0 && fam.metric.dot(&prev, &secant) > 0.0, "prev reverses the raw product only");
-        let t = fam.tangent(&jac, &prev).expect("the tangent");
-        let cos = fam.metric.dot(&t, &secant) / (fam.metric.norm(&t) * fam.metric.norm(&secant));
-        eprintln!("tangent vs the closed form's secant: cos {cos:.9} in the metric, λ component {:e}", t[d - 1]);
-        assert!(cos > 1.0 - 1e-6, "the tangent points against (or off) the closed form's branch: cos {cos}");
-        assert!(t[d - 1] > 0.0, "λ increases along the branch here");
-    }
-}
+pub(crate) mod tests;

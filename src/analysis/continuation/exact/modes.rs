@@ -1,6 +1,7 @@
 //! The orbits whose phases the exact walk's orbit builds share ([`Modes`]), at most [`KEPT`].
 use crate::analysis::polish::{Event, EventKind, PolishedOrbit};
 use crate::model::Model;
+use std::rc::Rc;
 
 /// A signature's events (contact, kind) and its contacts closed all period long.
 pub(super) type SignatureKey = (Vec<(usize, EventKind)>, Vec<usize>);
@@ -17,7 +18,7 @@ const KEPT: usize = 32;
 /// walk's time. A build is a function of these alone, so the copy is the build bit for bit.
 const RECENT: usize = 4;
 
-type Recent = (Vec<Event>, Vec<usize>, u64, PolishedOrbit);
+type Recent = (Vec<Event>, Vec<usize>, u64, Rc<PolishedOrbit>);
 
 /// The first orbit built of each signature met, whose phases' eigendecompositions every later
 /// orbit shares (the phase matrices do not depend on the parameter: one decomposition per contact
@@ -36,11 +37,11 @@ pub(super) struct Modes {
 impl Modes {
     /// The orbit built last for `events`, `always` at λ = `lambda` (bit for bit), when one of the
     /// last [`RECENT`] builds; its signature's use is counted as a build's would be.
-    pub fn again(&mut self, key: &SignatureKey, events: &[Event], always: &[usize], lambda: f64) -> Option<PolishedOrbit> {
+    pub fn again(&mut self, key: &SignatureKey, events: &[Event], always: &[usize], lambda: f64) -> Option<Rc<PolishedOrbit>> {
         let same = |e: &[Event]| {
             e.len() == events.len() && e.iter().zip(events).all(|(a, b)| a.contact == b.contact && a.kind == b.kind && a.seed.to_bits() == b.seed.to_bits())
         };
-        let orbit = self.recent.iter().rev().find(|r| r.2 == lambda.to_bits() && r.1 == always && same(&r.0)).map(|r| r.3.clone())?;
+        let orbit = self.recent.iter().rev().find(|r| r.2 == lambda.to_bits() && r.1 == always && same(&r.0)).map(|r| Rc::clone(&r.3))?;
         self.clock += 1;
         let clock = self.clock;
         self.orbits.iter_mut().filter(|(k, _, _)| k == key).for_each(|m| m.2 = clock);
@@ -48,11 +49,12 @@ impl Modes {
     }
 
     /// Keeps `orbit`, built for `events`, `always` at λ = `lambda`, for [`Self::again`].
-    pub fn remember(&mut self, events: Vec<Event>, always: &[usize], lambda: f64, orbit: &PolishedOrbit) {
+    pub fn remember(&mut self, events: Vec<Event>, always: &[usize], lambda: f64, orbit: &Rc<PolishedOrbit>) {
         if self.recent.len() >= RECENT {
             self.recent.remove(0);
         }
-        self.recent.push((events, always.to_vec(), lambda.to_bits(), orbit.clone()));
+        // Shared, not copied: a copy of the orbit (its model, phases) per build and per ask was 2 % of the rigid walk.
+        self.recent.push((events, always.to_vec(), lambda.to_bits(), Rc::clone(orbit)));
     }
 
     /// The orbit of the signature `key` (`events`, `always`) for `model`, its phases re-tuned from

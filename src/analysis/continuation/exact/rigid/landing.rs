@@ -49,7 +49,7 @@ pub(in super::super) fn landing_zero(fam: &Family, from: &[f64], e: usize, (la, 
         let mut g = w0.to_vec();
         g[d - 1] = lambda / rho;
         let w = fam.correct(&g, &e_l, lambda / rho)?;
-        let n = fam.node_with(w, &e_l, false)?;
+        let n = fam.trial_node(w, &e_l)?;
         let h = n.orbit.landing_force(e)?;
         trace(format_args!("landing zero: λ {lambda:.13}, force {h:e} of the scale"));
         Some((n.w, h))
