@@ -14,12 +14,7 @@ pub(super) const HANDOVER_JUMP: f64 = 5e-2;
 /// Why the discrete walk's first orbit `first` is not the exact walk's last one `last` (another
 /// branch), or None when they agree within [`HANDOVER_JUMP`].
 pub(super) fn left_branch(last: &BranchPoint, first: &BranchPoint, name: &str) -> Option<String> {
-    let scale = last.amplitude.iter().chain(&first.amplitude).fold(0.0_f64, |m, a| m.max(a.abs()));
-    let jump = last.amplitude.iter().zip(&first.amplitude).fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
-    let relative = if scale > 0.0 { jump / scale } else { 0.0 };
-    if relative.is_finite() && relative <= HANDOVER_JUMP && last.amplitude.len() == first.amplitude.len() {
-        return None;
-    }
+    let relative = jump(last, first)?;
     let contact_free = !first.masks.is_empty() && first.masks.iter().all(|&m| m == 0);
     let what = if contact_free { "a contact-free orbit" } else { "another orbit" };
     Some(format!(
@@ -29,6 +24,18 @@ pub(super) fn left_branch(last: &BranchPoint, first: &BranchPoint, name: &str) -
         100.0 * HANDOVER_JUMP,
         last.parameter,
     ))
+}
+
+/// The largest relative difference of the outputs' amplitudes between two orbits at one λ when
+/// they are not one orbit (above [`HANDOVER_JUMP`]; infinite for different outputs), else None.
+pub(super) fn jump(a: &BranchPoint, b: &BranchPoint) -> Option<f64> {
+    let scale = a.amplitude.iter().chain(&b.amplitude).fold(0.0_f64, |m, x| m.max(x.abs()));
+    let jump = a.amplitude.iter().zip(&b.amplitude).fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
+    let relative = if scale > 0.0 { jump / scale } else { 0.0 };
+    if relative.is_finite() && relative <= HANDOVER_JUMP && a.amplitude.len() == b.amplitude.len() {
+        return None;
+    }
+    Some(relative)
 }
 
 #[cfg(test)]

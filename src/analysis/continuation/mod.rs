@@ -23,6 +23,7 @@ mod handover;
 pub mod optimal_load;
 pub mod output;
 mod parameter;
+mod reentry;
 mod switch;
 
 pub use events::EventKind;
@@ -204,30 +205,8 @@ pub fn run(problem: &PeriodicProblem, param: Parameter, from: f64, to: f64, sett
     if walked.reached || walked.turned_back {
         return Ok(Branch { parameter: param, points: walked.points, stop: walked.stop, marches: 0, period_multiple: 1, label });
     }
-    // The rest of the range by the discrete walk, from where the exact one stopped.
-    let at = walked.points.last().map_or(from, |p| p.parameter);
-    let mut points = walked.points;
-    match run_discrete(problem, param, at, to, settings, on_point) {
-        Ok(rest) => {
-            if let (Some(last), Some(first)) = (points.last(), rest.points.first())
-                && let Some(why) = handover::left_branch(last, first, param.name())
-            {
-                let stop = format!("{}; exact orbit up to {} = {at}, {why}", walked.stop, param.name());
-                return Ok(Branch { parameter: param, points, stop, marches: rest.marches, period_multiple: 1, label });
-            }
-            points.extend(rest.points.into_iter().skip(1));
-            let stop = format!("{}; exact orbit up to {} = {at} ({}), discrete walk from there", rest.stop, param.name(), walked.stop);
-            Ok(Branch { parameter: param, points, stop, marches: rest.marches, period_multiple: 1, label })
-        }
-        Err(e) => Ok(Branch {
-            parameter: param,
-            points,
-            stop: format!("{}; the discrete walk from there failed: {e}", walked.stop),
-            marches: 0,
-            period_multiple: 1,
-            label,
-        }),
-    }
+    // The rest of the range by the discrete walk, from where the exact one stopped, and the exact walk again past it.
+    reentry::go_on(problem, param, (from, to), settings, on_point, walked)
 }
 
 fn check_range(from: f64, to: f64) -> Result<(), Error> {
@@ -247,18 +226,31 @@ pub fn run_discrete(
     settings: &ContinuationSettings,
     on_point: &dyn Fn(&BranchPoint),
 ) -> Result<Branch, Error> {
+    run_discrete_until((problem, param), (from, to), (settings, on_point), (&[], None))
+}
+
+/// [`run_discrete`], its first solve warm-started from `warm` when not empty (the exact orbit's
+/// active set where the exact walk stopped), its walk from `from` stopped where `until` says of a
+/// step's new points (events, then the step's point) that the exact walk re-enters there: that
+/// point dropped.
+fn run_discrete_until(
+    (problem, param): (&PeriodicProblem, Parameter),
+    (from, to): (f64, f64),
+    (settings, on_point): (&ContinuationSettings, &dyn Fn(&BranchPoint)),
+    (warm, until): (&[usize], Option<&Until>),
+) -> Result<Branch, Error> {
     check_range(from, to)?;
     let rho = (to - from).abs();
     let mut fam = family(problem, param, rho, settings);
     fam.map_at(from)?;
     let mut solver = PeriodicSolver::new(fam.problem_at(from)?);
-    let up = walk_from(&mut fam, &mut solver, from, to, settings, on_point)?;
+    let up = walk_from(&mut fam, &mut solver, from, to, settings, on_point, (warm, until))?;
     let (mut points, mut stop) = (up.points, up.stop);
     // A walk stopped in a zigzag (a fold of the orbit finer than the discrete branch's kinks,
     // the coarse blade's resonance tip): the rest of the curve from the other end, which meets
     // it there.
     if let Some(band) = up.zigzag {
-        let down = walk_from(&mut fam, &mut solver, to, from, settings, on_point)?;
+        let down = walk_from(&mut fam, &mut solver, to, from, settings, on_point, (&[], None))?;
         match down.zigzag {
             Some(other) if (other.0 - band.0).abs() <= ZIGZAG_MEET * rho => {
                 let (lo, hi) = (band.1.min(other.1), band.2.max(other.2));
@@ -293,12 +285,16 @@ fn walk_from(
     to: f64,
     settings: &ContinuationSettings,
     on_point: &dyn Fn(&BranchPoint),
+    (warm, until): (&[usize], Option<&Until>),
 ) -> Result<Walked, Error> {
     let name = fam.name();
     let dir = (to - from).signum();
     solver.update_problem(fam.problem_at(from)?);
     // A cold solve, as `solve` makes: an empty warm start would be Newton from the contact-free guess.
     solver.reset_warm_start();
+    if !warm.is_empty() {
+        solver.set_warm_start(warm);
+    }
     let first = solver.solve().map_err(|e| Error::from(e).context(format!("the start of the continuation at {name} = {from}")))?;
     let (k, m) = (solver.problem().instants(), solver.problem().model().contacts.len());
     let mut masks = vec![0u64; k];
@@ -312,7 +308,7 @@ fn walk_from(
     let here = Node::new(fam, start, tangent);
     let points = vec![point(fam, solver, &here, None, String::new())?];
     on_point(&points[0]);
-    let walk = Walk { from, to, secant: false, settings, on_point };
+    let walk = Walk { from, to, secant: false, settings, on_point, until };
     walk.follow(fam, solver, here, points, None)
 }
 
@@ -358,7 +354,12 @@ struct Walk<'a> {
     secant: bool,
     settings: &'a ContinuationSettings,
     on_point: &'a dyn Fn(&BranchPoint),
+    /// Where the walk stops for the exact walk to re-enter ([`run_discrete_until`]).
+    until: Option<&'a Until<'a>>,
 }
+
+/// Whether the exact walk re-enters at a step's last new point (its new points given).
+type Until<'a> = dyn Fn(&[BranchPoint]) -> bool + 'a;
 
 impl Walk<'_> {
     /// The unit tangent at `next`, oriented along the branch from `here`.
@@ -490,7 +491,15 @@ impl Walk<'_> {
                 points.push(point(fam, solver, &node, Some(kind), detail)?);
             }
             points.push(point(fam, solver, &last, None, detail.clone())?);
+            // The exact orbit's start replaces the step's point there.
+            let reentered = end.is_none() && detail.is_empty() && self.until.is_some_and(|u| u(&points[added..]));
+            if reentered {
+                points.pop();
+            }
             points[added..].iter().for_each(|p| (self.on_point)(p));
+            if reentered {
+                break format!("the exact walk re-enters at {name} = {}", last.solved.parameter(rho));
+            }
             if !detail.is_empty() {
                 break format!("rejoined the T branch at {name} = {}", last.solved.parameter(rho));
             }

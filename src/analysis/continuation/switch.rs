@@ -136,7 +136,7 @@ pub fn switch_at(
     let first = point(&fam2, &mut solver, &here, None, String::new())?;
     on_point(&first);
     points.push(first);
-    let walk = Walk { from, to, secant: true, settings, on_point };
+    let walk = Walk { from, to, secant: true, settings, on_point, until: None };
     let super::Walked { points, stop, .. } = walk.follow(&mut fam2, &mut solver, here, points, Some(&mut rejoin))?;
     let marches = fam2.marches + fam1.marches;
     Ok(Branch { parameter: param, points, stop, marches, period_multiple: 2, label: format!("2T from {name} = {:.7}", pd.parameter) })

@@ -124,4 +124,32 @@ impl PolishedOrbit {
         }
         total
     }
+
+    /// The grid LCP's active set of this orbit on `problem`'s k instants (z indices j·m + i, as
+    /// its solve reports them and [`Self::write`] reads them): a rigid contact's instants whose
+    /// impulse over the step is positive, a compliant one's whose paired clearance is negative.
+    /// A warm start for the grid LCP on this orbit's branch (one period T).
+    pub fn active_set(&self, problem: &crate::periodic::PeriodicProblem) -> Vec<usize> {
+        let (k, m) = (problem.instants(), self.model.contacts.len());
+        let h = self.period / k as f64;
+        let forces = self.all_phase_forces();
+        let mut set = Vec::new();
+        for j in 0..k {
+            let t = j as f64 * h;
+            let impulses = self.force_integrals(&forces, t, t + h);
+            for (i, c) in self.model.contacts.iter().enumerate() {
+                let active = match c.compliance {
+                    Compliance::Rigid => impulses[i] > 0.0,
+                    Compliance::Compliant { .. } => {
+                        let tp = ((j + problem.pairing_at(i).offset()) % k) as f64 * h;
+                        self.clearance(i, &self.state(tp), tp) < 0.0
+                    }
+                };
+                if active {
+                    set.push(j * m + i);
+                }
+            }
+        }
+        set
+    }
 }

@@ -22,14 +22,16 @@ mod pairs;
 mod profile;
 mod rigid;
 mod signature;
+mod start;
 mod steps;
 
 use super::{BranchPoint, ContinuationSettings, EventKind, Parameter, Source, floquet};
 use crate::analysis::polish::{self, EventKind as Switch, PolishedOrbit};
 use crate::error::Error;
-use crate::periodic::{PeriodicProblem, PeriodicSolver};
+use crate::periodic::PeriodicProblem;
 use family::{Family, Node, Signature, lambda_axis};
 use locate::{Test, locate};
+pub(super) use start::{Started, start};
 use steps::StepTrace;
 
 /// A phase shorter than this (fraction of the period) and shrinking has vanished: a grazing.
@@ -83,6 +85,8 @@ pub(super) struct Walked {
     pub reached: bool,
     /// The branch left the range through `from` (turned back): nothing left to do.
     pub turned_back: bool,
+    /// Where it stopped short (not at the point limit): the last point's exact orbit.
+    pub stopped: Option<PolishedOrbit>,
 }
 
 struct Walk<'a> {
@@ -101,6 +105,8 @@ struct Walk<'a> {
     drift: f64,
     /// The point before the current one, for a rigid margin's dip within a step ([`rigid::Behind`]).
     behind: Option<rigid::Behind>,
+    /// [`Walked::stopped`].
+    stopped: Option<PolishedOrbit>,
 }
 
 /// The scenes the exact walk takes: orbits of one forcing period.
@@ -121,17 +127,7 @@ pub(super) fn walk(
     settings: &ContinuationSettings,
     on_point: &dyn Fn(&BranchPoint),
 ) -> Result<Walked, Error> {
-    check(problem)?;
-    let mut start = problem.clone();
-    param.apply(&mut start, from)?;
-    let mut solver = PeriodicSolver::new(start.clone());
-    let r = solver.solve().map_err(|e| Error::from(e).context(format!("the start of the continuation at {} = {from}", param.name())))?;
-    let polished = polish::polish_noted(&start, &r).map_err(|e| Error::solve(format!("no exact orbit at {} = {from}: {e}", param.name())))?;
-    let (mut walk, here) = begin(problem, param, from, to, (to - from).abs(), &polished.orbit)?;
-    // Say how the start's event sequence was had where the grid's did not hold as read.
-    walk.push(&here, None, polished.note);
-    walk.report(on_point);
-    Ok(walk.follow(here, from, to, settings, on_point))
+    Ok(start(problem, param, from, to, (to - from).abs(), None)?.follow(from, to, settings, on_point))
 }
 
 /// The walk's first point: `orbit` (at λ = `from`) closed as a function of the parameter, its
@@ -148,7 +144,7 @@ fn begin<'a>(problem: &'a PeriodicProblem, param: Parameter, from: f64, to: f64,
     let dir = (to - from).signum();
     let prev: Vec<f64> = e_l.iter().map(|x| x * dir).collect();
     let here = fam.node(w0, &prev).ok_or_else(|| Error::solve(format!("singular Jacobian at {} = {from}", param.name())))?;
-    Ok((Walk { problem, fam, points: Vec::new(), stop_at_fold: false, fold: None, end: None, reported: 0, drift: 0.0, behind: None }, here))
+    Ok((Walk { problem, fam, points: Vec::new(), stop_at_fold: false, fold: None, end: None, reported: 0, drift: 0.0, behind: None, stopped: None }, here))
 }
 
 /// Where a front end's step along the exact branch ends ([`step`]).
@@ -252,7 +248,11 @@ impl Walk<'_> {
     ) -> (Walked, Option<f64>, Option<PolishedOrbit>) {
         let done = |mut w: Walk, stop: String, reached: bool, turned_back: bool| {
             w.report(on_point);
-            (Walked { points: w.points, stop, reached, turned_back }, w.fold, w.end)
+            (Walked { points: w.points, stop, reached, turned_back, stopped: w.stopped }, w.fold, w.end)
+        };
+        let short = |mut w: Walk, here: &Node, stop: String| {
+            w.stopped = Some(here.orbit.clone());
+            done(w, stop, false, false)
         };
         let rho = self.fam.rho;
         let dir = (to - from).signum();
@@ -272,12 +272,11 @@ impl Walk<'_> {
             // The step is measured in the metric: the tangent of unit metric length.
             let along = self.fam.metric.unit(&here.tangent);
             let shrinking = signature::shrinking(&self.fam, &here.w, &along);
-            if let Some(&(e, len, rate)) = shrinking.iter().find(|s| s.1 < VANISH) {
+            if let Some(&(e, len, _)) = shrinking.iter().find(|s| s.1 < VANISH) {
                 let (ev, ne) = (self.fam.sig.events[e], self.fam.ne());
                 let end = signature::partner(self.fam.base(), &self.fam.sig.events, e).unwrap_or((e + 1) % ne);
                 let which = format!("contact {}: {:?} → {:?}, {len:.1e} of the period", ev.contact, ev.kind, self.fam.sig.events[end].kind);
                 self.trace_reversed(&here, &which);
-                let _ = rate;
                 let next = if self.rigid_event(e) { self.rigid_vanish(&here, e, to) } else { self.remove_pair(&here, e) };
                 match next {
                     Some(next) if self.ends_here(&next, dir) => return done(self, "a fold at a grazing".into(), false, false),
@@ -288,7 +287,7 @@ impl Walk<'_> {
                     }
                     None => {
                         let stop = format!("a phase of the orbit vanishes at λ = {} ({which}) and the branch could not go on without it", here.lambda(rho));
-                        return done(self, stop, false, false);
+                        return short(self, &here, stop);
                     }
                 }
             }
@@ -365,7 +364,7 @@ impl Walk<'_> {
                     }
                     if ds < settings.min_step {
                         let stop = format!("no exact orbit at {} = {} with the smallest step", self.name(), here.lambda(rho));
-                        return done(self, stop, false, false);
+                        return short(self, &here, stop);
                     }
                     continue;
                 }
@@ -410,7 +409,7 @@ impl Walk<'_> {
                         let what = next.rigid_margin().map_or(String::new(), |m| format!(" (contact {}: the {} reaches zero)", m.contact, m.what));
                         let stop =
                             format!("a change of the rigid contacts' events near λ = {}{what}: the branch past it could not be started", here.lambda(rho));
-                        return done(self, stop, false, false);
+                        return short(self, &here, stop);
                     }
                 }
             }
@@ -440,7 +439,7 @@ impl Walk<'_> {
                         continue;
                     }
                     let stop = format!("a grazing near λ = {}: it could not be located on the arc", here.lambda(rho));
-                    return done(self, stop, false, false);
+                    return short(self, &here, stop);
                 };
                 match self.insert_pair(&here, &lo) {
                     Some(n) => {
@@ -454,7 +453,7 @@ impl Walk<'_> {
                     }
                     None => {
                         let stop = format!("a grazing near λ = {}: the branch with the new contact phase could not be started", here.lambda(rho));
-                        return done(self, stop, false, false);
+                        return short(self, &here, stop);
                     }
                 }
             }
