@@ -619,3 +619,37 @@ fn the_real_blades_period_doubling_is_located_on_the_walk_down() {
     assert!(off < 1e-5, "{} rad/s: the multiplier nearest −1 is {off:e} from it", pd.parameter);
     assert!((1141.3..1141.8).contains(&pd.parameter), "{} rad/s", pd.parameter);
 }
+
+/// Where the scene's grid (k = 1024) gives no exact orbit, the polish takes a finer grid's event
+/// sequence, solved warm from the coarser grid's orbit (polish/repair.rs): the real blade at
+/// Ω = 1215.5 rad/s, where a cold solve at k = 2048 misses and the walk fell back to the discrete
+/// one ("the grid at k = 2048 did not solve"). Reference: the cds LCP at k = 4096 (second order,
+/// reached warm from k = 1024), whose amplitude lies within its discretisation error of the exact one.
+#[test]
+#[ignore = "opt-in: needs examples/real-blade/job (CalculiX matrices, untracked) and ≈ 30 s CPU"]
+fn the_real_blades_walk_starts_exact_where_the_finer_grid_misses_cold() {
+    use periodic_contact::analysis::continuation::Source;
+    use periodic_contact::periodic::{PeriodFft, carried_active_set};
+    use periodic_contact::scene::Scene;
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/real-blade/blade.toml");
+    let (scene, dir) = Scene::load(&path).unwrap();
+    let p = scene.build_in("blade.toml", &dir).unwrap().problem;
+    let settings = ContinuationSettings { max_points: 3, ..ContinuationSettings::default() };
+    let b = continuation::run(&p, Parameter::Speed { lobes: 2 }, 1215.5, 1216.0, &settings, &|_| {}).unwrap();
+    let first = &b.points[0];
+    assert_eq!(first.source, Source::Exact, "{}: {}", first.parameter, b.stop);
+    let exact = first.amplitude.iter().cloned().fold(0.0, f64::max);
+    let mut grid = p.clone();
+    grid.set_frequency(2431.0).unwrap();
+    let coarse = grid.solve().unwrap();
+    let mut disc = grid.discretization();
+    disc.steps = 4096;
+    let mut fine = grid.clone();
+    fine.set_discretization(disc).unwrap();
+    let warm = carried_active_set(&coarse.active_set, p.model().contacts.len(), grid.instants(), fine.instants());
+    let r = fine.solve_with(&PeriodFft::new(fine.instants()), Some(&warm)).unwrap();
+    let half_range = |x: &Vec<f64>| 0.5 * (x.iter().cloned().fold(f64::MIN, f64::max) - x.iter().cloned().fold(f64::MAX, f64::min));
+    let lcp = r.displacement.values().map(half_range).fold(0.0, f64::max);
+    eprintln!("exact {exact:.6e}, cds k = 4096 {lcp:.6e}, relative {:.2e}", (exact - lcp).abs() / lcp);
+    assert!((exact - lcp).abs() <= 1e-3 * lcp, "exact {exact:e} against the k = 4096 grid's {lcp:e}");
+}

@@ -11,7 +11,7 @@
 use super::events::{self, Event};
 use super::{PolishFailure, PolishedOrbit, verify};
 use crate::model::Model;
-use crate::periodic::{PeriodicProblem, PeriodicSolver};
+use crate::periodic::{PeriodFft, PeriodicProblem, PeriodicSolver, carried_active_set};
 use crate::response::Response;
 
 /// A phase of one contact shorter than this (fraction of the period) after a repair is a pair
@@ -42,6 +42,8 @@ pub(super) fn polish_grid(problem: &PeriodicProblem, r: &Response) -> Result<Pol
     let k = r.steps;
     let mut fine = problem.clone();
     let mut steps = 2 * k;
+    // The last grid's active set, carried to the next grid as its warm start.
+    let mut last = (r.active_set.clone(), problem.instants());
     while steps <= FINEST {
         let mut disc = fine.discretization();
         disc.steps = steps;
@@ -49,9 +51,14 @@ pub(super) fn polish_grid(problem: &PeriodicProblem, r: &Response) -> Result<Pol
             break;
         }
         let why = |w: &str| format!("the scene's k = {k} gave an event sequence that is not the orbit's ({}); {w}", first.0);
-        let Ok(finer) = PeriodicSolver::new(fine.clone()).solve() else {
-            return Err(PolishFailure(why(&format!("the grid at k = {steps} did not solve"))));
+        // Warm from the coarser grid's orbit first: the same branch where orbits coexist, and where
+        // a cold solve misses (the real blade at 1215.5 rad/s, k = 2048); cold as before else.
+        let warm = carried_active_set(&last.0, model.contacts.len(), last.1, fine.instants());
+        let solved = fine.solve_with(&PeriodFft::new(fine.instants()), Some(&warm)).or_else(|_| PeriodicSolver::new(fine.clone()).solve());
+        let Ok(finer) = solved else {
+            return Err(PolishFailure(why(&format!("the grid at k = {steps} did not solve, warm from k = {} nor cold", steps / 2))));
         };
+        last = (finer.active_set.clone(), fine.instants());
         if finer.contacts.len() == model.contacts.len()
             && let Ok(p) = from_grid(&fine, &finer)
         {
