@@ -606,10 +606,7 @@ fn multipliers_of_a_bad_monodromy_are_nan() {
 #[ignore = "opt-in: needs examples/real-blade/job (CalculiX matrices, untracked) and ≈ 200 s CPU"]
 fn the_real_blades_period_doubling_is_located_on_the_walk_down() {
     use periodic_contact::analysis::continuation::EventKind;
-    use periodic_contact::scene::Scene;
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/real-blade/blade.toml");
-    let (scene, dir) = Scene::load(&path).unwrap();
-    let p = scene.build_in("blade.toml", &dir).unwrap().problem;
+    let p = real_blade();
     let b = continuation::run(&p, Parameter::Speed { lobes: 2 }, 1150.0, 1140.0, &ContinuationSettings::default(), &|_| {}).unwrap();
     let doublings: Vec<_> = b.events().filter(|e| e.event == Some(EventKind::PeriodDoubling)).collect();
     assert_eq!(doublings.len(), 1, "period doublings: {:?}", doublings.iter().map(|e| (e.parameter, &e.detail)).collect::<Vec<_>>());
@@ -630,10 +627,7 @@ fn the_real_blades_period_doubling_is_located_on_the_walk_down() {
 fn the_real_blades_walk_starts_exact_where_the_finer_grid_misses_cold() {
     use periodic_contact::analysis::continuation::Source;
     use periodic_contact::periodic::{PeriodFft, carried_active_set};
-    use periodic_contact::scene::Scene;
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/real-blade/blade.toml");
-    let (scene, dir) = Scene::load(&path).unwrap();
-    let p = scene.build_in("blade.toml", &dir).unwrap().problem;
+    let p = real_blade();
     let settings = ContinuationSettings { max_points: 3, ..ContinuationSettings::default() };
     let b = continuation::run(&p, Parameter::Speed { lobes: 2 }, 1215.5, 1216.0, &settings, &|_| {}).unwrap();
     let first = &b.points[0];
@@ -652,4 +646,11 @@ fn the_real_blades_walk_starts_exact_where_the_finer_grid_misses_cold() {
     let lcp = r.displacement.values().map(half_range).fold(0.0, f64::max);
     eprintln!("exact {exact:.6e}, cds k = 4096 {lcp:.6e}, relative {:.2e}", (exact - lcp).abs() / lcp);
     assert!((exact - lcp).abs() <= 1e-3 * lcp, "exact {exact:e} against the k = 4096 grid's {lcp:e}");
+}
+
+/// The real-blade benchmark's problem (examples/real-blade/blade.toml: needs its CalculiX job's matrices).
+fn real_blade() -> periodic_contact::periodic::PeriodicProblem {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/real-blade/blade.toml");
+    let (scene, dir) = periodic_contact::scene::Scene::load(&path).unwrap();
+    scene.build_in("blade.toml", &dir).unwrap().problem
 }
