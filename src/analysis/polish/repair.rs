@@ -11,7 +11,7 @@
 use super::events::{self, Event};
 use super::{PolishFailure, PolishedOrbit, verify};
 use crate::model::Model;
-use crate::periodic::{PeriodFft, PeriodicProblem, PeriodicSolver, carried_active_set};
+use crate::periodic::{PeriodicProblem, PeriodicSolver, carried_active_set, carried_state, step_map};
 use crate::response::Response;
 
 /// A phase of one contact shorter than this (fraction of the period) after a repair is a pair
@@ -23,6 +23,9 @@ const REPAIRS: usize = 4;
 /// The finest grid whose event sequence the polish tries (the real blade's LCP there: 139 264
 /// unknowns, ≈ 1 s of shooting).
 const FINEST: usize = 8192;
+/// The largest LCP a rung solves cold after its warm Newton missed: dense Lemke's cheap size
+/// (the LCP policy's `AUTO_LEMKE_MAX`).
+const COLD_MAX: usize = 256;
 
 /// The polished orbit and, when the scene's grid did not give its sequence as read, how it was had.
 pub struct Polished {
@@ -42,8 +45,7 @@ pub(super) fn polish_grid(problem: &PeriodicProblem, r: &Response) -> Result<Pol
     let k = r.steps;
     let mut fine = problem.clone();
     let mut steps = 2 * k;
-    // The last grid's active set, carried to the next grid as its warm start.
-    let mut last = (r.active_set.clone(), problem.instants());
+    let mut coarser = r.clone();
     while steps <= FINEST {
         let mut disc = fine.discretization();
         disc.steps = steps;
@@ -51,23 +53,37 @@ pub(super) fn polish_grid(problem: &PeriodicProblem, r: &Response) -> Result<Pol
             break;
         }
         let why = |w: &str| format!("the scene's k = {k} gave an event sequence that is not the orbit's ({}); {w}", first.0);
-        // Warm from the coarser grid's orbit first: the same branch where orbits coexist, and where
-        // a cold solve misses (the real blade at 1215.5 rad/s, k = 2048); cold as before else.
-        let warm = carried_active_set(&last.0, model.contacts.len(), last.1, fine.instants());
-        let solved = fine.solve_with(&PeriodFft::new(fine.instants()), Some(&warm)).or_else(|_| PeriodicSolver::new(fine.clone()).solve());
-        let Ok(finer) = solved else {
-            return Err(PolishFailure(why(&format!("the grid at k = {steps} did not solve, warm from k = {} nor cold", steps / 2))));
+        let Some(finer) = finer_grid(&fine, &coarser) else {
+            return Err(PolishFailure(why(&format!("the grid at k = {steps} did not solve from the k = {} grid's orbit", steps / 2))));
         };
-        last = (finer.active_set.clone(), fine.instants());
         if finer.contacts.len() == model.contacts.len()
             && let Ok(p) = from_grid(&fine, &finer)
         {
             let how = if p.note.is_empty() { String::new() } else { format!(", {}", p.note) };
             return Ok(Polished { orbit: p.orbit, note: why(&format!("the sequence of the grid at k = {steps}{how}")) });
         }
+        coarser = finer;
         steps *= 2;
     }
     Err(first)
+}
+
+/// The solution of `fine` (twice the grid of `coarser`, its solution): Newton of shooting from
+/// `coarser`'s orbit carried there, the same branch where orbits coexist (the real blade at
+/// 1215.5 rad/s, whose cold k = 2048 solve misses); no cold search nor dense fallback (a 64-DOF
+/// chain at ω = 0.03 rad/s spent 65 s at k = 4096 on those to fail); cold only where the LCP is
+/// small enough for dense Lemke ([`COLD_MAX`]) or the scheme has no step map. `None`: no solution.
+fn finer_grid(fine: &PeriodicProblem, coarser: &Response) -> Option<Response> {
+    let m = fine.model().contacts.len().max(1);
+    let (from, to) = (coarser.lcp.size / m, fine.instants());
+    let mut solver = PeriodicSolver::new(fine.clone());
+    solver.set_warm_start(&carried_active_set(&coarser.active_set, m, from, to));
+    solver.set_warm_state(coarser.orbit_state.as_deref().and_then(|s| carried_state(fine.discretization().scheme, s, from, to)));
+    if let Ok(r) = solver.solve_by_shooting(true) {
+        return Some(r);
+    }
+    let cold_is_cheap = to * m <= COLD_MAX || step_map(fine).is_err();
+    if cold_is_cheap { PeriodicSolver::new(fine.clone()).solve().ok() } else { None }
 }
 
 /// The orbit on the sequence of one grid's solution: as read, else without its near-grazing runs
@@ -161,5 +177,65 @@ fn pruned(model: &Model, mut orbit: PolishedOrbit) -> PolishedOrbit {
             Some(next) => orbit = next,
             None => return orbit,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::{Compliance, Contact, Force, Harmonic, Matrix, Structure};
+    use crate::periodic::{OutputSelection, SolverSettings};
+    use crate::time::{Discretization, Scheme};
+
+    /// A fixed–free chain of `n` unit masses and unit springs, damping 0.02 on the diagonal,
+    /// 0.1 cos ωt on the last DOF against a compliant stop (50, gap 1): the front ends' slow
+    /// re-solve (64 DOFs at ω = 0.0303 rad/s spent 65 s on a cold k = 4096 grid of this ladder).
+    fn chain(n: usize, omega: f64, steps: usize) -> PeriodicProblem {
+        let row = |i: usize, f: &dyn Fn(usize) -> f64| (0..n).map(|j| if j == i { f(i) } else { 0.0 }).collect::<Vec<f64>>();
+        let mass = Matrix::from_rows(&(0..n).map(|i| row(i, &|_| 1.0)).collect::<Vec<_>>());
+        let damping = Matrix::from_rows(&(0..n).map(|i| row(i, &|_| 0.02)).collect::<Vec<_>>());
+        let stiffness: Vec<Vec<f64>> = (0..n)
+            .map(|i| {
+                (0..n)
+                    .map(|j| {
+                        if i == j {
+                            if i + 1 < n { 2.0 } else { 1.0 }
+                        } else if i.abs_diff(j) == 1 {
+                            -1.0
+                        } else {
+                            0.0
+                        }
+                    })
+                    .collect()
+            })
+            .collect();
+        let model = Model {
+            structure: Structure { mass, stiffness: Matrix::from_rows(&stiffness), damping: Some(damping) },
+            forces: vec![Force { dof: n - 1, term: Harmonic { amplitude: 0.1, harmonic: 1, phase: 0.0 } }],
+            contacts: vec![Contact::on_dof(n - 1, 1.0, 1.0, Compliance::Compliant { stiffness: 50.0 })],
+            frequency: omega,
+            frictions: vec![],
+            rubbing: vec![],
+        };
+        let outputs = OutputSelection { displacement: vec![n - 1], velocity: vec![], acceleration: vec![], contacts: true };
+        PeriodicProblem::new(model, Discretization { scheme: Scheme::Bds2, steps, pairing: None }, outputs, SolverSettings::default()).unwrap()
+    }
+
+    #[test]
+    fn a_finer_grid_of_the_ladder_is_one_warm_newton_run_from_the_coarser_orbit() {
+        // Reference: the same grid solved cold.
+        // The rung starts from the coarser grid's orbit: at most one Newton run (30 iterations).
+        let (n, omega) = (16, 0.0303);
+        let coarse = chain(n, omega, 1024);
+        let coarser = PeriodicSolver::new(coarse).solve().unwrap();
+        let fine = chain(n, omega, 2048);
+        let rung = finer_grid(&fine, &coarser).expect("the rung solves from the coarser orbit");
+        let cold = PeriodicSolver::new(fine).solve().unwrap();
+        assert!(rung.lcp.pivots <= 30, "the rung took {} Newton iterations (cold: {})", rung.lcp.pivots, cold.lcp.pivots);
+        let (a, b) = (rung.displacement.values().next().unwrap(), cold.displacement.values().next().unwrap());
+        let scale = b.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+        let diff = a.iter().zip(b).fold(0.0f64, |s, (x, y)| s.max((x - y).abs()));
+        eprintln!("rung {} iterations, cold {}; max difference {diff:.3e} of {scale:.3e}", rung.lcp.pivots, cold.lcp.pivots);
+        assert!(diff <= 1e-8 * scale, "the rung's orbit differs from the cold one by {diff:.3e} (of {scale:.3e})");
     }
 }
