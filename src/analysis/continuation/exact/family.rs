@@ -45,6 +45,58 @@ const CHORD_CONTRACTION: f64 = 0.25;
 /// Central-difference step of the Jacobian (unknowns are O(1)).
 const DIFF: f64 = 1e-7;
 
+/// Why a corrector ([`Family::correct`]) found no solution, at its `iteration` (from 1): each
+/// calls for another cure (a shorter step, a merge, another signature), so the walk's stops name it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum Failure {
+    /// The signature's orbit could not be built at the iterate's λ (a phase's flow or modes).
+    Build { iteration: usize, lambda: f64 },
+    /// The iterate's event times left their order within the period (an event passed its neighbour).
+    Unordered { iteration: usize },
+    /// The shooting residual at the iterate could not be had (a flow or a reset failed) or is not finite.
+    Residual { iteration: usize },
+    /// The Jacobian at the iterate could not be had (its variational flow or the orbits at λ ± h).
+    Jacobian { iteration: usize },
+    /// The bordered Jacobian is singular (no LU solve).
+    Singular { iteration: usize },
+    /// A correction above 1 of the scaled unknowns (or not finite): the predictor outside Newton's basin.
+    Diverged { iteration: usize, correction: f64 },
+    /// [`MAX_ITERATIONS`] spent, the last correction still above the convergence test.
+    Exhausted { correction: f64 },
+}
+
+impl Failure {
+    /// The iteration it failed at (from 1).
+    pub fn iteration(&self) -> usize {
+        match *self {
+            Failure::Build { iteration, .. }
+            | Failure::Unordered { iteration }
+            | Failure::Residual { iteration }
+            | Failure::Jacobian { iteration }
+            | Failure::Singular { iteration }
+            | Failure::Diverged { iteration, .. } => iteration,
+            Failure::Exhausted { .. } => MAX_ITERATIONS,
+        }
+    }
+}
+
+impl std::fmt::Display for Failure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let i = self.iteration();
+        match self {
+            Failure::Build { lambda, .. } => write!(f, "the orbit of the signature could not be built at λ = {lambda} (iteration {i})"),
+            Failure::Unordered { .. } => write!(f, "the event times left their order within the period (iteration {i})"),
+            Failure::Residual { .. } => write!(f, "the shooting residual could not be had or is not finite (iteration {i})"),
+            Failure::Jacobian { .. } => write!(f, "the Jacobian could not be had (iteration {i})"),
+            Failure::Singular { .. } => write!(f, "the bordered Jacobian is singular (iteration {i})"),
+            Failure::Diverged { correction, .. } => {
+                write!(f, "the correction {correction:.1e} of the scaled unknowns exceeds 1 (iteration {i}): the predictor is outside Newton's basin")
+            }
+            Failure::Exhausted { correction } => write!(f, "{i} iterations spent, the last correction {correction:.1e}"),
+        }
+    }
+}
+
 pub(super) struct Family {
     base: Model,
     pub param: Parameter,
@@ -212,6 +264,12 @@ impl Family {
         (y, times)
     }
 
+    /// Whether the event times of `w` increase within one period (the shooting residual's domain).
+    fn ordered(&self, w: &[f64], period: f64) -> bool {
+        let (_, tau) = self.unpack(w, period);
+        self.ne() == 0 || (tau.windows(2).all(|p| p[0] < p[1]) && tau[self.ne() - 1] < tau[0] + period)
+    }
+
     fn residual_with(&self, orbit: &PolishedOrbit, w: &[f64]) -> Option<DVector<f64>> {
         let (y, times) = self.unpack(w, orbit.period());
         let mut r = timed(Stage::Residual, || orbit.shooting_residual(&y, &times))?;
@@ -322,12 +380,12 @@ impl Family {
     /// [`CHORD_CONTRACTION`] or better; fresh Jacobians (Newton) from the first that does not.
     /// One Jacobian costs the variational flow and two orbits rebuilt at λ ± h, a chord
     /// iteration one residual: on the coarse blade a step's Jacobians were most of its cost.
-    pub fn correct(&self, pred: &[f64], normal: &[f64], target: f64) -> Option<Vec<f64>> {
+    pub fn correct(&self, pred: &[f64], normal: &[f64], target: f64) -> Result<Vec<f64>, Failure> {
         let chord = self.chord.borrow().as_ref().filter(|c| c.key == self.key()).map(|c| c.jacobian.clone());
         if chord.is_some()
-            && let Some(w) = timed(Stage::Chord, || self.newton(pred, normal, target, chord))
+            && let Ok(w) = timed(Stage::Chord, || self.newton(pred, normal, target, chord))
         {
-            return Some(w);
+            return Ok(w);
         }
         timed(Stage::Newton, || self.newton(pred, normal, target, None))
     }
@@ -350,7 +408,23 @@ impl Family {
         (rest < ATTAINABLE).then_some(p - self.n2)
     }
 
-    fn newton(&self, pred: &[f64], normal: &[f64], target: f64, mut chord: Option<DMatrix<f64>>) -> Option<Vec<f64>> {
+    fn newton(&self, pred: &[f64], normal: &[f64], target: f64, chord: Option<DMatrix<f64>>) -> Result<Vec<f64>, Failure> {
+        let fresh = chord.is_none();
+        let mut corrections = Vec::new();
+        let start = super::profile::newton_clock();
+        let out = self.newton_with(pred, normal, target, chord, &mut corrections);
+        super::profile::newton_call(fresh, &out, &corrections, start);
+        out
+    }
+
+    fn newton_with(
+        &self,
+        pred: &[f64],
+        normal: &[f64],
+        target: f64,
+        mut chord: Option<DMatrix<f64>>,
+        corrections: &mut Vec<(f64, bool)>,
+    ) -> Result<Vec<f64>, Failure> {
         let d = self.dim();
         let mut w = pred.to_vec();
         let mut last = f64::INFINITY;
@@ -365,14 +439,17 @@ impl Family {
             }
             a.lu()
         };
-        for _ in 0..MAX_ITERATIONS {
-            let here = self.orbit(w[d - 1] * self.rho)?;
-            let f = self.residual_with(&here, &w)?;
+        for iteration in 1..=MAX_ITERATIONS {
+            let lambda = w[d - 1] * self.rho;
+            let here = self.orbit(lambda).ok_or(Failure::Build { iteration, lambda })?;
+            let f = self
+                .residual_with(&here, &w)
+                .ok_or_else(|| if self.ordered(&w, here.period()) { Failure::Residual { iteration } } else { Failure::Unordered { iteration } })?;
             let fresh = chord.is_none();
             let (jac, lu) = match &chord {
                 Some(j) => (None, &*chord_lu.get_or_insert_with(|| bordered(j))),
                 None => {
-                    let jac = self.jacobian_at(&here, &w)?;
+                    let jac = self.jacobian_at(&here, &w).ok_or(Failure::Jacobian { iteration })?;
                     let lu = bordered(&jac);
                     (Some(jac), &*chord_lu.insert(lu))
                 }
@@ -380,12 +457,13 @@ impl Family {
             let mut rhs = DVector::zeros(d);
             rhs.rows_mut(0, d - 1).copy_from(&(-&f));
             rhs[d - 1] = target - normal.iter().zip(&w).map(|(n, x)| n * x).sum::<f64>();
-            let dw = lu.solve(&rhs)?;
+            let dw = lu.solve(&rhs).ok_or(Failure::Singular { iteration })?;
             self.unresolved.set(self.unresolved_in(&dw));
             w.iter_mut().zip(dw.iter()).for_each(|(x, s)| *x += s);
             let step = dw.amax();
+            corrections.push((step, fresh));
             if !step.is_finite() || step > 1.0 {
-                return None;
+                return Err(Failure::Diverged { iteration, correction: step });
             }
             // A chord step is exact to Θ/(1 − Θ) of itself: CONVERGED holds it below 1e-10/3.
             if step < CONVERGED || (step < ATTAINABLE && step >= last && f.amax() < NOISE_DEFECT) {
@@ -394,7 +472,7 @@ impl Family {
                     self.last_jacobian.replace(Some((w.clone(), jac)));
                 }
                 self.unresolved.set(None);
-                return Some(w);
+                return Ok(w);
             }
             if !fresh && step > CHORD_CONTRACTION * last && step >= ATTAINABLE {
                 chord = None;
@@ -404,7 +482,7 @@ impl Family {
             }
             last = step;
         }
-        None
+        Err(Failure::Exhausted { correction: last })
     }
 
     /// What a Jacobian depends on besides w: the signature and the state scale.
