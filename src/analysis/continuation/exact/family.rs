@@ -16,6 +16,9 @@ use nalgebra::{DMatrix, DVector, Dyn, LU};
 use num_complex::Complex64;
 use std::rc::Rc;
 
+mod failure;
+pub(super) use failure::Failure;
+
 /// The event signature: the events in time order (their seeds unused) and the contacts closed
 /// all period long.
 #[derive(Clone, Debug)]
@@ -42,60 +45,16 @@ const NOISE_DEFECT: f64 = 1e-9;
 const MAX_ITERATIONS: usize = 12;
 /// Chord iterations go on while each correction is at most this fraction of the one before.
 const CHORD_CONTRACTION: f64 = 0.25;
+/// A search's trial ([`Family::correct_trial`]) has stalled when its fresh-Jacobian corrections
+/// stop decreasing: from the [`STALL_FROM`]th on, one no smaller than the one two before and above
+/// [`STALL_FLOOR`]. On the coarse rigid walk the landing searches' trials near a singular orbit
+/// (2398.88 rad/s) hovered at 1e-6 to 1e-3 for all 12 iterations, chord and fresh runs alike (2.9 s
+/// of 23 s); no trial that converged meets the test there, so the walk is the same bit for bit. The
+/// walk's steps are not tested: there a stall then recovers (validation/RECORD.md, session 36).
+const STALL_FROM: usize = 5;
+const STALL_FLOOR: f64 = 1e-5;
 /// Central-difference step of the Jacobian (unknowns are O(1)).
 const DIFF: f64 = 1e-7;
-
-/// Why a corrector ([`Family::correct`]) found no solution, at its `iteration` (from 1): each
-/// calls for another cure (a shorter step, a merge, another signature), so the walk's stops name it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) enum Failure {
-    /// The signature's orbit could not be built at the iterate's λ (a phase's flow or modes).
-    Build { iteration: usize, lambda: f64 },
-    /// The iterate's event times left their order within the period (an event passed its neighbour).
-    Unordered { iteration: usize },
-    /// The shooting residual at the iterate could not be had (a flow or a reset failed) or is not finite.
-    Residual { iteration: usize },
-    /// The Jacobian at the iterate could not be had (its variational flow or the orbits at λ ± h).
-    Jacobian { iteration: usize },
-    /// The bordered Jacobian is singular (no LU solve).
-    Singular { iteration: usize },
-    /// A correction above 1 of the scaled unknowns (or not finite): the predictor outside Newton's basin.
-    Diverged { iteration: usize, correction: f64 },
-    /// [`MAX_ITERATIONS`] spent, the last correction still above the convergence test.
-    Exhausted { correction: f64 },
-}
-
-impl Failure {
-    /// The iteration it failed at (from 1).
-    pub fn iteration(&self) -> usize {
-        match *self {
-            Failure::Build { iteration, .. }
-            | Failure::Unordered { iteration }
-            | Failure::Residual { iteration }
-            | Failure::Jacobian { iteration }
-            | Failure::Singular { iteration }
-            | Failure::Diverged { iteration, .. } => iteration,
-            Failure::Exhausted { .. } => MAX_ITERATIONS,
-        }
-    }
-}
-
-impl std::fmt::Display for Failure {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let i = self.iteration();
-        match self {
-            Failure::Build { lambda, .. } => write!(f, "the orbit of the signature could not be built at λ = {lambda} (iteration {i})"),
-            Failure::Unordered { .. } => write!(f, "the event times left their order within the period (iteration {i})"),
-            Failure::Residual { .. } => write!(f, "the shooting residual could not be had or is not finite (iteration {i})"),
-            Failure::Jacobian { .. } => write!(f, "the Jacobian could not be had (iteration {i})"),
-            Failure::Singular { .. } => write!(f, "the bordered Jacobian is singular (iteration {i})"),
-            Failure::Diverged { correction, .. } => {
-                write!(f, "the correction {correction:.1e} of the scaled unknowns exceeds 1 (iteration {i}): the predictor is outside Newton's basin")
-            }
-            Failure::Exhausted { correction } => write!(f, "{i} iterations spent, the last correction {correction:.1e}"),
-        }
-    }
-}
 
 pub(super) struct Family {
     base: Model,
@@ -381,13 +340,23 @@ impl Family {
     /// One Jacobian costs the variational flow and two orbits rebuilt at λ ± h, a chord
     /// iteration one residual: on the coarse blade a step's Jacobians were most of its cost.
     pub fn correct(&self, pred: &[f64], normal: &[f64], target: f64) -> Result<Vec<f64>, Failure> {
+        self.correct_with(pred, normal, target, false)
+    }
+
+    /// [`Self::correct`] for a search's trial, which its caller moves when it fails: failing
+    /// too where the corrections stall ([`Failure::Stalled`]).
+    pub fn correct_trial(&self, pred: &[f64], normal: &[f64], target: f64) -> Result<Vec<f64>, Failure> {
+        self.correct_with(pred, normal, target, true)
+    }
+
+    fn correct_with(&self, pred: &[f64], normal: &[f64], target: f64, stall: bool) -> Result<Vec<f64>, Failure> {
         let chord = self.chord.borrow().as_ref().filter(|c| c.key == self.key()).map(|c| c.jacobian.clone());
         if chord.is_some()
-            && let Ok(w) = timed(Stage::Chord, || self.newton(pred, normal, target, chord))
+            && let Ok(w) = timed(Stage::Chord, || self.newton(pred, normal, target, chord, stall))
         {
             return Ok(w);
         }
-        timed(Stage::Newton, || self.newton(pred, normal, target, None))
+        timed(Stage::Newton, || self.newton(pred, normal, target, None, stall))
     }
 
     /// The flight (its phase, from a pure impact to a re-impact of one contact with mass) whose
@@ -408,11 +377,11 @@ impl Family {
         (rest < ATTAINABLE).then_some(p - self.n2)
     }
 
-    fn newton(&self, pred: &[f64], normal: &[f64], target: f64, chord: Option<DMatrix<f64>>) -> Result<Vec<f64>, Failure> {
+    fn newton(&self, pred: &[f64], normal: &[f64], target: f64, chord: Option<DMatrix<f64>>, stall: bool) -> Result<Vec<f64>, Failure> {
         let fresh = chord.is_none();
         let mut corrections = Vec::new();
         let start = super::profile::newton_clock();
-        let out = self.newton_with(pred, normal, target, chord, &mut corrections);
+        let out = self.newton_with(pred, normal, target, (chord, stall), &mut corrections);
         super::profile::newton_call(fresh, &out, &corrections, start);
         out
     }
@@ -422,12 +391,14 @@ impl Family {
         pred: &[f64],
         normal: &[f64],
         target: f64,
-        mut chord: Option<DMatrix<f64>>,
+        (mut chord, stall): (Option<DMatrix<f64>>, bool),
         corrections: &mut Vec<(f64, bool)>,
     ) -> Result<Vec<f64>, Failure> {
         let d = self.dim();
         let mut w = pred.to_vec();
         let mut last = f64::INFINITY;
+        // The corrections of the iterations with fresh Jacobians, for the stall test.
+        let mut newton_steps: Vec<f64> = Vec::new();
         self.unresolved.set(None);
         // The chord's bordered matrix is the same at every chord iteration: factorised once.
         let mut chord_lu: Option<LU<f64, Dyn, Dyn>> = None;
@@ -473,6 +444,13 @@ impl Family {
                 }
                 self.unresolved.set(None);
                 return Ok(w);
+            }
+            if stall && fresh {
+                newton_steps.push(step);
+                let k = newton_steps.len();
+                if k >= STALL_FROM && step >= newton_steps[k - 3] && step >= STALL_FLOOR {
+                    return Err(Failure::Stalled { iteration, correction: step });
+                }
             }
             if !fresh && step > CHORD_CONTRACTION * last && step >= ATTAINABLE {
                 chord = None;

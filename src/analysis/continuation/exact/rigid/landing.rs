@@ -55,7 +55,7 @@ fn landing_zero_in(fam: &Family, from: &[f64], e: usize, (la, lb): (f64, f64), s
     let at = |w0: &[f64], lambda: f64| -> Option<(Vec<f64>, f64)> {
         let mut g = w0.to_vec();
         g[d - 1] = lambda / rho;
-        let w = profile::caller("landing", (lambda / rho - w0[d - 1]).abs(), || fam.correct(&g, &e_l, lambda / rho)).ok()?;
+        let w = profile::caller("landing", (lambda / rho - w0[d - 1]).abs(), || fam.correct_trial(&g, &e_l, lambda / rho)).ok()?;
         let n = fam.trial_node(w, &e_l)?;
         let h = n.orbit.landing_force(e)?;
         trace(format_args!("landing zero: λ {lambda:.13}, force {h:e} of the scale"));
