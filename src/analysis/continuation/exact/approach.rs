@@ -57,7 +57,7 @@ impl Walk<'_> {
         let wrap = if b <= e { 1.0 } else { 0.0 };
         let h = (len - LANDING) / rate;
         let pred: Vec<f64> = here.w.iter().zip(along).map(|(w, t)| w + h * t).collect();
-        let w = self.fam.correct(&pred, &normal, LANDING - wrap)?;
+        let w = super::profile::caller("land", h, || self.fam.correct(&pred, &normal, LANDING - wrap)).ok()?;
         let n = self.fam.node_with(w, along, false)?;
         let metric = &self.fam.metric;
         let drift = metric.norm(&n.w.iter().zip(&pred).map(|(a, b)| a - b).collect::<Vec<_>>());

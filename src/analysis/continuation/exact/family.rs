@@ -16,6 +16,9 @@ use nalgebra::{DMatrix, DVector, Dyn, LU};
 use num_complex::Complex64;
 use std::rc::Rc;
 
+mod failure;
+pub(super) use failure::Failure;
+
 /// The event signature: the events in time order (their seeds unused) and the contacts closed
 /// all period long.
 #[derive(Clone, Debug)]
@@ -42,6 +45,14 @@ const NOISE_DEFECT: f64 = 1e-9;
 const MAX_ITERATIONS: usize = 12;
 /// Chord iterations go on while each correction is at most this fraction of the one before.
 const CHORD_CONTRACTION: f64 = 0.25;
+/// A search's trial ([`Family::correct_trial`]) has stalled when its fresh-Jacobian corrections
+/// stop decreasing: from the [`STALL_FROM`]th on, one no smaller than the one two before and above
+/// [`STALL_FLOOR`]. On the coarse rigid walk the landing searches' trials near a singular orbit
+/// (2398.88 rad/s) hovered at 1e-6 to 1e-3 for all 12 iterations, chord and fresh runs alike (2.9 s
+/// of 23 s); no trial that converged meets the test there, so the walk is the same bit for bit. The
+/// walk's steps are not tested: there a stall then recovers (validation/RECORD.md, session 36).
+const STALL_FROM: usize = 5;
+const STALL_FLOOR: f64 = 1e-5;
 /// Central-difference step of the Jacobian (unknowns are O(1)).
 const DIFF: f64 = 1e-7;
 
@@ -212,6 +223,12 @@ impl Family {
         (y, times)
     }
 
+    /// Whether the event times of `w` increase within one period (the shooting residual's domain).
+    fn ordered(&self, w: &[f64], period: f64) -> bool {
+        let (_, tau) = self.unpack(w, period);
+        self.ne() == 0 || (tau.windows(2).all(|p| p[0] < p[1]) && tau[self.ne() - 1] < tau[0] + period)
+    }
+
     fn residual_with(&self, orbit: &PolishedOrbit, w: &[f64]) -> Option<DVector<f64>> {
         let (y, times) = self.unpack(w, orbit.period());
         let mut r = timed(Stage::Residual, || orbit.shooting_residual(&y, &times))?;
@@ -322,14 +339,24 @@ impl Family {
     /// [`CHORD_CONTRACTION`] or better; fresh Jacobians (Newton) from the first that does not.
     /// One Jacobian costs the variational flow and two orbits rebuilt at λ ± h, a chord
     /// iteration one residual: on the coarse blade a step's Jacobians were most of its cost.
-    pub fn correct(&self, pred: &[f64], normal: &[f64], target: f64) -> Option<Vec<f64>> {
+    pub fn correct(&self, pred: &[f64], normal: &[f64], target: f64) -> Result<Vec<f64>, Failure> {
+        self.correct_with(pred, normal, target, false)
+    }
+
+    /// [`Self::correct`] for a search's trial, which its caller moves when it fails: failing
+    /// too where the corrections stall ([`Failure::Stalled`]).
+    pub fn correct_trial(&self, pred: &[f64], normal: &[f64], target: f64) -> Result<Vec<f64>, Failure> {
+        self.correct_with(pred, normal, target, true)
+    }
+
+    fn correct_with(&self, pred: &[f64], normal: &[f64], target: f64, stall: bool) -> Result<Vec<f64>, Failure> {
         let chord = self.chord.borrow().as_ref().filter(|c| c.key == self.key()).map(|c| c.jacobian.clone());
         if chord.is_some()
-            && let Some(w) = timed(Stage::Chord, || self.newton(pred, normal, target, chord))
+            && let Ok(w) = timed(Stage::Chord, || self.newton(pred, normal, target, chord, stall))
         {
-            return Some(w);
+            return Ok(w);
         }
-        timed(Stage::Newton, || self.newton(pred, normal, target, None))
+        timed(Stage::Newton, || self.newton(pred, normal, target, None, stall))
     }
 
     /// The flight (its phase, from a pure impact to a re-impact of one contact with mass) whose
@@ -350,10 +377,28 @@ impl Family {
         (rest < ATTAINABLE).then_some(p - self.n2)
     }
 
-    fn newton(&self, pred: &[f64], normal: &[f64], target: f64, mut chord: Option<DMatrix<f64>>) -> Option<Vec<f64>> {
+    fn newton(&self, pred: &[f64], normal: &[f64], target: f64, chord: Option<DMatrix<f64>>, stall: bool) -> Result<Vec<f64>, Failure> {
+        let fresh = chord.is_none();
+        let mut corrections = Vec::new();
+        let start = super::profile::newton_clock();
+        let out = self.newton_with(pred, normal, target, (chord, stall), &mut corrections);
+        super::profile::newton_call(fresh, &out, &corrections, start);
+        out
+    }
+
+    fn newton_with(
+        &self,
+        pred: &[f64],
+        normal: &[f64],
+        target: f64,
+        (mut chord, stall): (Option<DMatrix<f64>>, bool),
+        corrections: &mut Vec<(f64, bool)>,
+    ) -> Result<Vec<f64>, Failure> {
         let d = self.dim();
         let mut w = pred.to_vec();
         let mut last = f64::INFINITY;
+        // The corrections of the iterations with fresh Jacobians, for the stall test.
+        let mut newton_steps: Vec<f64> = Vec::new();
         self.unresolved.set(None);
         // The chord's bordered matrix is the same at every chord iteration: factorised once.
         let mut chord_lu: Option<LU<f64, Dyn, Dyn>> = None;
@@ -365,14 +410,17 @@ impl Family {
             }
             a.lu()
         };
-        for _ in 0..MAX_ITERATIONS {
-            let here = self.orbit(w[d - 1] * self.rho)?;
-            let f = self.residual_with(&here, &w)?;
+        for iteration in 1..=MAX_ITERATIONS {
+            let lambda = w[d - 1] * self.rho;
+            let here = self.orbit(lambda).ok_or(Failure::Build { iteration, lambda })?;
+            let f = self
+                .residual_with(&here, &w)
+                .ok_or_else(|| if self.ordered(&w, here.period()) { Failure::Residual { iteration } } else { Failure::Unordered { iteration } })?;
             let fresh = chord.is_none();
             let (jac, lu) = match &chord {
                 Some(j) => (None, &*chord_lu.get_or_insert_with(|| bordered(j))),
                 None => {
-                    let jac = self.jacobian_at(&here, &w)?;
+                    let jac = self.jacobian_at(&here, &w).ok_or(Failure::Jacobian { iteration })?;
                     let lu = bordered(&jac);
                     (Some(jac), &*chord_lu.insert(lu))
                 }
@@ -380,12 +428,13 @@ impl Family {
             let mut rhs = DVector::zeros(d);
             rhs.rows_mut(0, d - 1).copy_from(&(-&f));
             rhs[d - 1] = target - normal.iter().zip(&w).map(|(n, x)| n * x).sum::<f64>();
-            let dw = lu.solve(&rhs)?;
+            let dw = lu.solve(&rhs).ok_or(Failure::Singular { iteration })?;
             self.unresolved.set(self.unresolved_in(&dw));
             w.iter_mut().zip(dw.iter()).for_each(|(x, s)| *x += s);
             let step = dw.amax();
+            corrections.push((step, fresh));
             if !step.is_finite() || step > 1.0 {
-                return None;
+                return Err(Failure::Diverged { iteration, correction: step });
             }
             // A chord step is exact to Θ/(1 − Θ) of itself: CONVERGED holds it below 1e-10/3.
             if step < CONVERGED || (step < ATTAINABLE && step >= last && f.amax() < NOISE_DEFECT) {
@@ -394,7 +443,14 @@ impl Family {
                     self.last_jacobian.replace(Some((w.clone(), jac)));
                 }
                 self.unresolved.set(None);
-                return Some(w);
+                return Ok(w);
+            }
+            if stall && fresh {
+                newton_steps.push(step);
+                let k = newton_steps.len();
+                if k >= STALL_FROM && step >= newton_steps[k - 3] && step >= STALL_FLOOR {
+                    return Err(Failure::Stalled { iteration, correction: step });
+                }
             }
             if !fresh && step > CHORD_CONTRACTION * last && step >= ATTAINABLE {
                 chord = None;
@@ -404,7 +460,7 @@ impl Family {
             }
             last = step;
         }
-        None
+        Err(Failure::Exhausted { correction: last })
     }
 
     /// What a Jacobian depends on besides w: the signature and the state scale.

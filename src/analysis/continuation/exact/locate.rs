@@ -79,7 +79,7 @@ fn locate_on(fam: &Family, a: &Node, b: &Node, test: &Test, touches: bool) -> Op
         let s = (u - bracket.lo.u) / bracket.len();
         let pred: Vec<f64> = lo.w.iter().zip(&hi.w).map(|(x, y)| x + s * (y - x)).collect();
         let trial = || {
-            let w = fam.correct(&pred, &normal, origin + u)?;
+            let w = profile::caller("bisect", (u - bracket.lo.u).abs(), || fam.correct(&pred, &normal, origin + u)).ok()?;
             if orbit_only { fam.orbit_node(w, &lo.tangent, touches) } else { fam.node_with(w, &lo.tangent, touches) }
         };
         // A bracket within the corrector's accuracy is the event: the coarse blade's fold at

@@ -140,7 +140,7 @@ fn begin<'a>(problem: &'a PeriodicProblem, param: Parameter, from: f64, to: f64,
     let e_l = lambda_axis(d);
     let w0 = fam
         .correct(&fam.pack(orbit, from), &e_l, from / rho)
-        .ok_or_else(|| Error::solve(format!("the polished orbit at {} = {from} did not close as a function of the parameter", param.name())))?;
+        .map_err(|why| Error::solve(format!("the polished orbit at {} = {from} did not close as a function of the parameter ({why})", param.name())))?;
     let dir = (to - from).signum();
     let prev: Vec<f64> = e_l.iter().map(|x| x * dir).collect();
     let here = fam.node(w0, &prev).ok_or_else(|| Error::solve(format!("singular Jacobian at {} = {from}", param.name())))?;
@@ -311,16 +311,16 @@ impl Walk<'_> {
             let tried = match landed {
                 Some((n, s)) => {
                     step = s;
-                    Some((n, None))
+                    Ok((n, None))
                 }
                 None => {
                     let pred: Vec<f64> = here.w.iter().zip(&along).map(|(w, t)| w + step * t).collect();
                     // Events that may pass each other did: the same step in their new order (not a change);
                     // the corrector may cross a close pair the predictor did not, or the reverse: then the
                     // pair's order toggled.
-                    self.try_step(&here, pred.clone(), step, settings.min_step).or_else(|| {
+                    self.try_step(&here, pred.clone(), step, settings.min_step).or_else(|first| {
                         self.fam.sig = old.clone();
-                        let toggled = signature::toggled(&self.fam, self.problem.model(), &here.w, &pred)?;
+                        let toggled = signature::toggled(&self.fam, self.problem.model(), &here.w, &pred).ok_or(first)?;
                         self.try_step(&here, toggled, step, settings.min_step)
                     })
                 }
@@ -331,13 +331,13 @@ impl Walk<'_> {
             // at 1200.86 rad/s, "−9.3e-1 of the period"; validation/RECORD.md).
             let mut origin = None;
             let next = match tried {
-                Some((n, moved)) => {
+                Ok((n, moved)) => {
                     if let Some(m) = moved {
                         origin = Some((std::mem::replace(&mut here, m), old));
                     }
                     n
                 }
-                None => {
+                Err(refused) => {
                     self.fam.sig = old;
                     // Right after a change, by quarters: the failures of the first step after a
                     // pair's insertion run from `initial_step` to ≈ 1e-5, the new phase's length.
@@ -363,7 +363,7 @@ impl Walk<'_> {
                         continue;
                     }
                     if ds < settings.min_step {
-                        let stop = format!("no exact orbit at {} = {} with the smallest step", self.name(), here.lambda(rho));
+                        let stop = format!("no exact orbit at {} = {} with the smallest step ({refused})", self.name(), here.lambda(rho));
                         return short(self, &here, stop);
                     }
                     continue;
@@ -380,7 +380,10 @@ impl Walk<'_> {
                 let pred: Vec<f64> = w0.iter().zip(&next.w).map(|(a, b)| a + f * (b - a)).collect();
                 let d = self.fam.dim();
                 let e_l = lambda_axis(d);
-                self.fam.correct(&pred, &e_l, bound / rho).and_then(|w| self.fam.node_with(w, &next.tangent, false)).unwrap_or(next)
+                profile::caller("bound", f64::NAN, || self.fam.correct(&pred, &e_l, bound / rho))
+                    .ok()
+                    .and_then(|w| self.fam.node_with(w, &next.tangent, false))
+                    .unwrap_or(next)
             } else {
                 next
             };
@@ -514,30 +517,6 @@ impl Walk<'_> {
         node.tangent[..n2].iter_mut().for_each(|t| *t /= scale);
         let norm = node.tangent.iter().map(|t| t * t).sum::<f64>().sqrt();
         node.tangent.iter_mut().for_each(|t| *t /= norm);
-    }
-
-    /// The step from `here` to the predictor `pred` ([`Self::pass`] first): the corrected point
-    /// and `here` re-expressed in a new order of its events, when the successive tangents are
-    /// within arccos [`MIN_COS`] (or the step is the smallest) and the point within [`MAX_DRIFT`]
-    /// steps of the predictor.
-    fn try_step(&mut self, here: &Node, pred: Vec<f64>, step: f64, min_step: f64) -> Option<(Node, Option<Node>)> {
-        let (pred, passed) = self.pass(here, pred);
-        let metric = &self.fam.metric;
-        // The metric weighs the event times alike: re-ordering them keeps the tangent a unit one.
-        let along = metric.unit(passed.as_ref().map_or(&here.tangent, |p| &p.tangent));
-        let normal = metric.lower(&along);
-        let target = dot(&normal, &pred);
-        // Oriented in the metric too ([`Family::tangent`]).
-        let n = self.fam.correct(&pred, &normal, target).and_then(|w| self.fam.node_with(w, &along, false))?;
-        let metric = &self.fam.metric;
-        let drift = metric.norm(&n.w.iter().zip(&pred).map(|(a, b)| a - b).collect::<Vec<_>>());
-        let turn = metric.dot(&metric.unit(&n.tangent), &along);
-        self.drift = drift / step;
-        ((turn >= MIN_COS || step <= min_step)
-            && drift <= MAX_DRIFT * step
-            && !signature::reversed(&self.fam, &n.w)
-            && !signature::collapsed(&self.fam, &pred, &n.w))
-        .then_some((n, passed))
     }
 
     /// A step retried shorter starts again from its own start and signature (`origin`, where a

@@ -23,7 +23,7 @@ impl Walk<'_> {
         self.fam.sig = sig;
         let d = self.fam.dim();
         let e_l = lambda_axis(d);
-        let w = self.fam.correct(&guess, &e_l, here.lambda(rho) / rho)?;
+        let w = super::profile::caller("pair", f64::NAN, || self.fam.correct(&guess, &e_l, here.lambda(rho) / rho)).ok()?;
         let sign = here.tangent[here.tangent.len() - 1].signum();
         let prev: Vec<f64> = e_l.iter().map(|x| x * if sign == 0.0 { 1.0 } else { sign }).collect();
         self.fam.node(w, &prev)
@@ -68,11 +68,11 @@ impl Walk<'_> {
         let wrap = if ib < ia { 1.0 } else { 0.0 };
         let mut g = guess.to_vec();
         g[n2 + ib] = g[n2 + ia] + len - wrap;
-        let first = self.fam.correct(&g, &normal, len - wrap).and_then(|w1| {
+        let first = super::profile::caller("pair", f64::NAN, || self.fam.correct(&g, &normal, len - wrap)).ok().and_then(|w1| {
             let mut g2 = w1.clone();
             g2[n2 + ia] -= 0.5 * len;
             g2[n2 + ib] += 0.5 * len;
-            let w2 = self.fam.correct(&g2, &normal, 2.0 * len - wrap)?;
+            let w2 = self.fam.correct(&g2, &normal, 2.0 * len - wrap).ok()?;
             let sec: Vec<f64> = w2.iter().zip(&w1).map(|(a, b)| a - b).collect();
             self.fam.node(w1, &sec)
         });

@@ -234,7 +234,11 @@ impl Walk<'_> {
             let l = lo.lambda(rho) + sense * f * rho;
             let mut g = lo.w.clone();
             g[d - 1] = l / rho;
-            let Some(merged) = self.fam.correct(&g, &e_l, l / rho).and_then(|w| self.fam.node_with(w, &e_l, false)) else { continue };
+            let Some(merged) =
+                super::profile::caller("unmerge", f, || self.fam.correct(&g, &e_l, l / rho)).ok().and_then(|w| self.fam.node_with(w, &e_l, false))
+            else {
+                continue;
+            };
             let (o, t) = (&merged.orbit, merged.orbit.period());
             let ne = o.times().len();
             let arc = if e + 1 < ne { o.times()[e + 1] - o.times()[e] } else { o.times()[0] + t - o.times()[e] };
@@ -254,7 +258,7 @@ impl Walk<'_> {
             let mut e_l1 = vec![0.0; guess.len()];
             e_l1[guess.len() - 1] = 1.0;
             let prev1: Vec<f64> = e_l1.iter().map(|x| x * sense).collect();
-            let first = self.fam.correct(&guess, &e_l1, l / rho).and_then(|w| self.fam.node(w, &prev1));
+            let first = super::profile::caller("unmerge", f, || self.fam.correct(&guess, &e_l1, l / rho)).ok().and_then(|w| self.fam.node(w, &prev1));
             trace(format_args!("unmerge: corrected {}, margin {:?}", first.is_some(), first.as_ref().map(margin)));
             match first {
                 Some(n) if margin(&n) >= -TOL => {
@@ -365,7 +369,7 @@ impl Walk<'_> {
         let d = self.fam.dim();
         let e_l = lambda_axis(d);
         let sense = at.tangent[at.tangent.len() - 1].signum();
-        let corrected = self.fam.correct(&guess, &e_l, lambda / rho);
+        let corrected = super::profile::caller("restart", f64::NAN, || self.fam.correct(&guess, &e_l, lambda / rho)).ok();
         trace(format_args!(
             "restart at λ {lambda:.10}: {before} -> {} events, corrected at λ fixed: {}, margin there {:?}",
             self.fam.ne(),
@@ -386,7 +390,9 @@ impl Walk<'_> {
                 let admissible = TRIAL.iter().any(|step| {
                     let pred: Vec<f64> = n.w.iter().zip(&n.tangent).map(|(w, t)| w + step * t).collect();
                     let target: f64 = n.tangent.iter().zip(&pred).map(|(t, p)| t * p).sum();
-                    let trial = self.fam.correct(&pred, &n.tangent, target).and_then(|w| self.fam.node_with(w, &n.tangent, false));
+                    let trial = super::profile::caller("restart", f64::NAN, || self.fam.correct(&pred, &n.tangent, target))
+                        .ok()
+                        .and_then(|w| self.fam.node_with(w, &n.tangent, false));
                     trace(format_args!(
                         "restart: sense {s}, trial {step:e}: λ {:?}, margin {:?}",
                         trial.as_ref().map(|t| t.lambda(rho)),
@@ -521,7 +527,8 @@ impl Walk<'_> {
             let d = self.fam.dim();
             let e_l = lambda_axis(d);
             let prev: Vec<f64> = e_l.iter().map(|x| x * sense).collect();
-            let node = self.fam.correct(&self.fam.pack(&orbit, l), &e_l, l / rho).and_then(|w| self.fam.node(w, &prev));
+            let node =
+                super::profile::caller("reseed", f, || self.fam.correct(&self.fam.pack(&orbit, l), &e_l, l / rho)).ok().and_then(|w| self.fam.node(w, &prev));
             trace(format_args!(
                 "reseed at λ {l}: {} events, corrected {}, margin {:?}",
                 self.fam.ne(),

@@ -1,5 +1,5 @@
 //! The family's tests and the exact walk's small test models.
-use super::{Family, Signature, lambda_axis};
+use super::{Failure, Family, Signature, lambda_axis};
 use crate::analysis::continuation::Parameter;
 use crate::analysis::polish;
 use crate::model::{Compliance, Contact, Force, Harmonic, Matrix, Model, Structure};
@@ -85,4 +85,32 @@ fn a_tangent_keeps_the_walks_sense_in_the_metric() {
     eprintln!("tangent vs the closed form's secant: cos {cos:.9} in the metric, λ component {:e}", t[d - 1]);
     assert!(cos > 1.0 - 1e-6, "the tangent points against (or off) the closed form's branch: cos {cos}");
     assert!(t[d - 1] > 0.0, "λ increases along the branch here");
+}
+
+/// A corrector's failure names its cause: on the contact-free tipped oscillator at Ω fixed the
+/// shooting residual is affine in the state, so Newton's first correction is the predictor's
+/// error itself, known from the closed-form orbit. A predictor 2 (scaled unknowns) off in the
+/// first displacement fails at iteration 1 as diverged with that correction (Newton's basin is
+/// capped at 1); one 0.5 off converges on the closed form.
+#[test]
+fn a_corrector_far_from_the_orbit_fails_as_diverged_by_its_error() {
+    let omega = 0.9;
+    let p = tipped(omega);
+    let sig = Signature { events: Vec::new(), always: Vec::new() };
+    let mut fam = Family::new(p.model(), Parameter::Frequency, 1.0, 1.0, sig);
+    let exact = closed_form(omega);
+    fam.ys = fam.scale_of(&exact);
+    let d = fam.dim();
+    let mut w = fam.scaled(&exact);
+    w.push(omega);
+    let off = |by: f64| -> Vec<f64> { w.iter().enumerate().map(|(i, x)| if i == 0 { x + by } else { *x }).collect() };
+    match fam.correct(&off(2.0), &lambda_axis(d), omega) {
+        Err(Failure::Diverged { iteration: 1, correction }) => {
+            assert!((correction - 2.0).abs() < 1e-6, "the first correction {correction}, the predictor's error 2")
+        }
+        other => panic!("a predictor 2 off: expected a divergence at iteration 1 by 2, got {other:?}"),
+    }
+    let near = fam.correct(&off(0.5), &lambda_axis(d), omega).expect("a predictor 0.5 off converges");
+    let error = near.iter().zip(&w).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+    assert!(error < 1e-8, "converged {error:e} from the closed form");
 }

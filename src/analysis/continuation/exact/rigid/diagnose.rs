@@ -56,7 +56,7 @@ impl Walk<'_> {
         for step in [1e-6, 1e-8, 1e-10] {
             let pred: Vec<f64> = here.w.iter().zip(&along).map(|(w, t)| w + step * t).collect();
             let target: f64 = normal.iter().zip(&pred).map(|(a, b)| a * b).sum();
-            let w = fam.correct(&pred, &normal, target);
+            let w = fam.correct(&pred, &normal, target).ok();
             let n = w.clone().and_then(|w| fam.node_with(w, &along, false));
             let verdict = n.as_ref().map(|n| {
                 let drift = fam.metric.norm(&n.w.iter().zip(&pred).map(|(a, b)| a - b).collect::<Vec<_>>());

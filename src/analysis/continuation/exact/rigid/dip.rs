@@ -100,8 +100,10 @@ impl Walk<'_> {
                     break;
                 }
                 let pred: Vec<f64> = here.w.iter().zip(&along).map(|(w, t)| w + x * t).collect();
-                let Some(v) =
-                    self.fam.correct(&pred, &normal, dot(&normal, &pred)).and_then(|w| self.fam.orbit_node(w, &along, false)).and_then(|n| part(&n, key))
+                let Some(v) = super::super::profile::caller("dip", f64::NAN, || self.fam.correct(&pred, &normal, dot(&normal, &pred)))
+                    .ok()
+                    .and_then(|w| self.fam.orbit_node(w, &along, false))
+                    .and_then(|n| part(&n, key))
                 else {
                     break;
                 };

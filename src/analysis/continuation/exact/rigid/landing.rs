@@ -5,7 +5,7 @@
 //! flight becomes visible (the impact oscillator: 8.1e-6 before the closed form's change), not
 //! the change of topology.
 use super::super::family::{Family, Node, Signature, lambda_axis};
-use super::super::{BRACKET, EventKind, Walk, signature};
+use super::super::{BRACKET, EventKind, Walk, profile, signature};
 use super::trace::trace;
 use super::{TOL, margin};
 use crate::analysis::polish;
@@ -43,12 +43,19 @@ pub(in super::super) fn lifted(n: &Node) -> Option<usize> {
 /// tangent along λ's `sense`, and the force's rate per unit λ (its sign: the side where the
 /// landing holds). `None` where the corrector fails or no zero is found.
 pub(in super::super) fn landing_zero(fam: &Family, from: &[f64], e: usize, (la, lb): (f64, f64), sense: f64) -> Option<(Node, f64)> {
+    let start = profile::newton_clock();
+    let out = landing_zero_in(fam, from, e, (la, lb), sense);
+    profile::search_done("landing", la, out.as_ref().map(|z| z.0.lambda(fam.rho)), start);
+    out
+}
+
+fn landing_zero_in(fam: &Family, from: &[f64], e: usize, (la, lb): (f64, f64), sense: f64) -> Option<(Node, f64)> {
     let (rho, d) = (fam.rho, fam.dim());
     let e_l = lambda_axis(d);
     let at = |w0: &[f64], lambda: f64| -> Option<(Vec<f64>, f64)> {
         let mut g = w0.to_vec();
         g[d - 1] = lambda / rho;
-        let w = fam.correct(&g, &e_l, lambda / rho)?;
+        let w = profile::caller("landing", (lambda / rho - w0[d - 1]).abs(), || fam.correct_trial(&g, &e_l, lambda / rho)).ok()?;
         let n = fam.trial_node(w, &e_l)?;
         let h = n.orbit.landing_force(e)?;
         trace(format_args!("landing zero: λ {lambda:.13}, force {h:e} of the scale"));
@@ -120,7 +127,7 @@ impl Walk<'_> {
         let old = std::mem::replace(&mut self.fam.sig, sig);
         let d = self.fam.dim();
         let e_l = lambda_axis(d);
-        let held = self.fam.correct(&guess, &e_l, lambda / rho).and_then(|w| self.fam.node_with(w, &e_l, false));
+        let held = profile::caller("held", f64::NAN, || self.fam.correct(&guess, &e_l, lambda / rho)).ok().and_then(|w| self.fam.node_with(w, &e_l, false));
         let zero = held
             .filter(|n| n.orbit.landing_force(k).is_some_and(|h| h < 0.0))
             .and_then(|n| landing_zero(&self.fam, &n.w, k, (lambda, lambda + sense * 1e-4 * rho), sense))

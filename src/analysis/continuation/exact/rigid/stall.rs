@@ -72,7 +72,8 @@ impl Walk<'_> {
             let l = here.lambda(rho) + sense * f * rho;
             let mut g = here.w.clone();
             g[d - 1] = l / rho;
-            let next = self.fam.correct(&g, &e_l, l / rho).and_then(|w| self.fam.node_with(w, &e_l, false));
+            let next =
+                super::super::profile::caller("stall", f64::NAN, || self.fam.correct(&g, &e_l, l / rho)).ok().and_then(|w| self.fam.node_with(w, &e_l, false));
             trace(format_args!(
                 "stall: the old signature at λ {l:.10} ({f:e} of ρ): corrected {}, margin {:?}",
                 next.is_some(),

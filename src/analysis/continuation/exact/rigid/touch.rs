@@ -76,17 +76,17 @@ pub(super) fn touch_point(fam: &mut Family, guess: &[f64], (la, lb): (f64, f64),
 /// where Newton's first steps exceed the scale, corrected on a 10× and 100× coarser state scale
 /// first, then on the family's own.
 fn correct_far(fam: &mut Family, guess: &[f64], normal: &[f64], target: f64) -> Option<Vec<f64>> {
-    if let Some(w) = fam.correct(guess, normal, target) {
+    if let Ok(w) = fam.correct(guess, normal, target) {
         return Some(w);
     }
     let (ys, states) = (fam.ys, fam.dim() - 1 - fam.ne());
     for f in [10.0, 100.0] {
         fam.ys = ys * f;
         let g: Vec<f64> = guess.iter().enumerate().map(|(i, w)| if i < states { w / f } else { *w }).collect();
-        let coarse = fam.correct(&g, normal, target);
+        let coarse = fam.correct(&g, normal, target).ok();
         fam.ys = ys;
         let fine = coarse.map(|w| w.iter().enumerate().map(|(i, w)| if i < states { w * f } else { *w }).collect::<Vec<f64>>());
-        if let Some(w) = fine.and_then(|w| fam.correct(&w, normal, target)) {
+        if let Some(w) = fine.and_then(|w| fam.correct(&w, normal, target).ok()) {
             return Some(w);
         }
     }
