@@ -617,6 +617,20 @@ fn the_real_blades_period_doubling_is_located_on_the_walk_down() {
     assert!((1141.3..1141.8).contains(&pd.parameter), "{} rad/s", pd.parameter);
 }
 
+/// A walk that spends its point limit ends there: the exact points as walked, the limit named,
+/// no discrete point past it (the discrete stretch after an exact stop had the whole limit again).
+#[test]
+fn a_walk_at_its_point_limit_ends_with_its_exact_points() {
+    let p = periodic_contact::scene::Scene::parse(&scene(256), "nlvib03").unwrap().to_problem("nlvib03").unwrap();
+    let settings = ContinuationSettings { max_points: 12, ..ContinuationSettings::default() };
+    let b = continuation::run(&p, Parameter::Frequency, 0.5, 0.8, &settings, &|_| {}).unwrap();
+    assert!(b.stop.starts_with("12 points (the limit)"), "{}", b.stop);
+    assert!((12..20).contains(&b.points.len()), "{} points", b.points.len());
+    assert!(b.points.iter().all(|q| q.source == continuation::Source::Exact), "a discrete point after the limit");
+    // The default limit reaches 0.8 on the same branch (nlvib03_exact_branch_is_the_same_at_every_k).
+    assert!(b.points.last().unwrap().parameter < 0.8);
+}
+
 /// Where the scene's grid (k = 1024) gives no exact orbit, the polish takes a finer grid's event
 /// sequence, solved warm from the coarser grid's orbit (polish/repair.rs): the real blade at
 /// Ω = 1215.5 rad/s, where a cold solve at k = 2048 misses and the walk fell back to the discrete

@@ -98,7 +98,9 @@ pub(super) fn go_on(
             }
             None => Vec::new(),
         };
-        let rest = match run_discrete_until((problem, param), (at, to), (settings, &streamed), (&warm, Some(&until))) {
+        // Within the point limit: its first orbit is the seam (not appended), so one point at the limit.
+        let budget = ContinuationSettings { max_points: settings.max_points.saturating_sub(points.len()) + 1, ..settings.clone() };
+        let rest = match run_discrete_until((problem, param), (at, to), (&budget, &streamed), (&warm, Some(&until))) {
             Ok(rest) => rest,
             Err(e) => return branch(points, format!("{stop}; the discrete walk from there failed: {e}{}", history(&stretches)), marches),
         };
@@ -108,7 +110,12 @@ pub(super) fn go_on(
         {
             return branch(points, format!("{stop}; exact orbit up to {name} = {at}, {why}{}", history(&stretches)), marches);
         }
+        let added = rest.points.len().saturating_sub(1);
         points.extend(rest.points.into_iter().skip(1));
+        if points.len() >= settings.max_points {
+            let then = if added > 0 { format!(" at {name} = {at}; the discrete walk from there to the point limit") } else { String::new() };
+            return branch(points, format!("{stop}{then}{}", history(&stretches)), marches);
+        }
         let failed = failed.into_inner();
         let Some(s) = started.into_inner() else {
             let tried = if failed.is_empty() { String::new() } else { format!("; no exact start at {}", failed.join("; ")) };
