@@ -11,7 +11,7 @@
 use super::events::{self, Event};
 use super::{PolishFailure, PolishedOrbit, verify};
 use crate::model::Model;
-use crate::periodic::{PeriodicProblem, PeriodicSolver, carried_active_set, carried_state, step_map};
+use crate::periodic::{AUTO_LEMKE_MAX, PeriodicProblem, PeriodicSolver, carried_active_set, carried_state, step_map};
 use crate::response::Response;
 
 /// A phase of one contact shorter than this (fraction of the period) after a repair is a pair
@@ -23,9 +23,6 @@ const REPAIRS: usize = 4;
 /// The finest grid whose event sequence the polish tries (the real blade's LCP there: 139 264
 /// unknowns, ≈ 1 s of shooting).
 const FINEST: usize = 8192;
-/// The largest LCP a rung solves cold after its warm Newton missed: dense Lemke's cheap size
-/// (the LCP policy's `AUTO_LEMKE_MAX`).
-const COLD_MAX: usize = 256;
 
 /// The polished orbit and, when the scene's grid did not give its sequence as read, how it was had.
 pub struct Polished {
@@ -45,7 +42,8 @@ pub(super) fn polish_grid(problem: &PeriodicProblem, r: &Response) -> Result<Pol
     let k = r.steps;
     let mut fine = problem.clone();
     let mut steps = 2 * k;
-    let mut coarser = r.clone();
+    // The coarser grid's orbit, carried to the next grid: its active set, shooting state and instants.
+    let mut coarser = Carried::of(r, problem.instants());
     while steps <= FINEST {
         let mut disc = fine.discretization();
         disc.steps = steps;
@@ -62,7 +60,7 @@ pub(super) fn polish_grid(problem: &PeriodicProblem, r: &Response) -> Result<Pol
             let how = if p.note.is_empty() { String::new() } else { format!(", {}", p.note) };
             return Ok(Polished { orbit: p.orbit, note: why(&format!("the sequence of the grid at k = {steps}{how}")) });
         }
-        coarser = finer;
+        coarser = Carried::of(&finer, fine.instants());
         steps *= 2;
     }
     Err(first)
@@ -72,18 +70,31 @@ pub(super) fn polish_grid(problem: &PeriodicProblem, r: &Response) -> Result<Pol
 /// `coarser`'s orbit carried there, the same branch where orbits coexist (the real blade at
 /// 1215.5 rad/s, whose cold k = 2048 solve misses); no cold search nor dense fallback (a 64-DOF
 /// chain at ω = 0.03 rad/s spent 65 s at k = 4096 on those to fail); cold only where the LCP is
-/// small enough for dense Lemke ([`COLD_MAX`]) or the scheme has no step map. `None`: no solution.
-fn finer_grid(fine: &PeriodicProblem, coarser: &Response) -> Option<Response> {
+/// small enough for dense Lemke ([`AUTO_LEMKE_MAX`]) or the scheme has no step map. `None`: no solution.
+fn finer_grid(fine: &PeriodicProblem, coarser: &Carried) -> Option<Response> {
     let m = fine.model().contacts.len().max(1);
-    let (from, to) = (coarser.lcp.size / m, fine.instants());
+    let (from, to) = (coarser.instants, fine.instants());
     let mut solver = PeriodicSolver::new(fine.clone());
     solver.set_warm_start(&carried_active_set(&coarser.active_set, m, from, to));
-    solver.set_warm_state(coarser.orbit_state.as_deref().and_then(|s| carried_state(fine.discretization().scheme, s, from, to)));
+    solver.set_warm_state(coarser.state.as_deref().and_then(|s| carried_state(fine.discretization().scheme, s, from, to)));
     if let Ok(r) = solver.solve_by_shooting(true) {
         return Some(r);
     }
-    let cold_is_cheap = to * m <= COLD_MAX || step_map(fine).is_err();
+    let cold_is_cheap = to * m <= AUTO_LEMKE_MAX || step_map(fine).is_err();
     if cold_is_cheap { PeriodicSolver::new(fine.clone()).solve().ok() } else { None }
+}
+
+/// What a rung of the ladder takes from the coarser grid's solution.
+struct Carried {
+    active_set: Vec<usize>,
+    state: Option<Vec<f64>>,
+    instants: usize,
+}
+
+impl Carried {
+    fn of(r: &Response, instants: usize) -> Carried {
+        Carried { active_set: r.active_set.clone(), state: r.orbit_state.clone(), instants }
+    }
 }
 
 /// The orbit on the sequence of one grid's solution: as read, else without its near-grazing runs
@@ -227,7 +238,7 @@ mod tests {
         // The rung starts from the coarser grid's orbit: at most one Newton run (30 iterations).
         let (n, omega) = (16, 0.0303);
         let coarse = chain(n, omega, 1024);
-        let coarser = PeriodicSolver::new(coarse).solve().unwrap();
+        let coarser = Carried::of(&PeriodicSolver::new(coarse.clone()).solve().unwrap(), coarse.instants());
         let fine = chain(n, omega, 2048);
         let rung = finer_grid(&fine, &coarser).expect("the rung solves from the coarser orbit");
         let cold = PeriodicSolver::new(fine).solve().unwrap();
